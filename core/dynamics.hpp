@@ -1,0 +1,56 @@
+#pragma once
+/// Forward and inverse dynamics of the four-bar at one instant: all dependent angles, rates and
+/// accelerations, the support reactions, the shaking force and moment, and the drive torque.
+#include <string>
+
+#include "core/expected.hpp"
+#include "core/kinematics.hpp"
+#include "core/model.hpp"
+#include "core/types.hpp"
+
+namespace bd::core {
+
+/// Everything the dynamics gives at one instant (DESIGN.md conventions).
+struct DynamicsSample {
+  FourBarState state;  // angles [rad], rates [rad/s], accelerations [rad/s^2]
+  Vec2 RA0{0, 0};      // force of the mechanism ON the ground at A0 [N]
+  Vec2 RA3{0, 0};      // force of the mechanism ON the ground at A3 [N]
+  Vec2 Fsh{0, 0};      // shaking force RA0 + RA3 [N]
+  double Msh{};        // shaking moment on the frame about A0: l4·RA3y - tau [N m]
+  double tau{};        // drive torque on the crank from the frame [N m] (0 in free motion)
+};
+
+/// Why the dynamics could not be evaluated at an instant.
+struct DynamicsError {
+  enum class Kind {
+    kAssembly,   // the loop cannot close at theta1
+    kSingular,   // a singular (dead-centre) position: the reduced inertia or a solve is singular
+    kNonFinite,  // a non-finite value appeared
+  };
+  Kind kind{Kind::kAssembly};
+  double theta1{};     // crank angle where it happened [rad]
+  std::string detail;  // the condition, in words, with numbers
+  /// One line, e.g. "singular position at theta1 = 1.234 rad: sin(theta3 - theta2) = 1e-17".
+  std::string what() const;
+};
+
+/// The formulations of the equations of motion (DESIGN.md "Formulations").
+enum class Formulation {
+  kMassMatrix,  // constant equivalent mass matrix / truss element (paper §4.2)
+};
+/// "mass-matrix".
+const char* to_string(Formulation f);
+
+/// Forward dynamics (free motion, tau = 0): the crank acceleration and everything else for crank
+/// angle theta1 [rad] and rate omega1 [rad/s] under the model's loads.
+Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model, double theta1,
+                                                         double omega1,
+                                                         Formulation f = Formulation::kMassMatrix);
+
+/// Inverse dynamics: the drive torque tau that gives crank acceleration alpha1 [rad/s^2] at
+/// theta1 [rad], omega1 [rad/s], with everything else.
+Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model, double theta1,
+                                                         double omega1, double alpha1,
+                                                         Formulation f = Formulation::kMassMatrix);
+
+}  // namespace bd::core

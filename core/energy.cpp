@@ -1,0 +1,2 @@
+// implemented by its owner; see core/energy.hpp
+#include "core/energy.hpp"

@@ -1,0 +1,81 @@
+#pragma once
+/// Closed-form kinematics of the four-bar (paper eqs. 2-10): positions, rates, accelerations,
+/// transfer functions, joint and centre-of-mass positions, transmission angle.
+#include <string>
+
+#include "core/expected.hpp"
+#include "core/model.hpp"
+#include "core/types.hpp"
+
+namespace bd::core {
+
+/// Link angles [rad] with the loop closed. theta2, theta3 lie in (-pi, pi].
+struct Pose {
+  double theta1{}, theta2{}, theta3{};
+};
+
+/// Why the loop cannot close at a crank angle.
+struct AssemblyError {
+  double theta1{};  // where it failed [rad]
+  double gap{};     // how far |A1A3| lies outside [|l2 - l3|, l2 + l3]: > 0 above, < 0 below [m]
+  /// "loop cannot close at theta1 = 2.094 rad: |A1A3| exceeds l2 + l3 by 0.1 m"
+  std::string what() const;
+};
+
+/// Closes the loop A0-A1-A2-A3 for crank angle theta1 [rad] on the given branch (eqs. 2-4).
+/// Fails, without throwing, where l23 = |A1A3| lies outside [|l2 - l3|, l2 + l3].
+Expected<Pose, AssemblyError> solve_position(const FourBar& model, double theta1, Branch branch);
+/// Same on the model's own branch.
+Expected<Pose, AssemblyError> solve_position(const FourBar& model, double theta1);
+
+/// First-order kinematic transfer functions Θ2 = dθ2/dθ1, Θ3 = dθ3/dθ1 (eq. 7) [-].
+struct TransferFunctions {
+  double Theta2{}, Theta3{};
+};
+TransferFunctions transfer_functions(const FourBar& model, const Pose& pose);
+
+/// Full kinematic state: the crank input and the dependent angles, rates and accelerations.
+struct FourBarState {
+  double theta1{}, omega1{}, alpha1{};  // input [rad], [rad/s], [rad/s^2]
+  double theta2{}, theta3{};            // position stage [rad]
+  double omega2{}, omega3{};            // velocity stage [rad/s]
+  double alpha2{}, alpha3{};            // acceleration stage [rad/s^2]
+};
+
+/// Coupler and rocker rates [rad/s] for crank rate omega1 (eq. 6); needs a closed pose.
+/// Returned in a state whose acceleration stage is zero.
+FourBarState solve_velocity(const FourBar& model, const Pose& pose, double omega1);
+/// Dependent accelerations for crank acceleration alpha1 (eqs. 9-10), filling the state's
+/// acceleration stage. `state` must have its position and velocity stages filled.
+FourBarState solve_acceleration(const FourBar& model, FourBarState state, double alpha1);
+/// The velocity-product part of the dependent accelerations: alpha_k = Θk·alpha1 + gamma_k.
+struct AccelerationBias {
+  double gamma2{}, gamma3{};  // [rad/s^2]
+};
+AccelerationBias acceleration_bias(const FourBar& model, const FourBarState& state);
+
+/// Joint positions in ground axes [m] (A0 is the origin, A3 = (l4, 0)).
+struct Joints {
+  Vec2 A0, A1, A2, A3;
+};
+Joints joint_positions(const FourBar& model, double theta1, double theta3);
+inline Joints joint_positions(const FourBar& model, const Pose& p) {
+  return joint_positions(model, p.theta1, p.theta3);
+}
+/// Centre of mass of link k = 1, 2, 3 in ground axes [m] for the given link angles.
+Vec2 centre_of_mass(const FourBar& model, int k, const Pose& pose);
+/// Velocity [m/s] and acceleration [m/s^2] of the centre of mass of link k.
+Vec2 centre_of_mass_velocity(const FourBar& model, int k, const FourBarState& s);
+Vec2 centre_of_mass_acceleration(const FourBar& model, int k, const FourBarState& s);
+
+/// Transmission angle mu [rad] in [0, pi]: the angle between coupler and rocker at A2.
+/// Good transmission near pi/2; 0 or pi are toggle (dead-centre) positions of the rocker drive.
+double transmission_angle(const Pose& pose);
+
+/// Loop-closure residual |l̄1 + l̄2 + l̄3 + l̄4| [m] of a pose (zero to round-off when closed).
+double closure_residual(const FourBar& model, const Pose& pose);
+
+/// Pose of a full state.
+inline Pose pose_of(const FourBarState& s) { return {s.theta1, s.theta2, s.theta3}; }
+
+}  // namespace bd::core

@@ -1,0 +1,2 @@
+// implemented by its owner; see core/metrics.hpp
+#include "core/metrics.hpp"

@@ -1,0 +1,2 @@
+// implemented by its owner; see core/simulate.hpp
+#include "core/simulate.hpp"

@@ -1,0 +1,69 @@
+#pragma once
+/// Scenes: free motion (forward dynamics integrated by SUNDIALS CVODE with error control, output
+/// at the requested instants by the integrator's dense output) and driven motion (constant crank
+/// speed, inverse dynamics per sample, no integration).
+#include <string>
+#include <vector>
+
+#include "core/dynamics.hpp"
+#include "core/model.hpp"
+
+namespace bd::core {
+
+/// Free motion from theta1, omega1 under the loads, sampled at `samples` instants evenly spaced
+/// over [0, duration], both ends included.
+struct FreeScene {
+  double theta1{};    // initial crank angle [rad]
+  double omega1{};    // initial crank rate [rad/s]
+  double duration{};  // [s], > 0
+  int samples{501};   // >= 2
+};
+
+/// Crank driven at the constant rate omega1 over whole revolutions, `samples` per revolution,
+/// evenly spaced in time, periodic end excluded. t runs over the revolutions.
+struct DrivenScene {
+  double theta1{};     // crank angle at t = 0 [rad]
+  double omega1{};     // constant crank rate [rad/s], != 0
+  int revolutions{1};  // >= 1
+  int samples{360};    // per revolution, >= 1
+};
+
+/// How to simulate (Ceres-style options: defaults in place, validate() says what is wrong).
+struct SimulateOptions {
+  Formulation formulation = Formulation::kMassMatrix;
+  double tolerance = 1e-10;           // integrator relative tolerance (free scenes)
+  double absolute_tolerance = 1e-12;  // on theta1 [rad] and omega1 [rad/s]
+  long max_steps = 1000000;           // integrator steps over the whole run
+  /// Empty when valid, else the problem in words.
+  std::string validate() const;
+};
+
+enum class SimulationStatus {
+  kNotRun,
+  kCompleted,
+  kAssemblyFailed,    // the loop cannot close at the crank angle reached
+  kSingular,          // a singular position was reached
+  kIntegratorFailed,  // CVODE gave up (step-size underflow, too many steps, ...)
+};
+const char* to_string(SimulationStatus s);
+
+/// The samples computed, in time order, and why the run stopped. On failure every sample
+/// before the failure is kept.
+struct Trajectory {
+  std::vector<double> t;                // [s]
+  std::vector<DynamicsSample> samples;  // one per t; angles continuous in time
+  SimulationStatus status = SimulationStatus::kNotRun;
+  std::string message = "simulate was not called";  // one line; names time and crank angle
+  long steps{};                                     // integrator steps (free scenes)
+  long rhs_evaluations{};                           // dynamics evaluations
+  bool ok() const { return status == SimulationStatus::kCompleted; }
+};
+
+/// @throws bd::InputError if the scene or options are invalid (duration <= 0, samples < 2, ...).
+Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
+                         const SimulateOptions& options = {});
+/// @throws bd::InputError if the scene or options are invalid (omega1 == 0, revolutions < 1, ...).
+Trajectory simulate_driven(const FourBar& model, const DrivenScene& scene,
+                           const SimulateOptions& options = {});
+
+}  // namespace bd::core

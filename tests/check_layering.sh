@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Includes point one way only: core <- balance <- optimize <- studies <- cli; third-party
+# headers stay behind their one door (yaml-cpp in studies/, CLI11 in cli/, NLopt and Ipopt in
+# optimize/*.cpp).
+cd "$(dirname "$0")/.." || exit 1
+fail=0
+forbid() {  # forbid DESCRIPTION REGEX PATH...
+  local what=$1 re=$2 hits
+  shift 2
+  hits=$(grep -rnE "#include [<\"]($re)" "$@" 2>/dev/null)
+  if [ -n "$hits" ]; then
+    echo "$what:"
+    echo "$hits"
+    fail=1
+  fi
+}
+forbid "core/ includes a higher layer" '(balance|optimize|studies|cli|tests)/' core
+forbid "balance/ includes a higher layer" '(optimize|studies|cli|tests)/' balance
+forbid "optimize/ includes a higher layer" '(studies|cli|tests)/' optimize
+forbid "studies/ includes a higher layer" '(cli|tests)/' studies
+forbid "yaml-cpp outside studies/" 'yaml-cpp/' core balance optimize cli
+forbid "CLI11 outside cli/" 'CLI/' core balance optimize studies
+forbid "NLopt or Ipopt outside optimize/*.cpp" '(nlopt|coin/|coin-or/|IpIpopt)' \
+  core balance studies cli $(ls optimize/*.hpp 2>/dev/null)
+[ $fail -eq 0 ] && echo "layering ok"
+exit $fail
