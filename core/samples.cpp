@@ -35,6 +35,26 @@ FourBar parallelogram() {
   return make_fourbar(m);
 }
 
+FourBar double_crank() {
+  FourBar m;
+  m.crank = {2.5, 2.0, 1.0, 0.2, 0.9};
+  m.coupler = {3.0, 3.0, 1.4, -0.3, 2.5};
+  m.rocker = {2.8, 2.5, 1.2, 0.1, 1.7};
+  m.frame_length = 1.0;
+  m.branch = Branch::kPlus;
+  return make_fourbar(m);
+}
+
+FourBar triple_rocker() {
+  FourBar m;
+  m.crank = {2.0, 1.0, 0.8, 0.1, 0.4};
+  m.coupler = {2.0, 1.5, 1.0, 0.0, 0.6};
+  m.rocker = {2.0, 1.2, 0.9, -0.1, 0.5};
+  m.frame_length = 3.5;
+  m.branch = Branch::kPlus;
+  return make_fourbar(m);
+}
+
 FourBar random_crank_rocker(std::mt19937_64& rng) {
   auto uniform = [&rng](double a, double b) {
     return std::uniform_real_distribution<double>(a, b)(rng);

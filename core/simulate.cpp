@@ -1,2 +1,421 @@
-// implemented by its owner; see core/simulate.hpp
 #include "core/simulate.hpp"
+
+#include <cvode/cvode.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
+
+#include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <cstdlib>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "core/input_error.hpp"
+#include "core/kinematics.hpp"
+
+namespace bd::core {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+// Largest crank step [rad] over which a dependent angle is unwrapped in one go; longer steps
+// between samples are walked through intermediate positions (see continue_angles).
+constexpr double kMaxUnwrapStep = 0.2;
+
+// |sin(theta3 - theta2)| at which a free motion is taken to have reached a limit (dead-centre)
+// position of the crank, where coupler and rocker align. Near such a limit the crank angle is
+// within x ~ sin² of it, the transfer functions grow like 1/sin and the crank ODE loses its
+// Lipschitz continuity: the exact motion reaches the limit in finite time with omega1 ~ sqrt(x)
+// -> 0, and (limit, 0) is a spurious equilibrium towards which the integrator, having lost the
+// little kinetic energy left there to its absolute tolerance, creeps for ever, while the real
+// linkage passes on to the other branch. So the run stops where |sin| falls to this level
+// (located by CVODE's root finding): the crank is then within ~1e-10 rad of its limit, far closer
+// than a motion that turns back before the limit would come by chance. The right-hand side
+// refuses points deeper inside (a tenth of it), so no step is taken there.
+constexpr double kDeadCentreSin = 1e-5;
+
+// Upper bound on the number of samples of one run, so the size arithmetic cannot overflow.
+constexpr long long kMaxSamples = 100'000'000;
+
+// "%.10g" of a value, for messages
+std::string number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", x);
+  return buf;
+}
+
+// The representative of `wrapped` (mod 2π) nearest to `reference`.
+double nearest_turn(double wrapped, double reference) {
+  return wrapped + kTwoPi * std::round((reference - wrapped) / kTwoPi);
+}
+
+// Makes theta2, theta3 of `next` (in (-π, π] from the kinematics) continue those of `prev`.
+// On its branch θ2 and θ3 are continuous functions of θ1, so their continuous values at
+// next.theta1 follow from walking θ1 from prev.theta1 to next.theta1, whatever path θ1 took in
+// time. Samples closer than kMaxUnwrapStep in θ1 (the usual case) need no extra work: θ2, θ3 then
+// change by far less than π. Longer steps (few samples per revolution) are walked through
+// intermediate positions. Allocates nothing.
+void continue_angles(const FourBar& model, const FourBarState& prev, FourBarState& next) {
+  double theta2 = prev.theta2, theta3 = prev.theta3;
+  const double step = next.theta1 - prev.theta1;
+  const int n = static_cast<int>(std::ceil(std::abs(step) / kMaxUnwrapStep));
+  for (int i = 1; i < n; ++i) {
+    const auto pose = solve_position(model, prev.theta1 + step * i / n);
+    if (!pose) break;  // cannot happen on a path the motion went through; fall back to nearest
+    theta2 = nearest_turn(pose->theta2, theta2);
+    theta3 = nearest_turn(pose->theta3, theta3);
+  }
+  next.theta2 = nearest_turn(next.theta2, theta2);
+  next.theta3 = nearest_turn(next.theta3, theta3);
+}
+
+SimulationStatus status_of(DynamicsError::Kind kind) {
+  switch (kind) {
+    case DynamicsError::Kind::kAssembly:
+      return SimulationStatus::kAssemblyFailed;
+    case DynamicsError::Kind::kSingular:
+      return SimulationStatus::kSingular;
+    case DynamicsError::Kind::kNonFinite:
+      return SimulationStatus::kIntegratorFailed;
+  }
+  return SimulationStatus::kIntegratorFailed;
+}
+
+// One line naming the condition, the time and the crank angle, e.g.
+// "singular position at t = 1.234 s, theta1 = 2.345 rad: sin(theta3 - theta2) = 1e-17".
+std::string failure_message(const DynamicsError& error, double t, double theta1) {
+  const char* what = error.kind == DynamicsError::Kind::kAssembly   ? "loop cannot close"
+                     : error.kind == DynamicsError::Kind::kSingular ? "singular position"
+                                                                    : "non-finite dynamics";
+  // an assembly error's detail repeats "loop cannot close at theta1 = ...: "; keep its reason
+  std::string_view detail = error.detail;
+  if (error.kind == DynamicsError::Kind::kAssembly) {
+    if (const auto colon = detail.find(": "); colon != std::string_view::npos) {
+      detail.remove_prefix(colon + 2);
+    }
+  }
+  std::string message = what;
+  message += " at t = " + number(t) + " s, theta1 = " + number(theta1) + " rad";
+  if (!detail.empty()) {
+    message += ": ";
+    message += detail;
+  }
+  return message;
+}
+
+// The error for a crank at a limit position, coupler and rocker aligned to sin_mu.
+DynamicsError dead_centre_error(double theta1, double sin_mu) {
+  char detail[160];
+  std::snprintf(detail, sizeof detail,
+                "sin(theta3 - theta2) = %.3g: coupler and rocker aligned, the crank has reached a "
+                "limit position",
+                sin_mu);
+  return {DynamicsError::Kind::kSingular, theta1, detail};
+}
+
+// True, with the error, when the coupler and rocker of a sample are aligned to within `limit`.
+bool at_dead_centre(const DynamicsSample& sample, double limit, DynamicsError& error) {
+  const double sin_mu = std::sin(sample.state.theta3 - sample.state.theta2);
+  if (std::abs(sin_mu) >= limit) return false;
+  error = dead_centre_error(sample.state.theta1, sin_mu);
+  return true;
+}
+
+void fail(Trajectory& out, const DynamicsError& error, double t, double theta1) {
+  out.status = status_of(error.kind);
+  out.message = failure_message(error, t, theta1);
+}
+
+// What the CVODE right-hand side needs, and what it saw when the dynamics failed.
+struct FreeMotion {
+  const FourBar* model{};
+  Formulation formulation{};
+  long evaluations{};      // forward_dynamics calls (right-hand side and samples)
+  bool rhs_failed{};       // a right-hand side failed since the last reset
+  DynamicsError error;     // the latest failure of the dynamics
+  double error_t{};        // its time [s]
+  double error_theta1{};   // its crank angle [rad]
+  std::string cvode_text;  // CVODE's last error message
+};
+
+// y = (theta1, omega1), y' = (omega1, alpha1(theta1, omega1)). A failure of the dynamics is
+// recoverable (1): CVODE then retries with a smaller step, and reports failure if it cannot.
+int free_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) {
+  auto& motion = *static_cast<FreeMotion*>(user_data);
+  const double theta1 = NV_Ith_S(y, 0), omega1 = NV_Ith_S(y, 1);
+  ++motion.evaluations;
+  const auto sample = forward_dynamics(*motion.model, theta1, omega1, motion.formulation);
+  if (!sample || at_dead_centre(*sample, 0.1 * kDeadCentreSin, motion.error)) {
+    motion.rhs_failed = true;
+    if (!sample) motion.error = sample.error();
+    motion.error_t = t;
+    motion.error_theta1 = theta1;
+    return 1;
+  }
+  NV_Ith_S(ydot, 0) = omega1;
+  NV_Ith_S(ydot, 1) = sample->state.alpha1;
+  return 0;
+}
+
+// g = |sin(theta3 - theta2)| - kDeadCentreSin: a root is the crank reaching a limit position.
+int dead_centre_root(sunrealtype /*t*/, N_Vector y, sunrealtype* g, void* user_data) {
+  const auto& motion = *static_cast<const FreeMotion*>(user_data);
+  const auto pose = solve_position(*motion.model, NV_Ith_S(y, 0));
+  g[0] = pose ? std::abs(std::sin(pose->theta3 - pose->theta2)) - kDeadCentreSin
+              : -kDeadCentreSin;  // beyond the limit (only on an interpolated point)
+  return 0;
+}
+
+// CVODE prints its errors by default; core never prints, so keep the text for the message.
+void keep_cvode_error(int error_code, const char* /*module*/, const char* function, char* msg,
+                      void* user_data) {
+  if (error_code >= 0) return;  // warnings (e.g. t + h == t) are not failures
+  auto& motion = *static_cast<FreeMotion*>(user_data);
+  motion.cvode_text = std::string(function) + ": " + msg;
+}
+
+// SUNDIALS objects, freed in reverse order of creation.
+struct Cvode {
+  SUNContext context{};
+  N_Vector y{}, atol{};
+  SUNNonlinearSolver solver{};
+  void* memory{};
+  Cvode() = default;
+  Cvode(const Cvode&) = delete;
+  Cvode& operator=(const Cvode&) = delete;
+  ~Cvode() {
+    if (memory != nullptr) CVodeFree(&memory);
+    if (solver != nullptr) SUNNonlinSolFree(solver);
+    if (atol != nullptr) N_VDestroy(atol);
+    if (y != nullptr) N_VDestroy(y);
+    if (context != nullptr) SUNContext_Free(&context);
+  }
+};
+
+void check_setup(int flag, const char* call) {
+  // with valid options the setup calls cannot fail except by running out of memory
+  if (flag != CV_SUCCESS) throw std::runtime_error(std::string("CVODE setup failed in ") + call);
+}
+
+void validate(const FreeScene& scene, const SimulateOptions& options) {
+  if (const std::string problem = options.validate(); !problem.empty()) throw InputError(problem);
+  if (!std::isfinite(scene.theta1)) {
+    throw InputError("scene.theta1 must be finite, got " + number(scene.theta1));
+  }
+  if (!std::isfinite(scene.omega1)) {
+    throw InputError("scene.omega1 must be finite, got " + number(scene.omega1));
+  }
+  if (!(scene.duration > 0.0) || !std::isfinite(scene.duration)) {
+    throw InputError("scene.duration must be > 0 s, got " + number(scene.duration));
+  }
+  if (scene.samples < 2 || scene.samples > kMaxSamples) {
+    throw InputError("scene.samples must be >= 2 (and <= 1e8), got " +
+                     std::to_string(scene.samples));
+  }
+}
+
+void validate(const DrivenScene& scene, const SimulateOptions& options) {
+  if (const std::string problem = options.validate(); !problem.empty()) throw InputError(problem);
+  if (!std::isfinite(scene.theta1)) {
+    throw InputError("scene.theta1 must be finite, got " + number(scene.theta1));
+  }
+  if (!(scene.omega1 != 0.0) || !std::isfinite(scene.omega1)) {
+    throw InputError("scene.omega1 must be finite and != 0 rad/s, got " + number(scene.omega1));
+  }
+  if (scene.revolutions < 1) {
+    throw InputError("scene.revolutions must be >= 1, got " + std::to_string(scene.revolutions));
+  }
+  if (scene.samples < 1) {
+    throw InputError("scene.samples must be >= 1, got " + std::to_string(scene.samples));
+  }
+  if (static_cast<long long>(scene.revolutions) * scene.samples > kMaxSamples) {
+    throw InputError("scene.revolutions * scene.samples must be <= 1e8, got " +
+                     std::to_string(static_cast<long long>(scene.revolutions) * scene.samples));
+  }
+}
+
+}  // namespace
+
+std::string SimulateOptions::validate() const {
+  if (!(tolerance > 0.0 && tolerance < 1.0)) {
+    return "tolerance must be > 0 and < 1, got " + number(tolerance);
+  }
+  if (!(absolute_tolerance > 0.0) || !std::isfinite(absolute_tolerance)) {
+    return "absolute_tolerance must be > 0, got " + number(absolute_tolerance);
+  }
+  if (max_steps < 1) return "max_steps must be >= 1, got " + std::to_string(max_steps);
+  switch (formulation) {
+    case Formulation::kMassMatrix:
+      break;
+    default:
+      return "formulation " + std::to_string(static_cast<int>(formulation)) + " is unknown";
+  }
+  return {};
+}
+
+const char* to_string(SimulationStatus s) {
+  switch (s) {
+    case SimulationStatus::kNotRun:
+      return "not-run";
+    case SimulationStatus::kCompleted:
+      return "completed";
+    case SimulationStatus::kAssemblyFailed:
+      return "assembly-failed";
+    case SimulationStatus::kSingular:
+      return "singular";
+    case SimulationStatus::kIntegratorFailed:
+      return "integrator-failed";
+  }
+  return "?";
+}
+
+Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
+                         const SimulateOptions& options) {
+  validate(scene, options);
+  const auto samples = static_cast<std::size_t>(scene.samples);
+  Trajectory out;
+  out.t.reserve(samples);
+  out.samples.reserve(samples);
+
+  FreeMotion motion;
+  motion.model = &model;
+  motion.formulation = options.formulation;
+
+  // the initial sample; a start outside the workspace or on a singular position stops here
+  ++motion.evaluations;
+  auto first = forward_dynamics(model, scene.theta1, scene.omega1, options.formulation);
+  if (!first || at_dead_centre(*first, kDeadCentreSin, motion.error)) {
+    fail(out, first ? motion.error : first.error(), 0.0, scene.theta1);
+    out.rhs_evaluations = motion.evaluations;
+    return out;
+  }
+  out.t.push_back(0.0);
+  out.samples.push_back(*first);
+
+  // Method: the crank equation is a smooth, non-stiff ODE of two states (its Jacobian has the
+  // eigenvalues of a slow oscillator, |lambda| ~ |omega1| + sqrt|d alpha1/d theta1|), solved
+  // at tight tolerances (1e-10). Variable-order Adams-Moulton (orders 1-12) reaches such
+  // tolerances with far fewer steps than BDF (orders <= 5), and a non-stiff problem needs no
+  // Newton iteration: the fixed-point corrector converges in one or two right-hand sides per
+  // step without Jacobians or linear solves (the CVODE guide's recommendation for non-stiff
+  // problems).
+  Cvode cv;
+  check_setup(SUNContext_Create(nullptr, &cv.context), "SUNContext_Create");
+  cv.y = N_VNew_Serial(2, cv.context);
+  cv.atol = N_VNew_Serial(2, cv.context);
+  if (cv.y == nullptr || cv.atol == nullptr) check_setup(CV_MEM_FAIL, "N_VNew_Serial");
+  NV_Ith_S(cv.y, 0) = scene.theta1;
+  NV_Ith_S(cv.y, 1) = scene.omega1;
+  NV_Ith_S(cv.atol, 0) = options.absolute_tolerance;  // theta1 [rad]
+  NV_Ith_S(cv.atol, 1) = options.absolute_tolerance;  // omega1 [rad/s]
+  cv.memory = CVodeCreate(CV_ADAMS, cv.context);
+  if (cv.memory == nullptr) check_setup(CV_MEM_FAIL, "CVodeCreate");
+  check_setup(CVodeSetErrHandlerFn(cv.memory, keep_cvode_error, &motion), "CVodeSetErrHandlerFn");
+  check_setup(CVodeInit(cv.memory, free_rhs, 0.0, cv.y), "CVodeInit");
+  check_setup(CVodeSetUserData(cv.memory, &motion), "CVodeSetUserData");
+  check_setup(CVodeSVtolerances(cv.memory, options.tolerance, cv.atol), "CVodeSVtolerances");
+  cv.solver = SUNNonlinSol_FixedPoint(cv.y, 0, cv.context);
+  if (cv.solver == nullptr) check_setup(CV_MEM_FAIL, "SUNNonlinSol_FixedPoint");
+  check_setup(CVodeSetNonlinearSolver(cv.memory, cv.solver), "CVodeSetNonlinearSolver");
+  check_setup(CVodeSetStopTime(cv.memory, scene.duration), "CVodeSetStopTime");
+  check_setup(CVodeRootInit(cv.memory, 1, dead_centre_root), "CVodeRootInit");
+
+  // each output by CVODE's own interpolant (CV_NORMAL), then the dynamics at that state
+  out.status = SimulationStatus::kCompleted;
+  out.message = "completed";
+  const double last = static_cast<double>(samples - 1);
+  for (std::size_t j = 1; j < samples; ++j) {
+    const double t_out =
+        j + 1 == samples ? scene.duration : scene.duration * static_cast<double>(j) / last;
+    // max_steps bounds the whole run, CVodeSetMaxNumSteps one call: give each call the rest
+    long steps = 0;
+    CVodeGetNumSteps(cv.memory, &steps);
+    if (steps >= options.max_steps) {
+      out.status = SimulationStatus::kIntegratorFailed;
+      out.message = "integrator stopped at t = " + number(out.t.back()) +
+                    " s, theta1 = " + number(out.samples.back().state.theta1) +
+                    " rad: max_steps = " + std::to_string(options.max_steps) + " reached";
+      break;
+    }
+    CVodeSetMaxNumSteps(cv.memory, options.max_steps - steps);
+
+    motion.rhs_failed = false;
+    sunrealtype t_reached = 0.0;
+    const int flag = CVode(cv.memory, t_out, cv.y, &t_reached, CV_NORMAL);
+    if (flag < 0) {
+      if (motion.rhs_failed) {
+        // the dynamics failed ahead of the last step and CVODE could not step around it
+        fail(out, motion.error, motion.error_t, motion.error_theta1);
+        out.message += "; integration stopped at t = " + number(t_reached) + " s";
+      } else {
+        // CVodeGetReturnFlagName mallocs its result
+        char* flag_name = CVodeGetReturnFlagName(flag);
+        out.status = SimulationStatus::kIntegratorFailed;
+        out.message = "integrator failed at t = " + number(t_reached) +
+                      " s, theta1 = " + number(NV_Ith_S(cv.y, 0)) + " rad: " + flag_name + ": " +
+                      motion.cvode_text;
+        std::free(flag_name);
+      }
+      break;
+    }
+    if (flag == CV_ROOT_RETURN) {
+      // the crank reached a limit position before t_out: stop there
+      const double theta1 = NV_Ith_S(cv.y, 0);
+      const auto pose = solve_position(model, theta1);
+      const double sin_mu = pose ? std::sin(pose->theta3 - pose->theta2) : 0.0;
+      fail(out, dead_centre_error(theta1, sin_mu), t_reached, theta1);
+      break;
+    }
+
+    const double theta1 = NV_Ith_S(cv.y, 0), omega1 = NV_Ith_S(cv.y, 1);
+    ++motion.evaluations;
+    auto sample = forward_dynamics(model, theta1, omega1, options.formulation);
+    if (!sample || at_dead_centre(*sample, kDeadCentreSin, motion.error)) {
+      fail(out, sample ? motion.error : sample.error(), t_reached, theta1);
+      break;
+    }
+    continue_angles(model, out.samples.back().state, sample->state);
+    out.t.push_back(t_reached);
+    out.samples.push_back(*sample);
+  }
+
+  CVodeGetNumSteps(cv.memory, &out.steps);
+  out.rhs_evaluations = motion.evaluations;
+  return out;
+}
+
+Trajectory simulate_driven(const FourBar& model, const DrivenScene& scene,
+                           const SimulateOptions& options) {
+  validate(scene, options);
+  const auto per_revolution = static_cast<std::size_t>(scene.samples);
+  const auto samples = per_revolution * static_cast<std::size_t>(scene.revolutions);
+  Trajectory out;
+  out.t.reserve(samples);
+  out.samples.reserve(samples);
+
+  // t_j = j·T/samples with period T = 2π/|omega1|; theta1 advances by omega1·t, alpha1 = 0
+  const double period = kTwoPi / std::abs(scene.omega1);
+  out.status = SimulationStatus::kCompleted;
+  out.message = "completed";
+  for (std::size_t j = 0; j < samples; ++j) {
+    const double t = period * static_cast<double>(j) / static_cast<double>(per_revolution);
+    const double theta1 = scene.theta1 + scene.omega1 * t;
+    ++out.rhs_evaluations;
+    auto sample = inverse_dynamics(model, theta1, scene.omega1, 0.0, options.formulation);
+    if (!sample) {
+      fail(out, sample.error(), t, theta1);
+      break;
+    }
+    if (j > 0) continue_angles(model, out.samples.back().state, sample->state);
+    out.t.push_back(t);
+    out.samples.push_back(*sample);
+  }
+  return out;
+}
+
+}  // namespace bd::core

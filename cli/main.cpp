@@ -1,0 +1,179 @@
+// balance-design: the command-line program. A thin layer over bd::studies: parse the command
+// line, load the study, run it, print a short summary, and map outcomes to exit codes.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "studies/load_study.hpp"
+#include "studies/runner.hpp"
+
+#ifndef BD_VERSION
+#define BD_VERSION "unknown"
+#endif
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace st = bd::studies;
+
+// exit codes (documented in --help and docs/study-format.md)
+constexpr int kExitOk = 0;
+constexpr int kExitInternal = 1;
+constexpr int kExitBadInput = 2;
+constexpr int kExitStoppedEarly = 3;
+
+constexpr const char* kFooter = R"(
+Outputs (in DIR, default results/<name>/ with <name> the study's `name`):
+  timeseries.csv  one row per sample: t,theta1,theta2,theta3,omega1,omega2,omega3,
+                  alpha1,alpha2,alpha3,RA0x,RA0y,RA3x,RA3y,Fshx,Fshy,Msh,tau (SI units, %.17g)
+  summary.json    study name, method used and why, scene, samples, status, metrics
+                  (Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max, RA0_max, RA3_max)
+  Files are written under a temporary name and renamed, so none is ever half-written.
+
+Exit codes:
+  0  the study ran to the end
+  1  unexpected internal error (or the output files could not be written)
+  2  bad input: the study file or the command line is wrong; one line FILE:LINE:COLUMN: message
+     on stderr, and nothing is written
+  3  the simulation stopped early (e.g. a dead-centre position); the samples computed so far and
+     summary.json are kept, and the reason (with time and crank angle) is printed on stderr
+
+The study-file format is described in docs/study-format.md; examples are in studies/examples/.
+)";
+
+struct RunArgs {
+  std::string study;
+  std::string out;
+};
+
+void print_summary(const st::Study& study, const st::RunResult& r) {
+  const bd::core::Metrics& m = r.metrics;
+  if (const auto* free = std::get_if<bd::core::FreeScene>(&study.scene)) {
+    std::printf("%s: free motion over %g s from theta1 = %g rad, omega1 = %g rad/s\n",
+                study.name.c_str(), free->duration, free->theta1, free->omega1);
+  } else {
+    const auto& d = std::get<bd::core::DrivenScene>(study.scene);
+    std::printf("%s: driven at omega1 = %g rad/s for %d revolution%s from theta1 = %g rad\n",
+                study.name.c_str(), d.omega1, d.revolutions, d.revolutions == 1 ? "" : "s",
+                d.theta1);
+  }
+  std::printf("  method   %s (%s%s)\n", bd::core::to_string(r.method.formulation),
+              study.formulation ? "" : "auto: ", r.method.reason.c_str());
+  std::printf("  samples  %zu, status %s", r.trajectory.samples.size(),
+              bd::core::to_string(r.trajectory.status));
+  if (std::holds_alternative<bd::core::FreeScene>(study.scene)) {
+    std::printf(", %ld integrator steps, %ld dynamics evaluations", r.trajectory.steps,
+                r.trajectory.rhs_evaluations);
+  }
+  std::printf("\n");
+  std::printf("  |Fsh|    rms %.6g N, max %.6g N\n", m.Fsh_rms, m.Fsh_max);
+  std::printf("  |Msh|    rms %.6g N m, max %.6g N m\n", m.Msh_rms, m.Msh_max);
+  if (std::holds_alternative<bd::core::DrivenScene>(study.scene)) {
+    std::printf("  |tau|    rms %.6g N m, max %.6g N m\n", m.tau_rms, m.tau_max);
+  }
+  std::printf("  |RA0|    max %.6g N;  |RA3| max %.6g N\n", m.RA0_max, m.RA3_max);
+  std::printf("  wrote    %s\n           %s\n", r.timeseries.string().c_str(),
+              r.summary.string().c_str());
+}
+
+int run(const RunArgs& args) {
+  // load and validate: any mistake is one line on stderr, and nothing is written
+  st::Study study;
+  try {
+    study = st::load_study(args.study);
+  } catch (const bd::InputError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitBadInput;
+  }
+
+  const fs::path out = args.out.empty() ? fs::path("results") / study.name : fs::path(args.out);
+  st::RunResult result;
+  try {
+    result = st::run_study(study, out);
+  } catch (const bd::InputError& e) {
+    std::fprintf(stderr, "%s: %s\n", args.study.c_str(), e.what());
+    return kExitBadInput;
+  }
+
+  std::fflush(stderr);
+  print_summary(study, result);
+  std::fflush(stdout);
+  if (!result.ok()) {
+    std::fprintf(stderr, "%s: simulation stopped early: %s\n", args.study.c_str(),
+                 result.trajectory.message.c_str());
+    return kExitStoppedEarly;
+  }
+  return kExitOk;
+}
+
+void add_run_options(CLI::App& cmd, RunArgs& args) {
+  cmd.add_option("STUDY", args.study, "the study file, e.g. studies/examples/paper-fourbar.yaml")
+      ->required()
+      ->type_name("FILE");
+  cmd.add_option("-o,--out", args.out,
+                 "output directory, created if needed (default: results/<name>/)")
+      ->type_name("DIR");
+}
+
+// `balance-design STUDY.yaml ...` is short for `balance-design run STUDY.yaml ...`
+std::vector<std::string> with_default_command(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (!args.empty()) {
+    const std::string& first = args.front();
+    const bool top_level =
+        first == "run" || first == "-h" || first == "--help" || first == "--version";
+    if (!top_level) args.insert(args.begin(), "run");
+  }
+  return args;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    CLI::App app{
+        "balance-design " BD_VERSION
+        ": shaking-force and shaking-moment balancing of planar four-bar linkages.\n"
+        "Simulates the linkage of a study file (free motion or a driven crank) and writes its\n"
+        "reaction forces, shaking force and moment and drive torque.\n\n"
+        "Commands:\n"
+        "  balance-design run STUDY.yaml [--out DIR]   run a study, write its outputs into DIR\n"
+        "  balance-design STUDY.yaml [--out DIR]       the same: run is the default command\n"
+        "  balance-design run --help                   the options of run\n",
+        "balance-design"};
+    app.footer(kFooter);
+    app.set_version_flag("--version", std::string("balance-design ") + BD_VERSION);
+    app.require_subcommand(1);
+
+    RunArgs args;
+    CLI::App* run_cmd = app.add_subcommand(
+        "run", "load STUDY.yaml, check it, simulate its scene and write the outputs into DIR");
+    add_run_options(*run_cmd, args);
+    run_cmd->footer(kFooter);
+
+    std::vector<std::string> argv_rest = with_default_command(argc, argv);
+    if (argv_rest.empty()) {
+      std::fputs(app.help().c_str(), stderr);
+      return kExitBadInput;
+    }
+    std::reverse(argv_rest.begin(), argv_rest.end());  // CLI11 takes the arguments reversed
+    try {
+      app.parse(argv_rest);
+    } catch (const CLI::ParseError& e) {
+      const int code = app.exit(e);
+      return code == 0 ? kExitOk : kExitBadInput;
+    }
+    return run(args);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "balance-design: error: %s\n", e.what());
+    return kExitInternal;
+  } catch (...) {
+    std::fprintf(stderr, "balance-design: unexpected internal error\n");
+    return kExitInternal;
+  }
+}

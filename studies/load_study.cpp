@@ -1,0 +1,582 @@
+#include "studies/load_study.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "core/kinematics.hpp"
+
+namespace bd::studies {
+
+StudyError::StudyError(std::string file, int line, int column, std::string message)
+    : InputError(line > 0 ? file + ":" + std::to_string(line) + ":" + std::to_string(column) +
+                                ": " + message
+                          : file + ": " + message),
+      file_(std::move(file)),
+      line_(line),
+      column_(column),
+      message_(std::move(message)) {}
+
+namespace {
+
+// largest number of rows a study may ask for (keeps a typo from filling the disk)
+constexpr double kMaxRows = 1e7;
+
+std::string format_number(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+// what a node holds, in words, for "expected X, got Y"
+std::string describe(const YAML::Node& n) {
+  if (!n.IsDefined() || n.IsNull()) return "nothing";
+  if (n.IsSequence()) return "a list";
+  if (n.IsMap()) return "a map";
+  std::string text = n.Scalar();
+  if (text.size() > 40) text = text.substr(0, 37) + "...";
+  return "'" + text + "'";
+}
+
+// reports mistakes at places in one study file
+class Reporter {
+ public:
+  explicit Reporter(std::string source) : source_(std::move(source)) {}
+  const std::string& source() const { return source_; }
+
+  [[noreturn]] void fail(const YAML::Mark& mark, const std::string& message) const {
+    if (mark.is_null()) throw StudyError(source_, 1, 1, message);
+    throw StudyError(source_, mark.line + 1, mark.column + 1, message);
+  }
+
+ private:
+  std::string source_;
+};
+
+// where a value is: its own mark, else its key's (an empty value is marked at the next token,
+// often on the next line, so it is reported at its key)
+YAML::Mark mark_of(const YAML::Node& value, const YAML::Mark& fallback) {
+  if (!value.IsDefined() || value.IsNull()) return fallback;
+  const YAML::Mark m = value.Mark();
+  return m.is_null() ? fallback : m;
+}
+
+// a YAML map with its keys checked once: no unknown, no duplicate, all plain names
+class MapReader {
+ public:
+  struct Entry {
+    std::string key;
+    YAML::Mark key_mark;
+    YAML::Node value;
+  };
+
+  // `path` names the map in messages ("" for the top level); `where` is the place of the key
+  // that introduces it (used for missing keys); `shape` is the expected content, in words
+  MapReader(const Reporter& r, const YAML::Node& node, std::string path, const YAML::Mark& where,
+            const std::string& shape)
+      : r_(r), path_(std::move(path)), where_(where) {
+    if (!node.IsMap()) {
+      r_.fail(mark_of(node, where_), (path_.empty() ? std::string("a study file") : path_) +
+                                         " must be a map " + shape + ", got " + describe(node));
+    }
+    for (auto it = node.begin(); it != node.end(); ++it) {
+      const YAML::Node key = it->first;
+      const YAML::Mark km = mark_of(key, where_);
+      if (!key.IsScalar()) {
+        r_.fail(km, "keys" + in() + " must be plain names, got " + describe(key));
+      }
+      const std::string name = key.Scalar();
+      for (const Entry& e : entries_) {
+        if (e.key == name) {
+          r_.fail(km, "duplicate key '" + name + "'" + in() + " (first given at line " +
+                          std::to_string(e.key_mark.line + 1) + ")");
+        }
+      }
+      entries_.push_back({name, km, it->second});
+    }
+  }
+
+  // every key must be one of `allowed`; `context` replaces the path in the message if given
+  void check_keys(const std::vector<std::string>& allowed, const std::string& context = "") const {
+    for (const Entry& e : entries_) {
+      bool ok = false;
+      for (const std::string& a : allowed) ok = ok || (a == e.key);
+      if (!ok) {
+        r_.fail(e.key_mark, "unknown key '" + e.key + "'" + (context.empty() ? in() : context) +
+                                "; allowed keys: " + join(allowed));
+      }
+    }
+  }
+
+  const Entry* find(const std::string& key) const {
+    for (const Entry& e : entries_) {
+      if (e.key == key) return &e;
+    }
+    return nullptr;
+  }
+  bool has(const std::string& key) const { return find(key) != nullptr; }
+
+  const Entry& require(const std::string& key, const std::string& meaning) const {
+    const Entry* e = find(key);
+    if (!e) {
+      r_.fail(where_, (path_.empty() ? std::string() : path_ + ": ") + "missing required key '" +
+                          key + "' (" + meaning + ")");
+    }
+    return *e;
+  }
+
+  std::string full(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  const YAML::Mark& where() const { return where_; }
+  const std::vector<Entry>& entries() const { return entries_; }
+
+ private:
+  std::string in() const { return path_.empty() ? " at the top level" : " in " + path_; }
+
+  const Reporter& r_;
+  std::string path_;
+  YAML::Mark where_;
+  std::vector<Entry> entries_;
+};
+
+// a finite number; `unit` in words for messages ("m", "kg", "rad/s", "" for none)
+double read_number(const Reporter& r, const YAML::Node& node, const YAML::Mark& fallback,
+                   const std::string& path, const std::string& unit) {
+  const std::string in_unit = unit.empty() ? "" : " in " + unit;
+  double value = 0.0;
+  if (!node.IsScalar() || !YAML::convert<double>::decode(node, value)) {
+    r.fail(mark_of(node, fallback),
+           path + " must be a number" + in_unit + ", got " + describe(node));
+  }
+  if (!std::isfinite(value)) {
+    r.fail(mark_of(node, fallback),
+           path + " must be a finite number" + in_unit + ", got " + describe(node));
+  }
+  return value;
+}
+
+double read_number(const Reporter& r, const MapReader::Entry& e, const std::string& path,
+                   const std::string& unit) {
+  return read_number(r, e.value, e.key_mark, path, unit);
+}
+
+// a whole number in [lo, hi]
+int read_count(const Reporter& r, const MapReader::Entry& e, const std::string& path, double lo,
+               double hi) {
+  const double v = read_number(r, e, path, "");
+  const YAML::Mark m = mark_of(e.value, e.key_mark);
+  if (v != std::floor(v)) r.fail(m, path + " must be a whole number, got " + describe(e.value));
+  if (v < lo) r.fail(m, path + " must be >= " + format_number(lo) + ", got " + format_number(v));
+  if (v > hi) r.fail(m, path + " must be <= " + format_number(hi) + ", got " + format_number(v));
+  return static_cast<int>(v);
+}
+
+std::string read_text(const Reporter& r, const MapReader::Entry& e, const std::string& path) {
+  if (!e.value.IsScalar()) {
+    r.fail(mark_of(e.value, e.key_mark), path + " must be text, got " + describe(e.value));
+  }
+  return e.value.Scalar();
+}
+
+// [x, y] with each element checked; element marks go to `marks` when given
+Vec2 read_vec2(const Reporter& r, const MapReader::Entry& e, const std::string& path,
+               const std::string& unit, YAML::Mark marks[2]) {
+  const YAML::Mark m = mark_of(e.value, e.key_mark);
+  if (!e.value.IsSequence() || e.value.size() != 2) {
+    r.fail(m, path + " must be a list of 2 numbers [x, y] in " + unit + ", got " +
+                  (e.value.IsSequence() ? "a list of " + std::to_string(e.value.size())
+                                        : describe(e.value)));
+  }
+  Vec2 v;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const YAML::Node item = e.value[i];
+    marks[i] = mark_of(item, m);
+    v[static_cast<Eigen::Index>(i)] =
+        read_number(r, item, m, path + "[" + std::to_string(i) + "]", unit);
+  }
+  return v;
+}
+
+// where each quantity make_fourbar() may complain about sits in the file
+struct Place {
+  std::string core_name;   // as make_fourbar() names it ("coupler.mass")
+  std::string study_path;  // as the study file names it ("linkage.coupler.mass")
+  YAML::Mark mark;
+};
+
+class StudyParser {
+ public:
+  explicit StudyParser(const Reporter& r) : r_(r) {}
+
+  Study parse(const YAML::Node& root) {
+    Study study;
+    study.source = r_.source();
+    if (!root.IsDefined() || root.IsNull()) {
+      r_.fail(YAML::Mark(),
+              "the study file is empty; expected the keys name, linkage and scene "
+              "(and optionally loads, method, tolerance)");
+    }
+    const MapReader top(r_, root, "", mark_of(root, YAML::Mark()),
+                        "of keys (name, linkage, scene, ...)");
+    top.check_keys({"name", "linkage", "loads", "scene", "method", "tolerance"});
+
+    study.name = read_name(top.require("name", "the study's name, used in output names"));
+
+    const MapReader::Entry& linkage = top.require("linkage", "the mechanism");
+    core::FourBar model = read_linkage(linkage);
+    if (const MapReader::Entry* loads = top.find("loads")) model.loads = read_loads(*loads);
+    study.model = checked_model(model, linkage.key_mark);
+
+    const MapReader::Entry& scene = top.require("scene", "what to simulate: free or driven");
+    study.scene = read_scene(scene);
+    check_assembly(study.model, study.scene, scene.key_mark);
+
+    if (const MapReader::Entry* method = top.find("method")) {
+      study.formulation = read_method(*method);
+    }
+    if (const MapReader::Entry* tol = top.find("tolerance")) {
+      study.tolerance = read_tolerance(*tol);
+    }
+    return study;
+  }
+
+ private:
+  std::string read_name(const MapReader::Entry& e) {
+    const std::string name = read_text(r_, e, "name");
+    const YAML::Mark m = mark_of(e.value, e.key_mark);
+    if (name.empty() || name.size() > 100) {
+      r_.fail(m, "name must have 1 to 100 characters, got " + std::to_string(name.size()));
+    }
+    for (char c : name) {
+      const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                      c == '.' || c == '_' || c == '-';
+      if (!ok) {
+        r_.fail(m,
+                "name may use only letters, digits, '.', '_' and '-' (it names the output "
+                "directory), got " +
+                    describe(e.value));
+      }
+    }
+    if (name[0] == '.') r_.fail(m, "name must not start with '.', got " + describe(e.value));
+    return name;
+  }
+
+  core::FourBar read_linkage(const MapReader::Entry& e) {
+    const MapReader lk(r_, e.value, "linkage", e.key_mark,
+                       "(type, frame, branch, crank, coupler, rocker)");
+    lk.check_keys({"type", "frame", "branch", "crank", "coupler", "rocker"});
+
+    const MapReader::Entry& type = lk.require("type", "the kind of linkage: fourbar");
+    const std::string t = read_text(r_, type, "linkage.type");
+    if (t != "fourbar") {
+      r_.fail(mark_of(type.value, type.key_mark),
+              "linkage.type '" + t + "' is not supported; expected fourbar");
+    }
+
+    core::FourBar model;
+    const MapReader::Entry& frame = lk.require("frame", "l4, the distance A0A3 in m");
+    model.frame_length = read_number(r_, frame, "linkage.frame", "m");
+    places_.push_back({"frame", "linkage.frame", mark_of(frame.value, frame.key_mark)});
+
+    const MapReader::Entry& branch = lk.require("branch", "the assembly mode, +1 or -1");
+    const double b = read_number(r_, branch, "linkage.branch", "");
+    if (b != 1.0 && b != -1.0) {
+      r_.fail(mark_of(branch.value, branch.key_mark),
+              "linkage.branch must be +1 or -1, got " + describe(branch.value));
+    }
+    model.branch = b > 0 ? core::Branch::kPlus : core::Branch::kMinus;
+    places_.push_back({"branch", "linkage.branch", mark_of(branch.value, branch.key_mark)});
+
+    model.crank = read_link(lk, "crank");
+    model.coupler = read_link(lk, "coupler");
+    model.rocker = read_link(lk, "rocker");
+    return model;
+  }
+
+  core::Link read_link(const MapReader& lk, const std::string& name) {
+    const std::string path = "linkage." + name;
+    const MapReader::Entry& e =
+        lk.require(name, "its length, mass, centre of mass (s, sigma or e, f) and inertia");
+    const MapReader m(r_, e.value, path, e.key_mark,
+                      "(length, mass, s and sigma or e and f, inertia)");
+    m.check_keys({"length", "mass", "s", "sigma", "e", "f", "inertia"});
+
+    auto number = [&](const MapReader::Entry& x, const char* unit) {
+      const double v = read_number(r_, x, path + "." + x.key, unit);
+      places_.push_back({name + "." + x.key, path + "." + x.key, mark_of(x.value, x.key_mark)});
+      return v;
+    };
+    const double length = number(m.require("length", "l in m"), "m");
+    const double mass = number(m.require("mass", "in kg"), "kg");
+
+    // centre of mass: exactly one complete pair, {s, sigma} or {e, f}
+    const MapReader::Entry* s = m.find("s");
+    const MapReader::Entry* sigma = m.find("sigma");
+    const MapReader::Entry* ce = m.find("e");
+    const MapReader::Entry* cf = m.find("f");
+    const MapReader::Entry* polar_first = first_of(s, sigma);
+    const MapReader::Entry* cart_first = first_of(ce, cf);
+    if (polar_first && cart_first) {
+      const MapReader::Entry* later =
+          polar_first->key_mark.pos > cart_first->key_mark.pos ? polar_first : cart_first;
+      r_.fail(later->key_mark, path +
+                                   " gives its centre of mass both as {s, sigma} and as "
+                                   "{e, f}; give one pair only");
+    }
+    if (!polar_first && !cart_first) {
+      r_.fail(e.key_mark, path +
+                              ": missing the centre of mass; give s [m] and sigma [rad], "
+                              "or e [m] and f [m]");
+    }
+    auto pair_check = [&](const MapReader::Entry* a, const MapReader::Entry* b, const char* an,
+                          const char* bn) {
+      if (a && !b) {
+        r_.fail(a->key_mark,
+                path + "." + an + " is given without " + bn + "; give both " + an + " and " + bn);
+      }
+    };
+    pair_check(s, sigma, "s", "sigma");
+    pair_check(sigma, s, "sigma", "s");
+    pair_check(ce, cf, "e", "f");
+    pair_check(cf, ce, "f", "e");
+
+    const double inertia =
+        number(m.require("inertia", "I about the centre of mass in kg m^2"), "kg m^2");
+    if (s) {
+      const double sv = number(*s, "m");
+      if (sv < 0) {
+        r_.fail(mark_of(s->value, s->key_mark), path +
+                                                    ".s must be >= 0 m (sigma gives the "
+                                                    "direction), got " +
+                                                    format_number(sv));
+      }
+      const double sg = number(*sigma, "rad");
+      return core::link_from_polar(length, mass, sv, sg, inertia);
+    }
+    core::Link link;
+    link.length = length;
+    link.mass = mass;
+    link.e = number(*ce, "m");
+    link.f = number(*cf, "m");
+    link.inertia = inertia;
+    return link;
+  }
+
+  static const MapReader::Entry* first_of(const MapReader::Entry* a, const MapReader::Entry* b) {
+    if (!a) return b;
+    if (!b) return a;
+    return a->key_mark.pos <= b->key_mark.pos ? a : b;
+  }
+
+  core::Loads read_loads(const MapReader::Entry& e) {
+    core::Loads loads;
+    if (e.value.IsNull()) return loads;  // `loads:` with nothing under it: all zero
+    const MapReader ld(r_, e.value, "loads", e.key_mark, "(gravity, crank, coupler, rocker)");
+    ld.check_keys({"gravity", "crank", "coupler", "rocker"});
+    if (const MapReader::Entry* g = ld.find("gravity")) {
+      YAML::Mark marks[2];
+      loads.gravity = read_vec2(r_, *g, "loads.gravity", "m/s^2", marks);
+      places_.push_back({"loads.gravity[0]", "loads.gravity[0]", marks[0]});
+      places_.push_back({"loads.gravity[1]", "loads.gravity[1]", marks[1]});
+    }
+    const char* names[] = {"crank", "coupler", "rocker"};
+    core::LinkLoad* targets[] = {&loads.crank, &loads.coupler, &loads.rocker};
+    for (int k = 0; k < 3; ++k) {
+      const MapReader::Entry* l = ld.find(names[k]);
+      if (!l || l->value.IsNull()) continue;
+      const std::string path = std::string("loads.") + names[k];
+      const MapReader lm(r_, l->value, path, l->key_mark, "(force, moment)");
+      lm.check_keys({"force", "moment"});
+      if (const MapReader::Entry* f = lm.find("force")) {
+        YAML::Mark marks[2];
+        targets[k]->force = read_vec2(r_, *f, path + ".force", "N", marks);
+        places_.push_back({path + ".force[0]", path + ".force[0]", marks[0]});
+        places_.push_back({path + ".force[1]", path + ".force[1]", marks[1]});
+      }
+      if (const MapReader::Entry* mo = lm.find("moment")) {
+        targets[k]->moment = read_number(r_, *mo, path + ".moment", "N m");
+        places_.push_back({path + ".moment", path + ".moment", mark_of(mo->value, mo->key_mark)});
+      }
+    }
+    return loads;
+  }
+
+  // core::make_fourbar() checks the physics; its complaint is reported where the value is
+  core::FourBar checked_model(const core::FourBar& model, const YAML::Mark& linkage_mark) {
+    try {
+      return core::make_fourbar(model);
+    } catch (const InputError& err) {
+      const std::string msg = err.what();
+      const Place* best = nullptr;
+      for (const Place& p : places_) {
+        const bool prefix = msg.compare(0, p.core_name.size(), p.core_name) == 0 &&
+                            (msg.size() == p.core_name.size() || msg[p.core_name.size()] == ' ');
+        if (prefix && (!best || p.core_name.size() > best->core_name.size())) best = &p;
+      }
+      if (best) r_.fail(best->mark, best->study_path + msg.substr(best->core_name.size()));
+      r_.fail(linkage_mark, msg);
+    }
+  }
+
+  Scene read_scene(const MapReader::Entry& e) {
+    const MapReader sc(r_, e.value, "scene", e.key_mark,
+                       "(type, theta1, omega1, duration or revolutions, samples)");
+    const MapReader::Entry& type = sc.require("type", "free or driven");
+    const std::string t = read_text(r_, type, "scene.type");
+    const YAML::Mark tm = mark_of(type.value, type.key_mark);
+    auto get = [&](const std::string& key, double fallback, const char* unit) {
+      const MapReader::Entry* x = sc.find(key);
+      return x ? read_number(r_, *x, "scene." + key, unit) : fallback;
+    };
+
+    if (t == "free") {
+      sc.check_keys({"type", "theta1", "omega1", "duration", "samples"}, " in scene (type: free)");
+      core::FreeScene free;
+      free.theta1 = get("theta1", 0.0, "rad");
+      note_theta1(sc);
+      free.omega1 = get("omega1", 0.0, "rad/s");
+      const MapReader::Entry& d = sc.require("duration", "the simulated time in s");
+      free.duration = read_number(r_, d, "scene.duration", "s");
+      if (free.duration <= 0) {
+        r_.fail(mark_of(d.value, d.key_mark),
+                "scene.duration must be > 0 s, got " + format_number(free.duration));
+      }
+      if (const MapReader::Entry* n = sc.find("samples")) {
+        free.samples = read_count(r_, *n, "scene.samples", 2, kMaxRows);
+      }
+      return free;
+    }
+    if (t == "driven") {
+      sc.check_keys({"type", "theta1", "omega1", "revolutions", "samples"},
+                    " in scene (type: driven)");
+      core::DrivenScene driven;
+      driven.theta1 = get("theta1", 0.0, "rad");
+      note_theta1(sc);
+      const MapReader::Entry& w = sc.require("omega1", "the constant crank speed in rad/s");
+      driven.omega1 = read_number(r_, w, "scene.omega1", "rad/s");
+      if (driven.omega1 == 0) {
+        r_.fail(mark_of(w.value, w.key_mark),
+                "scene.omega1 must be != 0 rad/s in a driven scene (the constant crank speed)");
+      }
+      if (const MapReader::Entry* n = sc.find("revolutions")) {
+        driven.revolutions = read_count(r_, *n, "scene.revolutions", 1, kMaxRows);
+      }
+      if (const MapReader::Entry* n = sc.find("samples")) {
+        driven.samples = read_count(r_, *n, "scene.samples", 1, kMaxRows);
+      }
+      if (static_cast<double>(driven.samples) * driven.revolutions > kMaxRows) {
+        r_.fail(e.key_mark,
+                "scene.samples x scene.revolutions must be <= " + format_number(kMaxRows) +
+                    " rows, got " +
+                    format_number(static_cast<double>(driven.samples) * driven.revolutions));
+      }
+      return driven;
+    }
+    r_.fail(tm, "scene.type must be free or driven, got " + describe(type.value));
+  }
+
+  void note_theta1(const MapReader& sc) {
+    if (const MapReader::Entry* x = sc.find("theta1")) {
+      scene_places_.push_back({"theta1", "scene.theta1", mark_of(x->value, x->key_mark)});
+    }
+  }
+
+  void check_assembly(const core::FourBar& model, const Scene& scene,
+                      const YAML::Mark& scene_mark) {
+    const double theta1 = std::visit([](const auto& s) { return s.theta1; }, scene);
+    const auto pose = core::solve_position(model, theta1);
+    if (pose) return;
+    // report at scene.theta1 when given, else at the scene (theta1 defaulted to 0)
+    YAML::Mark where = scene_mark;
+    for (const Place& p : scene_places_) where = p.mark;
+    r_.fail(where,
+            "the linkage cannot be assembled at the initial crank angle: " + pose.error().what());
+  }
+
+  std::optional<core::Formulation> read_method(const MapReader::Entry& e) {
+    const std::string name = read_text(r_, e, "method");
+    const YAML::Mark m = mark_of(e.value, e.key_mark);
+    bool known = false;
+    for (const char* n : kMethodNames) known = known || name == n;
+    if (!known) {
+      std::vector<std::string> all(std::begin(kMethodNames), std::end(kMethodNames));
+      r_.fail(m, "unknown method '" + name + "'; expected one of " + join(all));
+    }
+    if (name == "auto") return std::nullopt;
+    const auto f = available_formulation(name);
+    if (!f) {
+      std::vector<std::string> available;
+      for (const char* n : kMethodNames) {
+        if (std::string(n) == "auto" || available_formulation(n)) available.emplace_back(n);
+      }
+      r_.fail(m, "method '" + name + "' is not available yet; available: " + join(available));
+    }
+    return f;
+  }
+
+  double read_tolerance(const MapReader::Entry& e) {
+    const double tol = read_number(r_, e, "tolerance", "");
+    const YAML::Mark m = mark_of(e.value, e.key_mark);
+    if (!(tol > 0 && tol < 1)) {
+      r_.fail(m, "tolerance must be > 0 and < 1 (a relative tolerance), got " + format_number(tol));
+    }
+    core::SimulateOptions options;
+    options.tolerance = tol;
+    const std::string problem = options.validate();
+    if (!problem.empty()) r_.fail(m, "tolerance: " + problem);
+    return tol;
+  }
+
+  const Reporter& r_;
+  std::vector<Place> places_;        // linkage and loads values, for make_fourbar()'s messages
+  std::vector<Place> scene_places_;  // scene.theta1 when given
+};
+
+}  // namespace
+
+Study parse_study(const std::string& yaml_text, const std::string& source_name) {
+  const Reporter r(source_name);
+  std::vector<YAML::Node> docs;
+  try {
+    docs = YAML::LoadAll(yaml_text);
+  } catch (const YAML::Exception& e) {
+    r.fail(e.mark, e.msg);
+  }
+  if (docs.size() > 1) {
+    r.fail(mark_of(docs[1], YAML::Mark()),
+           "a study file holds one YAML document; found a second one (after '---')");
+  }
+  StudyParser parser(r);
+  try {
+    return parser.parse(docs.empty() ? YAML::Node() : docs[0]);
+  } catch (const YAML::Exception& e) {
+    // conversions are checked before use, so this is unexpected; still report it in place
+    r.fail(e.mark, e.msg);
+  }
+}
+
+Study load_study(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw StudyError(path, 0, 0, "is a directory, not a study file");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw StudyError(path, 0, 0, "cannot open the study file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw StudyError(path, 0, 0, "cannot read the study file");
+  return parse_study(text.str(), path);
+}
+
+}  // namespace bd::studies

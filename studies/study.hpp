@@ -1,0 +1,50 @@
+#pragma once
+/// A study: one linkage with its loads, one scene, and how to compute it (DESIGN.md "Study file
+/// (v1)"). Built by load_study()/parse_study() from a study.yaml, or directly in code.
+#include <optional>
+#include <string>
+#include <variant>
+
+#include "core/dynamics.hpp"
+#include "core/model.hpp"
+#include "core/simulate.hpp"
+
+namespace bd::studies {
+
+/// The scene to simulate: free motion (forward dynamics, integrated) or driven motion (constant
+/// crank speed, kinetostatics per sample).
+using Scene = std::variant<core::FreeScene, core::DrivenScene>;
+
+/// "free" or "driven".
+const char* scene_type(const Scene& scene);
+
+/// Method names accepted by the study file's `method` key, in the order the docs list them.
+/// Not every name is available yet; see available_formulation().
+inline constexpr const char* kMethodNames[] = {"auto", "opened-loop", "complex-masses",
+                                               "mass-matrix"};
+
+/// The formulation named `name` ("mass-matrix", ...) if core implements it, else nothing.
+std::optional<core::Formulation> available_formulation(const std::string& name);
+
+struct Study {
+  std::string name;     // used in output names: [A-Za-z0-9._-], not starting with '.'
+  core::FourBar model;  // linkage and loads, checked by core::make_fourbar()
+  Scene scene;          // free or driven
+  /// The formulation asked for; empty means `auto` (the runner picks, and says why).
+  std::optional<core::Formulation> formulation;
+  double tolerance = 1e-10;  // integrator relative tolerance (free scenes) [-]
+  std::string source;        // the study file as named by the user ("" when built in code)
+
+  /// "auto" or the requested formulation's name.
+  std::string method_name() const;
+};
+
+/// The formulation a run uses, and why (for the console and summary.json).
+struct MethodChoice {
+  core::Formulation formulation = core::Formulation::kMassMatrix;
+  std::string reason;
+};
+/// Resolves `auto` (DESIGN.md: the leanest formulation and evaluation path for the outputs).
+MethodChoice choose_method(const Study& study);
+
+}  // namespace bd::studies

@@ -1,0 +1,157 @@
+// The balance-design executable: exit codes, the one-line error on stderr, outputs where asked
+// and nothing written for bad input. Needs the executable built (target balance-design).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kExe = BD_BINARY_DIR "/bin/balance-design";
+const std::string kExamples = BD_SOURCE_DIR "/studies/examples";
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(fs::exists(kExe)) << kExe << " not built (cmake --build build --target "
+                                  << "balance-design)";
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("bd_cli_test_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // runs `balance-design ARGS` in dir_, keeping stdout and stderr; returns the exit code
+  int run(const std::string& args) {
+    const std::string cmd = "cd " + quote(dir_.string()) + " && " + quote(kExe) + " " + args +
+                            " >" + quote((dir_ / "stdout.txt").string()) + " 2>" +
+                            quote((dir_ / "stderr.txt").string());
+    const int status = std::system(cmd.c_str());
+    out_ = read(dir_ / "stdout.txt");
+    err_ = read(dir_ / "stderr.txt");
+    fs::remove(dir_ / "stdout.txt");
+    fs::remove(dir_ / "stderr.txt");
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+  void write(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name) << text;
+  }
+
+  fs::path dir_;
+  std::string out_, err_;
+};
+
+TEST_F(CliTest, RunWritesTheOutputsAndExitsZero) {
+  EXPECT_EQ(run("run " + quote(kExamples + "/paper-fourbar-driven.yaml") + " --out res"), 0)
+      << err_;
+  EXPECT_TRUE(err_.empty()) << err_;
+  EXPECT_TRUE(fs::exists(dir_ / "res" / "timeseries.csv"));
+  EXPECT_TRUE(fs::exists(dir_ / "res" / "summary.json"));
+  EXPECT_NE(out_.find("mass-matrix"), std::string::npos) << out_;
+  EXPECT_NE(out_.find("timeseries.csv"), std::string::npos) << out_;
+}
+
+TEST_F(CliTest, ShorthandUsesTheDefaultOutputDirectory) {
+  EXPECT_EQ(run(quote(kExamples + "/paper-fourbar.yaml")), 0) << err_;
+  const fs::path out = dir_ / "results" / "paper-fourbar";
+  EXPECT_TRUE(fs::exists(out / "timeseries.csv"));
+  EXPECT_TRUE(fs::exists(out / "summary.json"));
+  EXPECT_NE(read(out / "summary.json").find("\"study\": \"paper-fourbar\""), std::string::npos);
+}
+
+TEST_F(CliTest, BadInputExitsTwoWithOneLineAndWritesNothing) {
+  write("bad.yaml",
+        "name: bad\n"
+        "linkage:\n"
+        "  type: fourbar\n"
+        "  frame: 3.2\n"
+        "  branch: 1\n"
+        "  crank:   {length: 1.0, mass: 2.1, s: 0.6, sigma: 0.3, inertia: 1.1}\n"
+        "  coupler: {length: 3.0, mass: -1, s: 1.45, sigma: 0.4, inertia: 3.1}\n"
+        "  rocker:  {length: 2.0, mass: 2.2, s: 1.66, sigma: -0.4, inertia: 2.1}\n"
+        "scene: {type: free, duration: 1}\n");
+  EXPECT_EQ(run("bad.yaml --out res"), 2);
+  EXPECT_EQ(err_, "bad.yaml:7:32: linkage.coupler.mass must be > 0 kg, got -1\n");
+  EXPECT_FALSE(fs::exists(dir_ / "res"));
+  EXPECT_FALSE(fs::exists(dir_ / "results"));
+
+  // the default directory is not created either
+  EXPECT_EQ(run("run bad.yaml"), 2);
+  EXPECT_FALSE(fs::exists(dir_ / "results"));
+
+  // a YAML syntax error
+  write("syntax.yaml", "name: x\nlinkage: {frame: 3.2\n");
+  EXPECT_EQ(run("syntax.yaml --out res"), 2);
+  EXPECT_EQ(err_.rfind("syntax.yaml:", 0), 0u) << err_;
+  EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
+  EXPECT_FALSE(fs::exists(dir_ / "res"));
+
+  // a missing file
+  EXPECT_EQ(run("missing.yaml --out res"), 2);
+  EXPECT_EQ(err_, "missing.yaml: cannot open the study file\n");
+  EXPECT_FALSE(fs::exists(dir_ / "res"));
+}
+
+TEST_F(CliTest, BadCommandLineExitsTwo) {
+  EXPECT_EQ(run(""), 2);
+  EXPECT_EQ(run("run"), 2);
+  EXPECT_EQ(run("a.yaml b.yaml"), 2);
+  EXPECT_EQ(run("run a.yaml --bogus"), 2);
+}
+
+TEST_F(CliTest, SimulationStoppedEarlyExitsThreeAndKeepsResults) {
+  // the crank (2.5) of this linkage cannot turn fully: the driven run stops where the loop
+  // cannot close
+  write("stops.yaml",
+        "name: stops\n"
+        "linkage:\n"
+        "  type: fourbar\n"
+        "  frame: 3.2\n"
+        "  branch: 1\n"
+        "  crank:   {length: 2.5, mass: 2.1, s: 0.6, sigma: 0.3, inertia: 1.1}\n"
+        "  coupler: {length: 3.0, mass: 3.0, s: 1.45, sigma: 0.4, inertia: 3.1}\n"
+        "  rocker:  {length: 2.0, mass: 2.2, s: 1.66, sigma: -0.4, inertia: 2.1}\n"
+        "scene: {type: driven, theta1: 1.5707963267948966, omega1: 6.283185307179586}\n");
+  EXPECT_EQ(run("stops.yaml --out res"), 3) << err_;
+  EXPECT_EQ(err_.rfind("stops.yaml: simulation stopped early: ", 0), 0u) << err_;
+  EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
+  EXPECT_NE(err_.find("theta1"), std::string::npos) << err_;
+  EXPECT_TRUE(fs::exists(dir_ / "res" / "timeseries.csv"));
+  EXPECT_NE(read(dir_ / "res" / "summary.json").find("\"ok\": false"), std::string::npos);
+}
+
+TEST_F(CliTest, HelpAndVersion) {
+  EXPECT_EQ(run("--help"), 0);
+  for (const char* text : {"run", "--out", "timeseries.csv", "summary.json", "Exit codes"}) {
+    EXPECT_NE(out_.find(text), std::string::npos) << text;
+  }
+  EXPECT_EQ(run("run --help"), 0);
+  EXPECT_NE(out_.find("--out"), std::string::npos) << out_;
+  EXPECT_EQ(run("--version"), 0);
+  EXPECT_EQ(out_.rfind("balance-design ", 0), 0u) << out_;
+}
+
+}  // namespace
