@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Regenerates the README's figures from real runs of the example studies (needs gnuplot).
+#   docs/figures/make-figures.sh [BUILD_DIR]
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+bin=${1:-build}/bin/balance-design
+out=docs/figures
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+"$bin" run studies/examples/paper-fourbar.yaml --out "$tmp/free" >/dev/null
+"$bin" run studies/examples/paper-fourbar-driven.yaml --out "$tmp/driven" >/dev/null
+gnuplot <<GP
+set datafile separator ','
+set terminal svg size 720,400 dynamic font 'sans,12' background rgb 'white'
+set key outside right top
+set grid
+
+set output '$out/paper-fourbar-angles.svg'
+set title 'paper-fourbar: link angles in free motion (cf. paper Fig. 7)'
+set xlabel 't [s]'; set ylabel 'angle [rad]'
+plot '$tmp/free/timeseries.csv' every ::1 using 1:2 with lines lw 2 title 'θ1', \
+     '' every ::1 using 1:3 with lines lw 2 title 'θ2', \
+     '' every ::1 using 1:4 with lines lw 2 title 'θ3'
+
+set output '$out/paper-fourbar-reactions.svg'
+set title 'paper-fourbar: support reactions in free motion (cf. paper Fig. 8)'
+set ylabel 'force on the ground [N]'
+plot '$tmp/free/timeseries.csv' every ::1 using 1:11 with lines lw 2 title 'RA0x', \
+     '' every ::1 using 1:12 with lines lw 2 title 'RA0y', \
+     '' every ::1 using 1:13 with lines lw 2 title 'RA3x', \
+     '' every ::1 using 1:14 with lines lw 2 title 'RA3y'
+
+set output '$out/paper-fourbar-driven.svg'
+set title 'paper-fourbar-driven: crank at 2π rad/s, one revolution'
+set xlabel 'θ1 [rad]'; set ylabel '[N], [N m]'
+set xrange [0:2*pi]
+plot '$tmp/driven/timeseries.csv' every ::1 using 2:18 with lines lw 2 title 'drive torque τ', \
+     '' every ::1 using 2:(sqrt(\$15**2+\$16**2)) with lines lw 2 title '|Fsh|', \
+     '' every ::1 using 2:17 with lines lw 2 title 'Msh'
+GP
+echo "wrote $out/paper-fourbar-angles.svg $out/paper-fourbar-reactions.svg $out/paper-fourbar-driven.svg"
