@@ -1,9 +1,10 @@
 #include "core/mass_matrix.hpp"
 
 #include <cmath>
-#include <cstdio>
 
 #include <Eigen/QR>
+
+#include "core/formulation_support.hpp"
 
 namespace bd::core {
 
@@ -15,10 +16,6 @@ using Mat43 = Eigen::Matrix<double, 4, 3>;
 
 // joints in one vector [A0x, A0y, A1x, A1y, A2x, A2y, A3x, A3y]; link k joins joints k-1 and k,
 // so its four coordinates are the contiguous segment starting at 2(k-1)
-
-// |sin(theta3 - theta2)| below this is treated as a singular (dead-centre) position: the
-// transfer functions Θ2, Θ3 grow like 1/sin and carry a relative error ~eps/sin there
-constexpr double kSingularSin = 1e-10;
 
 Mat8 assembled_mass_matrix(const FourBar& model) {
   Mat8 M = Mat8::Zero();
@@ -44,27 +41,15 @@ Vec8 assembled_nodal_forces(const FourBar& model, const Joints& j, const Pose& p
   return F;
 }
 
-DynamicsError singular_error(double theta1, double sin_mu) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf,
-                "sin(theta3 - theta2) = %.3g: coupler and rocker are aligned (dead centre)",
-                sin_mu);
-  return {DynamicsError::Kind::kSingular, theta1, buf};
-}
-
 // Solves the mass-matrix formulation at one instant. Forward when `alpha1` is empty (tau = 0),
 // inverse otherwise.
 Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, double theta1, double omega1,
                                               const double* alpha1_given) {
   // position stage
-  const auto pose = solve_position(model, theta1);
-  if (!pose) {
-    return Unexpected(DynamicsError{DynamicsError::Kind::kAssembly, theta1, pose.error().what()});
-  }
+  const auto pose = nonsingular_pose(model, theta1);
+  if (!pose) return Unexpected(pose.error());
   const double l1 = model.crank.length, l3 = model.rocker.length;
   const Vec2 e1 = unit(pose->theta1), e2 = unit(pose->theta2), e3 = unit(pose->theta3);
-  const double sin_mu = cross(e2, e3);
-  if (!(std::abs(sin_mu) >= kSingularSin)) return Unexpected(singular_error(theta1, sin_mu));
   const Joints j = joint_positions(model, *pose);
 
   // velocity stage and the velocity-product accelerations
@@ -111,18 +96,7 @@ Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, double theta
   out.tau = tau;
   out.RA0 = -lambda(0) * e1 - r.segment<2>(0);  // ∂g1/∂A0 = -e1
   out.RA3 = lambda(2) * e3 - r.segment<2>(6);   // ∂g3/∂A3 = +e3
-  out.Fsh = out.RA0 + out.RA3;
-  out.Msh = model.frame_length * out.RA3.y() - tau;
-
-  const bool finite = std::isfinite(s.alpha1) && std::isfinite(s.alpha2) &&
-                      std::isfinite(s.alpha3) && std::isfinite(s.omega2) &&
-                      std::isfinite(s.omega3) && out.RA0.allFinite() && out.RA3.allFinite() &&
-                      std::isfinite(tau);
-  if (!finite) {
-    return Unexpected(DynamicsError{DynamicsError::Kind::kNonFinite, theta1,
-                                    "non-finite acceleration, reaction or torque"});
-  }
-  return out;
+  return completed_sample(model, out);
 }
 
 }  // namespace

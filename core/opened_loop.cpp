@@ -1,0 +1,2 @@
+// implemented by its owner; see core/opened_loop.hpp
+#include "core/opened_loop.hpp"
