@@ -21,6 +21,22 @@ void BM_ForwardDynamics(benchmark::State& state) {
 }
 BENCHMARK(BM_ForwardDynamics);
 
+// one evaluation by each formulation, forward (arg 0) and inverse (arg 1)
+void BM_Formulation(benchmark::State& state, Formulation f) {
+  const FourBar model = samples::paper_fourbar();
+  const bool inverse = state.range(0) == 1;
+  double theta1 = 1.0;
+  for (auto _ : state) {
+    auto sample = inverse ? inverse_dynamics(model, theta1, 2.0, 0.5, f)
+                          : forward_dynamics(model, theta1, 2.0, f);
+    benchmark::DoNotOptimize(sample);
+    theta1 += 1e-6;
+  }
+}
+BENCHMARK_CAPTURE(BM_Formulation, mass_matrix, Formulation::kMassMatrix)->Arg(0)->Arg(1);
+BENCHMARK_CAPTURE(BM_Formulation, opened_loop, Formulation::kOpenedLoop)->Arg(0)->Arg(1);
+BENCHMARK_CAPTURE(BM_Formulation, complex_masses, Formulation::kComplexMasses)->Arg(0)->Arg(1);
+
 // one inverse-dynamics evaluation (one driven sample)
 void BM_InverseDynamics(benchmark::State& state) {
   const FourBar model = samples::paper_fourbar();

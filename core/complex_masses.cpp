@@ -133,13 +133,19 @@ Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, double theta
   const PointKinematics S = centre_of_mass_frame(model, s);
   const Complex Fsh = F1 + F2 + F3 - total_mass(model) * to_complex(S.a);
 
-  // (b) rotation about S (eq. 40, divides by m1, m2, m3): the resultant moment gives R_A3y
-  const RotationAboutCentreOfMass c = rotation_about_centre_of_mass(model, *pose);
-  const double W_S = tau + model.loads.crank.moment - L1.inertia * s.alpha1 +
-                     model.loads.coupler.moment - L2.inertia * s.alpha2 +
-                     model.loads.rocker.moment - L3.inertia * s.alpha3 +
-                     inner(kI * c.c1, F1 - m1a1) / L1.mass + inner(kI * c.c2, F2 - m2a2) / L2.mass +
-                     inner(kI * c.c3, F3 - m3a3) / L3.mass;
+  // (b) rotation about S: eq. 40 gives each centre of mass's lever c̄_k about S times m_k; the
+  // virtual work uses c̄_k/m_k = r̄_k - r̄_S (the rigid-rotation identity the corrected eq. 40
+  // satisfies, tested). Taken directly, it divides by no mass; c̄_k/m_k would lose
+  // ~eps·m_tot/m_k at a small m_k (measured: 56 % at m1 = 1e-16 kg). It gives R_A3y.
+  const Complex rS = to_complex(S.r);
+  double W_S = tau + model.loads.crank.moment - L1.inertia * s.alpha1 +
+               model.loads.coupler.moment - L2.inertia * s.alpha2 + model.loads.rocker.moment -
+               L3.inertia * s.alpha3;
+  const Complex forces[3] = {F1 - m1a1, F2 - m2a2, F3 - m3a3};
+  for (int k = 1; k <= 3; ++k) {
+    const Complex lever = to_complex(centre_of_mass(model, k, *pose)) - rS;
+    W_S += inner(kI * lever, forces[k - 1]);
+  }
   const FrameVectors a = frame_vectors(model, *pose);
   const Complex p_SA0 = to_complex(a.a14 + a.a41 + a.a34);  // r̄_A0 - r̄_S
   const double RA3y = (W_S - inner(kI * p_SA0, Fsh)) / model.frame_length;
@@ -165,34 +171,36 @@ ComplexMassEquations complex_mass_equations(const FourBar& model, const Pose& po
   const Link &L1 = model.crank, &L2 = model.coupler, &L3 = model.rocker;
   const double m2 = L2.mass;
   const LinkVectors l = link_vectors(model, pose);
-  const EquivalentMasses e2 = equivalent_masses(L2);
-  // the coupler's complex masses on their lever arms: m̄2p l̄1 at A1 and m̄2q l̄3 at A2
-  const Complex p = e2.mp * l.l1, q = e2.mq * l.l3;
+  // the coupler's complex masses per unit mass on their lever arms: m̄2p l̄1/m2 at A1 and
+  // m̄2q l̄3/m2 at A2. Eqs. 37-39 print |m̄2p|²/m2, <m̄2p l̄1, m̄2q l̄3>/m2, ...; written with the
+  // unit-mass weights (1 - s̄2/l2) and s̄2/l2 they are the same numbers without the division,
+  // which loses accuracy when m2 is subnormal (measured: 25 % at m2 = 4.9e-324 kg).
+  const Complex w2 = com_offset(L2) / L2.length;
+  const Complex p = (1.0 - w2) * l.l1, q = w2 * l.l3;
 
   ComplexMassEquations eq;
   // eq. 37, last lines: I1 + m1 s1² + l1² |m̄2p|²/m2 and I3 + m3 s3'² + l3² |m̄2q|²/m2 with
-  // s3' = |l3 - s̄3| the distance of S3 from A3. The first (principal-vector) lines divide by
-  // m1 and m3 as well; these divide by m2 only, through the coupler terms.
+  // s3' = |l3 - s̄3| the distance of S3 from A3 (the first, principal-vector lines divide by m1
+  // and m3; principal_vector_forms() keeps them for the tests)
   eq.M.setZero();
-  eq.M(0, 0) = L1.inertia + L1.mass * std::norm(com_offset(L1)) + std::norm(p) / m2;
+  eq.M(0, 0) = L1.inertia + L1.mass * std::norm(com_offset(L1)) + m2 * std::norm(p);
   eq.M(1, 1) = L2.inertia;
-  eq.M(2, 2) = L3.inertia + L3.mass * std::norm(L3.length - com_offset(L3)) + std::norm(q) / m2;
-  // M13 = -⟨m̄2p l̄1, m̄2q l̄3⟩/m2 (divides by m2; the cos/sin line of eq. 37 is the same)
-  eq.M(0, 2) = eq.M(2, 0) = -inner(p, q) / m2;
-  // eq. 38: C13 = ⟨i m̄2p l̄1, m̄2q l̄3⟩/m2 (divides by m2)
-  eq.C13 = inner(kI * p, q) / m2;
+  eq.M(2, 2) = L3.inertia + L3.mass * std::norm(L3.length - com_offset(L3)) + m2 * std::norm(q);
+  // M13 = -<m̄2p l̄1, m̄2q l̄3>/m2 (the cos/sin line of eq. 37 is the same)
+  eq.M(0, 2) = eq.M(2, 0) = -m2 * inner(p, q);
+  // eq. 38: C13 = <i m̄2p l̄1, m̄2q l̄3>/m2
+  eq.C13 = m2 * inner(kI * p, q);
 
   // eq. 39. Q1: the moment about A0 of F̄1 at S1 = s̄1 l̄1/l1 (the simplified line; the
-  // principal-vector line divides by m1) and of the coupler's share m̄2p/m2 of F̄2 at A1
-  // (divides by m2). Q3 likewise about A3, with S3 - A3 = -(l3 - s̄3) l̄3/l3 and the share
-  // m̄2q/m2 of F̄2 at A2.
+  // principal-vector line divides by m1) and of the coupler's share m̄2p/m2 of F̄2 at A1.
+  // Q3 likewise about A3, with S3 - A3 = -(l3 - s̄3) l̄3/l3 and the share m̄2q/m2 of F̄2 at A2.
   const Complex F1 = applied_force(model, 1), F2 = applied_force(model, 2),
                 F3 = applied_force(model, 3);
   const Complex p_A0S1 = com_offset(L1) / L1.length * l.l1;
   const Complex p_A3S3 = -(L3.length - com_offset(L3)) / L3.length * l.l3;
-  eq.Q(0) = model.loads.crank.moment + inner(kI * p_A0S1, F1) + inner(kI * p, F2) / m2;
+  eq.Q(0) = model.loads.crank.moment + inner(kI * p_A0S1, F1) + inner(kI * p, F2);
   eq.Q(1) = model.loads.coupler.moment;
-  eq.Q(2) = model.loads.rocker.moment + inner(kI * p_A3S3, F3) + inner(-kI * q, F2) / m2;
+  eq.Q(2) = model.loads.rocker.moment + inner(kI * p_A3S3, F3) + inner(-kI * q, F2);
   return eq;
 }
 

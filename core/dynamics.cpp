@@ -2,7 +2,9 @@
 
 #include <cstdio>
 
+#include "core/complex_masses.hpp"
 #include "core/mass_matrix.hpp"
+#include "core/opened_loop.hpp"
 
 namespace bd::core {
 
@@ -19,6 +21,8 @@ std::string DynamicsError::what() const {
 const char* to_string(Formulation f) {
   switch (f) {
     case Formulation::kMassMatrix: return "mass-matrix";
+    case Formulation::kOpenedLoop: return "opened-loop";
+    case Formulation::kComplexMasses: return "complex-masses";
   }
   return "?";
 }
@@ -26,6 +30,9 @@ const char* to_string(Formulation f) {
 Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model, double theta1,
                                                          double omega1, Formulation f) {
   switch (f) {
+    case Formulation::kOpenedLoop: return forward_dynamics_opened_loop(model, theta1, omega1);
+    case Formulation::kComplexMasses:
+      return forward_dynamics_complex_masses(model, theta1, omega1);
     case Formulation::kMassMatrix: break;
   }
   return forward_dynamics_mass_matrix(model, theta1, omega1);
@@ -35,6 +42,10 @@ Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model, d
                                                          double omega1, double alpha1,
                                                          Formulation f) {
   switch (f) {
+    case Formulation::kOpenedLoop:
+      return inverse_dynamics_opened_loop(model, theta1, omega1, alpha1);
+    case Formulation::kComplexMasses:
+      return inverse_dynamics_complex_masses(model, theta1, omega1, alpha1);
     case Formulation::kMassMatrix: break;
   }
   return inverse_dynamics_mass_matrix(model, theta1, omega1, alpha1);

@@ -36,10 +36,15 @@ struct DynamicsError {
 
 /// The formulations of the equations of motion (DESIGN.md "Formulations").
 enum class Formulation {
-  kMassMatrix,  // constant equivalent mass matrix / truss element (paper §4.2)
+  kMassMatrix,     // constant equivalent mass matrix / truss element (paper §4.2)
+  kOpenedLoop,     // opened kinematic loop with principal vectors, 5x5 solve (paper §3)
+  kComplexMasses,  // closed loop with complex equivalent masses (paper §4.1)
 };
-/// "mass-matrix".
+/// "mass-matrix", "opened-loop", "complex-masses" (the study file's method names).
 const char* to_string(Formulation f);
+/// Every formulation, in the order the docs list them.
+inline constexpr Formulation kFormulations[] = {Formulation::kMassMatrix, Formulation::kOpenedLoop,
+                                                Formulation::kComplexMasses};
 
 /// Forward dynamics (free motion, tau = 0): the crank acceleration and everything else for crank
 /// angle theta1 [rad] and rate omega1 [rad/s] under the model's loads.

@@ -7,9 +7,13 @@
 
 namespace bd::core {
 
-/// |sin(theta3 - theta2)| below this is a singular (dead-centre) position: the transfer functions
-/// Θ2, Θ3 grow like 1/sin and carry a relative error ~eps/sin there.
-inline constexpr double kSingularSin = 1e-10;
+/// |sin(theta3 - theta2)| below this counts as a singular (dead-centre) position, and the dynamics
+/// returns kSingular instead of a number. Near a dead centre theta1 is an ill-conditioned input:
+/// the closed loop's angles move like sqrt(theta1 - limit), and every formulation's relative
+/// error is measured to grow like 7.8·eps/sin² (docs/failure-domains.md). At this threshold that
+/// bound is 1.7e-9, so every value returned is good to better than 2e-9; within 0.06° of a dead
+/// centre the tool says "singular" rather than return a number it cannot vouch for.
+inline constexpr double kSingularSin = 1e-3;
 
 /// The pose at theta1 on the model's branch, or kAssembly / kSingular.
 Expected<Pose, DynamicsError> nonsingular_pose(const FourBar& model, double theta1);

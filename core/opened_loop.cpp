@@ -131,18 +131,24 @@ OpenedLoopTerms opened_loop_terms(const FourBar& model, const Pose& pose) {
   t.D.row(1) = perp(l2).transpose();
   t.D.row(2) = perp(l3).transpose();
 
-  // eq. 25 with F̄k = applied force + m_k ḡ. Only dividing forms are printed; these divide by
-  // m1 (Q1: (m2+m3)/m1 <i ā12, F̄1>), m2 (Q2: (m1+m2)/m2 <i ā21, F̄2>, m3/m2 <i ā23, F̄2>) and
-  // m3 (Q3: m_tot/m3 <i ā32, F̄3>). The quotients stay finite as a mass tends to zero (ā12 ∝ m1,
-  // (m1+m2)ā21 + m3ā23 ∝ m2, ā32 ∝ m3) but are 0/0 at a zero mass; kept as printed.
+  // eq. 25 with F̄k = applied force + m_k ḡ: the moments about each link's first joint, with the
+  // forces on the links beyond shifted to its second joint. The paper prints them in principal
+  // vectors divided by a mass ((m2+m3)/m1 <i ā12, F̄1>, (m1+m2)/m2 <i ā21, F̄2> + m3/m2 <i ā23,
+  // F̄2>, m_tot/m3 <i ā32, F̄3>); those quotients are differences of O(m_tot) terms that are
+  // O(m_k), so at a small mass they lose ~eps·m_tot/m_k (measured: 8e-7 at m2 = 1e-8 kg,
+  // docs/failure-domains.md). Here the same moments, m_k r̄_k - m_k r̄_joint = m_k s̄_k l̄_k/l_k
+  // divided through exactly: <i s̄_k l̄_k/l_k, F̄k>, which divide by no mass.
   const Vec2 F1 = model.loads.crank.force + m1 * model.loads.gravity;
   const Vec2 F2 = model.loads.coupler.force + m2 * model.loads.gravity;
   const Vec2 F3 = model.loads.rocker.force + m3 * model.loads.gravity;
-  t.Q(0) = model.loads.crank.moment - inner_i(a.a14p, F1) - (m2 + m3) / m1 * inner_i(a.a12, F1) +
-           inner_i(l1, F2 + F3);
-  t.Q(1) = model.loads.coupler.moment - (m1 + m2) / m2 * inner_i(a.a21, F2) -
-           m3 / m2 * inner_i(a.a23, F2) + inner_i(l2, F3);
-  t.Q(2) = model.loads.rocker.moment - mt / m3 * inner_i(a.a32, F3);
+  auto com_from_first_joint = [](const Link& link, const Vec2& lk) {
+    return Vec2(link.e / link.length * lk + link.f / link.length * perp(lk));
+  };
+  t.Q(0) = model.loads.crank.moment + cross(com_from_first_joint(model.crank, l1), F1) +
+           cross(l1, F2 + F3);
+  t.Q(1) = model.loads.coupler.moment + cross(com_from_first_joint(model.coupler, l2), F2) +
+           cross(l2, F3);
+  t.Q(2) = model.loads.rocker.moment + cross(com_from_first_joint(model.rocker, l3), F3);
   return t;
 }
 

@@ -5,13 +5,16 @@
 
 namespace bd::core::samples {
 
-FourBar paper_fourbar() {
-  FourBar m = paper_fourbar_unloaded();
+FourBar with_paper_loads(FourBar m, const Vec2& gravity) {
+  // eq. 56
   m.loads.crank = {Vec2(1.1, 1.2), 0.37};
   m.loads.coupler = {Vec2(1.3, -1.4), 0.28};
   m.loads.rocker = {Vec2(1.5, 1.6), 0.19};
-  return m;
+  m.loads.gravity = gravity;
+  return make_fourbar(m);
 }
+
+FourBar paper_fourbar() { return with_paper_loads(paper_fourbar_unloaded()); }
 
 FourBar paper_fourbar_unloaded() {
   // eq. 56
@@ -51,6 +54,17 @@ FourBar triple_rocker() {
   m.coupler = {2.0, 1.5, 1.0, 0.0, 0.6};
   m.rocker = {2.0, 1.2, 0.9, -0.1, 0.5};
   m.frame_length = 3.5;
+  m.branch = Branch::kPlus;
+  return make_fourbar(m);
+}
+
+FourBar folding_rocker() {
+  // |A1A3| in [1.5, 3.5] against [|l2 - l3|, l2 + l3] = [1.8, 4.2]
+  FourBar m;
+  m.crank = {1.0, 1.5, 0.4, 0.1, 0.2};
+  m.coupler = {3.0, 2.5, 1.4, 0.2, 2.0};
+  m.rocker = {1.2, 1.2, 0.5, -0.1, 0.15};
+  m.frame_length = 2.5;
   m.branch = Branch::kPlus;
   return make_fourbar(m);
 }

@@ -19,6 +19,11 @@ FourBar double_crank();
 /// A triple rocker (non-Grashof, l_min + l_max = 5.5 > 4): the crank swings within
 /// |theta1| < 1.553 rad, where coupler and rocker stretch into a line (|A1A3| = l2 + l3).
 FourBar triple_rocker();
+/// A triple rocker whose limit is |A1A3| = |l2 - l3| (the coupler folds back onto the rocker):
+/// the crank swings within theta1 in [0.6402, 2 pi - 0.6402] rad.
+FourBar folding_rocker();
+/// The model with the paper's applied loads (eq. 56) on its links and the given gravity.
+FourBar with_paper_loads(FourBar model, const Vec2& gravity = Vec2(0, 0));
 /// A random linkage that assembles at every crank angle (a crank-rocker on a random branch),
 /// with random mass distributions (f != 0), random loads and random gravity.
 FourBar random_crank_rocker(std::mt19937_64& rng);

@@ -15,7 +15,9 @@
 #include <string_view>
 
 #include "core/input_error.hpp"
+#include "core/formulation_support.hpp"
 #include "core/kinematics.hpp"
+#include "core/opened_loop_dae.hpp"
 
 namespace bd::core {
 
@@ -34,10 +36,11 @@ constexpr double kMaxUnwrapStep = 0.2;
 // -> 0, and (limit, 0) is a spurious equilibrium towards which the integrator, having lost the
 // little kinetic energy left there to its absolute tolerance, creeps for ever, while the real
 // linkage passes on to the other branch. So the run stops where |sin| falls to this level
-// (located by CVODE's root finding): the crank is then within ~1e-10 rad of its limit, far closer
-// than a motion that turns back before the limit would come by chance. The right-hand side
-// refuses points deeper inside (a tenth of it), so no step is taken there.
-constexpr double kDeadCentreSin = 1e-5;
+// (located by CVODE's root finding), just before the dynamics itself refuses to answer
+// (kSingularSin, below which its values could not be vouched for): the crank is then within
+// ~1e-6 rad of its limit. The right-hand side refuses points deeper inside, so no step is
+// taken there. The opened-loop DAE (Formulation::kOpenedLoop) passes such limits instead.
+constexpr double kDeadCentreSin = 2 * kSingularSin;
 
 // Upper bound on the number of samples of one run, so the size arithmetic cannot overflow.
 constexpr long long kMaxSamples = 100'000'000;
@@ -251,6 +254,8 @@ std::string SimulateOptions::validate() const {
   if (max_steps < 1) return "max_steps must be >= 1, got " + std::to_string(max_steps);
   switch (formulation) {
     case Formulation::kMassMatrix:
+    case Formulation::kOpenedLoop:
+    case Formulation::kComplexMasses:
       break;
     default:
       return "formulation " + std::to_string(static_cast<int>(formulation)) + " is unknown";
@@ -277,6 +282,16 @@ const char* to_string(SimulationStatus s) {
 Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
                          const SimulateOptions& options) {
   validate(scene, options);
+  if (options.formulation == Formulation::kOpenedLoop) {
+    // the opened loop's own form: the DAE in theta1..theta3, kept on the loop closure by
+    // projection; it has no singularity at a crank limit position and passes through it
+    OpenedLoopDaeOptions dae;
+    dae.stabilisation = Stabilisation::kProjection;
+    dae.tolerance = options.tolerance;
+    dae.absolute_tolerance = options.absolute_tolerance;
+    dae.max_steps = options.max_steps;
+    return simulate_opened_loop_dae(model, scene, dae).trajectory;
+  }
   const auto samples = static_cast<std::size_t>(scene.samples);
   Trajectory out;
   out.t.reserve(samples);

@@ -59,6 +59,11 @@ struct Trajectory {
   bool ok() const { return status == SimulationStatus::kCompleted; }
 };
 
+/// With Formulation::kMassMatrix or kComplexMasses the reduced equation in theta1 is integrated;
+/// it stops (kSingular) where the crank reaches a limit position. With kOpenedLoop the opened
+/// loop's DAE in theta1..theta3 is integrated with projection onto the loop closure
+/// (core/opened_loop_dae.hpp); it passes through limit positions (the crank reverses, the
+/// branch flips), so a linkage whose crank cannot turn fully moves on physically.
 /// @throws bd::InputError if the scene or options are invalid (duration <= 0, samples < 2, ...).
 Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
                          const SimulateOptions& options = {});

@@ -506,23 +506,12 @@ class StudyParser {
 
   std::optional<core::Formulation> read_method(const MapReader::Entry& e) {
     const std::string name = read_text(r_, e, "method");
-    const YAML::Mark m = mark_of(e.value, e.key_mark);
-    bool known = false;
-    for (const char* n : kMethodNames) known = known || name == n;
-    if (!known) {
-      std::vector<std::string> all(std::begin(kMethodNames), std::end(kMethodNames));
-      r_.fail(m, "unknown method '" + name + "'; expected one of " + join(all));
-    }
     if (name == "auto") return std::nullopt;
-    const auto f = available_formulation(name);
-    if (!f) {
-      std::vector<std::string> available;
-      for (const char* n : kMethodNames) {
-        if (std::string(n) == "auto" || available_formulation(n)) available.emplace_back(n);
-      }
-      r_.fail(m, "method '" + name + "' is not available yet; available: " + join(available));
-    }
-    return f;
+    if (const auto f = formulation_named(name)) return f;
+    std::vector<std::string> all(std::begin(kMethodNames), std::end(kMethodNames));
+    r_.fail(mark_of(e.value, e.key_mark),
+            "unknown method '" + name + "'; expected one of " + join(all));
+    return std::nullopt;
   }
 
   double read_tolerance(const MapReader::Entry& e) {

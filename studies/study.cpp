@@ -1,20 +1,13 @@
 #include "studies/study.hpp"
 
-#include <string_view>
-
 namespace bd::studies {
-
-namespace {
-// every formulation core implements; extend when core::Formulation grows
-constexpr core::Formulation kAvailableFormulations[] = {core::Formulation::kMassMatrix};
-}  // namespace
 
 const char* scene_type(const Scene& scene) {
   return std::holds_alternative<core::FreeScene>(scene) ? "free" : "driven";
 }
 
-std::optional<core::Formulation> available_formulation(const std::string& name) {
-  for (core::Formulation f : kAvailableFormulations) {
+std::optional<core::Formulation> formulation_named(const std::string& name) {
+  for (core::Formulation f : core::kFormulations) {
     if (name == core::to_string(f)) return f;
   }
   return std::nullopt;
@@ -25,17 +18,39 @@ std::string Study::method_name() const {
 }
 
 MethodChoice choose_method(const Study& study) {
+  const bool free = std::holds_alternative<core::FreeScene>(study.scene);
+  // a free crank that cannot turn fully reaches limit positions, where theta1 stops being a
+  // coordinate: only the opened loop's DAE goes through them
+  const bool reaches_limits = free && !core::crank_turns_fully(study.model);
+  const std::string limits = std::string("the crank cannot turn fully (") +
+                             core::to_string(core::classify_grashof(study.model)) +
+                             ") and reaches limit positions";
+
   MethodChoice choice;
   if (study.formulation) {
     choice.formulation = *study.formulation;
     choice.reason = "requested in the study file";
+    if (reaches_limits && choice.formulation != core::Formulation::kOpenedLoop) {
+      choice.reason += "; " + limits +
+                       ", where this reduced equation in theta1 stops (auto would take the "
+                       "opened-loop DAE through them)";
+    }
+  } else if (reaches_limits) {
+    choice.formulation = core::Formulation::kOpenedLoop;
+    choice.reason = limits + "; the opened-loop DAE (projected onto the loop closure) passes "
+                             "through them, the reduced equation in theta1 would stop at the first";
   } else {
-    // only one formulation exists so far, and it is exact
-    choice.formulation = core::Formulation::kMassMatrix;
-    choice.reason = "the only formulation available; exact, constant 4x4 mass matrix";
+    choice.formulation = core::Formulation::kComplexMasses;
+    choice.reason =
+        "the cheapest exact formulation per evaluation (about 0.6 of the mass matrix's cost, "
+        "bench/dynamics_bench.cpp); all three agree to round-off";
   }
-  if (std::holds_alternative<core::DrivenScene>(study.scene)) {
+  if (!free) {
     choice.reason += "; no integrator: kinetostatics per sample";
+  } else if (choice.formulation == core::Formulation::kOpenedLoop) {
+    choice.reason += "; DAE in theta1..theta3 integrated by CVODE (BDF with projection)";
+  } else {
+    choice.reason += "; reduced equation in theta1 integrated by CVODE (Adams)";
   }
   return choice;
 }

@@ -19,12 +19,11 @@ using Scene = std::variant<core::FreeScene, core::DrivenScene>;
 const char* scene_type(const Scene& scene);
 
 /// Method names accepted by the study file's `method` key, in the order the docs list them.
-/// Not every name is available yet; see available_formulation().
 inline constexpr const char* kMethodNames[] = {"auto", "opened-loop", "complex-masses",
                                                "mass-matrix"};
 
-/// The formulation named `name` ("mass-matrix", ...) if core implements it, else nothing.
-std::optional<core::Formulation> available_formulation(const std::string& name);
+/// The formulation named `name` ("mass-matrix", "opened-loop", "complex-masses"), else nothing.
+std::optional<core::Formulation> formulation_named(const std::string& name);
 
 struct Study {
   std::string name;     // used in output names: [A-Za-z0-9._-], not starting with '.'
@@ -44,7 +43,12 @@ struct MethodChoice {
   core::Formulation formulation = core::Formulation::kMassMatrix;
   std::string reason;
 };
-/// Resolves `auto` (DESIGN.md: the leanest formulation and evaluation path for the outputs).
+/// Resolves `auto` (DESIGN.md: the leanest formulation and evaluation path for the outputs,
+/// never one inside its failure domain; docs/failure-domains.md "What auto must avoid"):
+/// - a free scene whose crank cannot turn fully: opened-loop, whose DAE passes the crank's limit
+///   positions (the reduced equation in theta1 would stop at the first one);
+/// - otherwise complex-masses, the cheapest exact formulation per evaluation.
+/// An explicit method is used as asked; the reason then notes what auto would do differently.
 MethodChoice choose_method(const Study& study);
 
 }  // namespace bd::studies

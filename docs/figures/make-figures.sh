@@ -9,6 +9,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 "$bin" run studies/examples/paper-fourbar.yaml --out "$tmp/free" >/dev/null
 "$bin" run studies/examples/paper-fourbar-driven.yaml --out "$tmp/driven" >/dev/null
+"$bin" run studies/examples/triple-rocker-free.yaml --out "$tmp/triple" >/dev/null
 gnuplot <<GP
 set datafile separator ','
 set terminal svg size 720,400 dynamic font 'sans,12' background rgb 'white'
@@ -37,5 +38,15 @@ set xrange [0:2*pi]
 plot '$tmp/driven/timeseries.csv' every ::1 using 2:18 with lines lw 2 title 'drive torque τ', \
      '' every ::1 using 2:(sqrt(\$15**2+\$16**2)) with lines lw 2 title '|Fsh|', \
      '' every ::1 using 2:17 with lines lw 2 title 'Msh'
+
+set output '$out/triple-rocker-free.svg'
+set title 'triple-rocker-free: swinging through its limit positions'
+set xlabel 't [s]'; set ylabel 'angle [rad]'
+set autoscale x
+plot '$tmp/triple/timeseries.csv' every ::1 using 1:2 with lines lw 2 title 'θ1', \
+     '' every ::1 using 1:3 with lines lw 2 title 'θ2', \
+     '' every ::1 using 1:4 with lines lw 2 title 'θ3', \
+     1.552938 with lines dt 2 lc 'gray' title 'crank limit ±1.553 rad', \
+     -1.552938 with lines dt 2 lc 'gray' notitle
 GP
-echo "wrote $out/paper-fourbar-angles.svg $out/paper-fourbar-reactions.svg $out/paper-fourbar-driven.svg"
+echo "wrote the figures in $out"

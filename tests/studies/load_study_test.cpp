@@ -178,14 +178,14 @@ TEST(LoadStudy, OtherMistakes) {
                "mass-matrix");
 }
 
-TEST(LoadStudy, FormulationsNotYetImplementedGiveAClearError) {
-  expect_error(kBase + "method: opened-loop\n", 18, 9, "method 'opened-loop' is not available yet");
-  expect_error(kBase + "method: complex-masses\n", 18, 9,
-               "method 'complex-masses' is not available yet");
-  const Study s = parse_study(kBase + "method: mass-matrix\n", "study.yaml");
-  ASSERT_TRUE(s.formulation.has_value());
-  EXPECT_EQ(*s.formulation, core::Formulation::kMassMatrix);
-  EXPECT_EQ(s.method_name(), "mass-matrix");
+TEST(LoadStudy, EveryFormulationCanBeRequested) {
+  for (const char* name : {"mass-matrix", "opened-loop", "complex-masses"}) {
+    const Study s = parse_study(kBase + "method: " + name + "\n", "study.yaml");
+    ASSERT_TRUE(s.formulation.has_value()) << name;
+    EXPECT_STREQ(core::to_string(*s.formulation), name);
+    EXPECT_EQ(s.method_name(), name);
+  }
+  EXPECT_FALSE(parse_study(kBase + "method: auto\n", "study.yaml").formulation.has_value());
 }
 
 TEST(LoadStudy, DrivenSceneNeedsANonZeroSpeed) {
