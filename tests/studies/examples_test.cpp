@@ -11,8 +11,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// each test writes under its own name: ctest runs the tests of this file in parallel
 RunResult run_example(const std::string& file) {
-  const fs::path out = fs::path(BD_BINARY_DIR) / "test-output" / "examples" / file;
+  const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+  const fs::path out =
+      fs::path(BD_BINARY_DIR) / "test-output" / "examples" / test->name() / file;
   fs::remove_all(out);
   return run_study(load_study(std::string(BD_SOURCE_DIR) + "/studies/examples/" + file), out);
 }
