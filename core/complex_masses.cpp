@@ -141,11 +141,13 @@ Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, double theta
   double W_S = tau + model.loads.crank.moment - L1.inertia * s.alpha1 +
                model.loads.coupler.moment - L2.inertia * s.alpha2 + model.loads.rocker.moment -
                L3.inertia * s.alpha3;
-  const Complex forces[3] = {F1 - m1a1, F2 - m2a2, F3 - m3a3};
-  for (int k = 1; k <= 3; ++k) {
-    const Complex lever = to_complex(centre_of_mass(model, k, *pose)) - rS;
-    W_S += inner(kI * lever, forces[k - 1]);
-  }
+  // centres of mass along the chain from A0: r̄1 = (s̄1/l1) l̄1, r̄2 = l̄1 + (s̄2/l2) l̄2,
+  // r̄3 = l̄1 + l̄2 + (s̄3/l3) l̄3
+  const Complex r1 = com_offset(L1) / L1.length * l.l1;
+  const Complex r2 = l.l1 + com_offset(L2) / L2.length * l.l2;
+  const Complex r3 = l.l1 + l.l2 + com_offset(L3) / L3.length * l.l3;
+  W_S += inner(kI * (r1 - rS), F1 - m1a1) + inner(kI * (r2 - rS), F2 - m2a2) +
+         inner(kI * (r3 - rS), F3 - m3a3);
   const FrameVectors a = frame_vectors(model, *pose);
   const Complex p_SA0 = to_complex(a.a14 + a.a41 + a.a34);  // r̄_A0 - r̄_S
   const double RA3y = (W_S - inner(kI * p_SA0, Fsh)) / model.frame_length;

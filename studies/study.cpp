@@ -42,7 +42,7 @@ MethodChoice choose_method(const Study& study) {
   } else {
     choice.formulation = core::Formulation::kComplexMasses;
     choice.reason =
-        "the cheapest exact formulation per evaluation (about 0.6 of the mass matrix's cost, "
+        "the cheapest exact formulation per evaluation (about half the mass matrix's cost, "
         "bench/dynamics_bench.cpp); all three agree to round-off";
   }
   if (!free) {
