@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "core/complex_masses.hpp"
+#include "core/counter_rotation.hpp"
 #include "core/mass_matrix.hpp"
 #include "core/opened_loop.hpp"
 
@@ -29,6 +30,7 @@ const char* to_string(Formulation f) {
 
 Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model, double theta1,
                                                          double omega1, Formulation f) {
+  if (has_counter_rotations(model)) return forward_dynamics_with_discs(model, theta1, omega1, f);
   switch (f) {
     case Formulation::kOpenedLoop: return forward_dynamics_opened_loop(model, theta1, omega1);
     case Formulation::kComplexMasses:
@@ -41,6 +43,9 @@ Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model, d
 Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model, double theta1,
                                                          double omega1, double alpha1,
                                                          Formulation f) {
+  if (has_counter_rotations(model)) {
+    return inverse_dynamics_with_discs(model, theta1, omega1, alpha1, f);
+  }
   switch (f) {
     case Formulation::kOpenedLoop:
       return inverse_dynamics_opened_loop(model, theta1, omega1, alpha1);

@@ -15,8 +15,11 @@ struct DynamicsSample {
   FourBarState state;  // angles [rad], rates [rad/s], accelerations [rad/s^2]
   Vec2 RA0{0, 0};      // force of the mechanism ON the ground at A0 [N]
   Vec2 RA3{0, 0};      // force of the mechanism ON the ground at A3 [N]
-  Vec2 Fsh{0, 0};      // shaking force RA0 + RA3 [N]
-  double Msh{};        // shaking moment on the frame about A0: l4·RA3y - tau [N m]
+  Vec2 RC1{0, 0};      // force ON the ground at the crank's counter-rotation shaft [N]
+  Vec2 RC3{0, 0};      // force ON the ground at the rocker's counter-rotation shaft [N]
+  Vec2 Fsh{0, 0};      // shaking force RA0 + RA3 + RC1 + RC3 [N]
+  /// shaking moment on the frame about A0: l4·RA3y - tau + at1 × RC1 + at3 × RC3 [N m]
+  double Msh{};
   double tau{};        // drive torque on the crank from the frame [N m] (0 in free motion)
 };
 
@@ -47,7 +50,9 @@ inline constexpr Formulation kFormulations[] = {Formulation::kMassMatrix, Formul
                                                 Formulation::kComplexMasses};
 
 /// Forward dynamics (free motion, tau = 0): the crank acceleration and everything else for crank
-/// angle theta1 [rad] and rate omega1 [rad/s] under the model's loads.
+/// angle theta1 [rad] and rate omega1 [rad/s] under the model's loads, with the model's
+/// counter-rotations (core/counter_rotation.hpp). The formulations' own entry points
+/// (forward_dynamics_mass_matrix, ...) model the bare linkage and ignore counter-rotations.
 Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model, double theta1,
                                                          double omega1,
                                                          Formulation f = Formulation::kMassMatrix);

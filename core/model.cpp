@@ -33,6 +33,10 @@ const char* link_name(int k) {
   return kNames[static_cast<std::size_t>(k - 1)];
 }
 
+bool has_counter_rotations(const FourBar& model) {
+  return model.counter_rotations.crank.inertia > 0 || model.counter_rotations.rocker.inertia > 0;
+}
+
 double total_mass(const FourBar& model) {
   return model.crank.mass + model.coupler.mass + model.rocker.mass;
 }
@@ -80,6 +84,21 @@ FourBar make_fourbar(const FourBar& candidate) {
   }
   check_finite("loads.gravity[0]", "m/s^2", m.loads.gravity.x());
   check_finite("loads.gravity[1]", "m/s^2", m.loads.gravity.y());
+  const CounterRotation* rotations[2] = {&m.counter_rotations.crank, &m.counter_rotations.rocker};
+  const Vec2 pivots[2] = {Vec2(0, 0), Vec2(m.frame_length, 0)};
+  const char* names[2] = {"counter_rotations.crank", "counter_rotations.rocker"};
+  for (int i = 0; i < 2; ++i) {
+    const CounterRotation& c = *rotations[i];
+    const std::string name = names[i];
+    require(std::isfinite(c.inertia) && c.inertia >= 0, name + ".inertia", ">= 0", "kg m^2",
+            c.inertia);
+    check_finite(name + ".at[0]", "m", c.at.x());
+    check_finite(name + ".at[1]", "m", c.at.y());
+    if (c.inertia > 0) {
+      const double d = (c.at - pivots[i]).norm();
+      require(d > 0, name + ": distance of the shaft from the link's pivot", "> 0", "m", d);
+    }
+  }
   if (m.branch != Branch::kPlus && m.branch != Branch::kMinus) {
     throw InputError("branch must be +1 or -1");
   }

@@ -42,6 +42,20 @@ struct Loads {
   LinkLoad crank, coupler, rocker;
 };
 
+/// A counter-rotating inertia (Berkof's moment balance, paper §5.2): a disc on a shaft fixed in
+/// the frame at `at`, geared to a link's pivot with ratio -1 (equal pitch radii |at - pivot|/2,
+/// an ideal mesh that transmits a tangential force only). The disc turns at minus the link's
+/// rate; its shaft carries the mesh force to the frame. Absent when inertia == 0.
+struct CounterRotation {
+  double inertia{};  // J about the shaft [kg m^2], >= 0
+  Vec2 at{0, 0};     // shaft position on the frame [m]; away from the link's pivot if J > 0
+};
+
+/// Counter-rotations geared to the crank (pivot A0) and to the rocker (pivot A3).
+struct CounterRotations {
+  CounterRotation crank, rocker;
+};
+
 /// Joints A0 (origin), A1, A2, A3 = (l4, 0). Link 1 crank A0->A1, link 2 coupler A1->A2,
 /// link 3 rocker A2->A3 (so the rocker's centre of mass is measured from A2).
 struct FourBar {
@@ -49,7 +63,11 @@ struct FourBar {
   double frame_length{};        // l4 = |A0A3| [m]
   Branch branch{Branch::kPlus};
   Loads loads;
+  CounterRotations counter_rotations;  // none by default
 };
+
+/// True when the model has a counter-rotating inertia on the crank or the rocker.
+bool has_counter_rotations(const FourBar& model);
 
 /// Link k = 1, 2, 3 of the model.
 const Link& link(const FourBar& model, int k);
@@ -58,7 +76,8 @@ const LinkLoad& link_load(const FourBar& model, int k);
 
 /// Checks and returns the model.
 /// @throws bd::InputError if a length or mass is not > 0 or finite, an inertia is < 0, or any
-///         value is not finite; the message names the link and quantity with its unit, e.g.
+///         value is not finite, or a counter-rotation with J > 0 sits on its link's pivot; the
+///         message names the link and quantity with its unit, e.g.
 ///         "coupler.mass must be > 0 kg, got -1.2".
 FourBar make_fourbar(const FourBar& candidate);
 

@@ -15,7 +15,9 @@
 #include <string_view>
 
 #include "core/input_error.hpp"
+#include "core/counter_rotation.hpp"
 #include "core/formulation_support.hpp"
+#include "core/opened_loop.hpp"
 #include "core/kinematics.hpp"
 #include "core/opened_loop_dae.hpp"
 
@@ -290,7 +292,23 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
     dae.tolerance = options.tolerance;
     dae.absolute_tolerance = options.absolute_tolerance;
     dae.max_steps = options.max_steps;
-    return simulate_opened_loop_dae(model, scene, dae).trajectory;
+    if (!has_counter_rotations(model)) return simulate_opened_loop_dae(model, scene, dae).trajectory;
+    // discs: the motion from the equations with I_k + J_k, then each sample's reactions from the
+    // bare linkage loaded by the mesh forces at the sample's own state (core/counter_rotation.hpp)
+    Trajectory out = simulate_opened_loop_dae(with_disc_inertia(model), scene, dae).trajectory;
+    for (std::size_t i = 0; i < out.samples.size(); ++i) {
+      const FourBarState& s = out.samples[i].state;
+      const MeshForces f = mesh_forces(model, s);
+      const auto bare = forward_dynamics_opened_loop(with_mesh_loads(model, s, f), s);
+      if (!bare) {  // cannot happen where the DAE itself evaluated; keep what came before
+        fail(out, bare.error(), out.t[i], s.theta1);
+        out.t.resize(i);
+        out.samples.resize(i);
+        break;
+      }
+      out.samples[i] = with_shaft_reactions(model, *bare, f);
+    }
+    return out;
   }
   const auto samples = static_cast<std::size_t>(scene.samples);
   Trajectory out;
