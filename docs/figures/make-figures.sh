@@ -10,6 +10,7 @@ trap 'rm -rf "$tmp"' EXIT
 "$bin" run studies/examples/paper-fourbar.yaml --out "$tmp/free" >/dev/null
 "$bin" run studies/examples/paper-fourbar-driven.yaml --out "$tmp/driven" >/dev/null
 "$bin" run studies/examples/triple-rocker-free.yaml --out "$tmp/triple" >/dev/null
+"$bin" run studies/examples/paper-fourbar-balanced.yaml --out "$tmp/balanced" >/dev/null
 gnuplot <<GP
 set datafile separator ','
 set terminal svg size 720,400 dynamic font 'sans,12' background rgb 'white'
@@ -48,5 +49,14 @@ plot '$tmp/triple/timeseries.csv' every ::1 using 1:2 with lines lw 2 title 'θ1
      '' every ::1 using 1:4 with lines lw 2 title 'θ3', \
      1.552938 with lines dt 2 lc 'gray' title 'crank limit ±1.553 rad', \
      -1.552938 with lines dt 2 lc 'gray' notitle
+
+set output '$out/paper-fourbar-balanced.svg'
+set title 'paper-fourbar-balanced: support reactions of the force-balanced linkage (cf. paper Fig. 9)'
+set xlabel 't [s]'; set ylabel 'force on the ground [N]'
+plot '$tmp/balanced/timeseries.csv' every ::1 using 1:11 with lines lw 2 title 'RA0x', \
+     '' every ::1 using 1:12 with lines lw 2 title 'RA0y', \
+     '' every ::1 using 1:13 with lines lw 2 dt 2 title 'RA3x', \
+     '' every ::1 using 1:14 with lines lw 2 dt 2 title 'RA3y', \
+     '' every ::1 using 1:(\$15+\$16) with lines lw 3 lc 'black' title 'Fshx + Fshy (zero)'
 GP
 echo "wrote the figures in $out"
