@@ -1,0 +1,149 @@
+#include "balance/counterweight.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "balance/conditions.hpp"
+#include "core/input_error.hpp"
+#include "core/principal_vectors.hpp"
+
+namespace bd::balance {
+
+namespace {
+
+using core::Complex;
+
+std::string format(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// "" when v is finite and > 0, else "<what> must be > 0 <unit>, got <v>"
+std::string positive(const char* what, const char* unit, double v) {
+  if (std::isfinite(v) && v > 0) return "";
+  return std::string(what) + " must be > 0 " + unit + ", got " + format(v);
+}
+
+// A counterweight of mass mc at `position` (link axes, from its pivot) whose mass moment is
+// `moment` = mc·position [kg m], realised as the spec asks.
+Counterweight realise(const CounterweightSpec& spec, Complex moment, double link_length) {
+  const double needed = std::abs(moment);  // mc·distance [kg m]
+  const Complex direction = moment / needed;
+  const bool disc = spec.shape == CounterweightShape::kDisc;
+  const double area_density = spec.density * std::numbers::pi * spec.thickness;  // m / r² [kg/m²]
+  Counterweight cw;
+  if (spec.mass) {
+    cw.mass = *spec.mass;
+    cw.distance = needed / cw.mass;
+  } else if (spec.radius) {
+    cw.mass = area_density * *spec.radius * *spec.radius;
+    cw.distance = needed / cw.mass;
+  } else {
+    cw.distance = spec.distance ? *spec.distance : link_length;
+    cw.mass = needed / cw.distance;
+  }
+  cw.position = core::to_vec(cw.distance * direction);
+  if (disc) {
+    cw.radius = spec.radius ? *spec.radius : std::sqrt(cw.mass / area_density);
+    cw.thickness = spec.thickness;
+    cw.inertia = 0.5 * cw.mass * cw.radius * cw.radius;
+  }
+  return cw;
+}
+
+}  // namespace
+
+std::string CounterweightSpec::validate() const {
+  const int given = (mass ? 1 : 0) + (distance ? 1 : 0) + (radius ? 1 : 0);
+  if (given > 1) {
+    std::string what;
+    auto add = [&what](const std::string& s) { what += (what.empty() ? "" : " and ") + s; };
+    if (mass) add("mass = " + format(*mass) + " kg");
+    if (distance) add("distance = " + format(*distance) + " m");
+    if (radius) add("radius = " + format(*radius) + " m");
+    return "give at most one of mass, distance and radius (the others are solved), got " + what;
+  }
+  if (shape != CounterweightShape::kPoint && shape != CounterweightShape::kDisc) {
+    return "shape must be point or disc";
+  }
+  if (radius && shape != CounterweightShape::kDisc) {
+    return "radius is given for a point counterweight; radius needs shape disc";
+  }
+  if (mass) {
+    if (std::string e = positive("mass", "kg", *mass); !e.empty()) return e;
+  }
+  if (distance) {
+    if (std::string e = positive("distance", "m", *distance); !e.empty()) return e;
+  }
+  if (radius) {
+    if (std::string e = positive("radius", "m", *radius); !e.empty()) return e;
+  }
+  if (shape == CounterweightShape::kDisc) {
+    if (std::string e = positive("thickness", "m", thickness); !e.empty()) return e;
+    if (std::string e = positive("density", "kg/m^3", density); !e.empty()) return e;
+  }
+  return "";
+}
+
+core::Link merged(const core::Link& link, const Counterweight& counterweight,
+                  bool from_second_joint) {
+  const double m = link.mass, mc = counterweight.mass, M = m + mc;
+  // both centres of mass in link axes from the first joint
+  const Vec2 s(link.e, link.f);
+  const Vec2 r = from_second_joint ? Vec2(Vec2(link.length, 0) + counterweight.position)
+                                   : counterweight.position;
+  const Vec2 c = (m * s + mc * r) / M;
+  core::Link out = link;
+  out.mass = M;
+  out.e = c.x();
+  out.f = c.y();
+  // parallel axes: each body's own inertia plus its mass times its squared distance from c
+  out.inertia =
+      link.inertia + m * (s - c).squaredNorm() + counterweight.inertia + mc * (r - c).squaredNorm();
+  return out;
+}
+
+ForceBalancedDesign force_balance(const core::FourBar& model, const CounterweightSpec& crank,
+                                  const CounterweightSpec& rocker) {
+  if (const std::string e = crank.validate(); !e.empty()) {
+    throw InputError("crank counterweight: " + e);
+  }
+  if (const std::string e = rocker.validate(); !e.empty()) {
+    throw InputError("rocker counterweight: " + e);
+  }
+  const core::FourBar checked = core::make_fourbar(model);
+  const core::Link &l1 = checked.crank, &l2 = checked.coupler, &l3 = checked.rocker;
+  const Complex s1(l1.e, l1.f), s2(l2.e, l2.f), s3(l3.e, l3.f);
+
+  // a side whose residual is round-off already keeps its link as it is
+  const BalanceReport before = check_balance(checked);
+  ForceBalancedDesign out;
+  out.model = checked;
+
+  // crank, about A0: m1' s̄1' = m1 s̄1 + mc p must equal -m2 (1 - s̄2/l2) l1 (eq. 57, first)
+  if (!before.force[0].holds) {
+    const Complex target = -l2.mass * (1.0 - s2 / l2.length) * l1.length;
+    const Counterweight cw = realise(crank, target - l1.mass * s1, l1.length);
+    out.model.crank = merged(l1, cw, false);
+    out.crank = cw;
+  }
+  // rocker, about A3: its mass moment m3 (s̄3 - l3) + mc q must equal m2 s̄2 l3 / l2
+  // (eq. 57, second, times l3)
+  if (!before.force[1].holds) {
+    const Complex target = l2.mass * s2 * l3.length / l2.length;
+    const Counterweight cw = realise(rocker, target - l3.mass * (s3 - l3.length), l3.length);
+    out.model.rocker = merged(l3, cw, true);
+    out.rocker = cw;
+  }
+  for (const std::optional<Counterweight>& cw : {out.crank, out.rocker}) {
+    if (!cw) continue;
+    out.added_mass += cw->mass;
+    out.added_inertia += cw->inertia + cw->mass * cw->distance * cw->distance;
+  }
+  out.model = core::make_fourbar(out.model);
+  return out;
+}
+
+}  // namespace bd::balance
