@@ -23,6 +23,10 @@ double kinetic_energy(const FourBar& model, const FourBarState& s) {
     T += 0.5 * l.mass * centre_of_mass_velocity(model, k, s).squaredNorm() +
          0.5 * l.inertia * omega * omega;
   }
+  // counter-rotating discs spin at minus their link's rate about fixed shafts (zero when absent)
+  const CounterRotations& discs = model.counter_rotations;
+  T += 0.5 * discs.crank.inertia * s.omega1 * s.omega1 +
+       0.5 * discs.rocker.inertia * s.omega3 * s.omega3;
   return T;
 }
 

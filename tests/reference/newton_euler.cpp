@@ -25,11 +25,32 @@
 // gives a_k = J_k alpha1 + (dJ_k/dtheta1) omega1^2. Centre-of-mass accelerations follow from the
 // joint accelerations as a_c = a_joint + alpha x rho - omega^2 rho, rho = c - joint.
 //
-// Nine equations; the unknowns are the eight pin-force components and one more:
-//   forward dynamics: alpha1 (tau = 0), moving -m_k J_k alpha1 and -I_k Theta_k alpha1 left;
+// Counter-rotating discs (model.counter_rotations, each present when its J > 0) are further rigid
+// bodies. Disc d turns on a shaft fixed in the frame at C, geared to link k (crank: pivot P = A0,
+// rocker: pivot P = A3) with ratio -1: a gear rigid with link k, centred on P, meshes with the
+// disc's gear, both of pitch radius |C - P|/2, at M = (P + C)/2. Rolling without slip at M:
+// link k's gear has v_M = omega_k perp(M - P) = omega_k perp(C - P)/2 and the disc's gear
+// omega_disc perp(M - C) = -omega_disc perp(C - P)/2, so omega_disc = -omega_k and
+// alpha_disc = -alpha_k. The ideal mesh carries only the tangential force G = g t,
+// t = perp(C - P)/|C - P|, ON the disc at M, and -G ON link k at M. The disc's centre of mass is
+// on its shaft (it never translates; its weight goes straight into the shaft and is not modelled).
+// Unknowns per disc: the shaft's bearing force B ON the disc (2) and g (1). Its equations:
+//
+//   disc     B + g t                  = 0                    (no translation)
+//            (M - C) x (g t)          = J alpha_disc = -J alpha_k   (moment about the shaft)
+//
+// and link k gains -g t in its force equation and -(M - c_k) x (g t) in its moment equation.
+// The force ON the ground at the shaft is RC = -B.
+//
+// Nine equations plus three per disc; the unknowns are the eight pin-force components, the
+// disc unknowns and one more:
+//   forward dynamics: alpha1 (tau = 0), moving -m_k J_k alpha1, -I_k Theta_k alpha1 and the
+//                     discs' +J Theta_k alpha1 left;
 //   inverse dynamics: tau (alpha1 given), a +1 in the crank's moment row.
-// A 9x9 LU solve gives them. Then Fsh = RA0 + RA3 and, about A0, Msh = l4 RA3y - tau (the
-// drive's stator reacts on the frame with -tau).
+// A 9x9, 12x12 or 15x15 LU solve gives them. Then Fsh = RA0 + RA3 + RC1 + RC3 and, about A0,
+// Msh = l4 RA3y - tau + C1 x RC1 + C3 x RC3 (the drive's stator reacts on the frame with -tau;
+// the shafts carry RC1, RC3 into the frame at C1, C3). Without discs the 9x9 system is exactly
+// the one of the plain four-bar.
 #include "tests/reference/newton_euler.hpp"
 
 #include <Eigen/Dense>
@@ -39,8 +60,10 @@
 namespace bd::reference {
 namespace {
 
-using Mat9 = Eigen::Matrix<double, 9, 9>;
-using Vec9 = Eigen::Matrix<double, 9, 1>;
+// the largest system: nine link equations and three per disc, two discs
+constexpr int kMaxUnknowns = 15;
+using MatN = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxUnknowns, kMaxUnknowns>;
+using VecN = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxUnknowns, 1>;
 
 enum class Unknown { kAlpha1, kTau };
 
@@ -54,6 +77,30 @@ Vec2 offset(double e, double f, double theta) { return e * unit(theta) + f * per
 
 // coefficients of P in the planar cross product d x P = dx Py - dy Px
 Eigen::RowVector2d cross_row(const Vec2& d) { return {-d.y(), d.x()}; }
+
+// A present counter-rotating disc: its shaft C, inertia J and the link (index 0 crank, 2 rocker)
+// and pivot P it is geared to.
+struct Disc {
+  double J{};
+  Vec2 C{0, 0};
+  int link{};
+  Vec2 P{0, 0};
+};
+
+// The n x n system solved with a fixed-size LU (n = 9 as the plain four-bar always had).
+template <int N>
+VecN lu_solve(const MatN& A, const VecN& b, double theta1) {
+  const Eigen::Matrix<double, N, N> Af = A;
+  const Eigen::Matrix<double, N, 1> bf = b;
+  const Eigen::FullPivLU<Eigen::Matrix<double, N, N>> lu(Af);
+  if (!lu.isInvertible()) {
+    throw std::domain_error("newton_euler: singular " + std::to_string(N) + "x" +
+                            std::to_string(N) + " system at theta1 = " + std::to_string(theta1) +
+                            " rad");
+  }
+  const Eigen::Matrix<double, N, 1> x = lu.solve(bf);
+  return x;
+}
 
 core::DynamicsSample solve(const core::FourBar& model, double theta1, double omega1,
                            Unknown unknown, double alpha1_given) {
@@ -97,8 +144,26 @@ core::DynamicsSample solve(const core::FourBar& model, double theta1, double ome
   // with alpha1 given, the accelerations are known in full
   const double alpha1_known = unknown == Unknown::kTau ? alpha1_given : 0.0;
 
-  Mat9 A = Mat9::Zero();
-  Vec9 b = Vec9::Zero();
+  // the counter-rotating discs present (J > 0), crank's first
+  std::array<Disc, 2> discs{};
+  int n_discs = 0;
+  const std::array<const core::CounterRotation*, 2> rotations{&model.counter_rotations.crank,
+                                                              &model.counter_rotations.rocker};
+  const std::array<int, 2> geared_link{0, 2};
+  const std::array<Vec2, 2> pivot{A0, A3};
+  std::array<int, 2> disc_of{-1, -1};  // index in discs of the crank's and the rocker's disc
+  for (int i = 0; i < 2; ++i) {
+    if (!(rotations[i]->inertia > 0)) continue;
+    if ((rotations[i]->at - pivot[i]).norm() == 0) {
+      throw std::domain_error("newton_euler: counter-rotation shaft on its link's pivot");
+    }
+    disc_of[i] = n_discs;
+    discs[n_discs++] = {rotations[i]->inertia, rotations[i]->at, geared_link[i], pivot[i]};
+  }
+  const int n = 9 + 3 * n_discs;
+
+  MatN A = MatN::Zero(n, n);
+  VecN b = VecN::Zero(n);
   // unknown columns: P0 -> 0, P1 -> 2, P2 -> 4, P3 -> 6, alpha1 or tau -> 8
   // rows of link k: force 3k, 3k+1; moment 3k+2
   for (int k = 0; k < 3; ++k) {
@@ -135,12 +200,35 @@ core::DynamicsSample solve(const core::FourBar& model, double theta1, double ome
   A.block<1, 2>(8, 4) = cross_row(A2 - c3);
   A.block<1, 2>(8, 6) = cross_row(A3 - c3);
 
-  const Eigen::FullPivLU<Mat9> lu(A);
-  if (!lu.isInvertible()) {
-    throw std::domain_error(
-        "newton_euler: singular 9x9 system at theta1 = " + std::to_string(theta1) + " rad");
+  // discs: unknown columns B -> 9 + 3d, 9 + 3d + 1 and g -> 9 + 3d + 2; rows: force 9 + 3d,
+  // 9 + 3d + 1, moment about the shaft 9 + 3d + 2
+  const std::array<Vec2, 3> com{c1, c2, c3};
+  for (int d = 0; d < n_discs; ++d) {
+    const Disc& D = discs[d];
+    const int k = D.link;
+    const Vec2 t = perp(D.C - D.P) / (D.C - D.P).norm();  // mesh direction
+    const Vec2 M = 0.5 * (D.P + D.C);                     // mesh point
+    const int col_B = 9 + 3 * d, col_g = 9 + 3 * d + 2;
+    const int row_f = 9 + 3 * d, row_m = 9 + 3 * d + 2;
+    // disc: B + g t = 0
+    A.block<2, 2>(row_f, col_B) = I2;
+    A.block<2, 1>(row_f, col_g) = t;
+    // disc: (M - C) x (g t) = -J alpha_k, alpha_k = Theta_k alpha1 + gamma_k
+    A(row_m, col_g) = cross(M - D.C, t);
+    if (unknown == Unknown::kAlpha1) {
+      A(row_m, 8) = D.J * Theta[k];
+      b(row_m) = -D.J * gamma[k];
+    } else {
+      b(row_m) = -D.J * (gamma[k] + Theta[k] * alpha1_known);
+    }
+    // link k: -g t at M
+    A.block<2, 1>(3 * k, col_g) = -t;
+    A(3 * k + 2, col_g) = -cross(M - com[k], t);
   }
-  const Vec9 x = lu.solve(b);
+
+  const VecN x = n == 9    ? lu_solve<9>(A, b, theta1)
+                 : n == 12 ? lu_solve<12>(A, b, theta1)
+                           : lu_solve<15>(A, b, theta1);
 
   // the sample: full state, reactions on the ground, shaking force and moment
   core::DynamicsSample s;
@@ -153,6 +241,14 @@ core::DynamicsSample solve(const core::FourBar& model, double theta1, double ome
   s.RA3 = -x.segment<2>(6);
   s.Fsh = s.RA0 + s.RA3;
   s.Msh = model.frame_length * s.RA3.y() - s.tau;
+  // the shafts: force ON the ground = minus the bearing force on the disc
+  if (disc_of[0] >= 0) s.RC1 = -x.segment<2>(9 + 3 * disc_of[0]);
+  if (disc_of[1] >= 0) s.RC3 = -x.segment<2>(9 + 3 * disc_of[1]);
+  if (n_discs > 0) {
+    s.Fsh += s.RC1 + s.RC3;
+    s.Msh += cross(model.counter_rotations.crank.at, s.RC1) +
+             cross(model.counter_rotations.rocker.at, s.RC3);
+  }
   return s;
 }
 

@@ -3,7 +3,8 @@
 /// link from first principles, with the pin forces as unknowns. It shares no code with core's
 /// dynamics formulations; from core it takes only the model types and the closed-form kinematics
 /// (position, transfer functions, acceleration bias), which core's kinematics tests check against
-/// finite differences.
+/// finite differences. Counter-rotating discs (FourBar::counter_rotations with J > 0) are extra
+/// rigid bodies with their shaft bearing force and tangential mesh force as unknowns.
 #include <array>
 
 #include "core/dynamics.hpp"
@@ -32,9 +33,11 @@ struct LinkageMotion {
 LinkageMotion linkage_motion(const core::FourBar& model, const core::FourBarState& state);
 
 /// Forward dynamics (free motion, tau = 0) under the model's loads: the returned sample has the
-/// full state (angles, rates, accelerations), RA0, RA3, Fsh, Msh and tau = 0.
-/// @throws std::domain_error if the loop cannot close at theta1 or the 9x9 system is singular
-///         (a test referee; callers choose assemblable, non-singular states).
+/// full state (angles, rates, accelerations), RA0, RA3, RC1, RC3 (zero without discs), Fsh, Msh
+/// and tau = 0.
+/// @throws std::domain_error if the loop cannot close at theta1, a disc's shaft sits on its
+///         link's pivot, or the linear system (9x9, plus 3 rows and columns per disc) is
+///         singular (a test referee; callers choose assemblable, non-singular states).
 core::DynamicsSample newton_euler_forward(const core::FourBar& model, double theta1, double omega1);
 
 /// Inverse dynamics: the drive torque tau that gives crank acceleration alpha1 [rad/s^2], with
