@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -32,7 +33,13 @@ Outputs (in DIR, default results/<name>/ with <name> the study's `name`):
   timeseries.csv  one row per sample: t,theta1,theta2,theta3,omega1,omega2,omega3,
                   alpha1,alpha2,alpha3,RA0x,RA0y,RA3x,RA3y,Fshx,Fshy,Msh,tau (SI units, %.17g)
   summary.json    study name, method used and why, scene, samples, status, metrics
-                  (Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max, RA0_max, RA3_max)
+                  (Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max, RA0_max, RA3_max,
+                  RA0_rms, RA3_rms); with a balance section also balance, balanced_run,
+                  balanced_metrics and reduction (balanced / original)
+  With a `balance:` section, besides (for the balanced design, same scene):
+  balanced-timeseries.csv  the balanced design's samples, columns as timeseries.csv
+  balanced.yaml            a complete study file of the balanced design
+  comparison.csv           metric,before,after,ratio for the main metrics, added mass and inertia
   Files are written under a temporary name and renamed, so none is ever half-written.
 
 Exit codes:
@@ -40,8 +47,9 @@ Exit codes:
   1  unexpected internal error (or the output files could not be written)
   2  bad input: the study file or the command line is wrong; one line FILE:LINE:COLUMN: message
      on stderr, and nothing is written
-  3  the simulation stopped early (e.g. a dead-centre position); the samples computed so far and
-     summary.json are kept, and the reason (with time and crank angle) is printed on stderr
+  3  a simulation stopped early (e.g. a dead-centre position), the original's or the balanced
+     design's; the samples computed so far and summary.json are kept, and the reason (with time
+     and crank angle) is printed on stderr
 
 The study-file format is described in docs/study-format.md; examples are in studies/examples/.
 )";
@@ -50,6 +58,57 @@ struct RunArgs {
   std::string study;
   std::string out;
 };
+
+// the balanced design: what was added, and before / after / ratio of the main metrics
+void print_balance(const st::Study& study, const st::RunResult& r) {
+  const st::BalancedDesign& b = *study.balance;
+  const st::BalancedRun& run = *r.balanced;
+  std::printf("  balance  force %s, moment %s: the balanced design is %s\n",
+              b.request.force ? "full" : "none", b.request.moment ? "full" : "none",
+              b.conditions.moment_balanced()  ? "force and moment balanced"
+              : b.conditions.force_balanced() ? "force balanced"
+                                              : "not balanced");
+  const std::optional<bd::balance::Counterweight>* cws[] = {&b.crank_counterweight,
+                                                            &b.rocker_counterweight};
+  const bd::balance::CounterweightSpec* specs[] = {&b.request.crank_counterweight,
+                                                   &b.request.rocker_counterweight};
+  const char* sides[] = {"crank", "rocker"};
+  const char* pivots[] = {"A0", "A3"};
+  for (int i = 0; i < 2; ++i) {
+    if (!cws[i]->has_value()) continue;
+    const bd::balance::Counterweight& c = **cws[i];
+    std::printf("  %-7s  counterweight (%s) %.6g kg at [%.6g, %.6g] m from %s (%.6g m)", sides[i],
+                st::to_string(specs[i]->shape), c.mass, c.position.x(), c.position.y(), pivots[i],
+                c.distance);
+    if (c.radius > 0) std::printf(", radius %.6g m", c.radius);
+    std::printf("\n");
+  }
+  const bd::core::CounterRotation* discs[] = {&b.model.counter_rotations.crank,
+                                              &b.model.counter_rotations.rocker};
+  for (int i = 0; i < 2; ++i) {
+    if (discs[i]->inertia <= 0) continue;
+    std::printf("  %-7s  counter-rotation J = %.6g kg m^2 on a shaft at [%.6g, %.6g] m\n", sides[i],
+                discs[i]->inertia, discs[i]->at.x(), discs[i]->at.y());
+  }
+  if (run.method.formulation == r.method.formulation && run.method.reason == r.method.reason) {
+    std::printf("  balanced design: method %s as above",
+                bd::core::to_string(run.method.formulation));
+  } else {
+    std::printf("  balanced design: method %s (%s%s)", bd::core::to_string(run.method.formulation),
+                study.formulation ? "" : "auto: ", run.method.reason.c_str());
+  }
+  std::printf(", %zu samples, status %s\n", run.trajectory.samples.size(),
+              bd::core::to_string(run.trajectory.status));
+  std::printf("  %-14s %14s %14s %12s\n", "metric", "before", "after", "ratio");
+  for (const st::ComparisonRow& row : st::comparison(study, r)) {
+    if (row.ratio) {
+      std::printf("  %-14s %14.6g %14.6g %12.4g\n", row.metric.c_str(), row.before, row.after,
+                  *row.ratio);
+    } else {
+      std::printf("  %-14s %14.6g %14.6g %12s\n", row.metric.c_str(), row.before, row.after, "-");
+    }
+  }
+}
 
 void print_summary(const st::Study& study, const st::RunResult& r) {
   const bd::core::Metrics& m = r.metrics;
@@ -77,8 +136,15 @@ void print_summary(const st::Study& study, const st::RunResult& r) {
     std::printf("  |tau|    rms %.6g N m, max %.6g N m\n", m.tau_rms, m.tau_max);
   }
   std::printf("  |RA0|    max %.6g N;  |RA3| max %.6g N\n", m.RA0_max, m.RA3_max);
-  std::printf("  wrote    %s\n           %s\n", r.timeseries.string().c_str(),
-              r.summary.string().c_str());
+  if (study.balance && r.balanced) print_balance(study, r);
+  std::printf("  wrote    %s\n", r.timeseries.string().c_str());
+  if (r.balanced) {
+    for (const fs::path& p :
+         {r.balanced->timeseries, r.balanced->study_file, r.balanced->comparison}) {
+      std::printf("           %s\n", p.string().c_str());
+    }
+  }
+  std::printf("           %s\n", r.summary.string().c_str());
 }
 
 int run(const RunArgs& args) {
@@ -104,8 +170,15 @@ int run(const RunArgs& args) {
   print_summary(study, result);
   std::fflush(stdout);
   if (!result.ok()) {
-    std::fprintf(stderr, "%s: simulation stopped early: %s\n", args.study.c_str(),
-                 result.trajectory.message.c_str());
+    // one line per run that stopped
+    if (!result.trajectory.ok()) {
+      std::fprintf(stderr, "%s: simulation stopped early: %s\n", args.study.c_str(),
+                   result.trajectory.message.c_str());
+    }
+    if (result.balanced && !result.balanced->trajectory.ok()) {
+      std::fprintf(stderr, "%s: simulation of the balanced design stopped early: %s\n",
+                   args.study.c_str(), result.balanced->trajectory.message.c_str());
+    }
     return kExitStoppedEarly;
   }
   return kExitOk;
@@ -140,7 +213,9 @@ int main(int argc, char** argv) {
         "balance-design " BD_VERSION
         ": shaking-force and shaking-moment balancing of planar four-bar linkages.\n"
         "Simulates the linkage of a study file (free motion or a driven crank) and writes its\n"
-        "reaction forces, shaking force and moment and drive torque.\n\n"
+        "reaction forces, shaking force and moment and drive torque; with a balance section it\n"
+        "also synthesises the balanced design (counterweights, counter-rotations), simulates\n"
+        "it in the same scene and compares the two.\n\n"
         "Commands:\n"
         "  balance-design run STUDY.yaml [--out DIR]   run a study, write its outputs into DIR\n"
         "  balance-design STUDY.yaml [--out DIR]       the same: run is the default command\n"

@@ -10,6 +10,7 @@ struct Metrics {
   double Msh_rms{}, Msh_max{};  // |Msh| [N m]
   double tau_rms{}, tau_max{};  // |tau| [N m]
   double RA0_max{}, RA3_max{};  // |R̄A0|, |R̄A3| [N]
+  double RA0_rms{}, RA3_rms{};  // |R̄A0|, |R̄A3| [N]
 };
 /// Metrics over the trajectory's samples (all zero when it has none).
 Metrics metrics(const Trajectory& trajectory);

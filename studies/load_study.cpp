@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -27,6 +28,9 @@ namespace {
 
 // largest number of rows a study may ask for (keeps a typo from filling the disk)
 constexpr double kMaxRows = 1e7;
+// longest study name, and what the balanced design's study appends to it
+constexpr std::size_t kMaxName = 100;
+constexpr std::string_view kBalancedSuffix = "-balanced";
 
 std::string format_number(double v) {
   char buf[64];
@@ -208,6 +212,9 @@ Vec2 read_vec2(const Reporter& r, const MapReader::Entry& e, const std::string& 
   return v;
 }
 
+// the links that can carry a counterweight or a counter-rotation, pivots A0 and A3
+constexpr const char* kSides[] = {"crank", "rocker"};
+
 // where each quantity make_fourbar() may complain about sits in the file
 struct Place {
   std::string core_name;   // as make_fourbar() names it ("coupler.mass")
@@ -229,9 +236,10 @@ class StudyParser {
     }
     const MapReader top(r_, root, "", mark_of(root, YAML::Mark()),
                         "of keys (name, linkage, scene, ...)");
-    top.check_keys({"name", "linkage", "loads", "scene", "method", "tolerance"});
+    top.check_keys({"name", "linkage", "loads", "scene", "method", "tolerance", "balance"});
 
-    study.name = read_name(top.require("name", "the study's name, used in output names"));
+    const MapReader::Entry& name = top.require("name", "the study's name, used in output names");
+    study.name = read_name(name);
 
     const MapReader::Entry& linkage = top.require("linkage", "the mechanism");
     core::FourBar model = read_linkage(linkage);
@@ -248,6 +256,17 @@ class StudyParser {
     if (const MapReader::Entry* tol = top.find("tolerance")) {
       study.tolerance = read_tolerance(*tol);
     }
+    if (const MapReader::Entry* balance = top.find("balance")) {
+      // the balanced design is written as a study named <name>-balanced
+      if (study.name.size() > kMaxName - kBalancedSuffix.size()) {
+        r_.fail(mark_of(name.value, name.key_mark),
+                "name must have at most " + std::to_string(kMaxName - kBalancedSuffix.size()) +
+                    " characters in a study with a balance section (balanced.yaml is named "
+                    "<name>" +
+                    std::string(kBalancedSuffix) + "), got " + std::to_string(study.name.size()));
+      }
+      study.balance = read_balance(*balance, study.model);
+    }
     return study;
   }
 
@@ -255,8 +274,9 @@ class StudyParser {
   std::string read_name(const MapReader::Entry& e) {
     const std::string name = read_text(r_, e, "name");
     const YAML::Mark m = mark_of(e.value, e.key_mark);
-    if (name.empty() || name.size() > 100) {
-      r_.fail(m, "name must have 1 to 100 characters, got " + std::to_string(name.size()));
+    if (name.empty() || name.size() > kMaxName) {
+      r_.fail(m, "name must have 1 to " + std::to_string(kMaxName) + " characters, got " +
+                     std::to_string(name.size()));
     }
     for (char c : name) {
       const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
@@ -275,7 +295,7 @@ class StudyParser {
   core::FourBar read_linkage(const MapReader::Entry& e) {
     const MapReader lk(r_, e.value, "linkage", e.key_mark,
                        "(type, frame, branch, crank, coupler, rocker)");
-    lk.check_keys({"type", "frame", "branch", "crank", "coupler", "rocker"});
+    lk.check_keys({"type", "frame", "branch", "crank", "coupler", "rocker", "counter_rotations"});
 
     const MapReader::Entry& type = lk.require("type", "the kind of linkage: fourbar");
     const std::string t = read_text(r_, type, "linkage.type");
@@ -301,7 +321,191 @@ class StudyParser {
     model.crank = read_link(lk, "crank");
     model.coupler = read_link(lk, "coupler");
     model.rocker = read_link(lk, "rocker");
+    if (const MapReader::Entry* cr = lk.find("counter_rotations")) {
+      model.counter_rotations = read_counter_rotations(*cr, model.frame_length);
+    }
     return model;
+  }
+
+  // linkage.counter_rotations: {crank: {inertia, at}, rocker: {inertia, at}}, each optional
+  core::CounterRotations read_counter_rotations(const MapReader::Entry& e, double frame) {
+    core::CounterRotations out;
+    if (e.value.IsNull()) return out;
+    const MapReader cr(r_, e.value, "linkage.counter_rotations", e.key_mark, "(crank, rocker)");
+    cr.check_keys({"crank", "rocker"});
+    core::CounterRotation* targets[] = {&out.crank, &out.rocker};
+    for (int i = 0; i < 2; ++i) {
+      const std::string side = kSides[i];
+      const MapReader::Entry* x = cr.find(side);
+      if (!x) continue;
+      const std::string path = "linkage.counter_rotations." + side;
+      const MapReader m(r_, x->value, path, x->key_mark, "(inertia, at)");
+      m.check_keys({"inertia", "at"});
+      const MapReader::Entry& j = m.require("inertia", "J of the disc about its shaft in kg m^2");
+      targets[i]->inertia = read_number(r_, j, path + ".inertia", "kg m^2");
+      places_.push_back({"counter_rotations." + side + ".inertia", path + ".inertia",
+                         mark_of(j.value, j.key_mark)});
+      const MapReader::Entry& at = m.require("at", "the shaft position [x, y] on the frame in m");
+      targets[i]->at = read_shaft(at, path + ".at", i, frame);
+    }
+    return out;
+  }
+
+  // a counter-rotation shaft position [x, y] on the frame, away from its link's pivot
+  Vec2 read_shaft(const MapReader::Entry& at, const std::string& path, int side, double frame) {
+    YAML::Mark marks[2];
+    const Vec2 p = read_vec2(r_, at, path, "m", marks);
+    const Vec2 pivot = side == 0 ? Vec2(0, 0) : Vec2(frame, 0);
+    if (p == pivot) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "'s pivot %s = (%.10g, %.10g) m, got [%.10g, %.10g]",
+                    side == 0 ? "A0" : "A3", pivot.x(), pivot.y(), p.x(), p.y());
+      r_.fail(mark_of(at.value, at.key_mark), path + " must differ from the " + kSides[side] + buf);
+    }
+    return p;
+  }
+
+  // balance: {force, moment, counterweights, counter_rotations}, then the synthesis itself
+  BalancedDesign read_balance(const MapReader::Entry& e, const core::FourBar& model) {
+    BalanceRequest request;
+    YAML::Mark force_mark = e.key_mark, moment_mark = e.key_mark;
+    if (!e.value.IsNull()) {  // `balance:` with nothing under it: the defaults
+      const MapReader b(r_, e.value, "balance", e.key_mark,
+                        "(force, moment, counterweights, counter_rotations)");
+      b.check_keys({"force", "moment", "counterweights", "counter_rotations"});
+      if (const MapReader::Entry* f = b.find("force")) {
+        request.force = read_full_or_none(*f, "balance.force");
+        force_mark = mark_of(f->value, f->key_mark);
+      }
+      if (const MapReader::Entry* m = b.find("moment")) {
+        request.moment = read_full_or_none(*m, "balance.moment");
+        moment_mark = mark_of(m->value, m->key_mark);
+      }
+      if (request.moment && !request.force) {
+        r_.fail(moment_mark,
+                "balance.moment: full needs balance.force: full (a moment balance starts from a "
+                "force-balanced design)");
+      }
+      if (const MapReader::Entry* cw = b.find("counterweights")) {
+        if (!request.force) {
+          r_.fail(cw->key_mark, "balance.counterweights are used only with balance.force: full");
+        }
+        read_counterweights(*cw, request);
+      }
+      if (const MapReader::Entry* cr = b.find("counter_rotations")) {
+        if (!request.moment) {
+          r_.fail(cr->key_mark,
+                  "balance.counter_rotations are used only with balance.moment: full");
+        }
+        read_shafts(*cr, model.frame_length, request);
+      }
+    }
+    // the synthesis: its complaint is reported at the key that asked for it
+    try {
+      return balance_design(model, request);
+    } catch (const SynthesisError& err) {
+      if (err.step() == SynthesisError::Step::kMoment) {
+        r_.fail(moment_mark, std::string("balance.moment: full is not possible: ") + err.what());
+      }
+      r_.fail(force_mark, std::string("balance.force: full is not possible: ") + err.what());
+    }
+  }
+
+  bool read_full_or_none(const MapReader::Entry& e, const std::string& path) {
+    const std::string v = read_text(r_, e, path);
+    if (v != "full" && v != "none") {
+      r_.fail(mark_of(e.value, e.key_mark),
+              path + " must be full or none, got " + describe(e.value));
+    }
+    return v == "full";
+  }
+
+  void read_counterweights(const MapReader::Entry& e, BalanceRequest& request) {
+    if (e.value.IsNull()) return;
+    const MapReader cw(r_, e.value, "balance.counterweights", e.key_mark, "(crank, rocker)");
+    cw.check_keys({"crank", "rocker"});
+    if (const MapReader::Entry* c = cw.find("crank")) {
+      request.crank_counterweight = read_counterweight(*c, "balance.counterweights.crank");
+    }
+    if (const MapReader::Entry* r = cw.find("rocker")) {
+      request.rocker_counterweight = read_counterweight(*r, "balance.counterweights.rocker");
+    }
+  }
+
+  // {shape, mass | distance | radius, thickness, density}
+  balance::CounterweightSpec read_counterweight(const MapReader::Entry& e,
+                                                const std::string& path) {
+    balance::CounterweightSpec spec;
+    if (e.value.IsNull()) return spec;
+    const MapReader m(r_, e.value, path, e.key_mark,
+                      "(shape, mass, distance, radius, thickness, density)");
+    m.check_keys({"shape", "mass", "distance", "radius", "thickness", "density"});
+    if (const MapReader::Entry* shape = m.find("shape")) {
+      const std::string t = read_text(r_, *shape, path + ".shape");
+      if (t != "point" && t != "disc") {
+        r_.fail(mark_of(shape->value, shape->key_mark),
+                path + ".shape must be point or disc, got " + describe(shape->value));
+      }
+      spec.shape =
+          t == "disc" ? balance::CounterweightShape::kDisc : balance::CounterweightShape::kPoint;
+    }
+    const bool disc = spec.shape == balance::CounterweightShape::kDisc;
+    auto positive = [&](const MapReader::Entry& x, const char* unit) {
+      const double v = read_number(r_, x, path + "." + x.key, unit);
+      if (!(v > 0)) {
+        r_.fail(mark_of(x.value, x.key_mark),
+                path + "." + x.key + " must be > 0 " + unit + ", got " + format_number(v));
+      }
+      return v;
+    };
+    // a disc's size: only for shape: disc
+    for (const char* key : {"radius", "thickness", "density"}) {
+      const MapReader::Entry* x = m.find(key);
+      if (x && !disc) {
+        r_.fail(x->key_mark, path + "." + key + " needs shape: disc (a point mass has no size)");
+      }
+    }
+    // at most one of mass, distance, radius is given; the rest is solved
+    const MapReader::Entry* given = nullptr;
+    for (const char* key : {"mass", "distance", "radius"}) {
+      const MapReader::Entry* x = m.find(key);
+      if (!x) continue;
+      if (given) {
+        const MapReader::Entry* later = given->key_mark.pos > x->key_mark.pos ? given : x;
+        r_.fail(later->key_mark, path +
+                                     ": give at most one of mass, distance and radius (the "
+                                     "rest is solved), got both " +
+                                     given->key + " and " + x->key);
+      }
+      given = x;
+    }
+    if (const MapReader::Entry* x = m.find("mass")) spec.mass = positive(*x, "kg");
+    if (const MapReader::Entry* x = m.find("distance")) spec.distance = positive(*x, "m");
+    if (const MapReader::Entry* x = m.find("radius")) spec.radius = positive(*x, "m");
+    if (const MapReader::Entry* x = m.find("thickness")) spec.thickness = positive(*x, "m");
+    if (const MapReader::Entry* x = m.find("density")) spec.density = positive(*x, "kg/m^3");
+    // anything else the balance layer objects to, at the side's key
+    const std::string problem = spec.validate();
+    if (!problem.empty()) r_.fail(e.key_mark, path + ": " + problem);
+    return spec;
+  }
+
+  // balance.counter_rotations: {crank: {at}, rocker: {at}}
+  void read_shafts(const MapReader::Entry& e, double frame, BalanceRequest& request) {
+    if (e.value.IsNull()) return;
+    const MapReader cr(r_, e.value, "balance.counter_rotations", e.key_mark, "(crank, rocker)");
+    cr.check_keys({"crank", "rocker"});
+    std::optional<Vec2>* targets[] = {&request.crank_at, &request.rocker_at};
+    for (int i = 0; i < 2; ++i) {
+      const std::string side = kSides[i];
+      const MapReader::Entry* x = cr.find(side);
+      if (!x) continue;
+      const std::string path = "balance.counter_rotations." + side;
+      const MapReader m(r_, x->value, path, x->key_mark, "(at)");
+      m.check_keys({"at"});
+      const MapReader::Entry& at = m.require("at", "the shaft position [x, y] on the frame in m");
+      *targets[i] = read_shaft(at, path + ".at", i, frame);
+    }
   }
 
   core::Link read_link(const MapReader& lk, const std::string& name) {

@@ -3,13 +3,17 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cassert>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <system_error>
+#include <utility>
 #include <variant>
+
+#include "studies/study_yaml.hpp"
 
 namespace bd::studies {
 
@@ -80,6 +84,121 @@ std::string number(double v) {
 }
 // JSON has no inf or nan: those become null
 std::string json_number(double v) { return std::isfinite(v) ? number(v) : "null"; }
+
+std::string json_vec(const Vec2& v) {
+  return "[" + json_number(v.x()) + ", " + json_number(v.y()) + "]";
+}
+
+// the metrics in summary.json order, with their names
+std::vector<std::pair<const char*, double>> metric_items(const core::Metrics& m) {
+  return {{"Fsh_rms", m.Fsh_rms}, {"Fsh_max", m.Fsh_max}, {"Msh_rms", m.Msh_rms},
+          {"Msh_max", m.Msh_max}, {"tau_rms", m.tau_rms}, {"tau_max", m.tau_max},
+          {"RA0_max", m.RA0_max}, {"RA3_max", m.RA3_max}, {"RA0_rms", m.RA0_rms},
+          {"RA3_rms", m.RA3_rms}};
+}
+
+// `"key": {...}` with one metric per line, indented by two spaces; `last` drops the comma
+std::string metrics_json(const char* key, const core::Metrics& m, bool last) {
+  std::string j = std::string("  \"") + key + "\": {\n";
+  const auto items = metric_items(m);
+  for (std::size_t k = 0; k < items.size(); ++k) {
+    j += std::string("    \"") + items[k].first + "\": " + json_number(items[k].second) +
+         (k + 1 < items.size() ? ",\n" : "\n");
+  }
+  return j + (last ? "  }\n" : "  },\n");
+}
+
+std::string method_json(const Study& study, const MethodChoice& method) {
+  return "{\"requested\": " + json_string(study.method_name()) +
+         ", \"used\": " + json_string(core::to_string(method.formulation)) +
+         ", \"reason\": " + json_string(method.reason) + "}";
+}
+
+// the balance section of summary.json: what was asked, what was added, which conditions hold
+std::string balance_json(const BalancedDesign& b) {
+  std::string j = "  \"balance\": {\n";
+  j += std::string("    \"force\": ") + (b.request.force ? "\"full\"" : "\"none\"") + ",\n";
+  j += std::string("    \"moment\": ") + (b.request.moment ? "\"full\"" : "\"none\"") + ",\n";
+
+  // counterweights actually added, crank first
+  std::vector<std::string> items;
+  const std::optional<balance::Counterweight>* cws[] = {&b.crank_counterweight,
+                                                        &b.rocker_counterweight};
+  const balance::CounterweightSpec* specs[] = {&b.request.crank_counterweight,
+                                               &b.request.rocker_counterweight};
+  const char* sides[] = {"crank", "rocker"};
+  for (int i = 0; i < 2; ++i) {
+    if (!cws[i]->has_value()) continue;
+    const balance::Counterweight& c = **cws[i];
+    items.push_back(
+        std::string("{\"link\": \"") + sides[i] + "\", \"shape\": \"" + to_string(specs[i]->shape) +
+        "\", \"mass\": " + json_number(c.mass) + ", \"position\": " + json_vec(c.position) +
+        ", \"distance\": " + json_number(c.distance) + ", \"radius\": " + json_number(c.radius) +
+        ", \"thickness\": " + json_number(c.thickness) +
+        ", \"inertia\": " + json_number(c.inertia) + "}");
+  }
+  auto list = [](const std::vector<std::string>& xs) {
+    if (xs.empty()) return std::string("[]");
+    std::string out = "[\n";
+    for (std::size_t k = 0; k < xs.size(); ++k) {
+      out += "      " + xs[k] + (k + 1 < xs.size() ? ",\n" : "\n");
+    }
+    return out + "    ]";
+  };
+  j += "    \"counterweights\": " + list(items) + ",\n";
+
+  // counter-rotations of the balanced design
+  items.clear();
+  const core::CounterRotation* discs[] = {&b.model.counter_rotations.crank,
+                                          &b.model.counter_rotations.rocker};
+  for (int i = 0; i < 2; ++i) {
+    if (discs[i]->inertia <= 0) continue;
+    items.push_back(std::string("{\"link\": \"") + sides[i] + "\", \"inertia\": " +
+                    json_number(discs[i]->inertia) + ", \"at\": " + json_vec(discs[i]->at) + "}");
+  }
+  j += "    \"counter_rotations\": " + list(items) + ",\n";
+  j += "    \"added_mass\": " + json_number(b.added_mass) + ",\n";
+  j += "    \"added_inertia\": " + json_number(b.added_inertia) + ",\n";
+  j += std::string("    \"force_balanced\": ") +
+       (b.conditions.force_balanced() ? "true" : "false") + ",\n";
+  j += std::string("    \"moment_balanced\": ") +
+       (b.conditions.moment_balanced() ? "true" : "false") + ",\n";
+
+  // check_balance of the balanced design, force conditions first
+  items.clear();
+  for (const auto* group : {&b.conditions.force, &b.conditions.moment}) {
+    for (const balance::Condition& c : *group) {
+      items.push_back(
+          "{\"name\": " + json_string(c.name) + ", \"residual\": " + json_number(c.residual) +
+          ", \"scale\": " + json_number(c.scale) + ", \"unit\": " + json_string(c.unit) +
+          ", \"holds\": " + (c.holds ? "true" : "false") + "}");
+    }
+  }
+  j += "    \"conditions\": " + list(items) + "\n";
+  return j + "  },\n";
+}
+
+// a trajectory's run facts (status, counts), without the braces
+std::string run_json_fields(const core::Trajectory& tr, const std::string& indent) {
+  std::string j;
+  j += indent + "\"samples\": " + std::to_string(tr.samples.size()) + ",\n";
+  j += indent + "\"status\": " + json_string(core::to_string(tr.status)) + ",\n";
+  j += indent + "\"ok\": " + (tr.ok() ? "true" : "false") + ",\n";
+  j += indent + "\"message\": " + json_string(tr.message) + ",\n";
+  j += indent + "\"steps\": " + std::to_string(tr.steps) + ",\n";
+  j += indent + "\"rhs_evaluations\": " + std::to_string(tr.rhs_evaluations);
+  return j;
+}
+
+core::Trajectory simulate(const Study& study, const MethodChoice& method) {
+  core::SimulateOptions options;
+  options.formulation = method.formulation;
+  options.tolerance = study.tolerance;
+  if (const auto* free = std::get_if<core::FreeScene>(&study.scene)) {
+    return core::simulate_free(study.model, *free, options);
+  }
+  return core::simulate_driven(study.model, std::get<core::DrivenScene>(study.scene), options);
+}
 
 void write_text(const std::string& text, const fs::path& file) {
   AtomicFile out(file);
@@ -152,14 +271,11 @@ void write_timeseries(const core::Trajectory& trajectory, const fs::path& file) 
 
 std::string summary_json(const Study& study, const RunResult& result) {
   const core::Trajectory& tr = result.trajectory;
-  const core::Metrics& m = result.metrics;
   std::string j = "{\n";
   j += "  \"format\": \"balance-design summary v1\",\n";
   j += "  \"study\": " + json_string(study.name) + ",\n";
   j += "  \"source\": " + json_string(study.source) + ",\n";
-  j += "  \"method\": {\"requested\": " + json_string(study.method_name()) +
-       ", \"used\": " + json_string(core::to_string(result.method.formulation)) +
-       ", \"reason\": " + json_string(result.method.reason) + "},\n";
+  j += "  \"method\": " + method_json(study, result.method) + ",\n";
   if (const auto* free = std::get_if<core::FreeScene>(&study.scene)) {
     j += "  \"scene\": {\"type\": \"free\", \"theta1\": " + json_number(free->theta1) +
          ", \"omega1\": " + json_number(free->omega1) +
@@ -173,23 +289,100 @@ std::string summary_json(const Study& study, const RunResult& result) {
          ", \"samples\": " + std::to_string(driven.samples) + "},\n";
   }
   j += "  \"tolerance\": " + json_number(study.tolerance) + ",\n";
-  j += "  \"samples\": " + std::to_string(tr.samples.size()) + ",\n";
-  j += "  \"status\": " + json_string(core::to_string(tr.status)) + ",\n";
-  j += std::string("  \"ok\": ") + (tr.ok() ? "true" : "false") + ",\n";
-  j += "  \"message\": " + json_string(tr.message) + ",\n";
-  j += "  \"steps\": " + std::to_string(tr.steps) + ",\n";
-  j += "  \"rhs_evaluations\": " + std::to_string(tr.rhs_evaluations) + ",\n";
-  j += "  \"metrics\": {\n";
-  const std::pair<const char*, double> items[] = {{"Fsh_rms", m.Fsh_rms}, {"Fsh_max", m.Fsh_max},
-                                                  {"Msh_rms", m.Msh_rms}, {"Msh_max", m.Msh_max},
-                                                  {"tau_rms", m.tau_rms}, {"tau_max", m.tau_max},
-                                                  {"RA0_max", m.RA0_max}, {"RA3_max", m.RA3_max}};
-  for (std::size_t k = 0; k < std::size(items); ++k) {
-    j += std::string("    \"") + items[k].first + "\": " + json_number(items[k].second) +
-         (k + 1 < std::size(items) ? ",\n" : "\n");
+  j += run_json_fields(tr, "  ") + ",\n";
+  const bool balanced = study.balance && result.balanced;
+  j += metrics_json("metrics", result.metrics, !balanced);
+  if (balanced) {
+    const BalancedRun& b = *result.balanced;
+    j += balance_json(*study.balance);
+    j += "  \"balanced_run\": {\n";
+    j += "    \"study\": " + json_string(study.name + "-balanced") + ",\n";
+    j += "    \"method\": " + method_json(study, b.method) + ",\n";
+    j += run_json_fields(b.trajectory, "    ") + "\n";
+    j += "  },\n";
+    j += metrics_json("balanced_metrics", b.metrics, false);
+    // balanced / original per metric; null where the original is 0
+    j += "  \"reduction\": {\n";
+    const auto before = metric_items(result.metrics);
+    const auto after = metric_items(b.metrics);
+    for (std::size_t k = 0; k < before.size(); ++k) {
+      const double ratio = after[k].second / before[k].second;
+      j += std::string("    \"") + before[k].first +
+           "\": " + (before[k].second != 0 ? json_number(ratio) : std::string("null")) +
+           (k + 1 < before.size() ? ",\n" : "\n");
+    }
+    j += "  }\n";
   }
-  j += "  }\n}\n";
+  j += "}\n";
   return j;
+}
+
+std::vector<ComparisonRow> comparison(const Study& study, const RunResult& result) {
+  assert(study.balance && result.balanced);
+  std::vector<ComparisonRow> rows;
+  const core::Metrics& a = result.metrics;
+  const core::Metrics& b = result.balanced->metrics;
+  const std::pair<const char*, std::pair<double, double>> items[] = {
+      {"Fsh_rms", {a.Fsh_rms, b.Fsh_rms}},
+      {"Fsh_max", {a.Fsh_max, b.Fsh_max}},
+      {"Msh_rms", {a.Msh_rms, b.Msh_rms}},
+      {"Msh_max", {a.Msh_max, b.Msh_max}},
+      {"tau_rms", {a.tau_rms, b.tau_rms}},
+      {"tau_max", {a.tau_max, b.tau_max}},
+      {"RA0_rms", {a.RA0_rms, b.RA0_rms}},
+      {"RA0_max", {a.RA0_max, b.RA0_max}},
+      {"RA3_rms", {a.RA3_rms, b.RA3_rms}},
+      {"RA3_max", {a.RA3_max, b.RA3_max}},
+      {"added_mass", {0.0, study.balance->added_mass}},
+      {"added_inertia", {0.0, study.balance->added_inertia}}};
+  for (const auto& [name, values] : items) {
+    ComparisonRow row{name, values.first, values.second, std::nullopt};
+    if (row.before != 0) row.ratio = row.after / row.before;
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+std::string comparison_csv(const Study& study, const RunResult& result) {
+  std::string text = std::string(kComparisonHeader) + "\n";
+  for (const ComparisonRow& row : comparison(study, result)) {
+    text += row.metric + "," + number(row.before) + "," + number(row.after) + "," +
+            (row.ratio ? number(*row.ratio) : std::string()) + "\n";
+  }
+  return text;
+}
+
+std::string balanced_yaml(const Study& study) {
+  assert(study.balance.has_value());
+  const BalancedDesign& b = *study.balance;
+  std::string header = "The balanced design of study '" + study.name + "', synthesised by\n";
+  header += "balance-design from its balance section (force: " +
+            std::string(b.request.force ? "full" : "none") +
+            ", moment: " + (b.request.moment ? "full" : "none") + ")";
+  header += study.source.empty() ? std::string(".\n") : " in\n  " + study.source + "\n";
+  const std::optional<balance::Counterweight>* cws[] = {&b.crank_counterweight,
+                                                        &b.rocker_counterweight};
+  const char* sides[] = {"crank", "rocker"};
+  const char* pivots[] = {"A0", "A3"};
+  for (int i = 0; i < 2; ++i) {
+    if (!cws[i]->has_value()) continue;
+    const balance::Counterweight& c = **cws[i];
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "The %s carries a counterweight of %.6g kg at %.6g m from %s (merged into the "
+                  "link below).\n",
+                  sides[i], c.mass, c.distance, pivots[i]);
+    header += line;
+  }
+  if (b.request.moment) {
+    header +=
+        "Counter-rotating discs on frame shafts cancel the shaking moment "
+        "(linkage.counter_rotations).\n";
+  }
+  header +=
+      "Links are in the polar form {s, sigma} with every digit (%.17g; e, f as comments).\n"
+      "Run it with\n  balance-design balanced.yaml";
+  return study_yaml(balanced_study(study), header);
 }
 
 RunResult run_study(const Study& study, const fs::path& out_dir) {
@@ -197,18 +390,19 @@ RunResult run_study(const Study& study, const fs::path& out_dir) {
   result.method = choose_method(study);
 
   // simulate first: an invalid scene throws before anything is created on disk
-  core::SimulateOptions options;
-  options.formulation = result.method.formulation;
-  options.tolerance = study.tolerance;
-  if (const auto* free = std::get_if<core::FreeScene>(&study.scene)) {
-    result.trajectory = core::simulate_free(study.model, *free, options);
-  } else {
-    result.trajectory =
-        core::simulate_driven(study.model, std::get<core::DrivenScene>(study.scene), options);
-  }
+  result.trajectory = simulate(study, result.method);
   result.metrics = core::metrics(result.trajectory);
+  std::optional<Study> balanced;
+  if (study.balance) {
+    balanced = balanced_study(study);
+    BalancedRun b;
+    b.method = choose_method(*balanced);
+    b.trajectory = simulate(*balanced, b.method);
+    b.metrics = core::metrics(b.trajectory);
+    result.balanced = std::move(b);
+  }
 
-  // then the files, summary last: a summary.json means its timeseries.csv is complete
+  // then the files, summary last: a summary.json means the other files are complete
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec) {
@@ -218,6 +412,15 @@ RunResult run_study(const Study& study, const fs::path& out_dir) {
   result.timeseries = out_dir / "timeseries.csv";
   result.summary = out_dir / "summary.json";
   write_timeseries(result.trajectory, result.timeseries);
+  if (result.balanced) {
+    BalancedRun& b = *result.balanced;
+    b.timeseries = out_dir / "balanced-timeseries.csv";
+    b.study_file = out_dir / "balanced.yaml";
+    b.comparison = out_dir / "comparison.csv";
+    write_timeseries(b.trajectory, b.timeseries);
+    write_text(balanced_yaml(study), b.study_file);
+    write_text(comparison_csv(study, result), b.comparison);
+  }
   write_text(summary_json(study, result), result.summary);
   return result;
 }

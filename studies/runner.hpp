@@ -1,8 +1,11 @@
 #pragma once
 /// Running a study: simulate its scene, then write timeseries.csv and summary.json
-/// (DESIGN.md "Outputs (v1 contract)").
+/// (DESIGN.md "Outputs (v1 contract)"); for a study with a balance section also the balanced
+/// design's balanced-timeseries.csv, balanced.yaml and comparison.csv.
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "core/metrics.hpp"
 #include "core/simulate.hpp"
@@ -15,16 +18,42 @@ inline constexpr const char* kTimeseriesHeader =
     "t,theta1,theta2,theta3,omega1,omega2,omega3,alpha1,alpha2,alpha3,RA0x,RA0y,RA3x,RA3y,Fshx,"
     "Fshy,Msh,tau";
 
+/// The header line of comparison.csv (without the newline).
+inline constexpr const char* kComparisonHeader = "metric,before,after,ratio";
+
+/// The balanced design's run in a balance study (same scene, method chosen for it alike).
+struct BalancedRun {
+  MethodChoice method;               // formulation used for the balanced design, and why
+  core::Trajectory trajectory;       // its samples and status
+  core::Metrics metrics;             // over its samples
+  std::filesystem::path timeseries;  // out_dir/balanced-timeseries.csv
+  std::filesystem::path study_file;  // out_dir/balanced.yaml
+  std::filesystem::path comparison;  // out_dir/comparison.csv
+};
+
 /// What a run did and where its files are.
 struct RunResult {
-  MethodChoice method;               // formulation used, and why
-  core::Trajectory trajectory;       // every sample computed, and the simulation's status
-  core::Metrics metrics;             // over the samples computed
-  std::filesystem::path timeseries;  // out_dir/timeseries.csv
-  std::filesystem::path summary;     // out_dir/summary.json
-  /// True when the simulation ran to the end (trajectory.ok()).
-  bool ok() const { return trajectory.ok(); }
+  MethodChoice method;                  // formulation used, and why (the original design)
+  core::Trajectory trajectory;          // every sample computed, and the simulation's status
+  core::Metrics metrics;                // over the samples computed
+  std::filesystem::path timeseries;     // out_dir/timeseries.csv
+  std::filesystem::path summary;        // out_dir/summary.json
+  std::optional<BalancedRun> balanced;  // set when the study has a balance section
+  /// True when every simulation ran to the end (the original's and the balanced design's).
+  bool ok() const { return trajectory.ok() && (!balanced || balanced->trajectory.ok()); }
 };
+
+/// One row of comparison.csv: a metric of the original design (before) and of the balanced
+/// one (after), and after/before (empty when before is 0).
+struct ComparisonRow {
+  std::string metric;  // "Fsh_rms", ..., "added_mass", "added_inertia"
+  double before{}, after{};
+  std::optional<double> ratio;
+};
+/// The rows of comparison.csv, in order: Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max,
+/// RA0_rms, RA0_max, RA3_rms, RA3_max, added_mass, added_inertia.
+/// Precondition: study.balance and result.balanced are set.
+std::vector<ComparisonRow> comparison(const Study& study, const RunResult& result);
 
 /// Simulates the study's scene (core::simulate_free or core::simulate_driven) and writes
 /// `timeseries.csv` and `summary.json` into out_dir, creating out_dir when needed (and only after
@@ -32,6 +61,10 @@ struct RunResult {
 /// file in out_dir and renamed into place, so no half-written output is ever left. When the
 /// simulation stops early, every sample computed so far is written and summary.json records the
 /// status and message; the result's ok() is then false.
+/// A study with a balance section also simulates its balanced design (balanced_study(), its own
+/// choose_method()) in the same scene and writes `balanced-timeseries.csv`, `balanced.yaml`
+/// (study_yaml() of the balanced design) and `comparison.csv`; summary.json gets `balance`,
+/// `balanced_run`, `balanced_metrics` and `reduction`. summary.json is always written last.
 /// @throws bd::InputError if the scene or options are invalid (core's checks).
 /// @throws std::runtime_error if an output file cannot be written (the message names it).
 RunResult run_study(const Study& study, const std::filesystem::path& out_dir);
@@ -42,6 +75,14 @@ void write_timeseries(const core::Trajectory& trajectory, const std::filesystem:
 
 /// The summary.json text of a run (UTF-8, ends in a newline).
 std::string summary_json(const Study& study, const RunResult& result);
+
+/// The comparison.csv text of a balance study's run: kComparisonHeader, then one row per
+/// comparison() entry, numbers "%.17g", ratio empty when before is 0.
+std::string comparison_csv(const Study& study, const RunResult& result);
+
+/// The balanced.yaml text of a balance study: study_yaml(balanced_study(study)) with a header
+/// comment saying where it came from.
+std::string balanced_yaml(const Study& study);
 
 /// `text` as a JSON string literal, quotes included, with every character that needs it escaped.
 std::string json_string(const std::string& text);

@@ -1,5 +1,7 @@
 #include "studies/study.hpp"
 
+#include <cassert>
+
 namespace bd::studies {
 
 const char* scene_type(const Scene& scene) {
@@ -15,6 +17,17 @@ std::optional<core::Formulation> formulation_named(const std::string& name) {
 
 std::string Study::method_name() const {
   return formulation ? std::string(core::to_string(*formulation)) : std::string("auto");
+}
+
+Study balanced_study(const Study& study) {
+  assert(study.balance.has_value());
+  Study b;
+  b.name = study.name + "-balanced";
+  b.model = study.balance->model;
+  b.scene = study.scene;
+  b.formulation = study.formulation;
+  b.tolerance = study.tolerance;
+  return b;
 }
 
 MethodChoice choose_method(const Study& study) {

@@ -8,6 +8,7 @@
 #include "core/dynamics.hpp"
 #include "core/model.hpp"
 #include "core/simulate.hpp"
+#include "studies/balance_study.hpp"
 
 namespace bd::studies {
 
@@ -33,10 +34,16 @@ struct Study {
   std::optional<core::Formulation> formulation;
   double tolerance = 1e-10;  // integrator relative tolerance (free scenes) [-]
   std::string source;        // the study file as named by the user ("" when built in code)
+  /// The study file's `balance:` section, synthesised at load time; empty when absent.
+  std::optional<BalancedDesign> balance;
 
   /// "auto" or the requested formulation's name.
   std::string method_name() const;
 };
+
+/// The study of the balanced design: name `<name>-balanced`, the balanced model, the same scene,
+/// method and tolerance, no balance section, no source. Precondition: study.balance is set.
+Study balanced_study(const Study& study);
 
 /// The formulation a run uses, and why (for the console and summary.json).
 struct MethodChoice {

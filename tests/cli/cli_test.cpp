@@ -10,6 +10,8 @@
 #include <sstream>
 #include <string>
 
+#include "tests/support/csv.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -143,9 +145,50 @@ TEST_F(CliTest, SimulationStoppedEarlyExitsThreeAndKeepsResults) {
   EXPECT_NE(read(dir_ / "res" / "summary.json").find("\"ok\": false"), std::string::npos);
 }
 
+TEST_F(CliTest, BalanceStudyPrintsTheComparisonAndWritesItsFiles) {
+  EXPECT_EQ(run(quote(kExamples + "/berkof-inline-moment-balanced.yaml") + " --out res"), 0)
+      << err_;
+  EXPECT_TRUE(err_.empty()) << err_;
+  for (const char* file : {"timeseries.csv", "summary.json", "balanced-timeseries.csv",
+                           "balanced.yaml", "comparison.csv"}) {
+    EXPECT_TRUE(fs::exists(dir_ / "res" / file)) << file;
+    EXPECT_NE(out_.find(file), std::string::npos) << file << " not in\n" << out_;
+  }
+  for (const char* text : {"balance  force full, moment full", "counterweight (point)",
+                           "counter-rotation J = ", "metric", "before", "after", "ratio", "Fsh_rms",
+                           "Msh_max", "tau_max", "RA3_max", "added_mass", "added_inertia"}) {
+    EXPECT_NE(out_.find(text), std::string::npos) << text << " not in\n" << out_;
+  }
+  // the written balanced design runs as a study of its own and reproduces the balanced run
+  // (balanced.yaml gives s, sigma: e, f come back within a few ulps, the outputs within 1e-12)
+  EXPECT_EQ(run("res/balanced.yaml --out again"), 0) << err_;
+  bd::testing::expect_same_numbers(dir_ / "again" / "timeseries.csv",
+                                   dir_ / "res" / "balanced-timeseries.csv", 1e-12);
+}
+
+TEST_F(CliTest, ImpossibleBalanceIsBadInputAtTheMomentKey) {
+  // the paper's coupler is not a Berkof coupler: no moment balance by counter-rotations
+  write("moment.yaml",
+        "name: moment\n"
+        "linkage:\n"
+        "  type: fourbar\n"
+        "  frame: 3.2\n"
+        "  branch: 1\n"
+        "  crank:   {length: 1.0, mass: 2.1, s: 0.6, sigma: 0.3, inertia: 1.1}\n"
+        "  coupler: {length: 3.0, mass: 3.0, s: 1.45, sigma: 0.4, inertia: 3.1}\n"
+        "  rocker:  {length: 2.0, mass: 2.2, s: 1.66, sigma: -0.4, inertia: 2.1}\n"
+        "scene: {type: driven, omega1: 1}\n"
+        "balance: {force: full, moment: full}\n");
+  EXPECT_EQ(run("moment.yaml --out res"), 2);
+  EXPECT_EQ(err_.rfind("moment.yaml:10:32: balance.moment: full is not possible: ", 0), 0u) << err_;
+  EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
+  EXPECT_FALSE(fs::exists(dir_ / "res"));
+}
+
 TEST_F(CliTest, HelpAndVersion) {
   EXPECT_EQ(run("--help"), 0);
-  for (const char* text : {"run", "--out", "timeseries.csv", "summary.json", "Exit codes"}) {
+  for (const char* text : {"run", "--out", "timeseries.csv", "summary.json", "Exit codes",
+                           "balanced-timeseries.csv", "balanced.yaml", "comparison.csv"}) {
     EXPECT_NE(out_.find(text), std::string::npos) << text;
   }
   EXPECT_EQ(run("run --help"), 0);

@@ -28,7 +28,7 @@ TEST(Examples, EveryExampleRunsToTheEnd) {
     const RunResult r = run_example(entry.path().filename().string());
     EXPECT_TRUE(r.ok()) << entry.path() << ": " << r.trajectory.message;
   }
-  EXPECT_GE(count, 3);
+  EXPECT_GE(count, 5);
 }
 
 TEST(Examples, TripleRockerSwingsThroughItsLimitPositions) {

@@ -280,5 +280,229 @@ TEST(LoadStudy, UnreadableFileNamesIt) {
   EXPECT_THROW(load_study("/nonexistent/study.yaml"), InputError);
 }
 
+// ---- linkage.counter_rotations ----
+
+TEST(LoadStudy, CounterRotationsOnTheLinkage) {
+  const Study s = parse_study(edit("inertia: 2.1}\n",
+                                   "inertia: 2.1}\n"
+                                   "  counter_rotations:\n"
+                                   "    crank: {inertia: 0.5, at: [0, -1]}\n"
+                                   "    rocker: {inertia: 1.5, at: [3.2, -2]}\n"),
+                              "study.yaml");
+  EXPECT_EQ(s.model.counter_rotations.crank.inertia, 0.5);
+  EXPECT_EQ(s.model.counter_rotations.crank.at, Vec2(0, -1));
+  EXPECT_EQ(s.model.counter_rotations.rocker.inertia, 1.5);
+  EXPECT_EQ(s.model.counter_rotations.rocker.at, Vec2(3.2, -2));
+  EXPECT_FALSE(s.balance.has_value());
+
+  // each side optional; none by default
+  const Study one =
+      parse_study(edit("inertia: 2.1}\n",
+                       "inertia: 2.1}\n  counter_rotations: {rocker: {inertia: 1, at: [4, 0]}}\n"),
+                  "study.yaml");
+  EXPECT_EQ(one.model.counter_rotations.crank.inertia, 0.0);
+  EXPECT_EQ(one.model.counter_rotations.rocker.inertia, 1.0);
+  EXPECT_FALSE(core::has_counter_rotations(parse_study(kBase, "study.yaml").model));
+}
+
+TEST(LoadStudy, CounterRotationMistakes) {
+  auto with = [](const std::string& lines) {
+    return edit("inertia: 2.1}\n", "inertia: 2.1}\n  counter_rotations:\n" + lines);  // line 15 on
+  };
+  expect_error(with("    crank: {inertia: -1, at: [0, -1]}\n"), 15, 22,
+               "linkage.counter_rotations.crank.inertia must be >= 0 kg m^2, got -1");
+  expect_error(with("    rocker: {inertia: 1, at: [3.2, 0]}\n"), 15, 30,
+               "linkage.counter_rotations.rocker.at must differ from the rocker's pivot A3 = (3.2, "
+               "0) m, got [3.2, 0]");
+  expect_error(with("    crank: {inertia: 1, at: [0, 0]}\n"), 15, 29,
+               "linkage.counter_rotations.crank.at must differ from the crank's pivot A0");
+  expect_error(with("    crank: {inertia: 1}\n"), 15, 5,
+               "linkage.counter_rotations.crank: missing required key 'at'");
+  expect_error(
+      with("    crank: {inertia: 1, at: [0, -1], radius: 2}\n"), 15, 38,
+      "unknown key 'radius' in linkage.counter_rotations.crank; allowed keys: inertia, at");
+  expect_error(with("    coupler: {inertia: 1, at: [0, -1]}\n"), 15, 5,
+               "unknown key 'coupler' in linkage.counter_rotations; allowed keys: crank, rocker");
+  expect_error(with("    crank: {inertia: 1, at: [0]}\n"), 15, 29,
+               "linkage.counter_rotations.crank.at must be a list of 2 numbers [x, y] in m");
+}
+
+// ---- balance ----
+
+// kBase with a Berkof coupler (f2 = 0, I2 = m2 e2 (l2 - e2) = 3 * 1.2 * 1.8)
+std::string berkof() {
+  return edit("  coupler: {length: 3.0, mass: 3.0, s: 1.45, sigma: 0.4, inertia: 3.1}\n",
+              "  coupler: {length: 3.0, mass: 3.0, e: 1.2, f: 0.0, inertia: 6.48}\n");
+}
+
+TEST(LoadStudy, ForceBalanceAloneSynthesisesTheDesignAtLoadTime) {
+  const Study s = parse_study(kBase + "balance: {force: full}\n", "study.yaml");
+  ASSERT_TRUE(s.balance.has_value());
+  const BalancedDesign& b = *s.balance;
+  EXPECT_TRUE(b.request.force);
+  EXPECT_FALSE(b.request.moment);
+  EXPECT_TRUE(b.conditions.force_balanced()) << b.conditions.text();
+  ASSERT_TRUE(b.crank_counterweight.has_value());
+  ASSERT_TRUE(b.rocker_counterweight.has_value());
+  // default: point masses at distances l1 and l3 from their pivots
+  EXPECT_NEAR(b.crank_counterweight->distance, 1.0, 1e-15);
+  EXPECT_NEAR(b.rocker_counterweight->distance, 2.0, 1e-15);
+  EXPECT_EQ(b.crank_counterweight->inertia, 0.0);
+  EXPECT_DOUBLE_EQ(b.added_mass, b.crank_counterweight->mass + b.rocker_counterweight->mass);
+  EXPECT_GT(b.model.crank.mass, s.model.crank.mass);  // the original is kept as it was
+  EXPECT_EQ(s.model.crank.mass, 2.1);
+  EXPECT_EQ(b.model.coupler.mass, s.model.coupler.mass);
+  EXPECT_FALSE(core::has_counter_rotations(b.model));
+
+  // `balance:` with nothing under it: the defaults (force full, moment none)
+  const Study d = parse_study(kBase + "balance:\n", "study.yaml");
+  ASSERT_TRUE(d.balance.has_value());
+  EXPECT_TRUE(d.balance->request.force);
+  EXPECT_FALSE(d.balance->request.moment);
+  EXPECT_EQ(d.balance->model.crank.mass, b.model.crank.mass);
+
+  // force: none leaves the design as it is
+  const Study n = parse_study(kBase + "balance: {force: none}\n", "study.yaml");
+  ASSERT_TRUE(n.balance.has_value());
+  EXPECT_FALSE(n.balance->crank_counterweight.has_value());
+  EXPECT_EQ(n.balance->model.crank.mass, 2.1);
+  EXPECT_EQ(n.balance->added_mass, 0.0);
+}
+
+TEST(LoadStudy, CounterweightSpecsReachTheSynthesis) {
+  const Study s = parse_study(kBase +
+                                  "balance:\n"
+                                  "  counterweights:\n"
+                                  "    crank:  {mass: 2.0}\n"
+                                  "    rocker: {distance: 0.8}\n",
+                              "study.yaml");
+  ASSERT_TRUE(s.balance && s.balance->crank_counterweight && s.balance->rocker_counterweight);
+  EXPECT_EQ(s.balance->request.crank_counterweight.mass, 2.0);
+  EXPECT_EQ(s.balance->crank_counterweight->mass, 2.0);
+  EXPECT_EQ(s.balance->rocker_counterweight->distance, 0.8);
+  EXPECT_TRUE(s.balance->conditions.force_balanced());
+
+  // discs: of a given size (position solved), or at a given distance (mass and radius solved)
+  const Study d = parse_study(kBase +
+                                  "balance:\n"
+                                  "  counterweights:\n"
+                                  "    crank:  {shape: disc, radius: 0.12, thickness: 0.02, "
+                                  "density: 7850}\n"
+                                  "    rocker: {shape: disc, distance: 0.8, thickness: 0.03}\n",
+                              "study.yaml");
+  const BalanceRequest& q = d.balance->request;
+  EXPECT_EQ(q.crank_counterweight.shape, balance::CounterweightShape::kDisc);
+  EXPECT_EQ(q.crank_counterweight.radius, 0.12);
+  EXPECT_EQ(q.crank_counterweight.thickness, 0.02);
+  EXPECT_EQ(q.crank_counterweight.density, 7850.0);
+  EXPECT_EQ(q.rocker_counterweight.thickness, 0.03);
+  EXPECT_EQ(q.rocker_counterweight.density, 7850.0);  // default: steel
+  const balance::Counterweight& c = *d.balance->crank_counterweight;
+  EXPECT_NEAR(c.mass, 7850 * M_PI * 0.12 * 0.12 * 0.02, 1e-12);
+  EXPECT_EQ(c.radius, 0.12);
+  EXPECT_NEAR(c.inertia, 0.5 * c.mass * 0.12 * 0.12, 1e-15);
+  EXPECT_EQ(d.balance->rocker_counterweight->distance, 0.8);
+  EXPECT_GT(d.balance->rocker_counterweight->radius, 0.0);
+  EXPECT_TRUE(d.balance->conditions.force_balanced());
+}
+
+TEST(LoadStudy, MomentBalanceOfABerkofCoupler) {
+  const Study s = parse_study(berkof() + "balance: {force: full, moment: full}\n", "study.yaml");
+  ASSERT_TRUE(s.balance.has_value());
+  const BalancedDesign& b = *s.balance;
+  EXPECT_TRUE(b.conditions.moment_balanced()) << b.conditions.text();
+  // default shafts (0, -l1) and (l4, -l3)
+  EXPECT_EQ(b.model.counter_rotations.crank.at, Vec2(0, -1.0));
+  EXPECT_EQ(b.model.counter_rotations.rocker.at, Vec2(3.2, -2.0));
+  EXPECT_GT(b.model.counter_rotations.crank.inertia, 0.0);
+  const double J =
+      b.model.counter_rotations.crank.inertia + b.model.counter_rotations.rocker.inertia;
+  const double counterweights = b.added_inertia - J;
+  EXPECT_GE(counterweights, 0.0);  // point masses: m d^2 about the pivots
+
+  const Study at = parse_study(berkof() +
+                                   "balance:\n"
+                                   "  moment: full\n"
+                                   "  counter_rotations:\n"
+                                   "    crank:  {at: [0.0, -0.5]}\n"
+                                   "    rocker: {at: [3.2, 1.5]}\n",
+                               "study.yaml");
+  EXPECT_EQ(at.balance->model.counter_rotations.crank.at, Vec2(0, -0.5));
+  EXPECT_EQ(at.balance->model.counter_rotations.rocker.at, Vec2(3.2, 1.5));
+}
+
+TEST(LoadStudy, BalanceMistakesAreReportedWhereTheyAre) {
+  // the balance layer's own verdict, at the `moment` value
+  {
+    const StudyError e = error_of(kBase + "balance:\n  force: full\n  moment: full\n");
+    EXPECT_EQ(e.line(), 20);
+    EXPECT_EQ(e.column(), 11);
+    EXPECT_EQ(e.message().rfind("balance.moment: full is not possible: ", 0), 0u) << e.what();
+    EXPECT_NE(e.message().find("Berkof coupler"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+  }
+  expect_error(kBase + "balance: {force: none, moment: full}\n", 18, 32,
+               "balance.moment: full needs balance.force: full");
+  expect_error(kBase + "balance: {force: partial}\n", 18, 18,
+               "balance.force must be full or none, got 'partial'");
+  expect_error(kBase + "balance: {moment: half}\n", 18, 19,
+               "balance.moment must be full or none, got 'half'");
+  expect_error(kBase + "balance: {torque: full}\n", 18, 11,
+               "unknown key 'torque' in balance; allowed keys: force, moment, counterweights, "
+               "counter_rotations");
+  expect_error(kBase + "balance: full\n", 18, 10, "balance must be a map");
+  const std::string cw = kBase + "balance:\n  counterweights:\n";  // the side is line 20
+  expect_error(cw + "    crank: {weight: 2}\n", 20, 13,
+               "unknown key 'weight' in balance.counterweights.crank; allowed keys: shape, mass, "
+               "distance, radius, thickness, density");
+  expect_error(cw + "    coupler: {mass: 2}\n", 20, 5,
+               "unknown key 'coupler' in balance.counterweights; allowed keys: crank, rocker");
+  expect_error(cw + "    crank: {mass: -1}\n", 20, 19,
+               "balance.counterweights.crank.mass must be > 0 kg, got -1");
+  expect_error(cw + "    rocker: {distance: 0}\n", 20, 24,
+               "balance.counterweights.rocker.distance must be > 0 m, got 0");
+  expect_error(cw + "    crank: {mass: 2, distance: 1}\n", 20, 22,
+               "balance.counterweights.crank: give at most one of mass, distance and radius");
+  expect_error(cw + "    crank: {radius: 0.1}\n", 20, 13,
+               "balance.counterweights.crank.radius needs shape: disc");
+  expect_error(cw + "    crank: {shape: cube}\n", 20, 20,
+               "balance.counterweights.crank.shape must be point or disc, got 'cube'");
+  expect_error(cw + "    crank: {shape: disc, density: -7850}\n", 20, 35,
+               "balance.counterweights.crank.density must be > 0 kg/m^3, got -7850");
+  expect_error(cw + "    crank: {mass: abc}\n", 20, 19,
+               "balance.counterweights.crank.mass must be a number in kg, got 'abc'");
+  // keys that would be ignored are errors
+  expect_error(kBase + "balance:\n  force: none\n  counterweights: {crank: {mass: 2}}\n", 20, 3,
+               "balance.counterweights are used only with balance.force: full");
+  expect_error(kBase + "balance:\n  counter_rotations: {crank: {at: [0, -1]}}\n", 19, 3,
+               "balance.counter_rotations are used only with balance.moment: full");
+  const std::string cr = berkof() + "balance:\n  moment: full\n  counter_rotations:\n";  // line 21
+  expect_error(cr + "    crank: {at: [0, 0]}\n", 21, 17,
+               "balance.counter_rotations.crank.at must differ from the crank's pivot A0");
+  expect_error(cr + "    rocker: {at: [3.2, 0]}\n", 21, 18,
+               "balance.counter_rotations.rocker.at must differ from the rocker's pivot A3");
+  expect_error(cr + "    rocker: {inertia: 2, at: [3.2, -1]}\n", 21, 14,
+               "unknown key 'inertia' in balance.counter_rotations.rocker; allowed keys: at");
+  expect_error(cr + "    rocker: {}\n", 21, 5,
+               "balance.counter_rotations.rocker: missing required key 'at'");
+  // balanced.yaml is named <name>-balanced, which must still be a valid name
+  expect_error(edit("name: t\n", "name: " + std::string(92, 'a') + "\n") + "balance:\n", 1, 7,
+               "name must have at most 91 characters in a study with a balance section");
+  EXPECT_NO_THROW(
+      parse_study(edit("name: t\n", "name: " + std::string(92, 'a') + "\n"), "study.yaml"));
+}
+
+TEST(LoadStudy, BalanceExamplesLoad) {
+  const Study f =
+      load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven-force-balanced.yaml");
+  ASSERT_TRUE(f.balance.has_value());
+  EXPECT_TRUE(f.balance->conditions.force_balanced());
+  EXPECT_FALSE(f.balance->request.moment);
+  const Study m = load_study(BD_SOURCE_DIR "/studies/examples/berkof-inline-moment-balanced.yaml");
+  ASSERT_TRUE(m.balance.has_value());
+  EXPECT_TRUE(m.balance->conditions.moment_balanced());
+  EXPECT_EQ(m.model.coupler.inertia, 6.48);
+}
+
 }  // namespace
 }  // namespace bd::studies

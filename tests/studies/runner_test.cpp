@@ -6,15 +6,20 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "studies/load_study.hpp"
+#include "tests/support/csv.hpp"
+#include "tests/support/models.hpp"
 
 namespace bd::studies {
 namespace {
@@ -189,6 +194,226 @@ TEST_F(RunnerTest, InvalidSceneCreatesNothing) {
   const fs::path out = dir_ / "never";
   EXPECT_THROW(run_study(study, out), InputError);
   EXPECT_FALSE(fs::exists(out));
+}
+
+// ---- balance studies ----
+
+const std::set<std::string> kBalanceFiles = {"balanced-timeseries.csv", "balanced.yaml",
+                                             "comparison.csv", "summary.json", "timeseries.csv"};
+
+// the value of `"key": ` in the JSON text after `from` (a number or null)
+std::string json_value(const std::string& json, const std::string& key, std::size_t from = 0) {
+  const std::string k = "\"" + key + "\": ";
+  const auto at = json.find(k, from);
+  if (at == std::string::npos) return "missing";
+  const auto begin = at + k.size();
+  return json.substr(begin, json.find_first_of(",\n}", begin) - begin);
+}
+
+TEST_F(RunnerTest, MomentBalanceStudyWritesBothDesignsAndTheComparison) {
+  const Study study =
+      load_study(BD_SOURCE_DIR "/studies/examples/berkof-inline-moment-balanced.yaml");
+  const RunResult r = run_study(study, dir_);
+  ASSERT_TRUE(r.ok()) << r.trajectory.message;
+  ASSERT_TRUE(r.balanced.has_value());
+  const BalancedRun& b = *r.balanced;
+  ASSERT_TRUE(b.trajectory.ok()) << b.trajectory.message;
+  EXPECT_EQ(names_in(dir_), kBalanceFiles);
+  EXPECT_EQ(b.timeseries, dir_ / "balanced-timeseries.csv");
+  EXPECT_EQ(b.study_file, dir_ / "balanced.yaml");
+  EXPECT_EQ(b.comparison, dir_ / "comparison.csv");
+  EXPECT_EQ(b.method.formulation, choose_method(balanced_study(study)).formulation);
+
+  // timeseries.csv is the original's, balanced-timeseries.csv the balanced design's
+  expect_rows_match(lines_of(read(r.timeseries)), r.trajectory);
+  const std::vector<std::string> rows = lines_of(read(b.timeseries));
+  EXPECT_EQ(rows[0], kTimeseriesHeader);
+  expect_rows_match(rows, b.trajectory);
+
+  // shaking force and moment vanish to round-off, measured against the original's
+  EXPECT_GT(r.metrics.Fsh_max, 100.0);
+  EXPECT_LT(b.metrics.Fsh_max, 1e-12 * r.metrics.Fsh_max);
+  EXPECT_LT(b.metrics.Msh_max, 1e-12 * r.metrics.Msh_max);
+  EXPECT_GT(b.metrics.tau_max, r.metrics.tau_max);  // the price: discs to accelerate
+}
+
+TEST_F(RunnerTest, ComparisonCsvHasEveryMetricBeforeAfterAndRatio) {
+  const Study study =
+      load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven-force-balanced.yaml");
+  const RunResult r = run_study(study, dir_);
+  ASSERT_TRUE(r.ok()) << r.trajectory.message;
+  EXPECT_EQ(names_in(dir_), kBalanceFiles);
+  const std::vector<std::string> lines = lines_of(read(r.balanced->comparison));
+  ASSERT_EQ(lines.size(), 13u);
+  EXPECT_EQ(lines[0], "metric,before,after,ratio");
+  const char* names[] = {"Fsh_rms", "Fsh_max", "Msh_rms", "Msh_max", "tau_rms",    "tau_max",
+                         "RA0_rms", "RA0_max", "RA3_rms", "RA3_max", "added_mass", "added_inertia"};
+  const core::Metrics& a = r.metrics;
+  const core::Metrics& z = r.balanced->metrics;
+  const double before[] = {a.Fsh_rms, a.Fsh_max, a.Msh_rms, a.Msh_max, a.tau_rms, a.tau_max,
+                           a.RA0_rms, a.RA0_max, a.RA3_rms, a.RA3_max, 0.0,       0.0};
+  const double after[] = {z.Fsh_rms,
+                          z.Fsh_max,
+                          z.Msh_rms,
+                          z.Msh_max,
+                          z.tau_rms,
+                          z.tau_max,
+                          z.RA0_rms,
+                          z.RA0_max,
+                          z.RA3_rms,
+                          z.RA3_max,
+                          study.balance->added_mass,
+                          study.balance->added_inertia};
+  for (std::size_t i = 0; i < 12; ++i) {
+    const std::string& line = lines[i + 1];
+    const auto comma = line.find(',');
+    EXPECT_EQ(line.substr(0, comma), names[i]);
+    const std::vector<double> v =
+        fields_of(line.substr(comma + 1) + (line.back() == ',' ? "0" : ""));
+    ASSERT_EQ(v.size(), 3u) << line;
+    EXPECT_EQ(v[0], before[i]) << line;  // %.17g: bit for bit
+    EXPECT_EQ(v[1], after[i]) << line;
+    if (before[i] == 0) {
+      EXPECT_EQ(line.back(), ',') << "ratio must be empty: " << line;
+    } else {
+      EXPECT_EQ(v[2], after[i] / before[i]) << line;
+    }
+  }
+  // RA0_rms, RA3_rms: RMS of the magnitudes over the samples
+  double sq0 = 0, sq3 = 0;
+  for (const core::DynamicsSample& d : r.trajectory.samples) {
+    sq0 += d.RA0.squaredNorm();
+    sq3 += d.RA3.squaredNorm();
+  }
+  const double n = static_cast<double>(r.trajectory.samples.size());
+  EXPECT_NEAR(a.RA0_rms, std::sqrt(sq0 / n), 1e-13 * a.RA0_rms);
+  EXPECT_NEAR(a.RA3_rms, std::sqrt(sq3 / n), 1e-13 * a.RA3_rms);
+  // force balanced: the shaking force is gone, |RA0| = |RA3| since RA0 + RA3 = 0
+  EXPECT_LT(z.Fsh_max, 1e-12 * a.Fsh_max);
+  EXPECT_NEAR(z.RA0_rms, z.RA3_rms, 1e-12 * z.RA0_rms);
+  EXPECT_GT(study.balance->added_mass, 0.0);
+}
+
+TEST_F(RunnerTest, SummaryJsonExtendsTheContractWithTheBalancedDesign) {
+  const Study study =
+      load_study(BD_SOURCE_DIR "/studies/examples/berkof-inline-moment-balanced.yaml");
+  const RunResult r = run_study(study, dir_);
+  ASSERT_TRUE(r.ok());
+  const std::string json = read(r.summary);
+  // the v1 keys, for the original design
+  for (const char* key : {"\"study\": \"berkof-inline-moment-balanced\"", "\"method\"",
+                          "\"scene\": {\"type\": \"driven\"", "\"ok\": true", "\"metrics\"",
+                          "\"RA0_max\"", "\"RA0_rms\"", "\"RA3_rms\""}) {
+    EXPECT_NE(json.find(key), std::string::npos) << key << " missing in\n" << json;
+  }
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "\"Fsh_max\": %.17g", r.metrics.Fsh_max);
+  EXPECT_LT(json.find(buf), json.find("\"balance\"")) << "metrics are the original's";
+  // the balance section
+  for (const char* key : {"\"balance\": {",
+                          "\"force\": \"full\"",
+                          "\"moment\": \"full\"",
+                          "\"counterweights\": [",
+                          "{\"link\": \"crank\", \"shape\": \"point\", \"mass\": ",
+                          "\"position\": [",
+                          "\"distance\": ",
+                          "\"radius\": ",
+                          "\"thickness\": ",
+                          "\"counter_rotations\": [",
+                          "{\"link\": \"rocker\", \"inertia\": ",
+                          "\"at\": [",
+                          "\"added_mass\": ",
+                          "\"added_inertia\": ",
+                          "\"force_balanced\": true",
+                          "\"moment_balanced\": true",
+                          "\"conditions\": [",
+                          "{\"name\": \"force.crank\", \"residual\": ",
+                          "\"holds\": true",
+                          "\"balanced_run\": {",
+                          "\"study\": \"berkof-inline-moment-balanced-balanced\"",
+                          "\"balanced_metrics\": {",
+                          "\"reduction\": {"}) {
+    EXPECT_NE(json.find(key), std::string::npos) << key << " missing in\n" << json;
+  }
+  EXPECT_EQ(json.find("\"holds\": false"), std::string::npos) << json;
+  std::snprintf(buf, sizeof buf, "%.17g", study.balance->added_mass);
+  EXPECT_EQ(json_value(json, "added_mass"), buf);
+  // reduction = balanced / original, per metric
+  const auto red = json.find("\"reduction\"");
+  std::snprintf(buf, sizeof buf, "%.17g", r.balanced->metrics.tau_max / r.metrics.tau_max);
+  EXPECT_EQ(json_value(json, "tau_max", red), buf);
+  std::snprintf(buf, sizeof buf, "%.17g", r.balanced->metrics.RA3_rms / r.metrics.RA3_rms);
+  EXPECT_EQ(json_value(json, "RA3_rms", red), buf);
+  std::snprintf(buf, sizeof buf, "%.17g", r.balanced->metrics.Msh_max);
+  EXPECT_EQ(json_value(json, "Msh_max", json.find("\"balanced_metrics\"")), buf);
+  EXPECT_EQ(json.back(), '\n');
+  EXPECT_EQ(json[json.size() - 2], '}');
+}
+
+TEST_F(RunnerTest, ZeroOriginalMetricGivesNullReductionAndEmptyRatio) {
+  // a free scene has no drive torque: tau is 0 before and after
+  const std::string text =
+      read(BD_SOURCE_DIR "/studies/examples/paper-fourbar.yaml") + "balance: {force: full}\n";
+  const Study study = parse_study(text, "free.yaml");
+  const RunResult r = run_study(study, dir_);
+  ASSERT_TRUE(r.ok()) << r.trajectory.message << " / " << r.balanced->trajectory.message;
+  const std::string json = read(r.summary);
+  const auto red = json.find("\"reduction\"");
+  EXPECT_EQ(json_value(json, "tau_rms", red), "null");
+  EXPECT_EQ(json_value(json, "tau_max", red), "null");
+  EXPECT_NE(json_value(json, "Fsh_rms", red), "null");
+  const std::string csv = read(r.balanced->comparison);
+  EXPECT_NE(csv.find("\ntau_rms,0,0,\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\nadded_mass,0,"), std::string::npos) << csv;
+}
+
+TEST_F(RunnerTest, BalancedYamlLoadsBackToTheSynthesisedDesignAndReproducesItsRun) {
+  for (const char* example :
+       {"berkof-inline-moment-balanced.yaml", "paper-fourbar-driven-force-balanced.yaml"}) {
+    SCOPED_TRACE(example);
+    const Study study = load_study(std::string(BD_SOURCE_DIR "/studies/examples/") + example);
+    const fs::path out = dir_ / example;
+    const RunResult r = run_study(study, out);
+    ASSERT_TRUE(r.ok());
+    const std::string text = read(r.balanced->study_file);
+    EXPECT_EQ(text.rfind("# The balanced design of study '" + study.name + "'", 0), 0u) << text;
+    EXPECT_EQ(text.find("balance:"), std::string::npos) << "no balance section:\n" << text;
+
+    // the same model: every number bit for bit except e, f, which balanced.yaml writes in the
+    // polar form s, sigma and so come back within a few ulps of s
+    const Study back = load_study(r.balanced->study_file.string());
+    EXPECT_EQ(back.name, study.name + "-balanced");
+    EXPECT_FALSE(back.balance.has_value());
+    bd::testing::expect_same_model(study.balance->model, back.model);
+
+    // and running it reproduces balanced-timeseries.csv: inputs a few ulps apart, outputs within
+    // 1e-12 of each column's scale (the dynamics is well conditioned away from dead centres)
+    const RunResult again = run_study(back, out / "again");
+    ASSERT_TRUE(again.ok());
+    EXPECT_EQ(again.method.formulation, r.balanced->method.formulation);
+    bd::testing::expect_same_numbers(again.timeseries, r.balanced->timeseries, 1e-12);
+  }
+}
+
+TEST_F(RunnerTest, BalanceStudyStoppedEarlyKeepsEveryFile) {
+  // the crank (2.5) cannot turn fully: both designs stop where the loop cannot close
+  Study study =
+      load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven-force-balanced.yaml");
+  study.model.crank = core::link_from_polar(2.5, 2.1, 0.6, 0.3, 1.1);
+  study.balance = balance_design(study.model, study.balance->request);
+  std::get<core::DrivenScene>(study.scene).theta1 = M_PI / 2;
+  const RunResult r = run_study(study, dir_);
+  EXPECT_FALSE(r.ok());
+  ASSERT_TRUE(r.balanced.has_value());
+  EXPECT_FALSE(r.balanced->trajectory.ok());
+  EXPECT_FALSE(r.balanced->trajectory.samples.empty());
+  EXPECT_EQ(names_in(dir_), kBalanceFiles);
+  expect_rows_match(lines_of(read(r.balanced->timeseries)), r.balanced->trajectory);
+  const std::string json = read(r.summary);
+  const auto run = json.find("\"balanced_run\"");
+  ASSERT_NE(run, std::string::npos);
+  EXPECT_EQ(json_value(json, "ok", run), "false");
+  EXPECT_NE(json.find(json_string(r.balanced->trajectory.message), run), std::string::npos);
 }
 
 TEST(JsonString, EscapesWhatJsonRequires) {
