@@ -1,0 +1,116 @@
+// Timings of the optimisation layer on the paper's four-bar (no loads), driven at 1 rev/s with
+// 360 samples per revolution, counterweights on crank and rocker (docs/performance.md):
+// - one evaluation of the program by the regressor: the objective with its gradient, and the
+//   whole program (objective, equalities and inequalities with their Jacobians);
+// - one fresh driven simulation of the same design (core::simulate_driven, what an evaluation
+//   would cost without the regressor), and of one revolution's metrics from it;
+// - one whole optimisation of the Berkof–Lowen problem (force balance as equalities, least RMS
+//   shaking moment) by SLSQP and by Ipopt.
+#include <benchmark/benchmark.h>
+
+#include <numbers>
+
+#include "core/metrics.hpp"
+#include "core/samples.hpp"
+#include "core/simulate.hpp"
+#include "optimize/nlp.hpp"
+#include "optimize/optimize.hpp"
+
+namespace {
+
+using namespace bd;
+using namespace bd::optimize;
+
+DesignProblem berkof_lowen() {
+  DesignProblem p;
+  p.original = core::samples::paper_fourbar_unloaded();
+  p.scene = core::DrivenScene{
+      .theta1 = 0.0, .omega1 = 2.0 * std::numbers::pi, .revolutions = 1, .samples = 360};
+  p.formulation = core::Formulation::kComplexMasses;
+  p.counterweights = {CounterweightVariables{.link = 1, .mass_max = 10.0, .distance_max = 1.0},
+                      CounterweightVariables{.link = 3, .mass_max = 10.0, .distance_max = 1.0}};
+  p.objective = {Term{Metric::kMshRms, 1.0}};
+  p.force_balance = true;
+  return p;
+}
+
+// a design point a little away from the start, nudged every iteration so nothing is hoisted
+Eigen::VectorXd nudged(const Nlp& nlp, Eigen::VectorXd& x) {
+  x[0] = x[0] < 0.5 * nlp.upper()[0] ? x[0] + 1e-9 : x[0] - 1e-9;
+  return x;
+}
+
+void BM_NlpObjectiveWithGradient(benchmark::State& state) {
+  const Nlp nlp(berkof_lowen());
+  Eigen::VectorXd x = nlp.start(), g(nlp.n());
+  for (auto _ : state) {
+    double f = nlp.objective(nudged(nlp, x), &g);
+    benchmark::DoNotOptimize(f);
+    benchmark::DoNotOptimize(g.data());
+  }
+}
+BENCHMARK(BM_NlpObjectiveWithGradient)->Unit(benchmark::kMicrosecond);
+
+void BM_NlpEvaluationWithDerivatives(benchmark::State& state) {
+  const Nlp nlp(berkof_lowen());
+  Eigen::VectorXd x = nlp.start(), g(nlp.n()), ceq, cin;
+  Eigen::MatrixXd jeq, jin;
+  for (auto _ : state) {
+    double f = nlp.objective(nudged(nlp, x), &g);
+    nlp.equalities(x, ceq, &jeq);
+    nlp.inequalities(x, cin, &jin);
+    benchmark::DoNotOptimize(f);
+    benchmark::DoNotOptimize(cin.data());
+    benchmark::DoNotOptimize(jin.data());
+  }
+}
+BENCHMARK(BM_NlpEvaluationWithDerivatives)->Unit(benchmark::kMicrosecond);
+
+// the same design simulated afresh (no derivatives), and summarised
+void BM_DrivenSimulation(benchmark::State& state) {
+  const DesignProblem p = berkof_lowen();
+  const Nlp nlp(p);
+  Eigen::VectorXd x = nlp.start();
+  core::SimulateOptions options;
+  options.formulation = p.formulation;
+  for (auto _ : state) {
+    const core::Trajectory t =
+        core::simulate_driven(nlp.design(nudged(nlp, x)), std::get<core::DrivenScene>(p.scene),
+                              options);
+    core::Metrics m = core::metrics(t);
+    benchmark::DoNotOptimize(m);
+  }
+}
+BENCHMARK(BM_DrivenSimulation)->Unit(benchmark::kMicrosecond);
+
+// building the program: the regressor (one inverse-dynamics call per column per sample)
+void BM_NlpConstruction(benchmark::State& state) {
+  const DesignProblem p = berkof_lowen();
+  for (auto _ : state) {
+    const Nlp nlp(p);
+    benchmark::DoNotOptimize(&nlp);
+  }
+}
+BENCHMARK(BM_NlpConstruction)->Unit(benchmark::kMillisecond);
+
+void BM_Optimize(benchmark::State& state, Algorithm algorithm) {
+  const DesignProblem p = berkof_lowen();
+  OptimizeOptions options;
+  options.algorithm = algorithm;
+  int evaluations = 0, iterations = 0;
+  bool converged = true;
+  for (auto _ : state) {
+    const OptimizeResult r = bd::optimize::optimize(p, options);
+    evaluations = r.evaluations;
+    iterations = r.iterations;
+    converged = converged && r.termination == Termination::kConverged;
+    benchmark::DoNotOptimize(r.objective);
+  }
+  state.counters["evaluations"] = evaluations;
+  state.counters["iterations"] = iterations;
+  state.counters["converged"] = converged ? 1 : 0;
+}
+BENCHMARK_CAPTURE(BM_Optimize, slsqp, Algorithm::kSlsqp)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Optimize, ipopt, Algorithm::kIpopt)->Unit(benchmark::kMillisecond);
+
+}  // namespace

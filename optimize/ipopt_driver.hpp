@@ -1,0 +1,20 @@
+#pragma once
+/// Internal to bd_optimize (included by optimize.cpp only): the Ipopt driver. Ipopt's own
+/// headers appear only in ipopt_driver.cpp.
+#include <Eigen/Core>
+
+#include "optimize/nlopt_driver.hpp"  // DriverOutcome, TrackedNlp
+#include "optimize/nlp.hpp"
+#include "optimize/optimize.hpp"
+
+namespace bd::optimize::detail {
+
+/// Runs Ipopt's interior-point method from x0 with exact first derivatives (a dense Jacobian of
+/// the equalities, then the inequalities as g(x) <= 0) and a limited-memory (L-BFGS) Hessian of
+/// the Lagrangian. tol = options.relative_tolerance, constr_viol_tol =
+/// 0.1 · options.constraint_tolerance, max_iter = options.max_evaluations, and the run is stopped
+/// once options.max_evaluations objective evaluations are spent. Nothing is printed.
+DriverOutcome solve_with_ipopt(const Nlp& nlp, const Eigen::VectorXd& x0,
+                               const OptimizeOptions& options);
+
+}  // namespace bd::optimize::detail

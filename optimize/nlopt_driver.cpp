@@ -1,0 +1,461 @@
+#include "optimize/nlopt_driver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <random>
+#include <string>
+#include <vector>
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wconversion"
+#pragma GCC diagnostic ignored "-Wshadow"
+#include <nlopt.h>
+#pragma GCC diagnostic pop
+
+namespace bd::optimize::detail {
+
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+bool same_point(const VectorXd& a, const VectorXd& b) {
+  return a.size() == b.size() && a.size() > 0 && a == b;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// TrackedNlp
+
+TrackedNlp::TrackedNlp(const Nlp& nlp, double constraint_tolerance)
+    : nlp_(nlp), tolerance_(constraint_tolerance) {}
+
+double TrackedNlp::objective(const VectorXd& x, VectorXd* grad) {
+  const double f = nlp_.objective(x, grad);
+  ++evaluations_;
+  x_f_ = x;
+  f_ = f;
+  consider();
+  return f;
+}
+
+void TrackedNlp::equalities(const VectorXd& x, VectorXd& c, MatrixXd* jac) {
+  nlp_.equalities(x, c, jac);
+  x_eq_ = x;
+  violation_eq_ = c.size() > 0 ? c.cwiseAbs().maxCoeff() : 0.0;
+  if (!std::isfinite(violation_eq_)) violation_eq_ = std::numeric_limits<double>::infinity();
+  consider();
+}
+
+void TrackedNlp::inequalities(const VectorXd& x, VectorXd& c, MatrixXd* jac) {
+  nlp_.inequalities(x, c, jac);
+  x_in_ = x;
+  violation_in_ = c.size() > 0 ? std::max(0.0, c.maxCoeff()) : 0.0;
+  if (!std::isfinite(violation_in_)) violation_in_ = std::numeric_limits<double>::infinity();
+  consider();
+}
+
+void TrackedNlp::consider() {
+  // f, c_eq and c_in must all be known at the same x (a part without constraints is always known)
+  if (x_f_.size() == 0 || !std::isfinite(f_)) return;
+  if (nlp_.n_eq() > 0 && !same_point(x_f_, x_eq_)) return;
+  if (nlp_.n_ineq() > 0 && !same_point(x_f_, x_in_)) return;
+  const double violation = std::max(nlp_.n_eq() > 0 ? violation_eq_ : 0.0,
+                                    nlp_.n_ineq() > 0 ? violation_in_ : 0.0);
+  if (violation > tolerance_ || f_ >= best_f_) return;
+  has_best_ = true;
+  best_f_ = f_;
+  best_x_ = x_f_;
+}
+
+double constraint_violation(const Nlp& nlp, const VectorXd& x, int* worst, double* value) {
+  double largest = 0.0;
+  int index = -1;
+  double at = 0.0;
+  VectorXd c;
+  if (nlp.n_eq() > 0) {
+    nlp.equalities(x, c, nullptr);
+    for (int i = 0; i < c.size(); ++i) {
+      const double v = std::isfinite(c[i]) ? std::abs(c[i]) : std::numeric_limits<double>::infinity();
+      if (v > largest) largest = v, index = i, at = c[i];
+    }
+  }
+  if (nlp.n_ineq() > 0) {
+    nlp.inequalities(x, c, nullptr);
+    for (int i = 0; i < c.size(); ++i) {
+      const double v = std::isfinite(c[i]) ? c[i] : std::numeric_limits<double>::infinity();
+      if (v > largest) largest = v, index = nlp.n_eq() + i, at = c[i];
+    }
+  }
+  if (worst) *worst = index;
+  if (value) *value = at;
+  return largest;
+}
+
+// ---------------------------------------------------------------------------------------------
+// NLopt
+
+namespace {
+
+// what the callbacks share; NLopt's C callbacks must not throw, so an exception is stored here,
+// the run is stopped, and the message is reported
+struct Context {
+  TrackedNlp* tracked{};
+  nlopt_opt opt{};
+  double delta{};  // mma: how far the inequalities are tightened
+  VectorXd x, grad, c;
+  MatrixXd jac;
+  std::string error;  // what a callback threw
+};
+
+void fail(Context& ctx, const std::exception& e) {
+  if (ctx.error.empty()) ctx.error = e.what();
+  nlopt_force_stop(ctx.opt);
+}
+
+double objective_cb(unsigned n, const double* x, double* grad, void* data) {
+  Context& ctx = *static_cast<Context*>(data);
+  try {
+    ctx.x = Eigen::Map<const VectorXd>(x, n);
+    double f;
+    if (grad) {
+      ctx.grad.resize(n);
+      f = ctx.tracked->objective(ctx.x, &ctx.grad);
+      Eigen::Map<VectorXd>(grad, n) = ctx.grad;
+    } else {
+      f = ctx.tracked->objective(ctx.x, nullptr);
+    }
+    // a design the evaluation cannot handle is infinitely bad, never NaN
+    return std::isfinite(f) ? f : HUGE_VAL;
+  } catch (const std::exception& e) {
+    fail(ctx, e);
+    return HUGE_VAL;
+  }
+}
+
+// c_eq(x) = 0 as one vector constraint; NLopt's gradient is m x n row-major
+void equalities_cb(unsigned m, double* result, unsigned n, const double* x, double* gradient,
+                   void* data) {
+  Context& ctx = *static_cast<Context*>(data);
+  try {
+    ctx.x = Eigen::Map<const VectorXd>(x, n);
+    ctx.tracked->equalities(ctx.x, ctx.c, gradient ? &ctx.jac : nullptr);
+    Eigen::Map<VectorXd>(result, m) = ctx.c;
+    if (gradient) Eigen::Map<RowMajorMatrix>(gradient, m, n) = ctx.jac;
+  } catch (const std::exception& e) {
+    fail(ctx, e);
+    std::fill(result, result + m, HUGE_VAL);
+  }
+}
+
+void inequalities_cb(unsigned m, double* result, unsigned n, const double* x, double* gradient,
+                     void* data) {
+  Context& ctx = *static_cast<Context*>(data);
+  try {
+    ctx.x = Eigen::Map<const VectorXd>(x, n);
+    ctx.tracked->inequalities(ctx.x, ctx.c, gradient ? &ctx.jac : nullptr);
+    Eigen::Map<VectorXd>(result, m) = ctx.c;
+    if (gradient) Eigen::Map<RowMajorMatrix>(gradient, m, n) = ctx.jac;
+  } catch (const std::exception& e) {
+    fail(ctx, e);
+    std::fill(result, result + m, HUGE_VAL);
+  }
+}
+
+// mma: c_in + δ <= 0 (MMA's last iterates may lie slightly outside the constraints)
+void tightened_inequalities_cb(unsigned m, double* result, unsigned n, const double* x,
+                               double* gradient, void* data) {
+  inequalities_cb(m, result, n, x, gradient, data);
+  const Context& ctx = *static_cast<const Context*>(data);
+  for (unsigned i = 0; i < m; ++i) result[i] += ctx.delta;
+}
+
+Termination termination_of(nlopt_result r) {
+  switch (r) {
+    case NLOPT_SUCCESS:
+    case NLOPT_STOPVAL_REACHED:
+    case NLOPT_FTOL_REACHED:
+    case NLOPT_XTOL_REACHED:
+      return Termination::kConverged;
+    case NLOPT_MAXEVAL_REACHED:
+    case NLOPT_MAXTIME_REACHED:
+      return Termination::kMaxEvaluations;
+    default:
+      return Termination::kFailed;
+  }
+}
+
+std::string describe(nlopt_result r) {
+  switch (r) {
+    case NLOPT_SUCCESS: return "success";
+    case NLOPT_STOPVAL_REACHED: return "stopval reached";
+    case NLOPT_FTOL_REACHED: return "ftol_rel reached";
+    case NLOPT_XTOL_REACHED: return "xtol_rel reached";
+    case NLOPT_MAXEVAL_REACHED: return "evaluation budget spent";
+    case NLOPT_MAXTIME_REACHED: return "time budget spent";
+    case NLOPT_FAILURE: return "generic failure";
+    case NLOPT_INVALID_ARGS: return "invalid arguments";
+    case NLOPT_OUT_OF_MEMORY: return "out of memory";
+    case NLOPT_ROUNDOFF_LIMITED: return "roundoff errors limited progress";
+    case NLOPT_FORCED_STOP: return "forced stop";
+    default: return "unknown NLopt result " + std::to_string(static_cast<int>(r));
+  }
+}
+
+const char* nlopt_name(Algorithm a) {
+  switch (a) {
+    case Algorithm::kSlsqp: return "NLopt LD_SLSQP";
+    case Algorithm::kMma: return "NLopt LD_MMA";
+    case Algorithm::kMlsl: return "multistart of NLopt LD_SLSQP";
+    case Algorithm::kIsres: return "NLopt GN_ISRES";
+    case Algorithm::kCobyla: return "NLopt LN_COBYLA";
+    case Algorithm::kIpopt: break;
+  }
+  return "NLopt";
+}
+
+// bounds a global method can sample: an infinite bound becomes x0 ± 10 max(1, |x0|)
+void finite_bounds(const VectorXd& x0, VectorXd& lower, VectorXd& upper) {
+  for (int i = 0; i < x0.size(); ++i) {
+    const double reach = 10.0 * std::max(1.0, std::abs(x0[i]));
+    if (!std::isfinite(lower[i])) lower[i] = std::min(x0[i], upper[i]) - reach;
+    if (!std::isfinite(upper[i])) upper[i] = std::max(x0[i], lower[i]) + reach;
+  }
+}
+
+// one NLopt run: the outcome with the point NLopt returned and its objective
+struct Run {
+  nlopt_result result{NLOPT_FAILURE};
+  VectorXd x;
+  double f = HUGE_VAL;
+  std::string error;   // a callback's exception or NLopt's own error message
+};
+
+Run run_nlopt(nlopt_algorithm algorithm, bool mma, TrackedNlp& tracked, const VectorXd& x0,
+              const VectorXd& lower, const VectorXd& upper, int max_evaluations,
+              const OptimizeOptions& options, bool stop_on_tolerances) {
+  const Nlp& nlp = tracked.nlp();
+  const unsigned n = static_cast<unsigned>(nlp.n());
+  Run run;
+  Context ctx;
+  ctx.tracked = &tracked;
+  ctx.delta = 0.5 * options.constraint_tolerance;
+  ctx.opt = nlopt_create(algorithm, n);
+  if (!ctx.opt) {
+    run.error = "nlopt_create failed";
+    return run;
+  }
+  // the options; any failure here is an invalid argument, reported as such
+  nlopt_result status = NLOPT_SUCCESS;
+  auto check = [&status](nlopt_result r) {
+    if (r < 0 && status >= 0) status = r;
+  };
+  check(nlopt_set_lower_bounds(ctx.opt, lower.data()));
+  check(nlopt_set_upper_bounds(ctx.opt, upper.data()));
+  check(nlopt_set_min_objective(ctx.opt, objective_cb, &ctx));
+  const double tol = 0.1 * options.constraint_tolerance;
+  const unsigned n_eq = static_cast<unsigned>(nlp.n_eq());
+  const unsigned n_in = static_cast<unsigned>(nlp.n_ineq());
+  if (n_eq > 0) {  // optimize() refuses equalities with mma
+    const std::vector<double> tols(n_eq, tol);
+    check(nlopt_add_equality_mconstraint(ctx.opt, n_eq, equalities_cb, &ctx, tols.data()));
+  }
+  if (n_in > 0) {
+    if (mma) {
+      // MMA's iterates approach the constraints' boundary from either side: tightened by δ
+      check(nlopt_add_inequality_mconstraint(ctx.opt, n_in, tightened_inequalities_cb, &ctx,
+                                             std::vector<double>(n_in, 0.0).data()));
+    } else {
+      const std::vector<double> tols(n_in, tol);
+      check(nlopt_add_inequality_mconstraint(ctx.opt, n_in, inequalities_cb, &ctx, tols.data()));
+    }
+  }
+  check(nlopt_set_maxeval(ctx.opt, std::max(1, max_evaluations)));
+  if (stop_on_tolerances) {
+    check(nlopt_set_xtol_rel(ctx.opt, options.relative_tolerance));
+    check(nlopt_set_ftol_rel(ctx.opt, options.relative_tolerance));
+  }
+
+  // the start inside the bounds (NLopt requires it)
+  run.x = x0.cwiseMax(lower).cwiseMin(upper);
+  if (status >= 0) {
+    double f = HUGE_VAL;
+    status = nlopt_optimize(ctx.opt, run.x.data(), &f);
+    run.f = f;
+  }
+  run.result = status;
+  if (!ctx.error.empty()) {
+    run.error = ctx.error;
+  } else if (status < 0) {
+    if (const char* msg = nlopt_get_errmsg(ctx.opt)) run.error = msg;
+  }
+  nlopt_destroy(ctx.opt);
+  return run;
+}
+
+// the point to report from a run: NLopt's own if it converged at a feasible point, else the
+// best feasible point the run visited (when better than NLopt's)
+VectorXd chosen_point(const Run& run, const TrackedNlp& tracked, double tolerance,
+                      std::string& note) {
+  const Nlp& nlp = tracked.nlp();
+  const bool feasible = constraint_violation(nlp, run.x) <= tolerance;
+  const bool converged = termination_of(run.result) == Termination::kConverged;
+  if (feasible && (converged || !tracked.has_best() || run.f <= tracked.best_objective())) {
+    return run.x;
+  }
+  if (tracked.has_best()) {
+    note = "; the best feasible point evaluated is returned";
+    return tracked.best_x();
+  }
+  return run.x;
+}
+
+std::string run_message(Algorithm a, const Run& run, int max_evaluations) {
+  std::string m = std::string(nlopt_name(a)) + ": " + describe(run.result);
+  if (run.result == NLOPT_MAXEVAL_REACHED) m += " (" + std::to_string(max_evaluations) + ")";
+  if (!run.error.empty()) m += ": " + run.error;
+  return m;
+}
+
+// the first primes, one per Halton dimension
+std::vector<int> primes(int count) {
+  std::vector<int> p;
+  for (int k = 2; static_cast<int>(p.size()) < count; ++k) {
+    bool prime = true;
+    for (int q : p) {
+      if (q * q > k) break;
+      if (k % q == 0) {
+        prime = false;
+        break;
+      }
+    }
+    if (prime) p.push_back(k);
+  }
+  return p;
+}
+
+// the radical inverse of i in base b (Halton coordinate) in [0, 1)
+double radical_inverse(int i, int b) {
+  double f = 1.0, r = 0.0;
+  for (int k = i; k > 0; k /= b) {
+    f /= b;
+    r += f * (k % b);
+  }
+  return r;
+}
+
+// "mlsl": a multistart of SLSQP runs from x0 and from Halton points (randomly shifted by the
+// seed, a Cranley-Patterson rotation) within the bounds, the best feasible optimum kept
+DriverOutcome multistart(const Nlp& nlp, const VectorXd& x0, const OptimizeOptions& options) {
+  constexpr int kStarts = 8;
+  TrackedNlp tracked(nlp, options.constraint_tolerance);
+  VectorXd lower = nlp.lower(), upper = nlp.upper();
+  finite_bounds(x0, lower, upper);
+  const int n = nlp.n();
+  const std::vector<int> base = primes(n);
+  std::mt19937_64 rng(options.seed);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  VectorXd shift(n);
+  for (int i = 0; i < n; ++i) shift[i] = uniform(rng);
+
+  DriverOutcome out;
+  bool have = false, have_feasible = false;
+  double best_f = HUGE_VAL, best_violation = HUGE_VAL;
+  int best_start = 0, runs = 0, feasible_runs = 0;
+  Run best_run;
+  for (int s = 0; s < kStarts; ++s) {
+    const int left = options.max_evaluations - tracked.evaluations();
+    if (left <= 0) break;
+    const int budget = std::max(1, left / (kStarts - s));
+    VectorXd start = x0;
+    if (s > 0) {
+      for (int i = 0; i < n; ++i) {
+        const double u = std::fmod(radical_inverse(s, base[i]) + shift[i], 1.0);
+        start[i] = lower[i] + u * (upper[i] - lower[i]);
+      }
+    }
+    tracked.reset_best();
+    Run run = run_nlopt(NLOPT_LD_SLSQP, false, tracked, start, nlp.lower(), nlp.upper(), budget,
+                        options, true);
+    ++runs;
+    std::string note;
+    run.x = chosen_point(run, tracked, options.constraint_tolerance, note);
+    const double violation = constraint_violation(nlp, run.x);
+    const bool feasible = violation <= options.constraint_tolerance;
+    if (feasible) {
+      ++feasible_runs;
+      run.f = nlp.objective(run.x, nullptr);
+    }
+    // a feasible run beats an infeasible one; among feasible ones the lower objective wins,
+    // among infeasible ones the smaller violation
+    const bool better = !have || (feasible && (!have_feasible || run.f < best_f)) ||
+                        (!feasible && !have_feasible && violation < best_violation);
+    if (better) {
+      have = true;
+      have_feasible = feasible;
+      best_f = run.f;
+      best_violation = violation;
+      best_start = s + 1;
+      best_run = run;
+    }
+  }
+  out.x = have ? best_run.x : x0;
+  out.evaluations = tracked.evaluations();
+  out.iterations = out.evaluations;
+  out.termination = have ? termination_of(best_run.result) : Termination::kMaxEvaluations;
+  if (out.termination == Termination::kConverged && tracked.evaluations() >= options.max_evaluations &&
+      runs < kStarts) {
+    out.termination = Termination::kMaxEvaluations;
+  }
+  out.message = "multistart of NLopt LD_SLSQP (mlsl): " + std::to_string(runs) + " of " +
+                std::to_string(kStarts) + " local runs, " + std::to_string(feasible_runs) +
+                " feasible; best from start " + std::to_string(best_start) + ": " +
+                describe(best_run.result);
+  if (!best_run.error.empty()) out.message += ": " + best_run.error;
+  return out;
+}
+
+}  // namespace
+
+DriverOutcome solve_with_nlopt(const Nlp& nlp, const VectorXd& x0,
+                               const OptimizeOptions& options) {
+  if (options.algorithm == Algorithm::kMlsl) return multistart(nlp, x0, options);
+
+  nlopt_algorithm algorithm = NLOPT_LD_SLSQP;
+  bool global = false;
+  switch (options.algorithm) {
+    case Algorithm::kSlsqp: algorithm = NLOPT_LD_SLSQP; break;
+    case Algorithm::kMma: algorithm = NLOPT_LD_MMA; break;
+    case Algorithm::kCobyla: algorithm = NLOPT_LN_COBYLA; break;
+    case Algorithm::kIsres:
+      algorithm = NLOPT_GN_ISRES;
+      global = true;
+      break;
+    case Algorithm::kMlsl:
+    case Algorithm::kIpopt: break;
+  }
+  VectorXd lower = nlp.lower(), upper = nlp.upper();
+  if (global) {
+    finite_bounds(x0, lower, upper);
+    nlopt_srand(options.seed);
+  }
+  TrackedNlp tracked(nlp, options.constraint_tolerance);
+  // ISRES is stochastic: it runs to its budget rather than stopping on a quiet generation
+  Run run = run_nlopt(algorithm, options.algorithm == Algorithm::kMma, tracked, x0, lower, upper,
+                      options.max_evaluations, options, !global);
+  if (global) nlopt_srand_time();
+
+  DriverOutcome out;
+  std::string note;
+  out.x = chosen_point(run, tracked, options.constraint_tolerance, note);
+  out.termination = termination_of(run.result);
+  out.message = run_message(options.algorithm, run, options.max_evaluations) + note;
+  out.evaluations = tracked.evaluations();
+  out.iterations = out.evaluations;
+  return out;
+}
+
+}  // namespace bd::optimize::detail

@@ -1,0 +1,78 @@
+#pragma once
+/// Internal to bd_optimize (included by optimize.cpp and ipopt_driver.cpp only): what a solver
+/// driver returns, the evaluation counter that remembers the best feasible point a solver has
+/// seen, and the NLopt driver. NLopt's own header appears only in nlopt_driver.cpp.
+#include <limits>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "optimize/nlp.hpp"
+#include "optimize/optimize.hpp"
+
+namespace bd::optimize::detail {
+
+/// What a driver found and why it stopped. optimize() turns it into an OptimizeResult (and
+/// re-checks feasibility itself).
+struct DriverOutcome {
+  Termination termination = Termination::kFailed;
+  std::string message;  // the solver's reason in words, e.g. "NLopt SLSQP: ftol_rel reached"
+  Eigen::VectorXd x;    // the point returned (the solver's, or the best feasible one it saw)
+  int iterations{};     // solver iterations (NLopt exposes none: its evaluations are reported)
+  int evaluations{};    // objective evaluations
+};
+
+/// The Nlp as a solver sees it: every call is forwarded, objective evaluations are counted, and
+/// the best point at which the objective and all constraints were evaluated (in any order) with
+/// a scaled violation <= the tolerance is remembered, so a run stopped by its budget can return
+/// the best feasible point it visited rather than its last iterate.
+class TrackedNlp {
+ public:
+  TrackedNlp(const Nlp& nlp, double constraint_tolerance);
+
+  const Nlp& nlp() const { return nlp_; }
+  double objective(const Eigen::VectorXd& x, Eigen::VectorXd* grad);
+  void equalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac);
+  void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac);
+
+  int evaluations() const { return evaluations_; }
+  bool has_best() const { return has_best_; }
+  const Eigen::VectorXd& best_x() const { return best_x_; }
+  double best_objective() const { return best_f_; }
+  /// Forgets the best point (a new local run of a multistart keeps counting evaluations).
+  void reset_best() { has_best_ = false; best_f_ = std::numeric_limits<double>::infinity(); }
+
+ private:
+  void consider();  // a candidate when f, c_eq and c_in are known at one x
+
+  const Nlp& nlp_;
+  double tolerance_;
+  int evaluations_{};
+  Eigen::VectorXd x_f_, x_eq_, x_in_;  // where each part was last evaluated
+  double f_{}, violation_eq_{}, violation_in_{};
+  bool has_best_{false};
+  Eigen::VectorXd best_x_;
+  double best_f_ = std::numeric_limits<double>::infinity();
+};
+
+/// Largest scaled constraint violation at x: max(|c_eq|, max(c_in, 0)), 0 without constraints.
+/// `worst` (if not null) receives the index into nlp.constraint_names() of the worst one (-1 if
+/// none is violated) and `value` its value.
+double constraint_violation(const Nlp& nlp, const Eigen::VectorXd& x, int* worst = nullptr,
+                            double* value = nullptr);
+
+/// Runs the NLopt algorithm of options.algorithm (slsqp, mma, mlsl, isres, cobyla) from x0.
+/// - slsqp, cobyla, isres: NLopt's LD_SLSQP, LN_COBYLA, GN_ISRES with the equalities and
+///   inequalities as vector constraints (tolerance 0.1 · options.constraint_tolerance each).
+/// - mma: LD_MMA takes inequalities only (optimize() refuses equalities: as pairs ±c <= δ they
+///   stall MMA far from the optimum); they are tightened to c + δ <= 0 with
+///   δ = 0.5 · options.constraint_tolerance, as MMA's last iterates may lie just outside.
+/// - mlsl: a multistart of LD_SLSQP runs (NLopt's own G_MLSL cannot take constraints): the
+///   first from x0, the others from a randomly shifted Halton sequence within the bounds
+///   (seeded by options.seed); the best feasible local optimum is kept.
+/// Budget: options.max_evaluations objective evaluations in all; xtol_rel = ftol_rel =
+/// options.relative_tolerance for the local methods, the budget alone for isres.
+DriverOutcome solve_with_nlopt(const Nlp& nlp, const Eigen::VectorXd& x0,
+                               const OptimizeOptions& options);
+
+}  // namespace bd::optimize::detail

@@ -1,0 +1,124 @@
+#pragma once
+/// A DesignProblem as a smooth nonlinear program in the variables x:
+///   minimise f(x)  subject to  c_eq(x) = 0,  c_in(x) <= 0,  lower <= x <= upper.
+///
+/// Variables, in this order (all in SI units, each of order one):
+/// - per counterweight (problem order): its mass m_c in [0, mass_max] [kg], then its centre
+///   (x, y) in link axes from the pivot (A0 for the crank, A3 for the rocker) [m], boxed in
+///   [-distance_max, distance_max] with the smooth envelope x² + y² <= distance_max² as an
+///   inequality. Cartesian rather than polar: an angle bound would cut the circle at ±π (a local
+///   solver could not pass through it) and the polar form is degenerate at the pivot;
+/// - per link parameter (problem order): its value within its bounds;
+/// - driven scenes only: one bound variable t per peak metric of the objective, in [0, t_max]
+///   with t_max a proven upper bound of that peak over the variable box: the peak enters as the
+///   smooth constraints |y_i(x)|² <= t² over the samples, never as a non-smooth max. Free scenes
+///   have no bound variables (their peaks are evaluated directly; the solvers there are
+///   derivative-free).
+///
+/// Objective: Σ_k w_k (metric_k / metric_k(original))² over the reaction metrics (RMS and peak;
+/// a peak term uses its bound variable t), plus w · added_mass / (original total mass): a
+/// weighted sum of the SQUARED normalised metrics. The squares make each RMS term a quadratic
+/// form in the inertial parameters (below), smooth also where the metric reaches 0 (a
+/// force-balanced design has Fsh_rms = 0, where |·| has a kink). For a single metric the
+/// minimiser is that of metric/original; with several, the squares weigh a term's large ratios
+/// more. The linear form Σ w metric/original through bound variables (min t s.t. RMS² <= t²)
+/// was tried and rejected: at a balanced optimum t = 0 the constraint's gradient vanishes and
+/// SLSQP stalls at the start while Ipopt exhausts its budget (measured; docs/performance.md).
+/// Limits: (metric / (value · original))² - 1 <= 0 (RMS: one constraint; peak: one per sample,
+/// |y_i|² against the limit; free scenes: one, on the directly evaluated peak);
+/// (added_mass - value) / (original total mass) <= 0.
+/// Force balance (eq. 57): four linear equalities in the inertial parameters, divided by the
+/// original total mass.
+///
+/// Driven scenes: the reactions, torque, shaking force and moment of every sample are affine in
+/// q = (π, ρ, 1): π the 14 inertial parameters (per link m, m e, m f, and J = I + m|s̄|² about the
+/// first joint; then the crank's and the rocker's counter-rotation inertias), ρ the links'
+/// centres of mass (e, f) where the applied forces F̄k act (core applies F̄k at the centre of
+/// mass, so its moment is linear in ρ, not in π), because the motion is prescribed. The
+/// regressor y_i = A_i q is computed once from core's inverse dynamics; every metric is then a
+/// quadratic form in q with an exact gradient through ∂q/∂x, at a cost independent of the
+/// number of samples for RMS metrics (|A q|² = |R q|² with R from a QR of the stacked rows).
+/// Free scenes: every evaluation is a forward simulation (core::simulate_free); no gradients
+/// (has_gradients() is false): derivative-free solvers only. A design whose simulation fails
+/// evaluates to +infinity (objective, limit constraints and every metric).
+///
+/// Evaluations are const; free scenes keep the last simulation in a mutex-guarded cache, so the
+/// objective and the constraints at the same x simulate once.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/metrics.hpp"
+#include "core/model.hpp"
+#include "optimize/problem.hpp"
+#include "optimize/optimize.hpp"
+
+namespace bd::optimize {
+
+class Nlp {
+ public:
+  /// Precomputes what the problem needs (the regressor for a driven scene, the original's
+  /// metrics for the normalisation).
+  /// @throws bd::InputError if problem.validate() is not empty.
+  /// @throws bd::InputError also if the scene cannot be evaluated for the original (a driven
+  /// crank that cannot turn, a failed free simulation), or if the original's value of a metric
+  /// in the objective or a limit is zero (to 1e-10 of the original's reactions), so that it
+  /// cannot normalise.
+  explicit Nlp(const DesignProblem& problem);
+  ~Nlp();
+  Nlp(const Nlp&) = delete;
+  Nlp& operator=(const Nlp&) = delete;
+
+  int n() const;       // variables, bound variables included
+  int n_eq() const;    // equality constraints
+  int n_ineq() const;  // inequality constraints (c <= 0)
+  const Eigen::VectorXd& lower() const;
+  const Eigen::VectorXd& upper() const;
+  /// The natural start: each link parameter at its value in the original design (clamped to its
+  /// bounds); each counterweight, which the original lacks, at half its mass_max and half its
+  /// distance_max on the far side of the pivot (crank: (-d/2, 0) from A0; rocker: (d/2, 0) from
+  /// A3, beyond the pivot); bound variables at the start design's peaks (feasible).
+  Eigen::VectorXd start() const;
+  /// Names of the variables and of the constraints, for messages ("crank counterweight mass [kg]",
+  /// "force balance, crank side (real part)", "Fsh_rms <= 0.2 x original", ...).
+  const std::vector<std::string>& variable_names() const;
+  const std::vector<std::string>& constraint_names() const;  // equalities first
+  /// True when exact gradients are available (driven scenes).
+  bool has_gradients() const;
+
+  /// The objective and, when `grad` is not null, its gradient.
+  double objective(const Eigen::VectorXd& x, Eigen::VectorXd* grad) const;
+  /// The equality constraints c_eq(x) (size n_eq) and, when `jac` is not null, their Jacobian
+  /// (n_eq x n). Scaled by the original total mass.
+  void equalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac) const;
+  /// The inequality constraints c_in(x) <= 0 (size n_ineq), Jacobian n_ineq x n, in this order:
+  /// the counterweight envelopes (x² + y²)/distance_max² - 1, the limits (problem order), then
+  /// the peak-bound constraints (|y_i|² - t²)/original² per sample for each peak objective term.
+  /// Gradients (objective, equalities, inequalities) are exact where has_gradients(); asking for
+  /// one otherwise throws std::logic_error. A wrong x.size() throws bd::InputError.
+  void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac) const;
+
+  /// The design at x (counterweights merged into their links), and its counterweights.
+  core::FourBar design(const Eigen::VectorXd& x) const;
+  std::vector<PlacedCounterweight> counterweights(const Eigen::VectorXd& x) const;
+  /// The samples of the design at x as this program evaluates them. Driven scenes: the
+  /// regressor's RA0, RA3, Fsh, Msh and tau at each instant of the scene (t and state.theta1
+  /// set, the rest of the state and RC1, RC3 zero); free scenes: core::simulate_free's trajectory.
+  core::Trajectory trajectory(const Eigen::VectorXd& x) const;
+  /// Metrics of the design at x as this program evaluates them (regressor or simulation):
+  /// core::metrics(trajectory(x)), or +infinity throughout when a free simulation fails.
+  core::Metrics metrics(const Eigen::VectorXd& x) const;
+  /// The value of one metric at x (added_mass included).
+  double metric(const Eigen::VectorXd& x, Metric m) const;
+  /// The original design's value of a metric (the normaliser); for added_mass the original
+  /// total mass [kg].
+  double original(Metric m) const;
+
+ private:
+  struct Impl;  // the regressor, the scaled problem data (the implementer may use plain members)
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace bd::optimize

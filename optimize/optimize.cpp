@@ -1,0 +1,339 @@
+#include "optimize/optimize.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "core/input_error.hpp"
+#include "optimize/ipopt_driver.hpp"
+#include "optimize/nlopt_driver.hpp"
+#include "optimize/nlp.hpp"
+
+namespace bd::optimize {
+
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+std::string format(double v, const char* how = "%.6g") {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, how, v);
+  return buf;
+}
+
+constexpr Algorithm kAlgorithms[] = {Algorithm::kSlsqp, Algorithm::kMma,   Algorithm::kIpopt,
+                                     Algorithm::kMlsl,  Algorithm::kIsres, Algorithm::kCobyla};
+
+// the value of a metric in core's summary (added_mass is not one of them)
+double value_of(const core::Metrics& m, Metric metric) {
+  switch (metric) {
+    case Metric::kFshRms: return m.Fsh_rms;
+    case Metric::kFshMax: return m.Fsh_max;
+    case Metric::kMshRms: return m.Msh_rms;
+    case Metric::kMshMax: return m.Msh_max;
+    case Metric::kTauRms: return m.tau_rms;
+    case Metric::kTauMax: return m.tau_max;
+    case Metric::kRA0Rms: return m.RA0_rms;
+    case Metric::kRA0Max: return m.RA0_max;
+    case Metric::kRA3Rms: return m.RA3_rms;
+    case Metric::kRA3Max: return m.RA3_max;
+    case Metric::kAddedMass: break;
+  }
+  return 0.0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// gradient check: analytic derivatives against central differences at x.
+// Step h = 1e-6 max(1, |x_i|) (the variables are O(1) in SI units): truncation ~h² |f'''|,
+// round-off ~eps |f| / h ~ 1e-10; an entry fails when |analytic - difference| exceeds
+// 1e-5 max(1, |analytic|, |difference|) (the scaled functions are O(1)). Where x ± h leaves the
+// bounds, the one-sided second-order formula (-3 f0 + 4 f1 - f2) / 2h is used instead.
+
+struct Worst {
+  double error = -1.0;
+  std::string what;
+  double analytic{}, difference{};
+};
+
+// the differences of every output of `fun` (objective or constraints) with respect to x_j
+template <class Fun>
+VectorXd difference(const Nlp& nlp, const VectorXd& x, int j, Fun&& fun) {
+  const double h = 1e-6 * std::max(1.0, std::abs(x[j]));
+  VectorXd xp = x;
+  auto at = [&](double step) {
+    xp[j] = x[j] + step;
+    return fun(xp);
+  };
+  if (x[j] - h >= nlp.lower()[j] && x[j] + h <= nlp.upper()[j]) {
+    return (at(h) - at(-h)) / (2 * h);
+  }
+  const double s = x[j] + 2 * h <= nlp.upper()[j] ? h : -h;  // into the box
+  return (-3.0 * at(0.0) + 4.0 * at(s) - at(2 * s)) / (2 * s);
+}
+
+void compare(const MatrixXd& analytic, const MatrixXd& numeric,
+             const std::vector<std::string>& rows, int row_offset, const Nlp& nlp, Worst& worst) {
+  for (int i = 0; i < analytic.rows(); ++i) {
+    for (int j = 0; j < analytic.cols(); ++j) {
+      const double a = analytic(i, j), d = numeric(i, j);
+      const double error = std::abs(a - d) / std::max({1.0, std::abs(a), std::abs(d)});
+      if (!(error <= worst.error) || !std::isfinite(error)) {
+        worst.error = std::isfinite(error) ? error : std::numeric_limits<double>::infinity();
+        worst.what = "d(" + rows[static_cast<size_t>(row_offset + i)] + ")/d(" +
+                     nlp.variable_names()[static_cast<size_t>(j)] + ")";
+        worst.analytic = a;
+        worst.difference = d;
+      }
+    }
+  }
+}
+
+// "" when every entry agrees, else the worst entry in words
+std::string check_gradients(const Nlp& nlp, const VectorXd& x) {
+  const int n = nlp.n();
+  Worst worst;
+  // objective
+  {
+    VectorXd g(n);
+    nlp.objective(x, &g);
+    MatrixXd numeric(1, n);
+    for (int j = 0; j < n; ++j) {
+      numeric(0, j) = difference(nlp, x, j, [&](const VectorXd& y) {
+        return VectorXd::Constant(1, nlp.objective(y, nullptr));
+      })[0];
+    }
+    compare(g.transpose(), numeric, {"objective"}, 0, nlp, worst);
+  }
+  // equalities, then inequalities (named as in constraint_names(): equalities first)
+  auto constraints = [&](int m, int offset, auto&& eval) {
+    if (m == 0) return;
+    VectorXd c;
+    MatrixXd jac;
+    eval(x, c, &jac);
+    MatrixXd numeric(m, n);
+    for (int j = 0; j < n; ++j) {
+      numeric.col(j) = difference(nlp, x, j, [&](const VectorXd& y) {
+        VectorXd cy;
+        eval(y, cy, nullptr);
+        return cy;
+      });
+    }
+    compare(jac, numeric, nlp.constraint_names(), offset, nlp, worst);
+  };
+  constraints(nlp.n_eq(), 0, [&](const VectorXd& y, VectorXd& c, MatrixXd* j) {
+    nlp.equalities(y, c, j);
+  });
+  constraints(nlp.n_ineq(), nlp.n_eq(), [&](const VectorXd& y, VectorXd& c, MatrixXd* j) {
+    nlp.inequalities(y, c, j);
+  });
+  if (worst.error <= 1e-5) return "";
+  return "gradient check failed: " + worst.what + " is " + format(worst.analytic, "%.9g") +
+         " analytically but " + format(worst.difference, "%.9g") +
+         " by central differences (relative error " + format(worst.error, "%.2g") + ")";
+}
+
+// ---------------------------------------------------------------------------------------------
+// verification: the optimum re-simulated with a formulation other than the optimiser's
+
+core::Formulation other_than(core::Formulation f) {
+  return f == core::Formulation::kMassMatrix ? core::Formulation::kComplexMasses
+                                             : core::Formulation::kMassMatrix;
+}
+
+// The largest relative difference between two evaluations of a design's metrics. A metric that
+// vanishes by cancellation (Fsh of a force-balanced design is RA0 + RA3 with |RA0| ~ |RA3|) is
+// only known to the round-off of the terms it is made of (~1e-14 of them), so each metric is
+// measured against max(|a|, |b|, 1e-4 · scale), the scale being the largest reaction for the
+// forces [N] and the largest of the moments and l4 times the largest reaction for the moments
+// [N m]: round-off then shows as ~1e-10, while a wrong formula still shows at the order of the
+// metric over that floor.
+double verification_error(const core::Metrics& a, const core::Metrics& b, double frame_length) {
+  const double force = std::max({a.RA0_max, a.RA3_max, b.RA0_max, b.RA3_max});
+  const double moment = std::max({a.tau_max, a.Msh_max, b.tau_max, b.Msh_max,
+                                  frame_length * force});
+  double worst = 0.0;
+  for (Metric m : kMetrics) {
+    if (m == Metric::kAddedMass) continue;
+    const double va = value_of(a, m), vb = value_of(b, m);
+    const bool is_moment = m == Metric::kMshRms || m == Metric::kMshMax ||
+                           m == Metric::kTauRms || m == Metric::kTauMax;
+    const double scale = std::max({std::abs(va), std::abs(vb), 1e-4 * (is_moment ? moment : force)});
+    if (scale == 0.0) continue;  // zero in both, and nothing to be zero against
+    const double error = std::abs(va - vb) / scale;
+    if (!std::isfinite(error)) return std::numeric_limits<double>::infinity();
+    worst = std::max(worst, error);
+  }
+  return worst;
+}
+
+}  // namespace
+
+const char* to_string(Algorithm a) {
+  switch (a) {
+    case Algorithm::kSlsqp: return "slsqp";
+    case Algorithm::kMma: return "mma";
+    case Algorithm::kIpopt: return "ipopt";
+    case Algorithm::kMlsl: return "mlsl";
+    case Algorithm::kIsres: return "isres";
+    case Algorithm::kCobyla: return "cobyla";
+  }
+  return "unknown";
+}
+
+std::optional<Algorithm> algorithm_named(const std::string& name) {
+  for (Algorithm a : kAlgorithms) {
+    if (name == to_string(a)) return a;
+  }
+  return std::nullopt;
+}
+
+bool uses_gradients(Algorithm a) {
+  return a == Algorithm::kSlsqp || a == Algorithm::kMma || a == Algorithm::kIpopt ||
+         a == Algorithm::kMlsl;
+}
+
+std::string OptimizeOptions::validate() const {
+  if (std::find(std::begin(kAlgorithms), std::end(kAlgorithms), algorithm) ==
+      std::end(kAlgorithms)) {
+    return "algorithm must be one of slsqp, mma, ipopt, mlsl, isres, cobyla";
+  }
+  if (max_evaluations < 1) {
+    return "max_evaluations must be >= 1, got " + std::to_string(max_evaluations);
+  }
+  if (!(std::isfinite(relative_tolerance) && relative_tolerance > 0 && relative_tolerance < 1)) {
+    return "relative_tolerance must be in (0, 1), got " + format(relative_tolerance, "%.17g");
+  }
+  if (!(std::isfinite(constraint_tolerance) && constraint_tolerance > 0)) {
+    return "constraint_tolerance must be > 0, got " + format(constraint_tolerance, "%.17g");
+  }
+  return "";
+}
+
+const char* to_string(Termination t) {
+  switch (t) {
+    case Termination::kNotRun: return "not run";
+    case Termination::kConverged: return "converged";
+    case Termination::kMaxEvaluations: return "max evaluations";
+    case Termination::kInfeasible: return "infeasible";
+    case Termination::kFailed: return "failed";
+  }
+  return "unknown";
+}
+
+std::string OptimizeResult::brief_report() const {
+  std::string s = std::string(to_string(algorithm)) + ": " + to_string(termination) + ", " +
+                  std::to_string(iterations) + " iterations, " + std::to_string(evaluations) +
+                  " evaluations, " + format(seconds, "%.3g") + " s, objective " +
+                  format(objective, "%.9g") + ", constraint violation " +
+                  format(constraint_violation, "%.2g");
+  if (termination == Termination::kNotRun || std::isnan(verification_error)) {
+    s += ", not verified";
+  } else {
+    s += ", verified by " + std::string(core::to_string(verified_with)) + " to " +
+         format(verification_error, "%.2g");
+  }
+  return s;
+}
+
+OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& options) {
+  if (const std::string e = options.validate(); !e.empty()) {
+    throw InputError("optimize options: " + e);
+  }
+  if (const std::string e = problem.validate(); !e.empty()) {
+    throw InputError("design problem: " + e);
+  }
+  const Nlp nlp(problem);
+  if (uses_gradients(options.algorithm) && !nlp.has_gradients()) {
+    throw InputError(std::string("algorithm '") + to_string(options.algorithm) +
+                     "' needs gradients, which a free scene does not provide; use cobyla or isres");
+  }
+  if (options.algorithm == Algorithm::kMma && nlp.n_eq() > 0) {
+    throw InputError(
+        "algorithm 'mma' takes inequality constraints only, and force_balance adds equalities; "
+        "use slsqp, ipopt, mlsl or cobyla");
+  }
+  const VectorXd x0 = nlp.start();
+  if (options.check_gradients && nlp.has_gradients()) {
+    // a wrong derivative would mislead every gradient method: stop before solving (Ceres)
+    if (std::string e = check_gradients(nlp, x0); !e.empty()) {
+      OptimizeResult r;
+      r.algorithm = options.algorithm;
+      r.termination = Termination::kFailed;
+      r.message = std::move(e);
+      r.x = x0;
+      r.objective = nlp.objective(x0, nullptr);
+      r.constraint_violation = detail::constraint_violation(nlp, x0);
+      r.design = nlp.design(x0);
+      r.counterweights = nlp.counterweights(x0);
+      r.metrics = nlp.metrics(x0);
+      r.verification_error = std::numeric_limits<double>::quiet_NaN();  // not verified
+      return r;
+    }
+  }
+
+  // the solve
+  const auto started = std::chrono::steady_clock::now();
+  detail::DriverOutcome outcome = options.algorithm == Algorithm::kIpopt
+                                      ? detail::solve_with_ipopt(nlp, x0, options)
+                                      : detail::solve_with_nlopt(nlp, x0, options);
+  const auto stopped = std::chrono::steady_clock::now();
+
+  OptimizeResult r;
+  r.algorithm = options.algorithm;
+  r.termination = outcome.termination;
+  r.message = outcome.message;
+  r.x = outcome.x;
+  r.iterations = outcome.iterations;
+  r.evaluations = outcome.evaluations;
+  r.seconds = std::chrono::duration<double>(stopped - started).count();
+  r.objective = nlp.objective(r.x, nullptr);
+
+  // feasibility of the point returned, whatever the solver said
+  int worst = -1;
+  double worst_value = 0.0;
+  r.constraint_violation = detail::constraint_violation(nlp, r.x, &worst, &worst_value);
+  if (r.constraint_violation > options.constraint_tolerance) {
+    const std::string& name = nlp.constraint_names()[static_cast<size_t>(worst)];
+    const bool equality = worst < nlp.n_eq();
+    r.termination = Termination::kInfeasible;
+    r.message = "no feasible design found: the binding constraint is '" + name + "' at " +
+                format(worst_value, "%.6g") + (equality ? " (must be 0" : " (must be <= 0") +
+                ", tolerance " + format(options.constraint_tolerance, "%.2g") + ") [" +
+                outcome.message + "]";
+  } else if (r.termination == Termination::kInfeasible) {
+    // the solver gave up on feasibility yet stopped at a feasible point: say so plainly
+    r.termination = Termination::kFailed;
+    r.message += " (the point returned is feasible)";
+  }
+
+  // the optimum as a design, as the optimiser evaluated it
+  r.design = nlp.design(r.x);
+  r.counterweights = nlp.counterweights(r.x);
+  r.metrics = nlp.metrics(r.x);
+
+  // verification: re-simulated with another formulation, compared metric by metric
+  core::SimulateOptions simulate;
+  simulate.formulation = other_than(problem.formulation);
+  simulate.tolerance = problem.tolerance;
+  r.verified_with = simulate.formulation;
+  const core::Trajectory trajectory =
+      std::holds_alternative<core::DrivenScene>(problem.scene)
+          ? core::simulate_driven(r.design, std::get<core::DrivenScene>(problem.scene), simulate)
+          : core::simulate_free(r.design, std::get<core::FreeScene>(problem.scene), simulate);
+  if (!trajectory.ok()) {
+    r.verification_error = std::numeric_limits<double>::infinity();
+    r.message += "; verification by " + std::string(core::to_string(simulate.formulation)) +
+                 " failed: " + trajectory.message;
+    return r;
+  }
+  r.verified = core::metrics(trajectory);
+  r.verification_error = verification_error(r.metrics, r.verified, r.design.frame_length);
+  return r;
+}
+
+}  // namespace bd::optimize

@@ -1,0 +1,91 @@
+#pragma once
+/// Solving a DesignProblem with NLopt or Ipopt (Ceres-style: options in, result out). The
+/// solvers' headers appear only in optimize/nlopt_driver.cpp and optimize/ipopt_driver.cpp.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "balance/counterweight.hpp"
+#include "core/metrics.hpp"
+#include "optimize/problem.hpp"
+
+namespace bd::optimize {
+
+enum class Algorithm {
+  kSlsqp,   // NLopt SLSQP: local, gradient-based, equality and inequality constraints
+  kMma,     // NLopt MMA (CCSA): local, gradient-based, inequality constraints only
+  kIpopt,   // Ipopt interior point with exact first derivatives (limited-memory Hessian)
+  kMlsl,    // NLopt MLSL (low-discrepancy multistart) with SLSQP as the local method: global
+  kIsres,   // NLopt ISRES: global, derivative-free, handles constraints (evolution strategy)
+  kCobyla,  // NLopt COBYLA: local, derivative-free
+};
+/// "slsqp", "mma", "ipopt", "mlsl", "isres", "cobyla" (the study file's names).
+const char* to_string(Algorithm a);
+std::optional<Algorithm> algorithm_named(const std::string& name);
+/// True for the methods that need gradients.
+bool uses_gradients(Algorithm a);
+
+struct OptimizeOptions {
+  Algorithm algorithm = Algorithm::kSlsqp;
+  int max_evaluations = 2000;
+  double relative_tolerance = 1e-8;   // on x and on the objective
+  double constraint_tolerance = 1e-9; // feasibility of the reported optimum (scaled)
+  bool check_gradients = false;       // compare analytic gradients with central differences first
+  unsigned seed = 1;                  // global methods
+  std::string validate() const;
+};
+
+enum class Termination {
+  kNotRun,
+  kConverged,        // a tolerance was met at a feasible point
+  kMaxEvaluations,   // stopped by the budget; the best feasible point so far is returned
+  kInfeasible,       // no feasible point found; the message names the binding constraint
+  kFailed,           // the solver failed (roundoff, invalid problem); the message says why
+};
+const char* to_string(Termination t);
+
+/// A counterweight of the optimum, in the balance layer's terms.
+struct PlacedCounterweight {
+  int link{};  // 1 or 3
+  balance::Counterweight counterweight;
+};
+
+struct OptimizeResult {
+  Termination termination = Termination::kNotRun;
+  std::string message = "optimize() was not called";
+  Algorithm algorithm = Algorithm::kSlsqp;
+  Eigen::VectorXd x;                  // the optimum's variables
+  double objective{};                 // at x
+  double constraint_violation{};      // largest scaled violation at x (0 when feasible)
+  int iterations{}, evaluations{};    // solver iterations, objective evaluations
+  double seconds{};                   // wall time of the solve
+  core::FourBar design;               // the optimum as a model (counterweights merged in)
+  std::vector<PlacedCounterweight> counterweights;
+  core::Metrics metrics;              // of the optimum, as the optimiser evaluated them
+  core::Metrics verified;             // re-simulated with another formulation
+  core::Formulation verified_with = core::Formulation::kMassMatrix;
+  double verification_error{};        // largest relative difference metrics vs verified
+  /// One line for the console and summary.json.
+  std::string brief_report() const;
+  bool ok() const { return termination == Termination::kConverged ||
+                           termination == Termination::kMaxEvaluations; }
+};
+
+/// Solves the problem from its natural start (every variable at its value in the original
+/// design, or mid-range where the original has none).
+/// @throws bd::InputError if the problem or the options are invalid.
+OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& options);
+
+/// The ε-constraint trade-off between two metrics: minimise `first` subject to
+/// second <= ε_i · second(original) for `points` values of ε spaced between the extremes found by
+/// minimising each metric alone. Each point is a verified design.
+struct ParetoPoint {
+  double epsilon{};  // the bound on the second metric, fraction of the original
+  OptimizeResult result;
+};
+std::vector<ParetoPoint> pareto_front(const DesignProblem& problem, Metric first, Metric second,
+                                      int points, const OptimizeOptions& options);
+
+}  // namespace bd::optimize

@@ -1,0 +1,90 @@
+#pragma once
+/// The optimisation problem: design variables on a four-bar, an objective and constraints built
+/// from the metrics of its simulated reactions (DESIGN.md "optimize"). Solver-agnostic: NLopt and
+/// Ipopt stay behind optimize() (optimize/optimize.hpp).
+#include <limits>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "balance/counterweight.hpp"
+#include "core/dynamics.hpp"
+#include "core/model.hpp"
+#include "core/simulate.hpp"
+
+namespace bd::optimize {
+
+/// Metrics of a design in the scene (RMS over samples, peak = max of magnitudes).
+// clang-format off
+enum class Metric {
+  kFshRms, kFshMax,  // |F̄sh| [N]
+  kMshRms, kMshMax,  // |Msh| [N m]
+  kTauRms, kTauMax,  // |tau| [N m]
+  kRA0Rms, kRA0Max,  // |R̄A0| [N]
+  kRA3Rms, kRA3Max,  // |R̄A3| [N]
+  kAddedMass,        // Σ (design mass - original mass) over the links [kg]
+};
+// clang-format on
+/// "Fsh_rms", "Fsh_max", ..., "added_mass" (the names of summary.json and comparison.csv).
+const char* to_string(Metric m);
+std::optional<Metric> metric_named(const std::string& name);
+inline constexpr Metric kMetrics[] = {
+    Metric::kFshRms, Metric::kFshMax, Metric::kMshRms, Metric::kMshMax, Metric::kTauRms,
+    Metric::kTauMax, Metric::kRA0Rms, Metric::kRA0Max, Metric::kRA3Rms, Metric::kRA3Max,
+    Metric::kAddedMass};
+/// True for the peak metrics (handled by a bound variable, never by a non-smooth max).
+bool is_peak(Metric m);
+
+/// One term of the objective: weight · (metric(design) / metric(original))² for the reaction
+/// metrics (squared so that the objective stays smooth where an RMS reaches 0; see
+/// optimize/nlp.hpp), weight · added_mass / (original total mass) for added_mass.
+struct Term {
+  Metric metric = Metric::kFshRms;
+  double weight = 1.0;  // >= 0
+};
+
+/// An upper limit on a metric: metric(design) <= fraction · metric(original); for added_mass
+/// the limit is in kg: added_mass <= value (any finite value: 0 or less keeps or removes mass).
+struct Limit {
+  Metric metric = Metric::kFshRms;
+  double value = 1.0;  // fraction of the original [-], or kg for added_mass
+};
+
+/// A counterweight as design variables: its mass and its centre (x, y) in the link frame (from
+/// A0 for the crank, from A3 for the rocker: link == 1 or 3) within distance_max of the pivot.
+/// Its inertia follows from the shape (disc: thickness and density fix the radius from the mass,
+/// so its inertia m²/(2 density pi thickness) is smooth in m).
+struct CounterweightVariables {
+  int link = 1;               // 1 crank, 3 rocker
+  double mass_max = 10.0;     // [kg], mass in [0, mass_max], > 0
+  double distance_max = 1.0;  // [m], |(x, y)| <= distance_max (the envelope), > 0
+  balance::CounterweightShape shape = balance::CounterweightShape::kPoint;
+  double thickness = 0.02;    // disc [m], > 0
+  double density = 7850.0;    // disc [kg/m^3], > 0
+};
+
+/// One of the link's own mass parameters as a design variable, within bounds.
+struct LinkParameterVariable {
+  int link = 2;  // 1, 2, 3
+  enum class Parameter { kMass, kE, kF, kInertia } parameter = Parameter::kMass;
+  double lower{}, upper{};  // [kg], [m], [m], [kg m^2]; mass lower > 0, inertia lower >= 0
+};
+
+/// What to optimise, on which design, in which scene.
+struct DesignProblem {
+  core::FourBar original;  // the starting design (geometry, loads, counter-rotations)
+  std::variant<core::FreeScene, core::DrivenScene> scene;
+  core::Formulation formulation = core::Formulation::kComplexMasses;  // for the evaluations
+  double tolerance = 1e-10;                                           // free scenes
+  std::vector<CounterweightVariables> counterweights;
+  std::vector<LinkParameterVariable> link_parameters;
+  std::vector<Term> objective;  // at least one term
+  std::vector<Limit> limits;
+  bool force_balance = false;  // the two complex conditions of eq. 57 as four equalities
+  /// Empty when valid, else the problem in words (no variables, bad bounds, no objective, ...),
+  /// e.g. "counterweights[1].link must be 1 (crank) or 3 (rocker), got 2".
+  std::string validate() const;
+};
+
+}  // namespace bd::optimize

@@ -1,0 +1,576 @@
+// The design problem as a nonlinear program (optimize/nlp.hpp): the driven regressor against
+// core's inverse dynamics, the metrics against core's, the analytic gradients against central
+// differences, the force-balance equalities against balance::force_balance, the free scene
+// against core::simulate_free.
+//
+// Tolerances.
+// - Regressor and metrics (driven): 1e-12 of the quantity's scale over the revolution (the peak
+//   reaction for forces, the peak moment or l4 times the peak reaction for moments). Both sides
+//   are exact; the regressor's columns are difference quotients with step 1 of an affine map, so
+//   only the round-off of the inverse dynamics (a few eps of the reactions) and of A q separates
+//   them.
+// - Gradients: central differences with h = 1e-6 (times max(1, |x_j|)): truncation ~ h^2 |f'''|
+//   ~ 1e-11, round-off ~ eps |f| / h ~ 1e-10 for values of order one (measured: <= 1e-9 of the
+//   row's scale), so 1e-6 of the row's largest gradient entry (at least 1e-2, as the values are
+//   of order one) leaves three orders of margin while a wrong term shows at order one.
+// - Regressor: measured within 1e-14 of the scales, so 1e-12 leaves two orders of margin.
+// - Force balance: the equalities are linear in the inertial parameters, evaluated to a few eps
+//   of the masses over the total mass: 1e-13.
+#include "optimize/nlp.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "balance/conditions.hpp"
+#include "balance/counterweight.hpp"
+#include "core/dynamics.hpp"
+#include "core/input_error.hpp"
+#include "core/metrics.hpp"
+#include "core/model.hpp"
+#include "core/samples.hpp"
+#include "core/simulate.hpp"
+
+namespace bd::optimize {
+namespace {
+
+using P = LinkParameterVariable::Parameter;
+
+double uniform(std::mt19937_64& rng, double a, double b) {
+  return std::uniform_real_distribution<double>(a, b)(rng);
+}
+
+core::FourBar with_counter_rotations(core::FourBar m) {
+  m.counter_rotations.crank = {0.3, Vec2(-0.5, 0.2)};
+  m.counter_rotations.rocker = {0.4, Vec2(m.frame_length + 0.3, -0.4)};
+  return core::make_fourbar(m);
+}
+
+// Two counterweights (a point on the crank, a light disc on the rocker, so its own inertia
+// matters) and link parameters on every link.
+DesignProblem driven_problem(const core::FourBar& model, core::Formulation f, int samples = 24) {
+  DesignProblem p;
+  p.original = model;
+  core::DrivenScene scene;
+  scene.theta1 = 0.3;
+  scene.omega1 = 2.5;
+  scene.samples = samples;
+  p.scene = scene;
+  p.formulation = f;
+  CounterweightVariables c1;
+  c1.link = 1;
+  c1.mass_max = 5.0;
+  c1.distance_max = 0.8;
+  CounterweightVariables c3;
+  c3.link = 3;
+  c3.mass_max = 4.0;
+  c3.distance_max = 1.0;
+  c3.shape = balance::CounterweightShape::kDisc;
+  c3.thickness = 0.05;
+  c3.density = 500.0;
+  p.counterweights = {c1, c3};
+  p.link_parameters = {{2, P::kMass, 1.0, 5.0},    {2, P::kE, 0.5, 2.0},
+                       {2, P::kF, -0.5, 0.5},      {2, P::kInertia, 0.5, 5.0},
+                       {1, P::kInertia, 0.1, 2.0}, {3, P::kMass, 1.0, 4.0},
+                       {3, P::kF, -0.3, 0.3}};
+  p.objective = {{Metric::kFshRms, 1.0}};
+  return p;
+}
+
+// Every metric in the objective and in a limit, with force balance: every kind of term and
+// constraint.
+DesignProblem full_problem(const core::FourBar& model, core::Formulation f) {
+  DesignProblem p = driven_problem(model, f, 12);
+  p.objective.clear();
+  p.limits.clear();
+  double w = 0.5;
+  for (Metric m : kMetrics) {
+    p.objective.push_back({m, w});
+    p.limits.push_back({m, m == Metric::kAddedMass ? 3.0 : 1.5});
+    w += 0.25;
+  }
+  p.force_balance = true;
+  return p;
+}
+
+int design_variables(const DesignProblem& p) {
+  return static_cast<int>(3 * p.counterweights.size() + p.link_parameters.size());
+}
+
+// A random point of the box; counterweights inside their envelopes; bound variables anywhere in
+// [0, 1.5 x their start] (not necessarily feasible: the derivatives do not care).
+Eigen::VectorXd random_x(const Nlp& nlp, const DesignProblem& p, std::mt19937_64& rng) {
+  Eigen::VectorXd x = nlp.start();
+  for (int j = 0; j < nlp.n(); ++j) {
+    const double hi = j < design_variables(p) ? nlp.upper()(j) : 1.5 * x(j);
+    x(j) = uniform(rng, nlp.lower()(j), hi);
+  }
+  for (std::size_t c = 0; c < p.counterweights.size(); ++c) {
+    const int j = 3 * static_cast<int>(c);
+    const double r = p.counterweights[c].distance_max * std::sqrt(uniform(rng, 0, 1));
+    const double phi = uniform(rng, -3.14159, 3.14159);
+    x(j + 1) = r * std::cos(phi);
+    x(j + 2) = r * std::sin(phi);
+  }
+  return x;
+}
+
+core::SimulateOptions options_of(const DesignProblem& p) {
+  core::SimulateOptions o;
+  o.formulation = p.formulation;
+  o.tolerance = p.tolerance;
+  return o;
+}
+
+struct Scales {
+  double force{}, moment{};
+};
+Scales scales_of(const core::Trajectory& t, double l4) {
+  Scales s;
+  for (const core::DynamicsSample& d : t.samples) {
+    s.force = std::max({s.force, d.RA0.norm(), d.RA3.norm(), d.Fsh.norm()});
+    s.moment = std::max({s.moment, std::abs(d.tau), std::abs(d.Msh)});
+  }
+  s.moment = std::max(s.moment, l4 * s.force);
+  return s;
+}
+
+std::vector<core::FourBar> test_models() {
+  std::vector<core::FourBar> models = {
+      core::samples::with_paper_loads(core::samples::paper_fourbar_unloaded(), Vec2(0, -9.81))};
+  std::mt19937_64 rng(7);
+  for (int i = 0; i < 3; ++i) models.push_back(core::samples::random_crank_rocker(rng));
+  const std::size_t bare = models.size();
+  for (std::size_t i = 0; i < bare; ++i) models.push_back(with_counter_rotations(models[i]));
+  return models;
+}
+
+TEST(Nlp, RegressorReproducesInverseDynamics) {
+  std::mt19937_64 rng(11);
+  for (const core::FourBar& model : test_models()) {
+    for (core::Formulation f : core::kFormulations) {
+      const DesignProblem p = driven_problem(model, f);
+      const Nlp nlp(p);
+      for (int trial = 0; trial < 3; ++trial) {
+        const Eigen::VectorXd x = random_x(nlp, p, rng);
+        const core::FourBar design = nlp.design(x);
+        const core::Trajectory ref =
+            core::simulate_driven(design, std::get<core::DrivenScene>(p.scene), options_of(p));
+        ASSERT_TRUE(ref.ok()) << ref.message;
+        const core::Trajectory got = nlp.trajectory(x);
+        ASSERT_EQ(got.samples.size(), ref.samples.size());
+        const Scales s = scales_of(ref, model.frame_length);
+        for (std::size_t i = 0; i < ref.samples.size(); ++i) {
+          const core::DynamicsSample &a = got.samples[i], &b = ref.samples[i];
+          const std::string at = std::string(core::to_string(f)) + ", sample " + std::to_string(i);
+          EXPECT_EQ(a.state.theta1, b.state.theta1) << at;
+          EXPECT_EQ(got.t[i], ref.t[i]) << at;
+          EXPECT_LT((a.RA0 - b.RA0).norm(), 1e-12 * s.force) << at;
+          EXPECT_LT((a.RA3 - b.RA3).norm(), 1e-12 * s.force) << at;
+          EXPECT_LT((a.Fsh - b.Fsh).norm(), 1e-12 * s.force) << at;
+          EXPECT_LT(std::abs(a.Msh - b.Msh), 1e-12 * s.moment) << at;
+          EXPECT_LT(std::abs(a.tau - b.tau), 1e-12 * s.moment) << at;
+        }
+      }
+    }
+  }
+}
+
+TEST(Nlp, MetricsMatchCoreMetricsOfTheDrivenDesign) {
+  std::mt19937_64 rng(12);
+  for (const core::FourBar& model : test_models()) {
+    const DesignProblem p = driven_problem(model, core::Formulation::kComplexMasses, 36);
+    const Nlp nlp(p);
+    for (int trial = 0; trial < 3; ++trial) {
+      const Eigen::VectorXd x = random_x(nlp, p, rng);
+      const core::Trajectory ref =
+          core::simulate_driven(nlp.design(x), std::get<core::DrivenScene>(p.scene), options_of(p));
+      ASSERT_TRUE(ref.ok());
+      const core::Metrics want = core::metrics(ref);
+      const core::Metrics got = nlp.metrics(x);
+      const Scales s = scales_of(ref, model.frame_length);
+      for (Metric m : kMetrics) {
+        if (m == Metric::kAddedMass) continue;
+        const double scale = (m == Metric::kMshRms || m == Metric::kMshMax ||
+                              m == Metric::kTauRms || m == Metric::kTauMax)
+                                 ? s.moment
+                                 : s.force;
+        // the summary of the regressor's samples, and the fast path (|R q| for an RMS)
+        const double* fields[] = {&got.Fsh_rms, &got.Fsh_max, &got.Msh_rms, &got.Msh_max,
+                                  &got.tau_rms, &got.tau_max, &got.RA0_rms, &got.RA0_max,
+                                  &got.RA3_rms, &got.RA3_max};
+        const double* wants[] = {&want.Fsh_rms, &want.Fsh_max, &want.Msh_rms, &want.Msh_max,
+                                 &want.tau_rms, &want.tau_max, &want.RA0_rms, &want.RA0_max,
+                                 &want.RA3_rms, &want.RA3_max};
+        const auto k = static_cast<std::size_t>(m);
+        EXPECT_NEAR(*fields[k], *wants[k], 1e-12 * scale) << to_string(m);
+        EXPECT_NEAR(nlp.metric(x, m), *wants[k], 1e-12 * scale) << to_string(m);
+      }
+      // added mass: the design's total mass minus the original's
+      EXPECT_NEAR(nlp.metric(x, Metric::kAddedMass),
+                  core::total_mass(nlp.design(x)) - core::total_mass(model),
+                  1e-13 * core::total_mass(model));
+    }
+  }
+}
+
+TEST(Nlp, OriginalValuesNormaliseTheObjective) {
+  // with no counterweight mass and the link parameters at their original values the design is
+  // the original: each squared term is 1, the added mass 0
+  const core::FourBar model = core::samples::paper_fourbar();
+  DesignProblem p = driven_problem(model, core::Formulation::kMassMatrix, 36);
+  p.link_parameters = {{2, P::kMass, 1.0, 5.0}};
+  p.objective = {{Metric::kFshRms, 2.0}, {Metric::kTauRms, 0.5}, {Metric::kAddedMass, 3.0}};
+  const Nlp nlp(p);
+  Eigen::VectorXd x = nlp.start();
+  x(0) = x(3) = 0.0;  // no counterweights
+  EXPECT_EQ(x(6), model.coupler.mass);
+  EXPECT_NEAR(nlp.objective(x, nullptr), 2.5, 1e-12);
+  const core::Metrics o = core::metrics(
+      core::simulate_driven(model, std::get<core::DrivenScene>(p.scene), options_of(p)));
+  EXPECT_EQ(nlp.original(Metric::kFshRms), o.Fsh_rms);
+  EXPECT_EQ(nlp.original(Metric::kAddedMass), core::total_mass(model));
+}
+
+TEST(Nlp, ObjectiveAndLimitsFollowTheirDefinitions) {
+  std::mt19937_64 rng(13);
+  const core::FourBar model = core::samples::random_crank_rocker(rng);
+  const DesignProblem p = full_problem(model, core::Formulation::kOpenedLoop);
+  const Nlp nlp(p);
+  const int samples = std::get<core::DrivenScene>(p.scene).samples;
+  const Eigen::VectorXd x = random_x(nlp, p, rng);
+  // objective: Σ w (metric/original)², a peak through its bound variable, added mass linear
+  double want = 0;
+  int t = design_variables(p);
+  for (const Term& term : p.objective) {
+    if (term.metric == Metric::kAddedMass) {
+      want += term.weight * nlp.metric(x, term.metric) / core::total_mass(model);
+    } else {
+      const double v = is_peak(term.metric) ? x(t++) : nlp.metric(x, term.metric);
+      want += term.weight * std::pow(v / nlp.original(term.metric), 2);
+    }
+  }
+  EXPECT_NEAR(nlp.objective(x, nullptr), want, 1e-12 * want);
+  // limits: the largest peak-limit constraint over the samples is (peak/limit)² - 1
+  Eigen::VectorXd c;
+  nlp.inequalities(x, c, nullptr);
+  ASSERT_EQ(c.size(), nlp.n_ineq());
+  ASSERT_EQ(static_cast<int>(nlp.constraint_names().size()), nlp.n_eq() + nlp.n_ineq());
+  int row = 2;  // after the two envelopes
+  for (const Limit& l : p.limits) {
+    const double v = nlp.metric(x, l.metric);
+    if (l.metric == Metric::kAddedMass) {
+      EXPECT_NEAR(c(row), (v - l.value) / core::total_mass(model), 1e-14);
+      ++row;
+    } else if (is_peak(l.metric)) {
+      const double worst = c.segment(row, samples).maxCoeff();
+      EXPECT_NEAR(worst, std::pow(v / (l.value * nlp.original(l.metric)), 2) - 1, 1e-12);
+      row += samples;
+    } else {
+      EXPECT_NEAR(c(row), std::pow(v / (l.value * nlp.original(l.metric)), 2) - 1, 1e-12);
+      ++row;
+    }
+  }
+  EXPECT_EQ(row + 5 * samples, nlp.n_ineq());  // then the five peak bounds' samples
+}
+
+// Central differences of a vector function, column by column.
+template <class F>
+Eigen::MatrixXd central_differences(const Eigen::VectorXd& x, int rows, F f) {
+  Eigen::MatrixXd jac(rows, x.size());
+  for (int j = 0; j < x.size(); ++j) {
+    const double h = 1e-6 * std::max(1.0, std::abs(x(j)));
+    Eigen::VectorXd xp = x, xm = x;
+    xp(j) += h;
+    xm(j) -= h;
+    jac.col(j) = (f(xp) - f(xm)) / (xp(j) - xm(j));
+  }
+  return jac;
+}
+
+void expect_rows_agree(const Eigen::MatrixXd& analytic, const Eigen::MatrixXd& numeric,
+                       const Nlp& nlp, const std::string& what, int row_offset) {
+  ASSERT_EQ(analytic.rows(), numeric.rows());
+  ASSERT_EQ(analytic.cols(), numeric.cols());
+  for (int i = 0; i < analytic.rows(); ++i) {
+    const double scale = std::max(analytic.row(i).cwiseAbs().maxCoeff(), 1e-2);
+    const double error = (analytic.row(i) - numeric.row(i)).cwiseAbs().maxCoeff();
+    EXPECT_LT(error, 1e-6 * scale)
+        << what << " row " << i << ": "
+        << nlp.constraint_names()[static_cast<std::size_t>(i + row_offset)];
+  }
+}
+
+TEST(Nlp, GradientsMatchCentralDifferences) {
+  std::mt19937_64 rng(14);
+  for (const core::FourBar& model : test_models()) {
+    const DesignProblem p = full_problem(model, core::Formulation::kMassMatrix);
+    const Nlp nlp(p);
+    ASSERT_TRUE(nlp.has_gradients());
+    for (int trial = 0; trial < 2; ++trial) {
+      const Eigen::VectorXd x = random_x(nlp, p, rng);
+      // objective
+      Eigen::VectorXd g;
+      nlp.objective(x, &g);
+      const Eigen::MatrixXd g_fd = central_differences(x, 1, [&](const Eigen::VectorXd& z) {
+        return Eigen::VectorXd::Constant(1, nlp.objective(z, nullptr));
+      });
+      ASSERT_EQ(g.size(), nlp.n());
+      const double scale = g.cwiseAbs().maxCoeff();
+      EXPECT_LT((g.transpose() - g_fd).cwiseAbs().maxCoeff(), 1e-6 * scale);
+      // equalities
+      Eigen::VectorXd c;
+      Eigen::MatrixXd jac;
+      nlp.equalities(x, c, &jac);
+      ASSERT_EQ(nlp.n_eq(), 4);
+      expect_rows_agree(jac,
+                        central_differences(x, nlp.n_eq(),
+                                            [&](const Eigen::VectorXd& z) {
+                                              Eigen::VectorXd v;
+                                              nlp.equalities(z, v, nullptr);
+                                              return v;
+                                            }),
+                        nlp, "equality", 0);
+      // inequalities
+      nlp.inequalities(x, c, &jac);
+      expect_rows_agree(jac,
+                        central_differences(x, nlp.n_ineq(),
+                                            [&](const Eigen::VectorXd& z) {
+                                              Eigen::VectorXd v;
+                                              nlp.inequalities(z, v, nullptr);
+                                              return v;
+                                            }),
+                        nlp, "inequality", nlp.n_eq());
+    }
+  }
+}
+
+TEST(Nlp, EqualitiesAreEquation57OverTheTotalMass) {
+  std::mt19937_64 rng(15);
+  for (const core::FourBar& model : test_models()) {
+    DesignProblem p = driven_problem(model, core::Formulation::kComplexMasses);
+    p.force_balance = true;
+    const Nlp nlp(p);
+    const Eigen::VectorXd x = random_x(nlp, p, rng);
+    const balance::ForceBalanceResiduals r = balance::force_balance_residuals(nlp.design(x));
+    Eigen::VectorXd c;
+    nlp.equalities(x, c, nullptr);
+    const double M = core::total_mass(model);
+    EXPECT_NEAR(c(0), r.crank.real() / M, 1e-13);
+    EXPECT_NEAR(c(1), r.crank.imag() / M, 1e-13);
+    EXPECT_NEAR(c(2), r.rocker.real() / M, 1e-13);
+    EXPECT_NEAR(c(3), r.rocker.imag() / M, 1e-13);
+  }
+}
+
+TEST(Nlp, ForceBalanceEqualitiesVanishForForceBalancedDesign) {
+  for (const balance::CounterweightShape shape :
+       {balance::CounterweightShape::kPoint, balance::CounterweightShape::kDisc}) {
+    const core::FourBar model = core::samples::paper_fourbar_unloaded();
+    balance::CounterweightSpec spec;
+    spec.shape = shape;
+    spec.distance = 0.5;
+    const balance::ForceBalancedDesign balanced = balance::force_balance(model, spec, spec);
+    ASSERT_TRUE(balanced.crank && balanced.rocker);
+
+    DesignProblem p = driven_problem(model, core::Formulation::kComplexMasses, 72);
+    p.link_parameters.clear();
+    p.force_balance = true;
+    for (CounterweightVariables& c : p.counterweights) {
+      c.shape = shape;
+      c.thickness = spec.thickness;
+      c.density = spec.density;
+      c.mass_max = 20.0;
+    }
+    const Nlp nlp(p);
+    Eigen::VectorXd x(6);
+    x << balanced.crank->mass, balanced.crank->position.x(), balanced.crank->position.y(),
+        balanced.rocker->mass, balanced.rocker->position.x(), balanced.rocker->position.y();
+    ASSERT_TRUE((x.array() <= nlp.upper().array()).all() &&
+                (x.array() >= nlp.lower().array()).all());
+    Eigen::VectorXd c;
+    nlp.equalities(x, c, nullptr);
+    EXPECT_LT(c.cwiseAbs().maxCoeff(), 1e-13) << c.transpose();
+    // the same design as balance's (its inertia included), and no shaking force in the scene
+    const core::FourBar design = nlp.design(x);
+    for (int k = 1; k <= 3; ++k) {
+      const core::Link &a = core::link(design, k), &b = core::link(balanced.model, k);
+      EXPECT_NEAR(a.mass, b.mass, 1e-13 * b.mass);
+      EXPECT_NEAR(a.e, b.e, 1e-13 * b.length);
+      EXPECT_NEAR(a.f, b.f, 1e-13 * b.length);
+      EXPECT_NEAR(a.inertia, b.inertia, 1e-13 * (b.inertia + b.mass * b.length * b.length));
+    }
+    EXPECT_LT(nlp.metric(x, Metric::kFshRms), 1e-12 * nlp.metric(x, Metric::kRA0Rms));
+    EXPECT_LT(nlp.metrics(x).Fsh_max, 1e-12 * nlp.metrics(x).RA0_max);
+    // and not otherwise: the start, and the balanced design with either counterweight moved
+    nlp.equalities(nlp.start(), c, nullptr);
+    EXPECT_GT(c.cwiseAbs().maxCoeff(), 1e-3);
+    for (int j : {0, 1, 2, 3, 4, 5}) {
+      Eigen::VectorXd y = x;
+      y(j) += 0.05;
+      nlp.equalities(y, c, nullptr);
+      EXPECT_GT(c.cwiseAbs().maxCoeff(), 1e-4) << "variable " << j;
+    }
+  }
+}
+
+TEST(Nlp, PeakBoundsHoldOverTheBox) {
+  // t_max bounds the peak of every design in the box, and the start is feasible
+  std::mt19937_64 rng(16);
+  for (const core::FourBar& model : test_models()) {
+    const DesignProblem p = full_problem(model, core::Formulation::kComplexMasses);
+    const Nlp nlp(p);
+    const Eigen::VectorXd x0 = nlp.start();
+    EXPECT_TRUE((x0.array() <= nlp.upper().array()).all());
+    EXPECT_TRUE((x0.array() >= nlp.lower().array()).all());
+    Eigen::VectorXd c;
+    nlp.inequalities(x0, c, nullptr);
+    const int samples = std::get<core::DrivenScene>(p.scene).samples;
+    EXPECT_LE(c.tail(5 * samples).maxCoeff(), 0.0);  // the peak bounds at the start
+    for (int trial = 0; trial < 20; ++trial) {
+      const Eigen::VectorXd x = random_x(nlp, p, rng);
+      int t = design_variables(p);
+      for (Metric m : kMetrics) {
+        if (is_peak(m)) {
+          EXPECT_LE(nlp.metric(x, m), nlp.upper()(t++)) << to_string(m);
+        }
+      }
+    }
+  }
+}
+
+TEST(Nlp, NamesAndSizes) {
+  const DesignProblem p =
+      full_problem(core::samples::paper_fourbar(), core::Formulation::kMassMatrix);
+  const Nlp nlp(p);
+  EXPECT_EQ(nlp.n(), design_variables(p) + 5);
+  EXPECT_EQ(nlp.lower().size(), nlp.n());
+  ASSERT_EQ(static_cast<int>(nlp.variable_names().size()), nlp.n());
+  EXPECT_EQ(nlp.variable_names()[0], "crank counterweight mass [kg]");
+  EXPECT_EQ(nlp.variable_names()[4], "rocker counterweight x from A3 in link axes [m]");
+  EXPECT_EQ(nlp.variable_names()[6], "coupler mass [kg]");
+  EXPECT_EQ(nlp.variable_names()[static_cast<std::size_t>(design_variables(p))],
+            "bound on Fsh_max [N]");
+  EXPECT_EQ(nlp.constraint_names()[0], "force balance, crank side (real part)");
+  EXPECT_EQ(nlp.constraint_names()[4], "crank counterweight within distance_max = 0.8 m of A0");
+  EXPECT_EQ(nlp.constraint_names()[6], "Fsh_rms <= 1.5 x original");
+  EXPECT_EQ(nlp.constraint_names()[7].rfind("Fsh_max <= 1.5 x original at sample 0", 0), 0u);
+  EXPECT_THROW(nlp.objective(Eigen::VectorXd::Zero(3), nullptr), InputError);
+  // the counterweights at x, as balance describes them
+  const Eigen::VectorXd x = nlp.start();
+  const std::vector<PlacedCounterweight> cws = nlp.counterweights(x);
+  ASSERT_EQ(cws.size(), 2u);
+  EXPECT_EQ(cws[0].link, 1);
+  EXPECT_EQ(cws[0].counterweight.mass, 2.5);
+  EXPECT_EQ(cws[0].counterweight.position, Vec2(-0.4, 0));
+  EXPECT_EQ(cws[1].link, 3);
+  EXPECT_EQ(cws[1].counterweight.position, Vec2(0.5, 0));
+  const double r2 = 2.0 / (500.0 * 3.141592653589793 * 0.05);
+  EXPECT_NEAR(cws[1].counterweight.radius, std::sqrt(r2), 1e-15);
+  EXPECT_NEAR(cws[1].counterweight.inertia, 0.5 * 2.0 * r2, 1e-15);
+}
+
+TEST(Nlp, ObjectiveNormaliserMustNotVanish) {
+  // a force-balanced original has Fsh_rms = 0 to round-off: nothing to normalise by
+  const balance::ForceBalancedDesign balanced =
+      balance::force_balance(core::samples::paper_fourbar_unloaded(), {}, {});
+  DesignProblem p = driven_problem(balanced.model, core::Formulation::kComplexMasses);
+  try {
+    const Nlp nlp(p);
+    ADD_FAILURE() << "no exception";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("objective[0]: the original design's Fsh_rms is"),
+              std::string::npos)
+        << e.what();
+  }
+  p.objective = {{Metric::kTauRms, 1.0}};
+  EXPECT_NO_THROW(Nlp{p});
+  p.objective[0].weight = 0;
+  p.objective.push_back({Metric::kRA0Max, 1.0});
+  p.limits = {{Metric::kFshMax, 0.5}};
+  EXPECT_THROW(Nlp{p}, InputError);
+}
+
+TEST(Nlp, InvalidProblemThrows) {
+  DesignProblem p = driven_problem(core::samples::paper_fourbar(), core::Formulation::kMassMatrix);
+  p.counterweights[1].link = 2;
+  try {
+    const Nlp nlp(p);
+    ADD_FAILURE() << "no exception";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "invalid design problem: counterweights[1].link must be 1 (crank) or 3 (rocker), "
+              "got 2");
+  }
+  // a driven crank that cannot turn
+  DesignProblem q = driven_problem(core::samples::triple_rocker(), core::Formulation::kMassMatrix);
+  EXPECT_THROW(Nlp{q}, InputError);
+}
+
+TEST(Nlp, FreeSceneSimulatesEveryDesign) {
+  std::mt19937_64 rng(17);
+  DesignProblem p = driven_problem(core::samples::paper_fourbar(), core::Formulation::kMassMatrix);
+  core::FreeScene scene;
+  scene.theta1 = 0.5;
+  scene.omega1 = 3.0;
+  scene.duration = 0.4;
+  scene.samples = 21;
+  p.scene = scene;
+  p.tolerance = 1e-9;
+  p.objective = {{Metric::kFshRms, 1.0}, {Metric::kMshMax, 0.5}, {Metric::kAddedMass, 0.1}};
+  p.limits = {{Metric::kRA0Max, 2.0}, {Metric::kMshRms, 3.0}, {Metric::kAddedMass, 4.0}};
+  p.force_balance = true;
+  const Nlp nlp(p);
+  EXPECT_FALSE(nlp.has_gradients());
+  EXPECT_EQ(nlp.n(), design_variables(p));  // no bound variables in free scenes
+  EXPECT_EQ(nlp.n_ineq(), 2 + 3);
+  const core::Metrics o = core::metrics(core::simulate_free(p.original, scene, options_of(p)));
+  EXPECT_EQ(nlp.original(Metric::kMshMax), o.Msh_max);
+
+  for (int trial = 0; trial < 3; ++trial) {
+    const Eigen::VectorXd x = random_x(nlp, p, rng);
+    const core::Trajectory t = core::simulate_free(nlp.design(x), scene, options_of(p));
+    ASSERT_TRUE(t.ok()) << t.message;
+    const core::Metrics want = core::metrics(t);
+    const core::Metrics got = nlp.metrics(x);
+    EXPECT_EQ(got.Fsh_rms, want.Fsh_rms);
+    EXPECT_EQ(got.Fsh_max, want.Fsh_max);
+    EXPECT_EQ(got.Msh_rms, want.Msh_rms);
+    EXPECT_EQ(got.Msh_max, want.Msh_max);
+    EXPECT_EQ(got.tau_rms, want.tau_rms);
+    EXPECT_EQ(got.tau_max, want.tau_max);
+    EXPECT_EQ(got.RA0_rms, want.RA0_rms);
+    EXPECT_EQ(got.RA0_max, want.RA0_max);
+    EXPECT_EQ(got.RA3_rms, want.RA3_rms);
+    EXPECT_EQ(got.RA3_max, want.RA3_max);
+    const double added = core::total_mass(nlp.design(x)) - core::total_mass(p.original);
+    EXPECT_NEAR(nlp.metric(x, Metric::kAddedMass), added, 1e-13);
+    // the objective and the limits from these metrics
+    const double f = std::pow(want.Fsh_rms / o.Fsh_rms, 2) +
+                     0.5 * std::pow(want.Msh_max / o.Msh_max, 2) +
+                     0.1 * added / core::total_mass(p.original);
+    EXPECT_NEAR(nlp.objective(x, nullptr), f, 1e-13 * f);
+    Eigen::VectorXd c;
+    nlp.inequalities(x, c, nullptr);
+    EXPECT_NEAR(c(2), std::pow(want.RA0_max / (2.0 * o.RA0_max), 2) - 1, 1e-13);
+    EXPECT_NEAR(c(3), std::pow(want.Msh_rms / (3.0 * o.Msh_rms), 2) - 1, 1e-13);
+    EXPECT_NEAR(c(4), (added - 4.0) / core::total_mass(p.original), 1e-13);
+    nlp.equalities(x, c, nullptr);
+    EXPECT_EQ(c.size(), 4);
+  }
+  // no gradients: asking is a programming error
+  const Eigen::VectorXd x = nlp.start();
+  Eigen::VectorXd g, c;
+  Eigen::MatrixXd jac;
+  EXPECT_THROW(nlp.objective(x, &g), std::logic_error);
+  EXPECT_THROW(nlp.equalities(x, c, &jac), std::logic_error);
+  EXPECT_THROW(nlp.inequalities(x, c, &jac), std::logic_error);
+}
+
+}  // namespace
+}  // namespace bd::optimize

@@ -1,0 +1,153 @@
+// The design problem (optimize/problem.hpp): metric names and DesignProblem::validate()'s
+// messages, one per mistake.
+#include "optimize/problem.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "core/samples.hpp"
+
+namespace bd::optimize {
+namespace {
+
+using P = LinkParameterVariable::Parameter;
+
+TEST(Problem, MetricNamesRoundTrip) {
+  const char* names[] = {"Fsh_rms", "Fsh_max", "Msh_rms", "Msh_max", "tau_rms",   "tau_max",
+                         "RA0_rms", "RA0_max", "RA3_rms", "RA3_max", "added_mass"};
+  ASSERT_EQ(std::size(kMetrics), std::size(names));
+  for (std::size_t i = 0; i < std::size(kMetrics); ++i) {
+    EXPECT_STREQ(to_string(kMetrics[i]), names[i]);
+    EXPECT_EQ(metric_named(names[i]), kMetrics[i]);
+    EXPECT_EQ(is_peak(kMetrics[i]), std::string(names[i]).ends_with("_max")) << names[i];
+  }
+  EXPECT_FALSE(metric_named("Fsh_RMS"));
+  EXPECT_FALSE(metric_named(""));
+}
+
+DesignProblem valid_problem() {
+  DesignProblem p;
+  p.original = core::samples::paper_fourbar();
+  core::DrivenScene scene;
+  scene.omega1 = 2.0;
+  scene.samples = 36;
+  p.scene = scene;
+  CounterweightVariables c1;
+  c1.link = 1;
+  CounterweightVariables c3;
+  c3.link = 3;
+  c3.shape = balance::CounterweightShape::kDisc;
+  p.counterweights = {c1, c3};
+  p.link_parameters = {{2, P::kMass, 1.0, 5.0}, {2, P::kInertia, 0.0, 4.0}, {3, P::kE, -1, 2}};
+  p.objective = {{Metric::kFshRms, 1.0}, {Metric::kMshMax, 0.0}};
+  p.limits = {{Metric::kTauMax, 1.2}, {Metric::kAddedMass, 0.0}};
+  return p;
+}
+
+template <class Change>
+std::string message_after(Change change) {
+  DesignProblem p = valid_problem();
+  change(p);
+  return p.validate();
+}
+
+TEST(Problem, ValidProblemsPass) {
+  EXPECT_EQ(valid_problem().validate(), "");
+  // link parameters alone, a free scene, an added-mass limit below zero (remove mass)
+  EXPECT_EQ(message_after([](DesignProblem& p) {
+              p.counterweights.clear();
+              p.scene = core::FreeScene{0.0, 1.0, 2.0, 11};
+              p.limits = {{Metric::kAddedMass, -0.5}};
+            }),
+            "");
+}
+
+TEST(Problem, ValidateNamesEachMistake) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.original.coupler.mass = -1.2; }),
+            "original design: coupler.mass must be > 0 kg, got -1.2");
+  EXPECT_EQ(message_after([](DesignProblem& p) {
+              p.counterweights.clear();
+              p.link_parameters.clear();
+            }),
+            "no design variables: give at least one counterweight or link parameter");
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.counterweights[1].link = 2; }),
+            "counterweights[1].link must be 1 (crank) or 3 (rocker), got 2");
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.counterweights[1].link = 1; }),
+            "counterweights[1]: a second counterweight on the crank (counterweights[0] is there "
+            "already); at most one per link");
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.counterweights[0].mass_max = 0; }),
+            "counterweights[0].mass_max must be > 0 kg, got 0");
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.counterweights[0].distance_max = -1; }),
+            "counterweights[0].distance_max must be > 0 m, got -1");
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.counterweights[1].thickness = 0; }),
+            "counterweights[1].thickness must be > 0 m, got 0");
+  EXPECT_EQ(message_after([nan](DesignProblem& p) { p.counterweights[1].density = nan; }),
+            "counterweights[1].density must be > 0 kg/m^3, got nan");
+  // a point counterweight ignores thickness and density
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.counterweights[0].density = 0; }), "");
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.link_parameters[0].link = 4; }),
+            "link_parameters[0].link must be 1, 2 or 3, got 4");
+  EXPECT_EQ(message_after([](DesignProblem& p) {
+              p.link_parameters[2] = {2, P::kMass, 1, 2};
+            }),
+            "link_parameters[2] (coupler.mass) appears twice");
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.link_parameters[0].lower = 0; }),
+            "link_parameters[0] (coupler.mass).lower must be > 0 kg, got 0");
+  EXPECT_EQ(
+      message_after([](DesignProblem& p) { p.link_parameters[1].lower = -0.1; }),
+      "link_parameters[1] (coupler.inertia).lower must be >= 0 kg m^2, got -0.10000000000000001");
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.link_parameters[2].upper = -2; }),
+            "link_parameters[2] (rocker.e).upper must be >= lower = -1 m, got -2");
+  EXPECT_EQ(message_after([nan](DesignProblem& p) { p.link_parameters[2].lower = nan; }),
+            "link_parameters[2] (rocker.e).lower must be finite m, got nan");
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.objective.clear(); }),
+            "objective: give at least one term");
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.objective[1].weight = -1; }),
+            "objective[1].weight (Msh_max) must be >= 0, got -1");
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.objective[0].weight = 0; }),
+            "objective: at least one term needs a weight > 0, all are 0");
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.limits[0].value = 0; }),
+            "limits[0].value (tau_max) must be > 0 (a fraction of the original), got 0");
+  EXPECT_EQ(message_after([](DesignProblem& p) {
+              p.limits[1].value = std::numeric_limits<double>::infinity();
+            }),
+            "limits[1].value (added_mass) must be finite kg, got inf");
+  EXPECT_EQ(message_after([](DesignProblem& p) {
+              p.scene = core::DrivenScene{0.0, 0.0, 1, 36};
+            }),
+            "scene.omega1 must be finite and != 0 rad/s, got 0");
+  EXPECT_EQ(message_after([](DesignProblem& p) {
+              p.scene = core::DrivenScene{0.0, 1.0, 0, 36};
+            }),
+            "scene.revolutions must be >= 1, got 0");
+  EXPECT_EQ(message_after([](DesignProblem& p) {
+              p.scene = core::FreeScene{0.0, 1.0, 0.0, 11};
+            }),
+            "scene.duration must be > 0 s, got 0");
+  EXPECT_EQ(message_after([](DesignProblem& p) {
+              p.scene = core::FreeScene{0.0, 1.0, 1.0, 1};
+            }),
+            "scene.samples must be >= 2, got 1");
+  EXPECT_EQ(message_after([](DesignProblem& p) {
+              p.scene = core::FreeScene{0.0, 1.0, 1.0, 11};
+              p.tolerance = 0;
+            }),
+            "tolerance must be > 0, got 0");
+  // free motion has no drive torque
+  EXPECT_EQ(message_after([](DesignProblem& p) {
+              p.scene = core::FreeScene{0.0, 1.0, 1.0, 11};
+              p.objective[1] = {Metric::kTauRms, 1.0};
+            }),
+            "objective[1]: tau_rms is 0 in a free scene (no drive torque)");
+  EXPECT_EQ(message_after([](DesignProblem& p) {
+              p.scene = core::FreeScene{0.0, 1.0, 1.0, 11};
+            }),
+            "limits[0]: tau_max is 0 in a free scene (no drive torque)");
+}
+
+}  // namespace
+}  // namespace bd::optimize
