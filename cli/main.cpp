@@ -27,6 +27,7 @@ constexpr int kExitOk = 0;
 constexpr int kExitInternal = 1;
 constexpr int kExitBadInput = 2;
 constexpr int kExitStoppedEarly = 3;
+constexpr int kExitNoOptimum = 4;
 
 constexpr const char* kFooter = R"(
 Outputs (in DIR, default results/<name>/ with <name> the study's `name`):
@@ -40,6 +41,13 @@ Outputs (in DIR, default results/<name>/ with <name> the study's `name`):
   balanced-timeseries.csv  the balanced design's samples, columns as timeseries.csv
   balanced.yaml            a complete study file of the balanced design
   comparison.csv           metric,before,after,ratio for the main metrics, added mass and inertia
+  With an `optimize:` section, besides (for the optimum, same scene):
+  optimized-timeseries.csv the optimum's samples, columns as timeseries.csv
+  optimized.yaml           a complete study file of the optimum
+  comparison.csv           metric,before,after,ratio as above (optimum vs original)
+  pareto.csv               with optimize.pareto: epsilon,<first>,<second>,termination,
+                           verification_error and the design variables, one row per point
+  summary.json then also has optimize, optimized_run, optimized_metrics and reduction.
   Files are written under a temporary name and renamed, so none is ever half-written.
 
 Exit codes:
@@ -50,6 +58,9 @@ Exit codes:
   3  a simulation stopped early (e.g. a dead-centre position), the original's or the balanced
      design's; the samples computed so far and summary.json are kept, and the reason (with time
      and crank angle) is printed on stderr
+  4  the optimiser found no design (infeasible, or it failed); the original's files and
+     summary.json (with the optimiser's message) are kept, and one line naming the binding
+     constraint is printed on stderr
 
 The study-file format is described in docs/study-format.md; examples are in studies/examples/.
 )";
@@ -58,6 +69,19 @@ struct RunArgs {
   std::string study;
   std::string out;
 };
+
+// before / after / ratio of the main metrics, added mass and inertia
+void print_comparison(const st::Study& study, const st::RunResult& r) {
+  std::printf("  %-14s %14s %14s %12s\n", "metric", "before", "after", "ratio");
+  for (const st::ComparisonRow& row : st::comparison(study, r)) {
+    if (row.ratio) {
+      std::printf("  %-14s %14.6g %14.6g %12.4g\n", row.metric.c_str(), row.before, row.after,
+                  *row.ratio);
+    } else {
+      std::printf("  %-14s %14.6g %14.6g %12s\n", row.metric.c_str(), row.before, row.after, "-");
+    }
+  }
+}
 
 // the balanced design: what was added, and before / after / ratio of the main metrics
 void print_balance(const st::Study& study, const st::RunResult& r) {
@@ -99,15 +123,40 @@ void print_balance(const st::Study& study, const st::RunResult& r) {
   }
   std::printf(", %zu samples, status %s\n", run.trajectory.samples.size(),
               bd::core::to_string(run.trajectory.status));
-  std::printf("  %-14s %14s %14s %12s\n", "metric", "before", "after", "ratio");
-  for (const st::ComparisonRow& row : st::comparison(study, r)) {
-    if (row.ratio) {
-      std::printf("  %-14s %14.6g %14.6g %12.4g\n", row.metric.c_str(), row.before, row.after,
-                  *row.ratio);
-    } else {
-      std::printf("  %-14s %14.6g %14.6g %12s\n", row.metric.c_str(), row.before, row.after, "-");
-    }
+  print_comparison(study, r);
+}
+
+// the optimum: how the solver ended, what it added, and before / after / ratio
+void print_optimize(const st::Study& study, const st::RunResult& r) {
+  const st::OptimizeRequest& req = *study.optimize;
+  const st::OptimizedRun& run = *r.optimized;
+  const bd::optimize::OptimizeResult& o = run.result;
+  std::printf("  optimize %s: minimise %s\n", bd::optimize::to_string(req.options.algorithm),
+              st::objective_text(req).c_str());
+  std::printf("           subject to %s\n", st::constraints_text(req).c_str());
+  std::printf("           %s\n", o.brief_report().c_str());
+  if (!run.found()) return;
+  for (const bd::optimize::PlacedCounterweight& p : o.counterweights) {
+    const bd::balance::Counterweight& c = p.counterweight;
+    std::printf("  %-7s  counterweight %.6g kg at [%.6g, %.6g] m from %s (%.6g m)",
+                bd::core::link_name(p.link), c.mass, c.position.x(), c.position.y(),
+                p.link == 1 ? "A0" : "A3", c.distance);
+    if (c.radius > 0) std::printf(", radius %.6g m", c.radius);
+    std::printf("\n");
   }
+  std::printf("  verified with %s: largest relative difference %.3g\n",
+              bd::core::to_string(o.verified_with), o.verification_error);
+  std::printf("  optimum: method %s, %zu samples, status %s\n",
+              bd::core::to_string(run.method.formulation), run.trajectory.samples.size(),
+              bd::core::to_string(run.trajectory.status));
+  if (!run.pareto.empty()) {
+    std::size_t found = 0;
+    for (const bd::optimize::ParetoPoint& p : run.pareto) found += p.result.ok() ? 1 : 0;
+    std::printf("  pareto   %s vs %s: %zu of %zu points found\n",
+                bd::optimize::to_string(req.pareto->first),
+                bd::optimize::to_string(req.pareto->second), found, run.pareto.size());
+  }
+  print_comparison(study, r);
 }
 
 void print_summary(const st::Study& study, const st::RunResult& r) {
@@ -137,11 +186,18 @@ void print_summary(const st::Study& study, const st::RunResult& r) {
   }
   std::printf("  |RA0|    max %.6g N;  |RA3| max %.6g N\n", m.RA0_max, m.RA3_max);
   if (study.balance && r.balanced) print_balance(study, r);
+  if (study.optimize && r.optimized) print_optimize(study, r);
   std::printf("  wrote    %s\n", r.timeseries.string().c_str());
   if (r.balanced) {
     for (const fs::path& p :
          {r.balanced->timeseries, r.balanced->study_file, r.balanced->comparison}) {
       std::printf("           %s\n", p.string().c_str());
+    }
+  }
+  if (r.optimized && r.optimized->found()) {
+    const st::OptimizedRun& o = *r.optimized;
+    for (const fs::path& p : {o.timeseries, o.study_file, o.comparison, o.pareto_file}) {
+      if (!p.empty()) std::printf("           %s\n", p.string().c_str());
     }
   }
   std::printf("           %s\n", r.summary.string().c_str());
@@ -169,7 +225,7 @@ int run(const RunArgs& args) {
   std::fflush(stderr);
   print_summary(study, result);
   std::fflush(stdout);
-  if (!result.ok()) {
+  if (result.stopped_early()) {
     // one line per run that stopped
     if (!result.trajectory.ok()) {
       std::fprintf(stderr, "%s: simulation stopped early: %s\n", args.study.c_str(),
@@ -179,7 +235,19 @@ int run(const RunArgs& args) {
       std::fprintf(stderr, "%s: simulation of the balanced design stopped early: %s\n",
                    args.study.c_str(), result.balanced->trajectory.message.c_str());
     }
+    if (result.optimized && result.optimized->found() && !result.optimized->trajectory.ok()) {
+      std::fprintf(stderr, "%s: simulation of the optimised design stopped early: %s\n",
+                   args.study.c_str(), result.optimized->trajectory.message.c_str());
+    }
     return kExitStoppedEarly;
+  }
+  if (result.optimized && result.optimized->failed()) {
+    // one line: the optimiser's message names the binding constraint
+    std::string message = result.optimized->result.message;
+    std::replace(message.begin(), message.end(), '\n', ' ');
+    std::fprintf(stderr, "%s: no optimum (%s): %s\n", args.study.c_str(),
+                 bd::optimize::to_string(result.optimized->result.termination), message.c_str());
+    return kExitNoOptimum;
   }
   return kExitOk;
 }
@@ -215,7 +283,8 @@ int main(int argc, char** argv) {
         "Simulates the linkage of a study file (free motion or a driven crank) and writes its\n"
         "reaction forces, shaking force and moment and drive torque; with a balance section it\n"
         "also synthesises the balanced design (counterweights, counter-rotations), simulates\n"
-        "it in the same scene and compares the two.\n\n"
+        "it in the same scene and compares the two; with an optimize section it searches for\n"
+        "the best design (NLopt, Ipopt) under constraints and does the same with it.\n\n"
         "Commands:\n"
         "  balance-design run STUDY.yaml [--out DIR]   run a study, write its outputs into DIR\n"
         "  balance-design STUDY.yaml [--out DIR]       the same: run is the default command\n"

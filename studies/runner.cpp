@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cassert>
 #include <cerrno>
@@ -13,6 +14,7 @@
 #include <utility>
 #include <variant>
 
+#include "optimize/nlp.hpp"
 #include "studies/study_yaml.hpp"
 
 namespace bd::studies {
@@ -178,6 +180,109 @@ std::string balance_json(const BalancedDesign& b) {
   return j + "  },\n";
 }
 
+// `"reduction": {...}`: after / before per metric; null where before is 0; `last` drops the comma
+std::string reduction_json(const core::Metrics& before_m, const core::Metrics& after_m, bool last) {
+  std::string j = "  \"reduction\": {\n";
+  const auto before = metric_items(before_m);
+  const auto after = metric_items(after_m);
+  for (std::size_t k = 0; k < before.size(); ++k) {
+    const double ratio = after[k].second / before[k].second;
+    j += std::string("    \"") + before[k].first +
+         "\": " + (before[k].second != 0 ? json_number(ratio) : std::string("null")) +
+         (k + 1 < before.size() ? ",\n" : "\n");
+  }
+  return j + (last ? "  }\n" : "  },\n");
+}
+
+// a JSON list of pre-formatted items, one per line at `indent` + 2 spaces
+std::string json_list(const std::vector<std::string>& xs, const std::string& indent) {
+  if (xs.empty()) return "[]";
+  std::string out = "[\n";
+  for (std::size_t k = 0; k < xs.size(); ++k) {
+    out += indent + "  " + xs[k] + (k + 1 < xs.size() ? ",\n" : "\n");
+  }
+  return out + indent + "]";
+}
+
+// the counterweights of an optimum, as balance_json writes them
+std::vector<std::string> counterweights_json(
+    const OptimizeRequest& request, const std::vector<optimize::PlacedCounterweight>& cws) {
+  std::vector<std::string> items;
+  for (const optimize::PlacedCounterweight& p : cws) {
+    balance::CounterweightShape shape = balance::CounterweightShape::kPoint;
+    for (const optimize::CounterweightVariables& v : request.counterweights) {
+      if (v.link == p.link) shape = v.shape;
+    }
+    const balance::Counterweight& c = p.counterweight;
+    items.push_back(
+        std::string("{\"link\": \"") + core::link_name(p.link) + "\", \"shape\": \"" +
+        to_string(shape) + "\", \"mass\": " + json_number(c.mass) +
+        ", \"position\": " + json_vec(c.position) + ", \"distance\": " + json_number(c.distance) +
+        ", \"radius\": " + json_number(c.radius) + ", \"thickness\": " + json_number(c.thickness) +
+        ", \"inertia\": " + json_number(c.inertia) + "}");
+  }
+  return items;
+}
+
+// the optimize section of summary.json: the problem, how the solver ended, the optimum
+std::string optimize_json(const Study& study, const RunResult& result) {
+  const OptimizeRequest& req = *study.optimize;
+  const OptimizedRun& o = *result.optimized;
+  const optimize::OptimizeResult& r = o.result;
+  std::string j = "  \"optimize\": {\n";
+  j += std::string("    \"algorithm\": \"") + optimize::to_string(req.options.algorithm) + "\",\n";
+  j += "    \"formulation\": " + json_string(core::to_string(result.method.formulation)) + ",\n";
+  std::vector<std::string> items;
+  for (const optimize::Term& t : req.objective) {
+    items.push_back(std::string("{\"metric\": \"") + optimize::to_string(t.metric) +
+                    "\", \"weight\": " + json_number(t.weight) + "}");
+  }
+  j += "    \"terms\": " + json_list(items, "    ") + ",\n";
+  j += std::string("    \"force_balance\": ") + (req.force_balance ? "true" : "false") + ",\n";
+  items.clear();
+  for (const optimize::Limit& l : req.limits) {
+    const bool kg = l.metric == optimize::Metric::kAddedMass;
+    items.push_back(std::string("{\"metric\": \"") + optimize::to_string(l.metric) +
+                    "\", \"value\": " + json_number(l.value) + ", \"unit\": \"" +
+                    (kg ? "kg" : "fraction of the original") + "\"}");
+  }
+  j += "    \"limits\": " + json_list(items, "    ") + ",\n";
+  j += std::string("    \"termination\": \"") + optimize::to_string(r.termination) + "\",\n";
+  j += "    \"message\": " + json_string(r.message) + ",\n";
+  j += "    \"iterations\": " + std::to_string(r.iterations) + ",\n";
+  j += "    \"evaluations\": " + std::to_string(r.evaluations) + ",\n";
+  j += "    \"seconds\": " + json_number(r.seconds) + ",\n";
+  const bool found = o.found();
+  j += "    \"objective\": " + (found ? json_number(r.objective) : std::string("null")) + ",\n";
+  j += "    \"constraint_violation\": " +
+       (found ? json_number(r.constraint_violation) : std::string("null")) + ",\n";
+  items.clear();
+  if (static_cast<std::size_t>(r.x.size()) == o.variable_names.size()) {
+    for (std::size_t k = 0; k < o.variable_names.size(); ++k) {
+      items.push_back("{\"name\": " + json_string(o.variable_names[k]) +
+                      ", \"value\": " + json_number(r.x[static_cast<Eigen::Index>(k)]) + "}");
+    }
+  }
+  j += "    \"variables\": " + json_list(items, "    ") + ",\n";
+  j += "    \"counterweights\": " +
+       json_list(found ? counterweights_json(req, r.counterweights) : std::vector<std::string>{},
+                 "    ") +
+       ",\n";
+  if (found) {
+    j += "    \"added_mass\": " + json_number(added_mass(study.model, r.design)) + ",\n";
+    j += "    \"added_inertia\": " + json_number(added_inertia(study.model, r.design)) + ",\n";
+    j += "    \"verified_with\": " + json_string(core::to_string(r.verified_with)) + ",\n";
+    j += "    \"verification_error\": " + json_number(r.verification_error) + ",\n";
+  }
+  if (req.pareto) {
+    j += std::string("    \"pareto\": {\"first\": \"") + optimize::to_string(req.pareto->first) +
+         "\", \"second\": \"" + optimize::to_string(req.pareto->second) +
+         "\", \"points\": " + std::to_string(o.pareto.size()) + "},\n";
+  }
+  j += "    \"brief_report\": " + json_string(r.brief_report()) + "\n";
+  return j + "  },\n";
+}
+
 // a trajectory's run facts (status, counts), without the braces
 std::string run_json_fields(const core::Trajectory& tr, const std::string& indent) {
   std::string j;
@@ -206,6 +311,37 @@ void write_text(const std::string& text, const fs::path& file) {
     throw std::runtime_error("cannot write " + file.string() + ": " + std::strerror(errno));
   }
   out.commit();
+}
+
+// solves an optimize study's problem and simulates the optimum; not run when the original's
+// simulation stopped early (its metrics are the normalisers)
+OptimizedRun optimize_study(const Study& study, const RunResult& original) {
+  OptimizedRun o;
+  if (!original.trajectory.ok()) {
+    o.result.message = "not run: the original design's simulation stopped early (" +
+                       original.trajectory.message + ")";
+    return o;
+  }
+  const OptimizeRequest& req = *study.optimize;
+  const optimize::DesignProblem problem = design_problem(study);
+  o.result = optimize::optimize(problem, req.options);
+  {
+    const optimize::Nlp nlp(problem);
+    o.variable_names = nlp.variable_names();
+  }
+  o.design_variables = std::min(static_cast<int>(o.variable_names.size()),
+                                3 * static_cast<int>(req.counterweights.size()) +
+                                    static_cast<int>(req.link_parameters.size()));
+  if (!o.found()) return o;
+  const Study best = optimized_study(study, o.result.design);
+  o.method = choose_method(best);
+  o.trajectory = simulate(best, o.method);
+  o.metrics = core::metrics(o.trajectory);
+  if (req.pareto) {
+    o.pareto = optimize::pareto_front(problem, req.pareto->first, req.pareto->second,
+                                      req.pareto->points, req.options);
+  }
+  return o;
 }
 
 }  // namespace
@@ -269,6 +405,25 @@ void write_timeseries(const core::Trajectory& trajectory, const fs::path& file) 
   out.commit();
 }
 
+namespace {
+
+// The keys of a second design's run (the balanced or the optimised one): `<what>_run`,
+// `<what>_metrics`, and `reduction` (second / original per metric; null where the original is 0).
+std::string second_run_json(const Study& study, const std::string& what, const MethodChoice& method,
+                            const core::Trajectory& trajectory, const core::Metrics& original,
+                            const core::Metrics& second) {
+  std::string j = "  \"" + what + "_run\": {\n";
+  j += "    \"study\": " + json_string(study.name + "-" + what) + ",\n";
+  j += "    \"method\": " + method_json(study, method) + ",\n";
+  j += run_json_fields(trajectory, "    ") + "\n";
+  j += "  },\n";
+  j += metrics_json((what + "_metrics").c_str(), second, false);
+  j += reduction_json(original, second, true);
+  return j;
+}
+
+}  // namespace
+
 std::string summary_json(const Study& study, const RunResult& result) {
   const core::Trajectory& tr = result.trajectory;
   std::string j = "{\n";
@@ -291,50 +446,48 @@ std::string summary_json(const Study& study, const RunResult& result) {
   j += "  \"tolerance\": " + json_number(study.tolerance) + ",\n";
   j += run_json_fields(tr, "  ") + ",\n";
   const bool balanced = study.balance && result.balanced;
-  j += metrics_json("metrics", result.metrics, !balanced);
+  const bool optimized = study.optimize && result.optimized;
+  j += metrics_json("metrics", result.metrics, !balanced && !optimized);
   if (balanced) {
     const BalancedRun& b = *result.balanced;
     j += balance_json(*study.balance);
-    j += "  \"balanced_run\": {\n";
-    j += "    \"study\": " + json_string(study.name + "-balanced") + ",\n";
-    j += "    \"method\": " + method_json(study, b.method) + ",\n";
-    j += run_json_fields(b.trajectory, "    ") + "\n";
-    j += "  },\n";
-    j += metrics_json("balanced_metrics", b.metrics, false);
-    // balanced / original per metric; null where the original is 0
-    j += "  \"reduction\": {\n";
-    const auto before = metric_items(result.metrics);
-    const auto after = metric_items(b.metrics);
-    for (std::size_t k = 0; k < before.size(); ++k) {
-      const double ratio = after[k].second / before[k].second;
-      j += std::string("    \"") + before[k].first +
-           "\": " + (before[k].second != 0 ? json_number(ratio) : std::string("null")) +
-           (k + 1 < before.size() ? ",\n" : "\n");
+    j += second_run_json(study, "balanced", b.method, b.trajectory, result.metrics, b.metrics);
+  }
+  if (optimized) {
+    const OptimizedRun& o = *result.optimized;
+    const bool found = o.found();
+    std::string section = optimize_json(study, result);
+    if (!found) section.replace(section.size() - 2, 1, "");  // the last key: no comma
+    j += section;
+    if (found) {
+      j += second_run_json(study, "optimized", o.method, o.trajectory, result.metrics, o.metrics);
     }
-    j += "  }\n";
   }
   j += "}\n";
   return j;
 }
 
 std::vector<ComparisonRow> comparison(const Study& study, const RunResult& result) {
-  assert(study.balance && result.balanced);
+  assert((study.balance && result.balanced) || (result.optimized && result.optimized->found()));
   std::vector<ComparisonRow> rows;
   const core::Metrics& a = result.metrics;
-  const core::Metrics& b = result.balanced->metrics;
+  const bool balanced = study.balance && result.balanced;
+  const core::Metrics& b = balanced ? result.balanced->metrics : result.optimized->metrics;
+  double mass = 0, inertia = 0;
+  if (balanced) {
+    mass = study.balance->added_mass;
+    inertia = study.balance->added_inertia;
+  } else {
+    mass = added_mass(study.model, result.optimized->result.design);
+    inertia = added_inertia(study.model, result.optimized->result.design);
+  }
   const std::pair<const char*, std::pair<double, double>> items[] = {
-      {"Fsh_rms", {a.Fsh_rms, b.Fsh_rms}},
-      {"Fsh_max", {a.Fsh_max, b.Fsh_max}},
-      {"Msh_rms", {a.Msh_rms, b.Msh_rms}},
-      {"Msh_max", {a.Msh_max, b.Msh_max}},
-      {"tau_rms", {a.tau_rms, b.tau_rms}},
-      {"tau_max", {a.tau_max, b.tau_max}},
-      {"RA0_rms", {a.RA0_rms, b.RA0_rms}},
-      {"RA0_max", {a.RA0_max, b.RA0_max}},
-      {"RA3_rms", {a.RA3_rms, b.RA3_rms}},
-      {"RA3_max", {a.RA3_max, b.RA3_max}},
-      {"added_mass", {0.0, study.balance->added_mass}},
-      {"added_inertia", {0.0, study.balance->added_inertia}}};
+      {"Fsh_rms", {a.Fsh_rms, b.Fsh_rms}}, {"Fsh_max", {a.Fsh_max, b.Fsh_max}},
+      {"Msh_rms", {a.Msh_rms, b.Msh_rms}}, {"Msh_max", {a.Msh_max, b.Msh_max}},
+      {"tau_rms", {a.tau_rms, b.tau_rms}}, {"tau_max", {a.tau_max, b.tau_max}},
+      {"RA0_rms", {a.RA0_rms, b.RA0_rms}}, {"RA0_max", {a.RA0_max, b.RA0_max}},
+      {"RA3_rms", {a.RA3_rms, b.RA3_rms}}, {"RA3_max", {a.RA3_max, b.RA3_max}},
+      {"added_mass", {0.0, mass}},         {"added_inertia", {0.0, inertia}}};
   for (const auto& [name, values] : items) {
     ComparisonRow row{name, values.first, values.second, std::nullopt};
     if (row.before != 0) row.ratio = row.after / row.before;
@@ -385,6 +538,79 @@ std::string balanced_yaml(const Study& study) {
   return study_yaml(balanced_study(study), header);
 }
 
+std::string optimized_yaml(const Study& study, const OptimizedRun& run) {
+  assert(study.optimize.has_value() && run.found());
+  const OptimizeRequest& req = *study.optimize;
+  const optimize::OptimizeResult& r = run.result;
+  std::string header = "The optimised design of study '" + study.name + "', found by\n";
+  header += "balance-design from its optimize section";
+  header += study.source.empty() ? std::string(".\n") : " in\n  " + study.source + "\n";
+  header += "Objective: minimise " + objective_text(req) + ".\n";
+  header += "Constraints: " + constraints_text(req) + ".\n";
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "Solver: %s, %s after %d evaluations; objective %.6g; verified with %s (largest "
+                "relative difference %.3g).\n",
+                optimize::to_string(req.options.algorithm), optimize::to_string(r.termination),
+                r.evaluations, r.objective, core::to_string(r.verified_with), r.verification_error);
+  header += line;
+  const char* pivots[] = {"", "A0", "", "A3"};
+  for (const optimize::PlacedCounterweight& p : r.counterweights) {
+    const balance::Counterweight& c = p.counterweight;
+    std::snprintf(line, sizeof line,
+                  "The %s carries a counterweight of %.6g kg at %.6g m from %s (merged into the "
+                  "link below).\n",
+                  core::link_name(p.link), c.mass, c.distance,
+                  p.link == 1 || p.link == 3 ? pivots[p.link] : "its pivot");
+    header += line;
+  }
+  header +=
+      "Links are in the polar form {s, sigma} with every digit (%.17g; e, f as comments).\n"
+      "Run it with\n  balance-design optimized.yaml";
+  return study_yaml(optimized_study(study, r.design), header);
+}
+
+namespace {
+
+// a CSV header field, quoted when it holds a comma, a quote or a line break
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+  std::string q = "\"";
+  for (char c : text) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+}  // namespace
+
+std::string pareto_csv(const Study& study, const OptimizedRun& run) {
+  assert(study.optimize && study.optimize->pareto);
+  const ParetoRequest& p = *study.optimize->pareto;
+  std::string text = std::string("epsilon,") + optimize::to_string(p.first) + "," +
+                     optimize::to_string(p.second) + ",termination,verification_error";
+  const int n = run.design_variables;
+  for (int k = 0; k < n; ++k)
+    text += "," + csv_field(run.variable_names[static_cast<std::size_t>(k)]);
+  text += "\n";
+  for (const optimize::ParetoPoint& point : run.pareto) {
+    const optimize::OptimizeResult& r = point.result;
+    text += number(point.epsilon);
+    if (r.ok()) {
+      const double mass = added_mass(study.model, r.design);
+      text += "," + number(metric_value(r.metrics, p.first, mass)) + "," +
+              number(metric_value(r.metrics, p.second, mass));
+    } else {
+      text += ",,";
+    }
+    text += std::string(",") + optimize::to_string(r.termination) + "," +
+            (r.ok() ? number(r.verification_error) : std::string());
+    for (int k = 0; k < n; ++k) {
+      text += "," + (k < r.x.size() ? number(r.x[k]) : std::string());
+    }
+    text += "\n";
+  }
+  return text;
+}
+
 RunResult run_study(const Study& study, const fs::path& out_dir) {
   RunResult result;
   result.method = choose_method(study);
@@ -401,6 +627,7 @@ RunResult run_study(const Study& study, const fs::path& out_dir) {
     b.metrics = core::metrics(b.trajectory);
     result.balanced = std::move(b);
   }
+  if (study.optimize) result.optimized = optimize_study(study, result);
 
   // then the files, summary last: a summary.json means the other files are complete
   std::error_code ec;
@@ -420,6 +647,19 @@ RunResult run_study(const Study& study, const fs::path& out_dir) {
     write_timeseries(b.trajectory, b.timeseries);
     write_text(balanced_yaml(study), b.study_file);
     write_text(comparison_csv(study, result), b.comparison);
+  }
+  if (result.optimized && result.optimized->found()) {
+    OptimizedRun& o = *result.optimized;
+    o.timeseries = out_dir / "optimized-timeseries.csv";
+    o.study_file = out_dir / "optimized.yaml";
+    o.comparison = out_dir / "comparison.csv";
+    write_timeseries(o.trajectory, o.timeseries);
+    write_text(optimized_yaml(study, o), o.study_file);
+    write_text(comparison_csv(study, result), o.comparison);
+    if (study.optimize->pareto) {
+      o.pareto_file = out_dir / "pareto.csv";
+      write_text(pareto_csv(study, o), o.pareto_file);
+    }
   }
   write_text(summary_json(study, result), result.summary);
   return result;

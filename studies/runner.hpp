@@ -1,7 +1,9 @@
 #pragma once
 /// Running a study: simulate its scene, then write timeseries.csv and summary.json
 /// (DESIGN.md "Outputs (v1 contract)"); for a study with a balance section also the balanced
-/// design's balanced-timeseries.csv, balanced.yaml and comparison.csv.
+/// design's balanced-timeseries.csv, balanced.yaml and comparison.csv; for a study with an
+/// optimize section the optimum's optimized-timeseries.csv, optimized.yaml, comparison.csv and,
+/// with a Pareto front, pareto.csv.
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -9,6 +11,7 @@
 
 #include "core/metrics.hpp"
 #include "core/simulate.hpp"
+#include "optimize/optimize.hpp"
 #include "studies/study.hpp"
 
 namespace bd::studies {
@@ -31,6 +34,32 @@ struct BalancedRun {
   std::filesystem::path comparison;  // out_dir/comparison.csv
 };
 
+/// The optimisation in an optimize study, and the optimum's run (same scene, method chosen for it
+/// alike).
+struct OptimizedRun {
+  optimize::OptimizeResult result;            // what optimize() returned (termination kNotRun,
+                                              // with a message, when it was not run)
+  std::vector<std::string> variable_names;    // of result.x, in order (optimize::Nlp's names)
+  int design_variables{};                     // the first ones of result.x: the design's own
+                                              // (the rest are bound variables of peak metrics)
+  std::vector<optimize::ParetoPoint> pareto;  // with optimize.pareto, point by point
+  MethodChoice method;                        // formulation used for the optimum, and why
+  core::Trajectory trajectory;                // the optimum simulated (none when not found)
+  core::Metrics metrics;                      // over its samples
+  std::filesystem::path timeseries;           // out_dir/optimized-timeseries.csv (when found)
+  std::filesystem::path study_file;           // out_dir/optimized.yaml (when found)
+  std::filesystem::path comparison;           // out_dir/comparison.csv (when found)
+  std::filesystem::path pareto_file;          // out_dir/pareto.csv (with a front, when found)
+  /// True when the optimiser returned a design (converged, or the budget ran out at a feasible
+  /// point): the optimum was simulated and its files written.
+  bool found() const { return result.ok(); }
+  /// True when the optimiser ran and found no design (infeasible, or it failed): exit code 4.
+  bool failed() const {
+    return result.termination == optimize::Termination::kInfeasible ||
+           result.termination == optimize::Termination::kFailed;
+  }
+};
+
 /// What a run did and where its files are.
 struct RunResult {
   MethodChoice method;                  // formulation used, and why (the original design)
@@ -39,12 +68,23 @@ struct RunResult {
   std::filesystem::path timeseries;     // out_dir/timeseries.csv
   std::filesystem::path summary;        // out_dir/summary.json
   std::optional<BalancedRun> balanced;  // set when the study has a balance section
-  /// True when every simulation ran to the end (the original's and the balanced design's).
-  bool ok() const { return trajectory.ok() && (!balanced || balanced->trajectory.ok()); }
+  std::optional<OptimizedRun> optimized;  // set when the study has an optimize section
+  /// True when every simulation ran to the end (the original's, the balanced design's, the
+  /// optimum's) and an optimize study found its optimum.
+  bool ok() const {
+    return trajectory.ok() && (!balanced || balanced->trajectory.ok()) &&
+           (!optimized || (optimized->found() && optimized->trajectory.ok()));
+  }
+  /// True when a simulation stopped early (the original's, the balanced design's or the
+  /// optimum's): exit code 3.
+  bool stopped_early() const {
+    return !trajectory.ok() || (balanced && !balanced->trajectory.ok()) ||
+           (optimized && optimized->found() && !optimized->trajectory.ok());
+  }
 };
 
-/// One row of comparison.csv: a metric of the original design (before) and of the balanced
-/// one (after), and after/before (empty when before is 0).
+/// One row of comparison.csv: a metric of the original design (before) and of the balanced or
+/// optimised one (after), and after/before (empty when before is 0).
 struct ComparisonRow {
   std::string metric;  // "Fsh_rms", ..., "added_mass", "added_inertia"
   double before{}, after{};
@@ -52,7 +92,10 @@ struct ComparisonRow {
 };
 /// The rows of comparison.csv, in order: Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max,
 /// RA0_rms, RA0_max, RA3_rms, RA3_max, added_mass, added_inertia.
-/// Precondition: study.balance and result.balanced are set.
+/// In an optimize study added_mass and added_inertia are those of studies::added_mass() and
+/// added_inertia() (negative when the optimum takes mass away).
+/// Precondition: study.balance and result.balanced are set, or result.optimized has found its
+/// optimum.
 std::vector<ComparisonRow> comparison(const Study& study, const RunResult& result);
 
 /// Simulates the study's scene (core::simulate_free or core::simulate_driven) and writes
@@ -64,8 +107,16 @@ std::vector<ComparisonRow> comparison(const Study& study, const RunResult& resul
 /// A study with a balance section also simulates its balanced design (balanced_study(), its own
 /// choose_method()) in the same scene and writes `balanced-timeseries.csv`, `balanced.yaml`
 /// (study_yaml() of the balanced design) and `comparison.csv`; summary.json gets `balance`,
-/// `balanced_run`, `balanced_metrics` and `reduction`. summary.json is always written last.
-/// @throws bd::InputError if the scene or options are invalid (core's checks).
+/// `balanced_run`, `balanced_metrics` and `reduction`.
+/// A study with an optimize section solves its design_problem() with optimize() (not when the
+/// original's simulation stopped early), simulates the optimum (optimized_study(), its own
+/// choose_method()) and writes `optimized-timeseries.csv`, `optimized.yaml` and `comparison.csv`;
+/// with optimize.pareto also pareto_front() as `pareto.csv`. summary.json gets `optimize`,
+/// `optimized_run`, `optimized_metrics` and `reduction`. When the optimiser finds no design
+/// (infeasible or failed) only the original's files are written, summary.json says why, and the
+/// result's optimized->failed() is true. summary.json is always written last.
+/// @throws bd::InputError if the scene or options are invalid (core's checks), or if an optimize
+///         study's problem is (the optimize layer's checks; load_study() has made them already).
 /// @throws std::runtime_error if an output file cannot be written (the message names it).
 RunResult run_study(const Study& study, const std::filesystem::path& out_dir);
 
@@ -76,13 +127,22 @@ void write_timeseries(const core::Trajectory& trajectory, const std::filesystem:
 /// The summary.json text of a run (UTF-8, ends in a newline).
 std::string summary_json(const Study& study, const RunResult& result);
 
-/// The comparison.csv text of a balance study's run: kComparisonHeader, then one row per
-/// comparison() entry, numbers "%.17g", ratio empty when before is 0.
+/// The comparison.csv text of a balance or optimize study's run: kComparisonHeader, then one row
+/// per comparison() entry, numbers "%.17g", ratio empty when before is 0.
 std::string comparison_csv(const Study& study, const RunResult& result);
 
 /// The balanced.yaml text of a balance study: study_yaml(balanced_study(study)) with a header
 /// comment saying where it came from.
 std::string balanced_yaml(const Study& study);
+
+/// The optimized.yaml text of an optimize study whose optimum was found:
+/// study_yaml(optimized_study(study, design)) with a header comment saying how it was found.
+std::string optimized_yaml(const Study& study, const OptimizedRun& run);
+
+/// The pareto.csv text: header `epsilon,<first>,<second>,termination,verification_error` and the
+/// design variables' names, then one row per point ("%.17g"; numbers empty for a point where no
+/// design was found). Precondition: study.optimize->pareto is set.
+std::string pareto_csv(const Study& study, const OptimizedRun& run);
 
 /// `text` as a JSON string literal, quotes included, with every character that needs it escaped.
 std::string json_string(const std::string& text);

@@ -30,6 +30,32 @@ Study balanced_study(const Study& study) {
   return b;
 }
 
+Study optimized_study(const Study& study, const core::FourBar& design) {
+  Study o;
+  o.name = study.name + "-optimized";
+  o.model = design;
+  o.scene = study.scene;
+  o.formulation = study.formulation;
+  o.tolerance = study.tolerance;
+  return o;
+}
+
+optimize::DesignProblem design_problem(const Study& study) {
+  assert(study.optimize.has_value());
+  const OptimizeRequest& r = *study.optimize;
+  optimize::DesignProblem p;
+  p.original = study.model;
+  p.scene = study.scene;
+  p.formulation = choose_method(study).formulation;
+  p.tolerance = study.tolerance;
+  p.counterweights = r.counterweights;
+  p.link_parameters = r.link_parameters;
+  p.objective = r.objective;
+  p.limits = r.limits;
+  p.force_balance = r.force_balance;
+  return p;
+}
+
 MethodChoice choose_method(const Study& study) {
   const bool free = std::holds_alternative<core::FreeScene>(study.scene);
   // a free crank that cannot turn fully reaches limit positions, where theta1 stops being a

@@ -8,7 +8,9 @@
 #include "core/dynamics.hpp"
 #include "core/model.hpp"
 #include "core/simulate.hpp"
+#include "optimize/problem.hpp"
 #include "studies/balance_study.hpp"
+#include "studies/optimize_study.hpp"
 
 namespace bd::studies {
 
@@ -36,6 +38,9 @@ struct Study {
   std::string source;        // the study file as named by the user ("" when built in code)
   /// The study file's `balance:` section, synthesised at load time; empty when absent.
   std::optional<BalancedDesign> balance;
+  /// The study file's `optimize:` section, checked at load time and solved by the runner; empty
+  /// when absent. A study has a balance section or an optimize section, never both.
+  std::optional<OptimizeRequest> optimize;
 
   /// "auto" or the requested formulation's name.
   std::string method_name() const;
@@ -44,6 +49,15 @@ struct Study {
 /// The study of the balanced design: name `<name>-balanced`, the balanced model, the same scene,
 /// method and tolerance, no balance section, no source. Precondition: study.balance is set.
 Study balanced_study(const Study& study);
+
+/// The study of an optimised design: name `<name>-optimized`, model `design`, the same scene,
+/// method and tolerance, no balance or optimize section, no source.
+Study optimized_study(const Study& study, const core::FourBar& design);
+
+/// The design problem of an optimize study: the request's variables, objective, constraints,
+/// with the study's model as the original, its scene and tolerance, and the formulation its run
+/// uses (choose_method(study)). Precondition: study.optimize is set.
+optimize::DesignProblem design_problem(const Study& study);
 
 /// The formulation a run uses, and why (for the console and summary.json).
 struct MethodChoice {

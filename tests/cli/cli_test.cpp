@@ -185,10 +185,93 @@ TEST_F(CliTest, ImpossibleBalanceIsBadInputAtTheMomentKey) {
   EXPECT_FALSE(fs::exists(dir_ / "res"));
 }
 
+// the driven paper linkage, unloaded, with an optimize section appended (from line 10)
+const std::string kDrivenPaper =
+    "name: opt\n"
+    "linkage:\n"
+    "  type: fourbar\n"
+    "  frame: 3.2\n"
+    "  branch: 1\n"
+    "  crank:   {length: 1.0, mass: 2.1, s: 0.6, sigma: 0.3, inertia: 1.1}\n"
+    "  coupler: {length: 3.0, mass: 3.0, s: 1.45, sigma: 0.4, inertia: 3.1}\n"
+    "  rocker:  {length: 2.0, mass: 2.2, s: 1.66, sigma: -0.4, inertia: 2.1}\n"
+    "scene: {type: driven, omega1: 6.283185307179586}\n";
+
+TEST_F(CliTest, OptimizeStudyPrintsTheOptimumAndWritesItsFiles) {
+  EXPECT_EQ(run(quote(kExamples + "/berkof-lowen-min-shaking-moment.yaml") + " --out res"), 0)
+      << err_;
+  EXPECT_TRUE(err_.empty()) << err_;
+  for (const char* file : {"timeseries.csv", "summary.json", "optimized-timeseries.csv",
+                           "optimized.yaml", "comparison.csv"}) {
+    EXPECT_TRUE(fs::exists(dir_ / "res" / file)) << file;
+    EXPECT_NE(out_.find(file), std::string::npos) << file << " not in\n" << out_;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "res" / "pareto.csv"));
+  for (const char* text : {"optimize slsqp: minimise 1 x Msh_rms", "subject to full force balance",
+                           "converged", "counterweight ", "verified with ", "metric", "before",
+                           "after", "ratio", "Msh_rms", "added_mass"}) {
+    EXPECT_NE(out_.find(text), std::string::npos) << text << " not in\n" << out_;
+  }
+  // the written optimum runs as a study of its own and reproduces the optimum's run
+  EXPECT_EQ(run("res/optimized.yaml --out again"), 0) << err_;
+  bd::testing::expect_same_numbers(dir_ / "again" / "timeseries.csv",
+                                   dir_ / "res" / "optimized-timeseries.csv", 1e-12);
+}
+
+TEST_F(CliTest, NoOptimumExitsFourAndKeepsTheOriginal) {
+  // a full force balance needs far more than 0.01 kg of counterweight on each side
+  write("infeasible.yaml", kDrivenPaper +
+                               "optimize:\n"
+                               "  objective: {Msh_rms: 1}\n"
+                               "  constraints: {force_balance: true}\n"
+                               "  variables:\n"
+                               "    counterweights: {crank: {mass_max: 0.01}, rocker: {mass_max: "
+                               "0.01}}\n");
+  EXPECT_EQ(run("infeasible.yaml --out res"), 4) << err_;
+  EXPECT_EQ(err_.rfind("infeasible.yaml: no optimum (infeasible): ", 0), 0u) << err_;
+  EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
+  EXPECT_NE(err_.find("force balance"), std::string::npos)
+      << "names the binding constraint: " << err_;
+  EXPECT_TRUE(fs::exists(dir_ / "res" / "timeseries.csv"));
+  EXPECT_FALSE(fs::exists(dir_ / "res" / "optimized.yaml"));
+  EXPECT_FALSE(fs::exists(dir_ / "res" / "comparison.csv"));
+  const std::string summary = read(dir_ / "res" / "summary.json");
+  EXPECT_NE(summary.find("\"termination\": \"infeasible\""), std::string::npos) << summary;
+  EXPECT_NE(out_.find("infeasible"), std::string::npos) << out_;
+}
+
+TEST_F(CliTest, BadOptimizeSectionIsBadInputWithItsPlace) {
+  write("bad-opt.yaml", kDrivenPaper +
+                            "optimize:\n"
+                            "  objective: {Msh_avg: 1}\n"
+                            "  variables: {counterweights: {crank: }}\n");
+  EXPECT_EQ(run("bad-opt.yaml --out res"), 2);
+  EXPECT_EQ(err_.rfind("bad-opt.yaml:11:15: unknown metric 'Msh_avg' in optimize.objective; "
+                       "expected one of Fsh_rms, ",
+                       0),
+            0u)
+      << err_;
+  EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
+  EXPECT_FALSE(fs::exists(dir_ / "res"));
+
+  write("both.yaml", kDrivenPaper + "balance: {force: full}\n" +
+                         "optimize:\n"
+                         "  objective: {Msh_rms: 1}\n"
+                         "  variables: {counterweights: {crank: }}\n");
+  EXPECT_EQ(run("both.yaml --out res"), 2);
+  EXPECT_EQ(err_.rfind("both.yaml:11:1: a study has a balance section or an optimize section, "
+                       "not both",
+                       0),
+            0u)
+      << err_;
+}
+
 TEST_F(CliTest, HelpAndVersion) {
   EXPECT_EQ(run("--help"), 0);
-  for (const char* text : {"run", "--out", "timeseries.csv", "summary.json", "Exit codes",
-                           "balanced-timeseries.csv", "balanced.yaml", "comparison.csv"}) {
+  for (const char* text :
+       {"run", "--out", "timeseries.csv", "summary.json", "Exit codes", "balanced-timeseries.csv",
+        "balanced.yaml", "comparison.csv", "optimize:", "optimized-timeseries.csv",
+        "optimized.yaml", "pareto.csv", "  4  the optimiser found no design"}) {
     EXPECT_NE(out_.find(text), std::string::npos) << text;
   }
   EXPECT_EQ(run("run --help"), 0);

@@ -26,9 +26,34 @@ TEST(Examples, EveryExampleRunsToTheEnd) {
     if (entry.path().extension() != ".yaml") continue;
     ++count;
     const RunResult r = run_example(entry.path().filename().string());
-    EXPECT_TRUE(r.ok()) << entry.path() << ": " << r.trajectory.message;
+    EXPECT_TRUE(r.ok()) << entry.path() << ": " << r.trajectory.message
+                        << (r.optimized ? " / " + r.optimized->result.message : "");
   }
   EXPECT_GE(count, 5);
+}
+
+TEST(Examples, OptimumsAreVerifiedByASecondFormulation) {
+  for (const char* file :
+       {"berkof-lowen-min-shaking-moment.yaml", "weighted-counterweights.yaml"}) {
+    SCOPED_TRACE(file);
+    const RunResult r = run_example(file);
+    ASSERT_TRUE(r.optimized.has_value());
+    const optimize::OptimizeResult& o = r.optimized->result;
+    ASSERT_TRUE(r.ok()) << o.message;
+    EXPECT_EQ(o.termination, optimize::Termination::kConverged) << o.message;
+    EXPECT_NE(o.verified_with, r.method.formulation);
+    EXPECT_LE(o.verification_error, 1e-9) << o.brief_report();
+    // every term of the objective is 1 for the original: the optimum must do better than the
+    // weights' sum, or (Berkof-Lowen) meet the force balance the original does not
+    EXPECT_LT(r.optimized->metrics.Fsh_rms, r.metrics.Fsh_rms);
+  }
+  // the force balance holds: the shaking force vanishes to round-off
+  const RunResult b = run_example("berkof-lowen-min-shaking-moment.yaml");
+  EXPECT_LT(b.optimized->metrics.Fsh_max, 1e-9 * b.metrics.Fsh_max);
+  const RunResult w = run_example("weighted-counterweights.yaml");
+  const core::Metrics& a = w.metrics;
+  const core::Metrics& z = w.optimized->metrics;
+  EXPECT_LT(z.Fsh_rms / a.Fsh_rms + z.Msh_rms / a.Msh_rms + z.tau_rms / a.tau_rms, 3.0);
 }
 
 TEST(Examples, TripleRockerSwingsThroughItsLimitPositions) {

@@ -504,5 +504,304 @@ TEST(LoadStudy, BalanceExamplesLoad) {
   EXPECT_EQ(m.model.coupler.inertia, 6.48);
 }
 
+// ---- optimize ----
+
+// kBase in a driven scene (same line numbers: lines 15-17 stay three lines)
+std::string driven() {
+  return edit("  type: free\n  theta1: 1.0\n  duration: 5.0\n",
+              "  type: driven\n  theta1: 1.0\n  omega1: 6.283185307179586\n");
+}
+
+// a complete optimize section from line 18
+const std::string kOptimize =
+    "optimize:\n"                                                                   // 18
+    "  algorithm: slsqp\n"                                                          // 19
+    "  objective: {Msh_rms: 1.0, tau_rms: 0.5}\n"                                   // 20
+    "  constraints:\n"                                                              // 21
+    "    force_balance: true\n"                                                     // 22
+    "    Fsh_rms: 0.2\n"                                                            // 23
+    "    added_mass: 6.0\n"                                                         // 24
+    "  variables:\n"                                                                // 25
+    "    counterweights:\n"                                                         // 26
+    "      crank: {mass_max: 8.0, distance_max: 0.9}\n"                             // 27
+    "      rocker: {mass_max: 9.0, shape: disc, thickness: 0.03, density: 7000}\n"  // 28
+    "    links:\n"                                                                  // 29
+    "      coupler: {mass: [2.0, 4.0], inertia: [1.0, 8.0]}\n"                      // 30
+    "  max_evaluations: 500\n"                                                      // 31
+    "  tolerance: 1.0e-7\n"                                                         // 32
+    "  pareto: {first: Fsh_rms, second: Msh_rms, points: 5}\n";                     // 33
+
+// driven() + kOptimize with the first occurrence of `from` in the section replaced by `to`
+std::string opt_edit(const std::string& from, const std::string& to) {
+  std::string text = kOptimize;
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return driven() + text;
+}
+
+// a minimal optimize section from line 18 (variables at line 20)
+const std::string kMinimal =
+    "optimize:\n"                                 // 18
+    "  objective: {Msh_rms: 1}\n"                 // 19
+    "  variables:\n"                              // 20
+    "    counterweights: {crank: , rocker: }\n";  // 21
+
+TEST(LoadStudy, OptimizeSectionReadsEveryKey) {
+  const Study s = parse_study(driven() + kOptimize, "study.yaml");
+  ASSERT_TRUE(s.optimize.has_value());
+  EXPECT_FALSE(s.balance.has_value());
+  const OptimizeRequest& r = *s.optimize;
+  EXPECT_EQ(r.options.algorithm, optimize::Algorithm::kSlsqp);
+  EXPECT_EQ(r.options.max_evaluations, 500);
+  EXPECT_EQ(r.options.relative_tolerance, 1e-7);
+  ASSERT_EQ(r.objective.size(), 2u);
+  EXPECT_EQ(r.objective[0].metric, optimize::Metric::kMshRms);
+  EXPECT_EQ(r.objective[0].weight, 1.0);
+  EXPECT_EQ(r.objective[1].metric, optimize::Metric::kTauRms);
+  EXPECT_EQ(r.objective[1].weight, 0.5);
+  EXPECT_TRUE(r.force_balance);
+  ASSERT_EQ(r.limits.size(), 2u);
+  EXPECT_EQ(r.limits[0].metric, optimize::Metric::kFshRms);
+  EXPECT_EQ(r.limits[0].value, 0.2);
+  EXPECT_EQ(r.limits[1].metric, optimize::Metric::kAddedMass);
+  EXPECT_EQ(r.limits[1].value, 6.0);
+  ASSERT_EQ(r.counterweights.size(), 2u);
+  EXPECT_EQ(r.counterweights[0].link, 1);
+  EXPECT_EQ(r.counterweights[0].mass_max, 8.0);
+  EXPECT_EQ(r.counterweights[0].distance_max, 0.9);
+  EXPECT_EQ(r.counterweights[0].shape, balance::CounterweightShape::kPoint);
+  EXPECT_EQ(r.counterweights[1].link, 3);
+  EXPECT_EQ(r.counterweights[1].mass_max, 9.0);
+  EXPECT_EQ(r.counterweights[1].distance_max, 2.0);  // default: the rocker's length
+  EXPECT_EQ(r.counterweights[1].shape, balance::CounterweightShape::kDisc);
+  EXPECT_EQ(r.counterweights[1].thickness, 0.03);
+  EXPECT_EQ(r.counterweights[1].density, 7000.0);
+  using P = optimize::LinkParameterVariable::Parameter;
+  ASSERT_EQ(r.link_parameters.size(), 2u);
+  EXPECT_EQ(r.link_parameters[0].link, 2);
+  EXPECT_EQ(r.link_parameters[0].parameter, P::kMass);
+  EXPECT_EQ(r.link_parameters[0].lower, 2.0);
+  EXPECT_EQ(r.link_parameters[0].upper, 4.0);
+  EXPECT_EQ(r.link_parameters[1].parameter, P::kInertia);
+  EXPECT_EQ(r.link_parameters[1].upper, 8.0);
+  ASSERT_TRUE(r.pareto.has_value());
+  EXPECT_EQ(r.pareto->first, optimize::Metric::kFshRms);
+  EXPECT_EQ(r.pareto->second, optimize::Metric::kMshRms);
+  EXPECT_EQ(r.pareto->points, 5);
+
+  // the design problem: the study's model, scene, tolerance and the formulation its run uses
+  const optimize::DesignProblem p = design_problem(s);
+  EXPECT_EQ(p.original.coupler.mass, s.model.coupler.mass);
+  EXPECT_TRUE(std::holds_alternative<core::DrivenScene>(p.scene));
+  EXPECT_EQ(p.formulation, choose_method(s).formulation);
+  EXPECT_EQ(p.tolerance, s.tolerance);
+  EXPECT_TRUE(p.force_balance);
+  EXPECT_EQ(p.validate(), "");
+}
+
+TEST(LoadStudy, OptimizeDefaults) {
+  const Study s = parse_study(driven() + kMinimal, "study.yaml");
+  ASSERT_TRUE(s.optimize.has_value());
+  const OptimizeRequest& r = *s.optimize;
+  const optimize::OptimizeOptions defaults;
+  EXPECT_EQ(r.options.algorithm, optimize::Algorithm::kSlsqp);
+  EXPECT_EQ(r.options.max_evaluations, defaults.max_evaluations);
+  EXPECT_EQ(r.options.relative_tolerance, defaults.relative_tolerance);
+  EXPECT_FALSE(r.force_balance);
+  EXPECT_TRUE(r.limits.empty());
+  EXPECT_FALSE(r.pareto.has_value());
+  ASSERT_EQ(r.counterweights.size(), 2u);
+  // point masses of up to 10 kg within the link's own length of the pivot
+  EXPECT_EQ(r.counterweights[0].mass_max, 10.0);
+  EXPECT_EQ(r.counterweights[0].distance_max, 1.0);
+  EXPECT_EQ(r.counterweights[1].distance_max, 2.0);
+  EXPECT_EQ(r.counterweights[1].shape, balance::CounterweightShape::kPoint);
+  EXPECT_TRUE(r.link_parameters.empty());
+
+  // every algorithm by name, in a driven scene
+  for (const char* name : {"slsqp", "mma", "ipopt", "mlsl", "isres", "cobyla"}) {
+    const Study a = parse_study(driven() + kMinimal + "  algorithm: " + name + "\n", "study.yaml");
+    EXPECT_STREQ(optimize::to_string(a.optimize->options.algorithm), name);
+  }
+  // constraints may be empty; added_mass may be negative (take mass away)
+  EXPECT_NO_THROW(parse_study(driven() + kMinimal + "  constraints:\n", "study.yaml"));
+  const Study neg =
+      parse_study(driven() + kMinimal + "  constraints: {added_mass: -0.5}\n", "study.yaml");
+  EXPECT_EQ(neg.optimize->limits.at(0).value, -0.5);
+}
+
+TEST(LoadStudy, OptimizeMistakesAreReportedWhereTheyAre) {
+  const std::string all =
+      "Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max, RA0_rms, RA0_max, RA3_rms, "
+      "RA3_max, added_mass";
+  expect_error(opt_edit("  tolerance: 1.0e-7\n", "  tolerence: 1.0e-7\n"), 32, 3,
+               "unknown key 'tolerence' in optimize; allowed keys: algorithm, objective, "
+               "constraints, variables, max_evaluations, tolerance, pareto");
+  expect_error(opt_edit("algorithm: slsqp", "algorithm: bfgs"), 19, 14,
+               "unknown algorithm 'bfgs' in optimize.algorithm; expected one of slsqp, mma, "
+               "ipopt, mlsl, isres, cobyla");
+  // metric names: the valid ones are listed
+  expect_error(opt_edit("Msh_rms: 1.0,", "Msh_mean: 1.0,"), 20, 15,
+               "unknown metric 'Msh_mean' in optimize.objective; expected one of " + all);
+  expect_error(opt_edit("    Fsh_rms: 0.2\n", "    Fsh_peak: 0.2\n"), 23, 5,
+               "unknown constraint 'Fsh_peak' in optimize.constraints; expected force_balance "
+               "or one of " +
+                   all);
+  expect_error(opt_edit("first: Fsh_rms", "first: shaking"), 33, 19,
+               "unknown metric 'shaking' in optimize.pareto.first; expected one of " + all);
+  // values
+  expect_error(opt_edit("tau_rms: 0.5", "tau_rms: -0.5"), 20, 38,
+               "optimize.objective.tau_rms must be >= 0 (a weight), got -0.5");
+  expect_error(opt_edit("{Msh_rms: 1.0, tau_rms: 0.5}", "{Msh_rms: 0, tau_rms: 0}"), 20, 3,
+               "optimize.objective needs at least one metric with a weight > 0");
+  expect_error(opt_edit("Fsh_rms: 0.2", "Fsh_rms: 0"), 23, 14,
+               "optimize.constraints.Fsh_rms must be > 0 (a fraction of the original design's "
+               "value), got 0");
+  expect_error(opt_edit("force_balance: true", "force_balance: full"), 22, 20,
+               "optimize.constraints.force_balance must be true or false, got 'full'");
+  expect_error(opt_edit("mass_max: 8.0", "mass_max: -8"), 27, 25,
+               "optimize.variables.counterweights.crank.mass_max must be > 0 kg, got -8");
+  expect_error(opt_edit("distance_max: 0.9", "distance_max: 0"), 27, 44,
+               "optimize.variables.counterweights.crank.distance_max must be > 0 m, got 0");
+  expect_error(opt_edit("{mass_max: 8.0,", "{thickness: 0.02, mass_max: 8.0,"), 27, 15,
+               "optimize.variables.counterweights.crank.thickness needs shape: disc");
+  expect_error(opt_edit("shape: disc", "shape: cube"), 28, 38,
+               "optimize.variables.counterweights.rocker.shape must be point or disc, got 'cube'");
+  expect_error(opt_edit("      crank: {", "      coupler: {"), 27, 7,
+               "unknown key 'coupler' in optimize.variables.counterweights; allowed keys: crank, "
+               "rocker");
+  expect_error(opt_edit("mass: [2.0, 4.0]", "mass: [4.0, 2.0]"), 30, 23,
+               "optimize.variables.links.coupler.mass must have lower < upper, got [4, 2]");
+  expect_error(opt_edit("mass: [2.0, 4.0]", "mass: [0, 4.0]"), 30, 24,
+               "optimize.variables.links.coupler.mass lower bound must be > 0 kg");
+  expect_error(opt_edit("inertia: [1.0, 8.0]", "inertia: [-1.0, 8.0]"), 30, 45,
+               "optimize.variables.links.coupler.inertia lower bound must be >= 0 kg m^2");
+  expect_error(opt_edit("mass: [2.0, 4.0]", "mass: 3.0"), 30, 23,
+               "optimize.variables.links.coupler.mass must be a list of 2 numbers [lower, "
+               "upper] in kg, got '3.0'");
+  expect_error(opt_edit("{mass: [2.0, 4.0],", "{length: [2.0, 4.0],"), 30, 17,
+               "unknown key 'length' in optimize.variables.links.coupler; allowed keys: mass, e, "
+               "f, inertia");
+  expect_error(
+      opt_edit("      coupler: {mass: [2.0, 4.0], inertia: [1.0, 8.0]}", "      coupler: {}"), 30,
+      7, "optimize.variables.links.coupler: give at least one of mass, e, f, inertia");
+  expect_error(opt_edit("max_evaluations: 500", "max_evaluations: 0"), 31, 20,
+               "optimize.max_evaluations must be >= 1, got 0");
+  expect_error(opt_edit("max_evaluations: 500", "max_evaluations: 2.5"), 31, 20,
+               "optimize.max_evaluations must be a whole number");
+  expect_error(opt_edit("tolerance: 1.0e-7", "tolerance: 2"), 32, 14,
+               "optimize.tolerance must be > 0 and < 1");
+  expect_error(opt_edit("second: Msh_rms", "second: Fsh_rms"), 33, 36,
+               "optimize.pareto.second must differ from first (both are Fsh_rms)");
+  expect_error(opt_edit("points: 5", "points: 1"), 33, 53, "optimize.pareto.points must be >= 2");
+  expect_error(opt_edit("{first: Fsh_rms, ", "{"), 33, 3,
+               "optimize.pareto: missing required key 'first'");
+  // required keys, empty section, no variables
+  expect_error(driven() + "optimize:\n  variables: {counterweights: {crank: }}\n", 18, 1,
+               "optimize: missing required key 'objective'");
+  expect_error(driven() + "optimize: {objective: {Msh_rms: 1}}\n", 18, 1,
+               "optimize: missing required key 'variables'");
+  expect_error(driven() + "optimize:\n", 18, 1, "optimize must be a map");
+  expect_error(driven() + "optimize:\n  objective: {Msh_rms: 1}\n  variables: {links: }\n", 20, 3,
+               "optimize.variables: no design variable");
+}
+
+TEST(LoadStudy, OptimizeAndBalanceAreMutuallyExclusive) {
+  expect_error(driven() + "balance: {force: full}\n" + kMinimal, 19, 1,
+               "a study has a balance section or an optimize section, not both (balance is "
+               "given at line 18)");
+  expect_error(driven() + kMinimal + "balance: {force: full}\n", 22, 1,
+               "a study has a balance section or an optimize section, not both (optimize is "
+               "given at line 18)");
+  // optimized.yaml is named <name>-optimized, which must still be a valid name
+  const std::string long_name =
+      "name: " + std::string(91, 'a') + "\n" + driven().substr(std::string("name: t\n").size());
+  expect_error(long_name + kMinimal, 1, 7,
+               "name must have at most 90 characters in a study with an optimize section");
+}
+
+TEST(LoadStudy, OptimizeMetricsAFreeSceneCannotHave) {
+  // no drive torque in free motion: nothing to normalise by
+  expect_error(kBase +
+                   "optimize:\n  algorithm: cobyla\n  objective: {tau_rms: 1}\n"
+                   "  variables: {counterweights: {crank: }}\n",
+               20, 15, "optimize.objective.tau_rms: a free scene has no drive torque");
+  expect_error(kBase +
+                   "optimize:\n  algorithm: cobyla\n  objective: {Msh_rms: 1}\n"
+                   "  constraints: {tau_max: 2}\n  variables: {counterweights: {crank: }}\n",
+               21, 17, "optimize.constraints.tau_max: a free scene has no drive torque");
+}
+
+TEST(LoadStudy, GradientAlgorithmInAFreeSceneIsAnErrorAtAlgorithm) {
+  // kBase set in motion (one line longer: the optimize section starts at line 19)
+  const std::string moving = edit("  duration: 5.0\n", "  duration: 0.5\n  omega1: 6.0\n");
+  const std::string section =
+      "  objective: {Msh_rms: 1}\n  variables: {counterweights: {crank: }}\n";
+  // the message is optimize()'s own
+  const StudyError e = error_of(moving + "optimize:\n  algorithm: slsqp\n" + section);
+  EXPECT_EQ(e.line(), 20);
+  EXPECT_EQ(e.column(), 14);
+  EXPECT_EQ(e.message().rfind("optimize.algorithm: ", 0), 0u) << e.what();
+  EXPECT_NE(e.message().find("needs gradients"), std::string::npos) << e.what();
+  EXPECT_NE(e.message().find("cobyla"), std::string::npos) << e.what();
+  // the default algorithm is slsqp: reported at the section
+  const StudyError d = error_of(moving + "optimize:\n" + section);
+  EXPECT_EQ(d.line(), 19);
+  EXPECT_EQ(d.column(), 1);
+  EXPECT_NE(d.message().find("needs gradients"), std::string::npos) << d.what();
+  // a derivative-free method is fine
+  EXPECT_NO_THROW(parse_study(moving + "optimize:\n  algorithm: cobyla\n" + section, "study.yaml"));
+}
+
+TEST(LoadStudy, OptimizeNeedsOriginalMetricsToNormaliseBy) {
+  // kBase has no loads and starts at rest: nothing moves, every metric is 0
+  expect_error(kBase +
+                   "optimize:\n  algorithm: cobyla\n  objective: {Fsh_rms: 0, Msh_rms: 1}\n"
+                   "  variables: {counterweights: {crank: }}\n",
+               20, 27,
+               "optimize.objective.Msh_rms: the original design's Msh_rms is 0 N m, too small to "
+               "normalise by");
+  // a driven scene the original cannot run through (the crank cannot turn fully)
+  const std::string stuck =
+      edit("  type: free\n  theta1: 1.0\n  duration: 5.0\n",
+           "  type: driven\n  theta1: 1.5707963267948966\n  omega1: 6.283185307179586\n");
+  const std::string text = stuck.substr(0, stuck.find("    length: 1.0\n")) + "    length: 2.5\n" +
+                           stuck.substr(stuck.find("    length: 1.0\n") + 16);
+  EXPECT_NO_THROW(parse_study(text, "study.yaml"));  // runs, and stops early (exit code 3)
+  expect_error(text + kMinimal, 18, 1,
+               "optimize: the original design cannot be evaluated in the driven scene");
+  // the paper's force-balanced linkage, driven: no shaking force to normalise by
+  std::string balanced = driven();
+  for (const auto& [from, to] :
+       {std::pair<std::string, std::string>{"    s: 0.6\n    sigma: 0.3\n",
+                                            "    s: 0.83696749777390356\n"
+                                            "    sigma: 2.8145330430599738\n"},
+        {"s: 1.66, sigma: -0.4", "s: 3.2548589414457618, sigma: 0.15837131642962568"}}) {
+    balanced.replace(balanced.find(from), from.size(), to);
+  }
+  const std::string section =
+      "optimize:\n  objective: {Msh_rms: 1}\n  variables: {counterweights: {crank: }}\n";
+  EXPECT_NO_THROW(parse_study(balanced + section, "study.yaml"));
+  expect_error(balanced + section + "  constraints: {Fsh_max: 0.5}\n", 21, 17,
+               "optimize.constraints.Fsh_max: the original design's Fsh_max is");
+  // and the Pareto front's metrics
+  expect_error(balanced + section + "  pareto: {first: Fsh_rms, second: Msh_rms}\n", 21, 19,
+               "optimize.pareto.first: the original design's Fsh_rms is");
+  expect_error(balanced + section + "  pareto: {first: Msh_rms, second: Fsh_max}\n", 21, 36,
+               "optimize.pareto.second: the original design's Fsh_max is");
+}
+
+TEST(LoadStudy, OptimizeExamplesLoad) {
+  for (const char* file :
+       {"berkof-lowen-min-shaking-moment.yaml", "weighted-counterweights.yaml"}) {
+    SCOPED_TRACE(file);
+    const Study s = load_study(std::string(BD_SOURCE_DIR "/studies/examples/") + file);
+    ASSERT_TRUE(s.optimize.has_value());
+    EXPECT_TRUE(std::holds_alternative<core::DrivenScene>(s.scene));
+    EXPECT_EQ(s.optimize->counterweights.size(), 2u);
+  }
+}
+
 }  // namespace
 }  // namespace bd::studies

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/metrics.hpp"
 #include "studies/load_study.hpp"
 #include "tests/support/csv.hpp"
 #include "tests/support/models.hpp"
@@ -414,6 +415,254 @@ TEST_F(RunnerTest, BalanceStudyStoppedEarlyKeepsEveryFile) {
   ASSERT_NE(run, std::string::npos);
   EXPECT_EQ(json_value(json, "ok", run), "false");
   EXPECT_NE(json.find(json_string(r.balanced->trajectory.message), run), std::string::npos);
+}
+
+// ---- optimize studies ----
+
+const std::set<std::string> kOptimizeFiles = {"comparison.csv", "optimized-timeseries.csv",
+                                              "optimized.yaml", "summary.json", "timeseries.csv"};
+
+// the driven paper linkage (paper-fourbar-driven.yaml) with an optimize section appended
+Study driven_with(const std::string& optimize_section, const std::string& name) {
+  return parse_study(
+      read(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml") + optimize_section, name);
+}
+
+TEST_F(RunnerTest, OptimizeStudyWritesTheOptimumAndTheComparison) {
+  const Study study =
+      load_study(BD_SOURCE_DIR "/studies/examples/berkof-lowen-min-shaking-moment.yaml");
+  const RunResult r = run_study(study, dir_);
+  ASSERT_TRUE(r.ok()) << r.optimized->result.message;
+  ASSERT_TRUE(r.optimized.has_value());
+  const OptimizedRun& o = *r.optimized;
+  EXPECT_TRUE(o.found());
+  EXPECT_FALSE(o.failed());
+  EXPECT_EQ(names_in(dir_), kOptimizeFiles);
+  EXPECT_EQ(o.timeseries, dir_ / "optimized-timeseries.csv");
+  EXPECT_EQ(o.study_file, dir_ / "optimized.yaml");
+  EXPECT_EQ(o.comparison, dir_ / "comparison.csv");
+  EXPECT_TRUE(o.pareto_file.empty());
+  EXPECT_EQ(o.method.formulation,
+            choose_method(optimized_study(study, o.result.design)).formulation);
+
+  // timeseries.csv is the original's, optimized-timeseries.csv the optimum's
+  expect_rows_match(lines_of(read(r.timeseries)), r.trajectory);
+  const std::vector<std::string> rows = lines_of(read(o.timeseries));
+  EXPECT_EQ(rows[0], kTimeseriesHeader);
+  expect_rows_match(rows, o.trajectory);
+
+  // verified by a second formulation
+  EXPECT_NE(o.result.verified_with, design_problem(study).formulation);
+  EXPECT_LE(o.result.verification_error, 1e-9);
+
+  // force balanced (the equalities hold), and no worse in Msh_rms than the textbook
+  // force balance (point masses at l1 and l3), which is one of the feasible designs
+  EXPECT_LT(o.metrics.Fsh_max, 1e-6 * r.metrics.Fsh_max);
+  const BalancedDesign textbook = balance_design(study.model, BalanceRequest{});
+  const core::Trajectory t = core::simulate_driven(
+      textbook.model, std::get<core::DrivenScene>(study.scene), core::SimulateOptions{});
+  const core::Metrics m = core::metrics(t);
+  EXPECT_LT(o.metrics.Msh_rms, m.Msh_rms * (1 + 1e-6));
+  // the metrics simulated in the scene are those the optimiser evaluated
+  EXPECT_NEAR(o.metrics.Msh_rms, o.result.metrics.Msh_rms, 1e-9 * r.metrics.Msh_rms);
+
+  // comparison.csv: the same rows as a balance study's, for the optimum
+  const std::vector<std::string> lines = lines_of(read(o.comparison));
+  ASSERT_EQ(lines.size(), 13u);
+  EXPECT_EQ(lines[0], "metric,before,after,ratio");
+  const std::vector<ComparisonRow> cmp = comparison(study, r);
+  ASSERT_EQ(cmp.size(), 12u);
+  EXPECT_EQ(cmp[2].metric, "Msh_rms");
+  EXPECT_EQ(cmp[2].before, r.metrics.Msh_rms);
+  EXPECT_EQ(cmp[2].after, o.metrics.Msh_rms);
+  EXPECT_EQ(cmp[10].metric, "added_mass");
+  EXPECT_EQ(cmp[10].after, added_mass(study.model, o.result.design));
+  EXPECT_EQ(cmp[11].metric, "added_inertia");
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "Msh_rms,%.17g,%.17g,%.17g", r.metrics.Msh_rms, o.metrics.Msh_rms,
+                o.metrics.Msh_rms / r.metrics.Msh_rms);
+  EXPECT_EQ(lines[3], buf);
+  EXPECT_EQ(lines[11].rfind("added_mass,0,", 0), 0u) << lines[11];
+}
+
+TEST_F(RunnerTest, OptimizeSummaryJsonExtendsTheContract) {
+  const Study study = load_study(BD_SOURCE_DIR "/studies/examples/weighted-counterweights.yaml");
+  const RunResult r = run_study(study, dir_);
+  ASSERT_TRUE(r.ok()) << r.optimized->result.message;
+  const OptimizedRun& o = *r.optimized;
+  const std::string json = read(r.summary);
+  for (const char* key : {"\"study\": \"weighted-counterweights\"",
+                          "\"metrics\": {",
+                          "\"optimize\": {",
+                          "\"algorithm\": \"slsqp\"",
+                          "\"formulation\": ",
+                          "\"terms\": [",
+                          "{\"metric\": \"tau_rms\", \"weight\": 1}",
+                          "\"force_balance\": false",
+                          "\"limits\": []",
+                          "\"termination\": ",
+                          "\"message\": ",
+                          "\"iterations\": ",
+                          "\"evaluations\": ",
+                          "\"seconds\": ",
+                          "\"objective\": ",
+                          "\"constraint_violation\": ",
+                          "\"variables\": [",
+                          "{\"name\": ",
+                          "\"counterweights\": [",
+                          "{\"link\": \"crank\", \"shape\": \"point\", \"mass\": ",
+                          "{\"link\": \"rocker\", \"shape\": \"disc\", \"mass\": ",
+                          "\"added_mass\": ",
+                          "\"added_inertia\": ",
+                          "\"verified_with\": ",
+                          "\"verification_error\": ",
+                          "\"brief_report\": ",
+                          "\"optimized_run\": {",
+                          "\"study\": \"weighted-counterweights-optimized\"",
+                          "\"optimized_metrics\": {",
+                          "\"reduction\": {"}) {
+    EXPECT_NE(json.find(key), std::string::npos) << key << " missing in\n" << json;
+  }
+  EXPECT_EQ(json.find("\"balance\""), std::string::npos);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", o.result.objective);
+  EXPECT_EQ(json_value(json, "objective", json.find("\"optimize\"")), buf);
+  std::snprintf(buf, sizeof buf, "%.17g", o.result.verification_error);
+  EXPECT_EQ(json_value(json, "verification_error"), buf);
+  EXPECT_LE(o.result.verification_error, 1e-9);
+  std::snprintf(buf, sizeof buf, "%.17g", o.metrics.Fsh_rms / r.metrics.Fsh_rms);
+  EXPECT_EQ(json_value(json, "Fsh_rms", json.find("\"reduction\"")), buf);
+  std::snprintf(buf, sizeof buf, "%.17g", o.metrics.tau_max);
+  EXPECT_EQ(json_value(json, "tau_max", json.find("\"optimized_metrics\"")), buf);
+  // every variable by name, in the order of x
+  ASSERT_EQ(static_cast<std::size_t>(o.result.x.size()), o.variable_names.size());
+  EXPECT_EQ(o.design_variables, 6);  // mass, distance, angle per counterweight
+  for (std::size_t k = 0; k < o.variable_names.size(); ++k) {
+    EXPECT_NE(json.find(json_string(o.variable_names[k])), std::string::npos)
+        << o.variable_names[k];
+  }
+  // the weighted sum went down from 3 (each term is 1 for the original)
+  EXPECT_LT(o.result.objective, 3.0);
+  EXPECT_EQ(json.back(), '\n');
+  EXPECT_EQ(json[json.size() - 2], '}');
+}
+
+TEST_F(RunnerTest, OptimizedYamlLoadsBackToTheOptimumAndReproducesItsRun) {
+  for (const char* example :
+       {"berkof-lowen-min-shaking-moment.yaml", "weighted-counterweights.yaml"}) {
+    SCOPED_TRACE(example);
+    const Study study = load_study(std::string(BD_SOURCE_DIR "/studies/examples/") + example);
+    const fs::path out = dir_ / example;
+    const RunResult r = run_study(study, out);
+    ASSERT_TRUE(r.ok());
+    const OptimizedRun& o = *r.optimized;
+    const std::string text = read(o.study_file);
+    EXPECT_EQ(text.rfind("# The optimised design of study '" + study.name + "'", 0), 0u) << text;
+    EXPECT_EQ(text.find("optimize:"), std::string::npos) << "no optimize section:\n" << text;
+    EXPECT_NE(text.find("counterweight of "), std::string::npos) << text;
+
+    // the same model, e and f within a few ulps (polar form)
+    const Study back = load_study(o.study_file.string());
+    EXPECT_EQ(back.name, study.name + "-optimized");
+    EXPECT_FALSE(back.optimize.has_value());
+    bd::testing::expect_same_model(o.result.design, back.model);
+
+    // running it reproduces optimized-timeseries.csv to 1e-12 of each column's scale
+    const RunResult again = run_study(back, out / "again");
+    ASSERT_TRUE(again.ok());
+    EXPECT_EQ(again.method.formulation, o.method.formulation);
+    bd::testing::expect_same_numbers(again.timeseries, o.timeseries, 1e-12);
+  }
+}
+
+TEST_F(RunnerTest, ParetoFrontIsWrittenPointByPoint) {
+  const Study study = driven_with(
+      "optimize:\n"
+      "  objective: {Fsh_rms: 1}\n"
+      "  variables:\n"
+      "    counterweights: {crank: {mass_max: 10}, rocker: {mass_max: 10}}\n"
+      "  pareto: {first: Fsh_rms, second: Msh_rms, points: 3}\n",
+      "pareto.yaml");
+  const RunResult r = run_study(study, dir_);
+  ASSERT_TRUE(r.ok()) << r.optimized->result.message;
+  const OptimizedRun& o = *r.optimized;
+  std::set<std::string> files = kOptimizeFiles;
+  files.insert("pareto.csv");
+  EXPECT_EQ(names_in(dir_), files);
+  EXPECT_EQ(o.pareto_file, dir_ / "pareto.csv");
+  ASSERT_EQ(o.pareto.size(), 3u);
+  const std::vector<std::string> lines = lines_of(read(o.pareto_file));
+  ASSERT_EQ(lines.size(), 4u);
+  std::string header = "epsilon,Fsh_rms,Msh_rms,termination,verification_error";
+  for (int k = 0; k < o.design_variables; ++k) header += "," + o.variable_names[k];
+  EXPECT_EQ(lines[0], header);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const optimize::ParetoPoint& p = o.pareto[i];
+    SCOPED_TRACE(lines[i + 1]);
+    ASSERT_TRUE(p.result.ok()) << p.result.message;
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "%.17g,%.17g,%.17g,%s,%.17g", p.epsilon,
+                  p.result.metrics.Fsh_rms, p.result.metrics.Msh_rms,
+                  optimize::to_string(p.result.termination), p.result.verification_error);
+    EXPECT_EQ(lines[i + 1].rfind(buf, 0), 0u);
+    EXPECT_LE(p.result.verification_error, 1e-9);
+    // Msh_rms within its bound, epsilon x the original's
+    EXPECT_LE(p.result.metrics.Msh_rms, p.epsilon * r.metrics.Msh_rms * (1 + 1e-6));
+  }
+  // a trade-off: the tighter the bound on Msh_rms, the larger the least Fsh_rms
+  EXPECT_GT(o.pareto[0].epsilon, o.pareto[2].epsilon);
+  EXPECT_LE(o.pareto[0].result.metrics.Fsh_rms, o.pareto[2].result.metrics.Fsh_rms * (1 + 1e-6));
+  EXPECT_NE(read(r.summary).find("\"pareto\": {\"first\": \"Fsh_rms\", \"second\": \"Msh_rms\", "
+                                 "\"points\": 3}"),
+            std::string::npos);
+}
+
+TEST_F(RunnerTest, InfeasibleOptimizationKeepsTheOriginalAndSaysWhy) {
+  // a full force balance needs far more than 0.01 kg of counterweight
+  const Study study = driven_with(
+      "optimize:\n"
+      "  objective: {Msh_rms: 1}\n"
+      "  constraints: {force_balance: true}\n"
+      "  variables:\n"
+      "    counterweights: {crank: {mass_max: 0.01}, rocker: {mass_max: 0.01}}\n",
+      "infeasible.yaml");
+  const RunResult r = run_study(study, dir_);
+  EXPECT_FALSE(r.ok());
+  EXPECT_FALSE(r.stopped_early());
+  ASSERT_TRUE(r.optimized.has_value());
+  EXPECT_TRUE(r.optimized->failed());
+  EXPECT_FALSE(r.optimized->found());
+  EXPECT_EQ(r.optimized->result.termination, optimize::Termination::kInfeasible);
+  EXPECT_NE(r.optimized->result.message.find("force balance"), std::string::npos)
+      << r.optimized->result.message;
+  EXPECT_EQ(names_in(dir_), (std::set<std::string>{"summary.json", "timeseries.csv"}));
+  expect_rows_match(lines_of(read(r.timeseries)), r.trajectory);
+  const std::string json = read(r.summary);
+  EXPECT_NE(json.find("\"termination\": \"infeasible\""), std::string::npos) << json;
+  EXPECT_NE(json.find(json_string(r.optimized->result.message)), std::string::npos) << json;
+  EXPECT_EQ(json.find("\"optimized_run\""), std::string::npos) << json;
+  EXPECT_EQ(json.find("\"optimized_metrics\""), std::string::npos) << json;
+  EXPECT_EQ(json.back(), '\n');
+  EXPECT_EQ(json[json.size() - 2], '}');
+  EXPECT_EQ(json[json.size() - 4], '}') << "no comma before the closing brace:\n" << json;
+}
+
+TEST_F(RunnerTest, OptimizationIsNotRunWhenTheOriginalStopsEarly) {
+  Study study = driven_with(
+      "optimize:\n"
+      "  objective: {Msh_rms: 1}\n"
+      "  variables: {counterweights: {crank: }}\n",
+      "stops.yaml");
+  study.model.crank = core::link_from_polar(2.5, 2.1, 0.6, 0.3, 1.1);
+  std::get<core::DrivenScene>(study.scene).theta1 = M_PI / 2;
+  const RunResult r = run_study(study, dir_);
+  EXPECT_FALSE(r.ok());
+  EXPECT_TRUE(r.stopped_early());
+  ASSERT_TRUE(r.optimized.has_value());
+  EXPECT_FALSE(r.optimized->failed());
+  EXPECT_EQ(r.optimized->result.termination, optimize::Termination::kNotRun);
+  EXPECT_NE(r.optimized->result.message.find("not run"), std::string::npos);
+  EXPECT_EQ(names_in(dir_), (std::set<std::string>{"summary.json", "timeseries.csv"}));
 }
 
 TEST(JsonString, EscapesWhatJsonRequires) {

@@ -1,0 +1,110 @@
+#include "studies/optimize_study.hpp"
+
+#include <cstdio>
+
+namespace bd::studies {
+
+namespace {
+
+// %g with enough digits for a person, not for a round trip
+std::string short_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+// a link's inertia about the point p (link axes, from its first joint) [kg m^2]
+double inertia_about(const core::Link& l, const Vec2& p) {
+  return l.inertia + l.mass * (Vec2(l.e, l.f) - p).squaredNorm();
+}
+
+}  // namespace
+
+const char* to_string(optimize::LinkParameterVariable::Parameter p) {
+  using P = optimize::LinkParameterVariable::Parameter;
+  switch (p) {
+    case P::kMass:
+      return "mass";
+    case P::kE:
+      return "e";
+    case P::kF:
+      return "f";
+    case P::kInertia:
+      return "inertia";
+  }
+  return "?";
+}
+
+double added_mass(const core::FourBar& original, const core::FourBar& design) {
+  double sum = 0;
+  for (int k = 1; k <= 3; ++k) sum += core::link(design, k).mass - core::link(original, k).mass;
+  return sum;
+}
+
+double added_inertia(const core::FourBar& original, const core::FourBar& design) {
+  // pivots in link axes: crank A0 and coupler A1 (first joints), rocker A3 (its second joint)
+  const Vec2 pivots[] = {Vec2(0, 0), Vec2(0, 0), Vec2(original.rocker.length, 0)};
+  double sum = 0;
+  for (int k = 1; k <= 3; ++k) {
+    sum += inertia_about(core::link(design, k), pivots[k - 1]) -
+           inertia_about(core::link(original, k), pivots[k - 1]);
+  }
+  sum += design.counter_rotations.crank.inertia - original.counter_rotations.crank.inertia;
+  sum += design.counter_rotations.rocker.inertia - original.counter_rotations.rocker.inertia;
+  return sum;
+}
+
+double metric_value(const core::Metrics& m, optimize::Metric metric, double added) {
+  using M = optimize::Metric;
+  switch (metric) {
+    case M::kFshRms:
+      return m.Fsh_rms;
+    case M::kFshMax:
+      return m.Fsh_max;
+    case M::kMshRms:
+      return m.Msh_rms;
+    case M::kMshMax:
+      return m.Msh_max;
+    case M::kTauRms:
+      return m.tau_rms;
+    case M::kTauMax:
+      return m.tau_max;
+    case M::kRA0Rms:
+      return m.RA0_rms;
+    case M::kRA0Max:
+      return m.RA0_max;
+    case M::kRA3Rms:
+      return m.RA3_rms;
+    case M::kRA3Max:
+      return m.RA3_max;
+    case M::kAddedMass:
+      return added;
+  }
+  return 0.0;
+}
+
+std::string objective_text(const OptimizeRequest& request) {
+  std::string text;
+  for (const optimize::Term& t : request.objective) {
+    if (!text.empty()) text += " + ";
+    text += short_number(t.weight) + " x " + optimize::to_string(t.metric);
+  }
+  return text + " (each / original)";
+}
+
+std::string constraints_text(const OptimizeRequest& request) {
+  std::string text;
+  auto add = [&](const std::string& s) { text += (text.empty() ? "" : "; ") + s; };
+  if (request.force_balance) add("full force balance (eq. 57)");
+  for (const optimize::Limit& l : request.limits) {
+    if (l.metric == optimize::Metric::kAddedMass) {
+      add("added_mass <= " + short_number(l.value) + " kg");
+    } else {
+      add(std::string(optimize::to_string(l.metric)) + " <= " + short_number(l.value) +
+          " x original");
+    }
+  }
+  return text.empty() ? "none" : text;
+}
+
+}  // namespace bd::studies

@@ -1,0 +1,107 @@
+// The optimize section's helpers: what an optimum added (mass, inertia about the pivots), metric
+// look-up by name, the problem and the study of an optimum built from a study.
+#include "studies/optimize_study.hpp"
+
+#include <gtest/gtest.h>
+
+#include "balance/counterweight.hpp"
+#include "core/samples.hpp"
+#include "studies/study.hpp"
+
+namespace bd::studies {
+namespace {
+
+TEST(OptimizeStudy, AddedMassAndInertiaOfCounterweightsAreABalanceStudysOwn) {
+  // the textbook force balance: what force_balance reports is what the helpers find
+  const core::FourBar model = core::samples::paper_fourbar_unloaded();
+  const balance::ForceBalancedDesign fb =
+      balance::force_balance(model, balance::CounterweightSpec{}, balance::CounterweightSpec{});
+  EXPECT_NEAR(added_mass(model, fb.model), fb.added_mass, 1e-13 * fb.added_mass);
+  // inertias about A0 and A3: the parallel-axis sums agree to round-off of the merge
+  EXPECT_NEAR(added_inertia(model, fb.model), fb.added_inertia, 1e-12 * fb.added_inertia);
+  EXPECT_EQ(added_mass(model, model), 0.0);
+  EXPECT_EQ(added_inertia(model, model), 0.0);
+}
+
+TEST(OptimizeStudy, TakingMassAwayIsNegativeAndCounterRotationsCount) {
+  const core::FourBar model = core::samples::paper_fourbar_unloaded();
+  core::FourBar lighter = model;
+  lighter.coupler.mass -= 1.0;
+  lighter.coupler.inertia -= 0.5;
+  EXPECT_DOUBLE_EQ(added_mass(model, lighter), -1.0);
+  // the coupler about A1: I + m |s|^2 changes by -0.5 - 1 |s2|^2
+  const double s2 = model.coupler.s();
+  EXPECT_NEAR(added_inertia(model, lighter), -0.5 - s2 * s2, 1e-13);
+  core::FourBar discs = model;
+  discs.counter_rotations.crank = {2.0, Vec2(0, -1)};
+  EXPECT_DOUBLE_EQ(added_inertia(model, discs), 2.0);
+}
+
+TEST(OptimizeStudy, MetricValuesByName) {
+  core::Metrics m;
+  m.Fsh_rms = 1;
+  m.Fsh_max = 2;
+  m.Msh_rms = 3;
+  m.Msh_max = 4;
+  m.tau_rms = 5;
+  m.tau_max = 6;
+  m.RA0_rms = 7;
+  m.RA0_max = 8;
+  m.RA3_rms = 9;
+  m.RA3_max = 10;
+  double expected = 1;
+  for (optimize::Metric metric : optimize::kMetrics) {
+    if (metric == optimize::Metric::kAddedMass) continue;
+    EXPECT_EQ(metric_value(m, metric, 0.0), expected) << optimize::to_string(metric);
+    expected += 1;
+  }
+  EXPECT_EQ(metric_value(m, optimize::Metric::kAddedMass, 12.5), 12.5);
+}
+
+TEST(OptimizeStudy, TextsSayWhatIsMinimisedUnderWhichConstraints) {
+  OptimizeRequest r;
+  r.objective = {{optimize::Metric::kMshRms, 1.0}, {optimize::Metric::kTauRms, 0.5}};
+  EXPECT_EQ(objective_text(r), "1 x Msh_rms + 0.5 x tau_rms (each / original)");
+  EXPECT_EQ(constraints_text(r), "none");
+  r.force_balance = true;
+  r.limits = {{optimize::Metric::kFshRms, 0.2}, {optimize::Metric::kAddedMass, 6.0}};
+  EXPECT_EQ(constraints_text(r),
+            "full force balance (eq. 57); Fsh_rms <= 0.2 x original; added_mass <= 6 kg");
+  EXPECT_STREQ(to_string(optimize::LinkParameterVariable::Parameter::kInertia), "inertia");
+}
+
+TEST(OptimizeStudy, DesignProblemAndOptimizedStudyComeFromTheStudy) {
+  Study s;
+  s.name = "t";
+  s.model = core::samples::paper_fourbar_unloaded();
+  s.scene = core::DrivenScene{0.0, 6.28, 1, 90};
+  s.tolerance = 1e-9;
+  OptimizeRequest r;
+  r.objective = {{optimize::Metric::kMshRms, 1.0}};
+  r.counterweights = {optimize::CounterweightVariables{}};
+  r.force_balance = true;
+  s.optimize = r;
+  const optimize::DesignProblem p = design_problem(s);
+  EXPECT_EQ(p.original.crank.mass, s.model.crank.mass);
+  EXPECT_EQ(std::get<core::DrivenScene>(p.scene).samples, 90);
+  EXPECT_EQ(p.formulation, choose_method(s).formulation);
+  EXPECT_EQ(p.tolerance, 1e-9);
+  EXPECT_TRUE(p.force_balance);
+  EXPECT_EQ(p.counterweights.size(), 1u);
+  s.formulation = core::Formulation::kOpenedLoop;  // a requested method is used as asked
+  EXPECT_EQ(design_problem(s).formulation, core::Formulation::kOpenedLoop);
+
+  core::FourBar design = s.model;
+  design.crank.mass = 5.0;
+  const Study o = optimized_study(s, design);
+  EXPECT_EQ(o.name, "t-optimized");
+  EXPECT_EQ(o.model.crank.mass, 5.0);
+  EXPECT_EQ(o.formulation, s.formulation);
+  EXPECT_EQ(o.tolerance, 1e-9);
+  EXPECT_FALSE(o.optimize.has_value());
+  EXPECT_FALSE(o.balance.has_value());
+  EXPECT_TRUE(o.source.empty());
+}
+
+}  // namespace
+}  // namespace bd::studies
