@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "studies/load_study.hpp"
+#include "studies/report.hpp"
 #include "studies/runner.hpp"
 
 #ifndef BD_VERSION
@@ -48,6 +49,13 @@ Outputs (in DIR, default results/<name>/ with <name> the study's `name`):
   pareto.csv               with optimize.pareto: epsilon,<first>,<second>,termination,
                            verification_error and the design variables, one row per point
   summary.json then also has optimize, optimized_run, optimized_metrics and reduction.
+  report.html     the page to look at: the study's inputs, the method and why, the status,
+                  the metrics and comparison tables and charts (angles, reactions, shaking-force
+                  hodograph, shaking moment, drive torque and bearing loads, the linkage with its
+                  principal points and centre of mass, the Pareto front); self-contained, no
+                  network. Charts need gnuplot (BD_GNUPLOT names another program); without it
+                  the page has the tables and says so. A report that cannot be written is one
+                  warning line on stderr and does not change the exit code.
   Files are written under a temporary name and renamed, so none is ever half-written.
 
 Exit codes:
@@ -64,6 +72,68 @@ Exit codes:
 
 The study-file format is described in docs/study-format.md; examples are in studies/examples/.
 )";
+
+// `validate STUDY.yaml`: load and check only, write nothing
+int validate(const std::string& file) {
+  try {
+    const st::Study study = st::load_study(file);
+    std::printf("%s: ok (study %s, %s scene, method %s)\n", file.c_str(), study.name.c_str(),
+                st::scene_type(study.scene), study.method_name().c_str());
+    return kExitOk;
+  } catch (const bd::InputError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitBadInput;
+  }
+}
+
+// the "source" of a run's summary.json (the study file as named when it ran), else empty
+std::string summary_source(const fs::path& summary) {
+  std::FILE* f = std::fopen(summary.c_str(), "rb");
+  if (!f) return {};
+  std::string text;
+  char buf[4096];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) text.append(buf, n);
+  std::fclose(f);
+  const std::size_t key = text.find("\"source\":");
+  if (key == std::string::npos) return {};
+  std::size_t i = text.find('"', key + 9);
+  if (i == std::string::npos) return {};
+  std::string out;
+  for (++i; i < text.size() && text[i] != '"'; ++i) {
+    if (text[i] == '\\' && i + 1 < text.size()) ++i;  // the JSON escape of \\ or \"
+    out += text[i];
+  }
+  return out;
+}
+
+// `report DIR`: rebuild DIR/report.html from DIR's data files and the study they came from
+int report(const std::string& dir) {
+  const fs::path summary = fs::path(dir) / "summary.json";
+  if (!fs::exists(summary)) {
+    std::fprintf(stderr, "%s: no summary.json here: not the output folder of a run\n", dir.c_str());
+    return kExitBadInput;
+  }
+  const std::string source = summary_source(summary);
+  if (source.empty()) {
+    std::fprintf(stderr,
+                 "%s: summary.json names no study file (\"source\"), so the report "
+                 "cannot be rebuilt\n",
+                 summary.c_str());
+    return kExitBadInput;
+  }
+  st::Study study;
+  try {
+    study = st::load_study(source);
+  } catch (const bd::InputError& e) {
+    std::fprintf(stderr, "%s (the study file of %s)\n", e.what(), summary.c_str());
+    return kExitBadInput;
+  }
+  const fs::path written = st::write_report(study, dir);  // errors: exit 1 with the message
+  const std::string gnuplot = st::find_gnuplot();
+  std::printf("wrote %s%s\n", written.c_str(),
+              gnuplot.empty() ? " (without charts: gnuplot not found)" : "");
+  return kExitOk;
+}
 
 struct RunArgs {
   std::string study;
@@ -201,6 +271,8 @@ void print_summary(const st::Study& study, const st::RunResult& r) {
     }
   }
   std::printf("           %s\n", r.summary.string().c_str());
+  const fs::path page = r.summary.parent_path() / "report.html";
+  if (fs::exists(page)) std::printf("  report   %s\n", page.string().c_str());
 }
 
 int run(const RunArgs& args) {
@@ -266,8 +338,8 @@ std::vector<std::string> with_default_command(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (!args.empty()) {
     const std::string& first = args.front();
-    const bool top_level =
-        first == "run" || first == "-h" || first == "--help" || first == "--version";
+    const bool top_level = first == "run" || first == "validate" || first == "report" ||
+                           first == "-h" || first == "--help" || first == "--version";
     if (!top_level) args.insert(args.begin(), "run");
   }
   return args;
@@ -288,6 +360,10 @@ int main(int argc, char** argv) {
         "Commands:\n"
         "  balance-design run STUDY.yaml [--out DIR]   run a study, write its outputs into DIR\n"
         "  balance-design STUDY.yaml [--out DIR]       the same: run is the default command\n"
+        "  balance-design validate STUDY.yaml          load and check the study only; prints\n"
+        "                                              an ok line (exit 0) or the error (exit 2)\n"
+        "  balance-design report DIR                   rebuild DIR/report.html from the data\n"
+        "                                              files of a run (and its study file)\n"
         "  balance-design run --help                   the options of run\n",
         "balance-design"};
     app.footer(kFooter);
@@ -299,6 +375,19 @@ int main(int argc, char** argv) {
         "run", "load STUDY.yaml, check it, simulate its scene and write the outputs into DIR");
     add_run_options(*run_cmd, args);
     run_cmd->footer(kFooter);
+
+    std::string validate_file;
+    CLI::App* validate_cmd = app.add_subcommand(
+        "validate", "load STUDY.yaml and check it; write nothing (exit 0 ok, 2 bad input)");
+    validate_cmd->add_option("STUDY", validate_file, "the study file")
+        ->required()
+        ->type_name("FILE");
+    std::string report_dir;
+    CLI::App* report_cmd =
+        app.add_subcommand("report", "rebuild DIR/report.html from the data files of a run in DIR");
+    report_cmd->add_option("DIR", report_dir, "the output folder of a run (has summary.json)")
+        ->required()
+        ->type_name("DIR");
 
     std::vector<std::string> argv_rest = with_default_command(argc, argv);
     if (argv_rest.empty()) {
@@ -312,6 +401,8 @@ int main(int argc, char** argv) {
       const int code = app.exit(e);
       return code == 0 ? kExitOk : kExitBadInput;
     }
+    if (validate_cmd->parsed()) return validate(validate_file);
+    if (report_cmd->parsed()) return report(report_dir);
     return run(args);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "balance-design: error: %s\n", e.what());

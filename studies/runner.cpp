@@ -15,6 +15,7 @@
 #include <variant>
 
 #include "optimize/nlp.hpp"
+#include "studies/report.hpp"
 #include "studies/study_yaml.hpp"
 
 namespace bd::studies {
@@ -662,6 +663,14 @@ RunResult run_study(const Study& study, const fs::path& out_dir) {
     }
   }
   write_text(summary_json(study, result), result.summary);
+  // the report is read back from the files just written; it never fails the run
+  try {
+    write_report(study, out_dir);
+  } catch (const std::exception& e) {
+    std::error_code remove_ec;
+    fs::remove(out_dir / "report.html", remove_ec);  // never a stale page of an earlier run
+    std::fprintf(stderr, "balance-design: warning: report.html not written: %s\n", e.what());
+  }
   return result;
 }
 

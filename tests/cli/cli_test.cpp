@@ -266,12 +266,71 @@ TEST_F(CliTest, BadOptimizeSectionIsBadInputWithItsPlace) {
       << err_;
 }
 
+TEST_F(CliTest, ValidateChecksAndWritesNothing) {
+  EXPECT_EQ(run("validate " + quote(kExamples + "/paper-fourbar-driven-force-balanced.yaml")), 0)
+      << err_;
+  EXPECT_TRUE(err_.empty()) << err_;
+  EXPECT_NE(
+      out_.find(": ok (study paper-fourbar-driven-force-balanced, driven scene, method auto)"),
+      std::string::npos)
+      << out_;
+  EXPECT_EQ(out_.find('\n'), out_.size() - 1) << out_;
+  EXPECT_TRUE(fs::is_empty(dir_));  // nothing written, not even results/
+
+  write("bad.yaml", "name: bad\nlinkage: {type: fourbar, frame: 3.2, bogus: 1}\n");
+  EXPECT_EQ(run("validate bad.yaml"), 2);
+  EXPECT_TRUE(out_.empty()) << out_;
+  EXPECT_EQ(err_.rfind("bad.yaml:", 0), 0u) << err_;
+  EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
+  EXPECT_EQ(run("validate missing.yaml"), 2);
+  EXPECT_EQ(err_, "missing.yaml: cannot open the study file\n");
+  EXPECT_EQ(run("validate"), 2);
+}
+
+TEST_F(CliTest, RunWritesTheReportAndReportRebuildsIt) {
+  EXPECT_EQ(run("run " + quote(kExamples + "/paper-fourbar-driven.yaml") + " --out res"), 0)
+      << err_;
+  EXPECT_TRUE(err_.empty()) << err_;
+  ASSERT_TRUE(fs::exists(dir_ / "res" / "report.html"));
+  EXPECT_NE(out_.find("report.html"), std::string::npos) << out_;
+  const std::string first = read(dir_ / "res" / "report.html");
+  fs::remove(dir_ / "res" / "report.html");
+
+  EXPECT_EQ(run("report res"), 0) << err_;
+  EXPECT_TRUE(err_.empty()) << err_;
+  EXPECT_NE(out_.find("wrote res/report.html"), std::string::npos) << out_;
+  EXPECT_EQ(read(dir_ / "res" / "report.html"), first);
+
+  // without gnuplot the page is still written, and says the charts need it
+  EXPECT_EQ(run("report res BD_GNUPLOT_UNUSED"), 2);  // one folder only
+  EXPECT_EQ(std::system(("cd " + quote(dir_.string()) + " && BD_GNUPLOT=/nonexistent " +
+                         quote(kExe) + " report res >/dev/null 2>&1")
+                            .c_str()),
+            0);
+  EXPECT_NE(read(dir_ / "res" / "report.html").find("The charts need gnuplot"), std::string::npos);
+}
+
+TEST_F(CliTest, ReportNeedsTheFolderOfARun) {
+  fs::create_directories(dir_ / "empty");
+  EXPECT_EQ(run("report empty"), 2);
+  EXPECT_EQ(err_, "empty: no summary.json here: not the output folder of a run\n");
+  EXPECT_FALSE(fs::exists(dir_ / "empty" / "report.html"));
+
+  // a summary whose study file is gone
+  fs::create_directories(dir_ / "orphan");
+  write("orphan/summary.json", "{\n  \"study\": \"x\",\n  \"source\": \"gone.yaml\"\n}\n");
+  EXPECT_EQ(run("report orphan"), 2);
+  EXPECT_NE(err_.find("gone.yaml: cannot open the study file"), std::string::npos) << err_;
+  EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
+}
+
 TEST_F(CliTest, HelpAndVersion) {
   EXPECT_EQ(run("--help"), 0);
   for (const char* text :
-       {"run", "--out", "timeseries.csv", "summary.json", "Exit codes", "balanced-timeseries.csv",
-        "balanced.yaml", "comparison.csv", "optimize:", "optimized-timeseries.csv",
-        "optimized.yaml", "pareto.csv", "  4  the optimiser found no design"}) {
+       {"run", "validate STUDY.yaml", "report DIR", "report.html", "gnuplot", "--out",
+        "timeseries.csv", "summary.json", "Exit codes", "balanced-timeseries.csv", "balanced.yaml",
+        "comparison.csv", "optimize:", "optimized-timeseries.csv", "optimized.yaml", "pareto.csv",
+        "  4  the optimiser found no design"}) {
     EXPECT_NE(out_.find(text), std::string::npos) << text;
   }
   EXPECT_EQ(run("run --help"), 0);

@@ -100,7 +100,8 @@ TEST_F(RunnerTest, FreeSceneWritesTheContractFiles) {
   EXPECT_EQ(r.method.reason, choose_method(study).reason);
 
   // nothing but the two final files: no temporary left behind
-  EXPECT_EQ(names_in(out), (std::set<std::string>{"summary.json", "timeseries.csv"}));
+  EXPECT_EQ(names_in(out),
+            (std::set<std::string>{"report.html", "summary.json", "timeseries.csv"}));
 
   const std::vector<std::string> lines = lines_of(read(r.timeseries));
   ASSERT_FALSE(lines.empty());
@@ -157,7 +158,8 @@ TEST_F(RunnerTest, DrivenSceneWritesOneRowPerSampleAndSaysWhyNoIntegrator) {
   EXPECT_NE(json.find("\"revolutions\": 1"), std::string::npos) << json;
   EXPECT_NE(json.find("no integrator: kinetostatics per sample"), std::string::npos) << json;
   EXPECT_GT(r.metrics.tau_max, 0.0);
-  EXPECT_EQ(names_in(dir_), (std::set<std::string>{"summary.json", "timeseries.csv"}));
+  EXPECT_EQ(names_in(dir_),
+            (std::set<std::string>{"report.html", "summary.json", "timeseries.csv"}));
 }
 
 TEST_F(RunnerTest, RunningAgainReplacesTheFiles) {
@@ -166,7 +168,8 @@ TEST_F(RunnerTest, RunningAgainReplacesTheFiles) {
   const std::string first = read(dir_ / "timeseries.csv");
   run_study(study, dir_);
   EXPECT_EQ(read(dir_ / "timeseries.csv"), first);
-  EXPECT_EQ(names_in(dir_), (std::set<std::string>{"summary.json", "timeseries.csv"}));
+  EXPECT_EQ(names_in(dir_),
+            (std::set<std::string>{"report.html", "summary.json", "timeseries.csv"}));
 }
 
 TEST_F(RunnerTest, SimulationStoppedEarlyKeepsItsSamplesAndSaysWhy) {
@@ -186,7 +189,8 @@ TEST_F(RunnerTest, SimulationStoppedEarlyKeepsItsSamplesAndSaysWhy) {
   EXPECT_NE(json.find(json_string(r.trajectory.message)), std::string::npos) << json;
   EXPECT_NE(json.find(std::string("\"status\": \"") + core::to_string(r.trajectory.status)),
             std::string::npos);
-  EXPECT_EQ(names_in(dir_), (std::set<std::string>{"summary.json", "timeseries.csv"}));
+  EXPECT_EQ(names_in(dir_),
+            (std::set<std::string>{"report.html", "summary.json", "timeseries.csv"}));
 }
 
 TEST_F(RunnerTest, InvalidSceneCreatesNothing) {
@@ -199,8 +203,9 @@ TEST_F(RunnerTest, InvalidSceneCreatesNothing) {
 
 // ---- balance studies ----
 
-const std::set<std::string> kBalanceFiles = {"balanced-timeseries.csv", "balanced.yaml",
-                                             "comparison.csv", "summary.json", "timeseries.csv"};
+const std::set<std::string> kBalanceFiles = {
+    "balanced-timeseries.csv", "balanced.yaml", "comparison.csv", "report.html", "summary.json",
+    "timeseries.csv"};
 
 // the value of `"key": ` in the JSON text after `from` (a number or null)
 std::string json_value(const std::string& json, const std::string& key, std::size_t from = 0) {
@@ -420,7 +425,8 @@ TEST_F(RunnerTest, BalanceStudyStoppedEarlyKeepsEveryFile) {
 // ---- optimize studies ----
 
 const std::set<std::string> kOptimizeFiles = {"comparison.csv", "optimized-timeseries.csv",
-                                              "optimized.yaml", "summary.json", "timeseries.csv"};
+                                              "optimized.yaml", "report.html",
+                                              "summary.json",   "timeseries.csv"};
 
 // the driven paper linkage (paper-fourbar-driven.yaml) with an optimize section appended
 Study driven_with(const std::string& optimize_section, const std::string& name) {
@@ -635,7 +641,8 @@ TEST_F(RunnerTest, InfeasibleOptimizationKeepsTheOriginalAndSaysWhy) {
   EXPECT_EQ(r.optimized->result.termination, optimize::Termination::kInfeasible);
   EXPECT_NE(r.optimized->result.message.find("force balance"), std::string::npos)
       << r.optimized->result.message;
-  EXPECT_EQ(names_in(dir_), (std::set<std::string>{"summary.json", "timeseries.csv"}));
+  EXPECT_EQ(names_in(dir_),
+            (std::set<std::string>{"report.html", "summary.json", "timeseries.csv"}));
   expect_rows_match(lines_of(read(r.timeseries)), r.trajectory);
   const std::string json = read(r.summary);
   EXPECT_NE(json.find("\"termination\": \"infeasible\""), std::string::npos) << json;
@@ -662,7 +669,8 @@ TEST_F(RunnerTest, OptimizationIsNotRunWhenTheOriginalStopsEarly) {
   EXPECT_FALSE(r.optimized->failed());
   EXPECT_EQ(r.optimized->result.termination, optimize::Termination::kNotRun);
   EXPECT_NE(r.optimized->result.message.find("not run"), std::string::npos);
-  EXPECT_EQ(names_in(dir_), (std::set<std::string>{"summary.json", "timeseries.csv"}));
+  EXPECT_EQ(names_in(dir_),
+            (std::set<std::string>{"report.html", "summary.json", "timeseries.csv"}));
 }
 
 TEST(JsonString, EscapesWhatJsonRequires) {

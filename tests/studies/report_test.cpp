@@ -1,0 +1,217 @@
+// The study report: every run writes a self-contained report.html with the study's name, the
+// metrics exactly as summary.json has them, a chart per figure when gnuplot is there (and a plain
+// notice when it is not), and no reference to the network.
+#include "studies/report.hpp"
+
+#include <gtest/gtest.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "studies/load_study.hpp"
+#include "studies/runner.hpp"
+
+namespace bd::studies {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+// sets an environment variable for the scope, restoring the old value after
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    ::setenv(name, value, 1);
+  }
+  ~ScopedEnv() {
+    if (old_) {
+      ::setenv(name_, old_->c_str(), 1);
+    } else {
+      ::unsetenv(name_);
+    }
+  }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+class ReportTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("bd_report_test_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+// every "name": number pair of summary.json's metrics objects, as written
+std::vector<std::string> metric_values(const std::string& json) {
+  std::vector<std::string> values;
+  const std::regex pair("\"(Fsh|Msh|tau|RA0|RA3)_(rms|max)\": ([-+0-9.eE]+)");
+  for (auto it = std::sregex_iterator(json.begin(), json.end(), pair); it != std::sregex_iterator();
+       ++it) {
+    values.push_back((*it)[3].str());
+  }
+  return values;
+}
+
+// the text with the SVG and XLink namespace names taken out
+std::string without_namespaces(std::string html) {
+  for (const std::string ns : {"http://www.w3.org/2000/svg", "http://www.w3.org/1999/xlink"}) {
+    for (std::size_t at = html.find(ns); at != std::string::npos; at = html.find(ns, at)) {
+      html.erase(at, ns.size());
+    }
+  }
+  return html;
+}
+
+// every <svg ...>...</svg> of the page
+std::vector<std::string> svgs(const std::string& html) {
+  std::vector<std::string> out;
+  for (std::size_t at = html.find("<svg"); at != std::string::npos; at = html.find("<svg", at)) {
+    const std::size_t end = html.find("</svg>", at);
+    if (end == std::string::npos) break;
+    out.push_back(html.substr(at, end - at));
+    at = end;
+  }
+  return out;
+}
+
+TEST_F(ReportTest, BalanceRunWritesASelfContainedReport) {
+  const Study study =
+      load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven-force-balanced.yaml");
+  const RunResult r = run_study(study, dir_);
+  ASSERT_TRUE(r.ok());
+  const fs::path page = dir_ / "report.html";
+  ASSERT_TRUE(fs::exists(page));
+  const std::string html = read(page);
+  EXPECT_NE(html.find("<title>" + study.name), std::string::npos);
+  EXPECT_NE(html.find("complex-masses"), std::string::npos);  // the method used, and why
+  EXPECT_NE(html.find(r.method.reason), std::string::npos);
+  EXPECT_NE(html.find(">completed<"), std::string::npos);
+
+  // every metric value (original and balanced) exactly as summary.json writes it
+  const std::vector<std::string> values = metric_values(read(r.summary));
+  ASSERT_EQ(values.size(), 30u);  // metrics, balanced_metrics, reduction
+  for (const std::string& v : values) EXPECT_NE(html.find("\"" + v + "\""), std::string::npos) << v;
+  // the comparison table's rows, from comparison.csv
+  EXPECT_NE(html.find("comparison.csv"), std::string::npos);
+  EXPECT_NE(html.find(">added_mass<"), std::string::npos);
+
+  // nothing fetched from anywhere
+  const std::string rest = without_namespaces(html);
+  EXPECT_EQ(rest.find("http://"), std::string::npos);
+  EXPECT_EQ(rest.find("https://"), std::string::npos);
+  EXPECT_EQ(rest.find("<script"), std::string::npos);
+  EXPECT_EQ(rest.find("<link"), std::string::npos);
+
+  if (find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
+  const std::vector<std::string> charts = svgs(html);
+  EXPECT_EQ(charts.size(), 6u);  // angles, reactions, hodograph, Msh, drive, linkage
+  for (const char* id :
+       {"angles", "reactions", "hodograph", "shaking-moment", "drive", "linkage"}) {
+    EXPECT_NE(html.find(std::string("id=\"chart-") + id + "\""), std::string::npos) << id;
+  }
+  for (const std::string& svg : charts) EXPECT_GT(count(svg, "<path"), 3u);
+  EXPECT_NE(html.find("balanced"), std::string::npos);  // the overlay's legend
+  EXPECT_EQ(html.find("need gnuplot"), std::string::npos);
+  // ids made unique per chart
+  EXPECT_EQ(count(html, "id='gpPt0'"), 0u);
+  EXPECT_EQ(count(html, "id='angles-gpPt0'"), 1u);
+}
+
+TEST_F(ReportTest, WithoutGnuplotTheReportSaysSoAndKeepsTheTables) {
+  const ScopedEnv env("BD_GNUPLOT", "/nonexistent/gnuplot");
+  EXPECT_EQ(find_gnuplot(), "");
+  const Study study = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar.yaml");
+  const RunResult r = run_study(study, dir_);
+  ASSERT_TRUE(r.ok());
+  const std::string html = read(dir_ / "report.html");
+  EXPECT_NE(html.find("The charts need gnuplot"), std::string::npos);
+  EXPECT_EQ(html.find("<svg"), std::string::npos);
+  for (const std::string& v : metric_values(read(r.summary))) {
+    EXPECT_NE(html.find("\"" + v + "\""), std::string::npos) << v;
+  }
+  EXPECT_NE(html.find("href=\"timeseries.csv\""), std::string::npos);
+  EXPECT_NE(html.find("The linkage at the drawn samples"), std::string::npos);
+}
+
+TEST_F(ReportTest, OptimizeRunWithParetoFrontHasItsChartAndTable) {
+  std::string yaml = read(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml");
+  yaml +=
+      "optimize:\n"
+      "  objective: {Fsh_rms: 1}\n"
+      "  variables:\n"
+      "    counterweights: {crank: {mass_max: 10}, rocker: {mass_max: 10}}\n"
+      "  pareto: {first: Fsh_rms, second: Msh_rms, points: 3}\n";
+  const fs::path file = dir_ / "pareto.yaml";
+  std::ofstream(file) << yaml;
+  const Study study = load_study(file.string());
+  const fs::path out = dir_ / "out";
+  const RunResult r = run_study(study, out);
+  ASSERT_TRUE(r.ok());
+  const std::string html = read(out / "report.html");
+  EXPECT_NE(html.find("<h2>Pareto front</h2>"), std::string::npos);
+  EXPECT_NE(html.find("<h2>Comparison</h2>"), std::string::npos);
+  EXPECT_NE(html.find("optimised"), std::string::npos);
+  if (find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
+  EXPECT_EQ(svgs(html).size(), 7u);
+  EXPECT_NE(html.find("id=\"chart-pareto\""), std::string::npos);
+}
+
+TEST_F(ReportTest, ReportIsRebuiltFromTheDataFiles) {
+  const Study study = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml");
+  run_study(study, dir_);
+  const std::string first = read(dir_ / "report.html");
+  fs::remove(dir_ / "report.html");
+  EXPECT_EQ(write_report(study, dir_), dir_ / "report.html");
+  EXPECT_EQ(read(dir_ / "report.html"), first);  // the same files give the same page
+}
+
+TEST_F(ReportTest, FolderWithoutSummaryIsAnError) {
+  const Study study = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml");
+  EXPECT_THROW(report_html(study, dir_, ""), std::runtime_error);
+  EXPECT_FALSE(fs::exists(dir_ / "report.html"));
+}
+
+TEST_F(ReportTest, GnuplotFailureIsAWarningAndTheRunGoesOn) {
+  const ScopedEnv env("BD_GNUPLOT", "/bin/false");
+  const Study study = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml");
+  ::testing::internal::CaptureStderr();
+  const RunResult r = run_study(study, dir_);
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_TRUE(r.ok());
+  EXPECT_TRUE(fs::exists(dir_ / "summary.json"));
+  EXPECT_FALSE(fs::exists(dir_ / "report.html"));
+  EXPECT_NE(err.find("warning: report.html not written: gnuplot failed"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace bd::studies
