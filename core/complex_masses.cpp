@@ -60,14 +60,16 @@ Complex applied_force(const FourBar& model, int k) {
 // s̄ = e + i f of a link [m]
 Complex com_offset(const Link& l) { return {l.e, l.f}; }
 
-// the link vectors l̄1, l̄2, l̄3 [m]
-struct LinkVectors {
+// the link vectors l̄1, l̄2, l̄3 as complex numbers [m]
+struct ComplexLinks {
   Complex l1, l2, l3;
 };
-LinkVectors link_vectors(const FourBar& m, const Pose& p) {
-  return {std::polar(m.crank.length, p.theta1), std::polar(m.coupler.length, p.theta2),
-          std::polar(m.rocker.length, p.theta3)};
+ComplexLinks complex_links(const LinkVectors& l) {
+  return {to_complex(l.l1), to_complex(l.l2), to_complex(l.l3)};
 }
+
+// eqs. 37-39 from the link vectors (complex_mass_equations() without the trigonometry)
+ComplexMassEquations equations(const FourBar& model, const ComplexLinks& l);
 
 // the convective terms Σ_k C_jk θ̇_k² of eq. 36 (only C13 = -C31 is nonzero) [N m]
 Eigen::Vector3d convective_terms(const ComplexMassEquations& eq, const FourBarState& s) {
@@ -87,19 +89,17 @@ Eigen::Vector3d constraint_forces(const ComplexMassEquations& eq, const FourBarS
 // (tau = 0), inverse otherwise.
 Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, double theta1, double omega1,
                                               const double* alpha1_given) {
-  // position stage
-  const auto pose = nonsingular_pose(model, theta1);
-  if (!pose) return Unexpected(pose.error());
-  const LinkVectors l = link_vectors(model, *pose);
-  const ComplexMassEquations eq = complex_mass_equations(model, *pose);
-
-  // velocity stage and the velocity-product accelerations θ̈_k = Θ_k θ̈1 + γ_k
-  FourBarState s = solve_velocity(model, *pose, omega1);
-  const TransferFunctions tf = transfer_functions(model, *pose);
-  const AccelerationBias bias = acceleration_bias(model, s);
+  // position and velocity stages and the velocity-product accelerations θ̈_k = Θ_k θ̈1 + γ_k,
+  // once for the whole instant
+  const auto instant = nonsingular_instant(model, theta1, omega1);
+  if (!instant) return Unexpected(instant.error());
+  const ComplexLinks l = complex_links(instant->l);
+  const ComplexMassEquations eq = equations(model, l);
+  const TransferFunctions& tf = instant->tf;
+  const AccelerationBias& bias = instant->bias;
+  const Eigen::Vector3d convective = convective_terms(eq, instant->state);
   const Eigen::Vector3d Theta(1.0, tf.Theta2, tf.Theta3);
   const Eigen::Vector3d gamma(0.0, bias.gamma2, bias.gamma3);
-  const Eigen::Vector3d convective = convective_terms(eq, s);
 
   // reduced equation: δθ = Θ δθ1 keeps the loop closed, so Σ_j Θ_j Q^c_j = 0 and
   // (Θᵀ M Θ) θ̈1 = Θᵀ (Q - M γ - C θ̇²) + τ   (τ enters Q1, Θ1 = 1)
@@ -112,9 +112,7 @@ Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, double theta
     alpha1 = *alpha1_given;
     tau = inertia * alpha1 - rhs;
   }
-  s.alpha1 = alpha1;
-  s.alpha2 = tf.Theta2 * alpha1 + bias.gamma2;
-  s.alpha3 = tf.Theta3 * alpha1 + bias.gamma3;
+  const FourBarState s = instant->accelerated(alpha1);
 
   // mass centre accelerations times masses (eq. 35 in the complex masses; the principal-vector
   // brackets of m1 r̈1 and m3 r̈3 equal m̄1q l̄1 and -m̄3p l̄3 and divide by no mass either)
@@ -130,7 +128,8 @@ Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, double theta
                 F3 = applied_force(model, 3);
 
   // (a) translation of S: the resultant of the reactions
-  const PointKinematics S = centre_of_mass_frame(model, s);
+  const FrameVectors a = frame_vectors(model, instant->l);
+  const PointKinematics S = centre_of_mass_frame(a, s);
   const Complex Fsh = F1 + F2 + F3 - total_mass(model) * to_complex(S.a);
 
   // (b) rotation about S: eq. 40 gives each centre of mass's lever c̄_k about S times m_k; the
@@ -148,7 +147,6 @@ Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, double theta
   const Complex r3 = l.l1 + l.l2 + com_offset(L3) / L3.length * l.l3;
   W_S += inner(kI * (r1 - rS), F1 - m1a1) + inner(kI * (r2 - rS), F2 - m2a2) +
          inner(kI * (r3 - rS), F3 - m3a3);
-  const FrameVectors a = frame_vectors(model, *pose);
   const Complex p_SA0 = to_complex(a.a14 + a.a41 + a.a34);  // r̄_A0 - r̄_S
   const double RA3y = (W_S - inner(kI * p_SA0, Fsh)) / model.frame_length;
 
@@ -170,9 +168,14 @@ Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, double theta
 }  // namespace
 
 ComplexMassEquations complex_mass_equations(const FourBar& model, const Pose& pose) {
+  return equations(model, complex_links(link_vectors(model, pose)));
+}
+
+namespace {
+
+ComplexMassEquations equations(const FourBar& model, const ComplexLinks& l) {
   const Link &L1 = model.crank, &L2 = model.coupler, &L3 = model.rocker;
   const double m2 = L2.mass;
-  const LinkVectors l = link_vectors(model, pose);
   // the coupler's complex masses per unit mass on their lever arms: m̄2p l̄1/m2 at A1 and
   // m̄2q l̄3/m2 at A2. Eqs. 37-39 print |m̄2p|²/m2, <m̄2p l̄1, m̄2q l̄3>/m2, ...; written with the
   // unit-mass weights (1 - s̄2/l2) and s̄2/l2 they are the same numbers without the division,
@@ -206,10 +209,12 @@ ComplexMassEquations complex_mass_equations(const FourBar& model, const Pose& po
   return eq;
 }
 
+}  // namespace
+
 PrincipalVectorForms principal_vector_forms(const FourBar& model, const Pose& pose) {
   const Link &L1 = model.crank, &L2 = model.coupler, &L3 = model.rocker;
   const double m1 = L1.mass, m2 = L2.mass, m3 = L3.mass;
-  const LinkVectors l = link_vectors(model, pose);
+  const ComplexLinks l = complex_links(link_vectors(model, pose));
   const EquivalentMasses e2 = equivalent_masses(L2);
   const FrameVectors v = frame_vectors(model, pose);
   const Complex a14 = to_complex(v.a14), a34 = to_complex(v.a34), a12p = to_complex(v.a12p),

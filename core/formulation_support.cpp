@@ -5,12 +5,17 @@
 
 namespace bd::core {
 
-Expected<Pose, DynamicsError> nonsingular_pose(const FourBar& model, double theta1) {
-  const auto pose = solve_position(model, theta1);
-  if (!pose) {
-    return Unexpected(DynamicsError{DynamicsError::Kind::kAssembly, theta1, pose.error().what()});
+namespace {
+
+// the closed loop at theta1, or kAssembly / kSingular
+Expected<ClosedLoop, DynamicsError> nonsingular_loop(const FourBar& model, double theta1) {
+  const auto loop = solve_loop(model, theta1, model.branch);
+  if (!loop) {
+    return Unexpected(DynamicsError{DynamicsError::Kind::kAssembly, theta1, loop.error().what()});
   }
-  const double sin_mu = std::sin(pose->theta3 - pose->theta2);
+  // sin(theta3 - theta2) = l̄2 × l̄3 / (l2 l3)
+  const double sin_mu =
+      cross(loop->l.l2, loop->l.l3) / (model.coupler.length * model.rocker.length);
   if (!(std::abs(sin_mu) >= kSingularSin)) {
     char buf[160];
     std::snprintf(buf, sizeof buf,
@@ -18,7 +23,40 @@ Expected<Pose, DynamicsError> nonsingular_pose(const FourBar& model, double thet
                   sin_mu);
     return Unexpected(DynamicsError{DynamicsError::Kind::kSingular, theta1, buf});
   }
-  return *pose;
+  return *loop;
+}
+
+}  // namespace
+
+Expected<Pose, DynamicsError> nonsingular_pose(const FourBar& model, double theta1) {
+  const auto loop = nonsingular_loop(model, theta1);
+  if (!loop) return Unexpected(loop.error());
+  return loop->pose;
+}
+
+FourBarState ClosedInstant::accelerated(double alpha1) const {
+  FourBarState s = state;
+  s.alpha1 = alpha1;
+  s.alpha2 = tf.Theta2 * alpha1 + bias.gamma2;
+  s.alpha3 = tf.Theta3 * alpha1 + bias.gamma3;
+  return s;
+}
+
+Expected<ClosedInstant, DynamicsError> nonsingular_instant(const FourBar& model, double theta1,
+                                                           double omega1) {
+  const auto loop = nonsingular_loop(model, theta1);
+  if (!loop) return Unexpected(loop.error());
+  ClosedInstant c;
+  c.l = loop->l;
+  c.tf = transfer_functions(c.l);
+  c.state.theta1 = theta1;
+  c.state.theta2 = loop->pose.theta2;
+  c.state.theta3 = loop->pose.theta3;
+  c.state.omega1 = omega1;
+  c.state.omega2 = c.tf.Theta2 * omega1;
+  c.state.omega3 = c.tf.Theta3 * omega1;
+  c.bias = acceleration_bias(c.l, c.state);
+  return c;
 }
 
 Expected<DynamicsSample, DynamicsError> completed_sample(const FourBar& model, DynamicsSample s) {

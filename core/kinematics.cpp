@@ -11,15 +11,6 @@ namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
-// link vectors l̄1, l̄2, l̄3 of a pose [m]
-struct LinkVectors {
-  Vec2 l1, l2, l3;
-};
-LinkVectors link_vectors(const FourBar& m, double theta1, double theta2, double theta3) {
-  return {m.crank.length * unit(theta1), m.coupler.length * unit(theta2),
-          m.rocker.length * unit(theta3)};
-}
-
 // s̄_k turned into ground axes at link angle theta: R(theta)·(e, f) [m]
 Vec2 com_offset(const Link& l, double theta) {
   const Vec2 u = unit(theta);
@@ -58,11 +49,17 @@ std::string AssemblyError::what() const {
   return buf;
 }
 
-Expected<Pose, AssemblyError> solve_position(const FourBar& model, double theta1, Branch branch) {
+LinkVectors link_vectors(const FourBar& m, const Pose& p) {
+  return {m.crank.length * unit(p.theta1), m.coupler.length * unit(p.theta2),
+          m.rocker.length * unit(p.theta3)};
+}
+
+Expected<ClosedLoop, AssemblyError> solve_loop(const FourBar& model, double theta1, Branch branch) {
   const double l1 = model.crank.length, l2 = model.coupler.length, l3 = model.rocker.length,
                l4 = model.frame_length;
   // l̄23 = l̄2 + l̄3 = -l̄1 - l̄4 = A3 - A1 (eq. 2)
-  const Vec2 l23v(l4 - l1 * std::cos(theta1), -l1 * std::sin(theta1));
+  const Vec2 l1v = l1 * unit(theta1);
+  const Vec2 l23v(l4 - l1v.x(), -l1v.y());
   const double l23 = l23v.norm();
   if (!(l23 > 0)) return Unexpected(AssemblyError{theta1, 0.0});
 
@@ -90,7 +87,14 @@ Expected<Pose, AssemblyError> solve_position(const FourBar& model, double theta1
   const Vec2 u = l23v / l23;
   const Vec2 l2v = d23 * u + h23 * perp(u);
   const Vec2 l3v = l23v - l2v;
-  return Pose{theta1, std::atan2(l2v.y(), l2v.x()), std::atan2(l3v.y(), l3v.x())};
+  return ClosedLoop{Pose{theta1, std::atan2(l2v.y(), l2v.x()), std::atan2(l3v.y(), l3v.x())},
+                    LinkVectors{l1v, l2v, l3v}};
+}
+
+Expected<Pose, AssemblyError> solve_position(const FourBar& model, double theta1, Branch branch) {
+  const auto loop = solve_loop(model, theta1, branch);
+  if (!loop) return Unexpected(loop.error());
+  return loop->pose;
 }
 
 Expected<Pose, AssemblyError> solve_position(const FourBar& model, double theta1) {
@@ -98,8 +102,11 @@ Expected<Pose, AssemblyError> solve_position(const FourBar& model, double theta1
 }
 
 TransferFunctions transfer_functions(const FourBar& model, const Pose& p) {
+  return transfer_functions(link_vectors(model, p));
+}
+
+TransferFunctions transfer_functions(const LinkVectors& v) {
   // eq. 7 via cross products: l̄1 Θ1 + l̄2 Θ2 + l̄3 Θ3 = 0 (eq. 5), crossed with l̄3 and l̄2
-  const LinkVectors v = link_vectors(model, p.theta1, p.theta2, p.theta3);
   return {-cross(v.l3, v.l1) / cross(v.l3, v.l2), -cross(v.l2, v.l1) / cross(v.l2, v.l3)};
 }
 
@@ -116,8 +123,11 @@ FourBarState solve_velocity(const FourBar& model, const Pose& pose, double omega
 }
 
 AccelerationBias acceleration_bias(const FourBar& model, const FourBarState& s) {
+  return acceleration_bias(link_vectors(model, pose_of(s)), s);
+}
+
+AccelerationBias acceleration_bias(const LinkVectors& v, const FourBarState& s) {
   // eq. 8: Σ l̄k α_k = -i b with b = Σ l̄k ω_k²; crossed with l̄3 and l̄2 (eqs. 9-10)
-  const LinkVectors v = link_vectors(model, s.theta1, s.theta2, s.theta3);
   const Vec2 b = v.l1 * (s.omega1 * s.omega1) + v.l2 * (s.omega2 * s.omega2) +
                  v.l3 * (s.omega3 * s.omega3);
   return {-v.l3.dot(b) / cross(v.l3, v.l2), -v.l2.dot(b) / cross(v.l2, v.l3)};
@@ -173,7 +183,7 @@ double transmission_angle(const Pose& p) {
 }
 
 double closure_residual(const FourBar& model, const Pose& p) {
-  const LinkVectors v = link_vectors(model, p.theta1, p.theta2, p.theta3);
+  const LinkVectors v = link_vectors(model, p);
   return (v.l1 + v.l2 + v.l3 + Vec2(-model.frame_length, 0.0)).norm();
 }
 

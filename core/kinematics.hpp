@@ -28,11 +28,30 @@ Expected<Pose, AssemblyError> solve_position(const FourBar& model, double theta1
 /// Same on the model's own branch.
 Expected<Pose, AssemblyError> solve_position(const FourBar& model, double theta1);
 
+/// Link vectors l̄1, l̄2, l̄3 in ground axes [m].
+struct LinkVectors {
+  Vec2 l1, l2, l3;
+};
+/// The link vectors at the angles of a pose (closed or not): three cos/sin pairs.
+LinkVectors link_vectors(const FourBar& model, const Pose& pose);
+
+/// A closed pose together with its link vectors as the position solve produces them (eq. 4).
+/// The dynamics solves the loop once per instant and works with these vectors, so it spends no
+/// atan2 → cos/sin round trips; they equal link_vectors(model, pose) to round-off.
+struct ClosedLoop {
+  Pose pose;
+  LinkVectors l;  // [m]
+};
+/// solve_position() that also returns the link vectors; fails in the same way.
+Expected<ClosedLoop, AssemblyError> solve_loop(const FourBar& model, double theta1, Branch branch);
+
 /// First-order kinematic transfer functions Θ2 = dθ2/dθ1, Θ3 = dθ3/dθ1 (eq. 7) [-].
 struct TransferFunctions {
   double Theta2{}, Theta3{};
 };
 TransferFunctions transfer_functions(const FourBar& model, const Pose& pose);
+/// The same from the link vectors of a closed pose (no trigonometry).
+TransferFunctions transfer_functions(const LinkVectors& l);
 
 /// Full kinematic state: the crank input and the dependent angles, rates and accelerations.
 struct FourBarState {
@@ -53,6 +72,8 @@ struct AccelerationBias {
   double gamma2{}, gamma3{};  // [rad/s^2]
 };
 AccelerationBias acceleration_bias(const FourBar& model, const FourBarState& state);
+/// The same from the link vectors of the state's pose (no trigonometry).
+AccelerationBias acceleration_bias(const LinkVectors& l, const FourBarState& state);
 
 /// Joint positions in ground axes [m] (A0 is the origin, A3 = (l4, 0)).
 struct Joints {

@@ -18,16 +18,24 @@ enum class Unknown { kAlpha1, kTau };
 // ⟨i x̄, ȳ⟩ of the paper: the inner product of i·x̄ (x̄ turned by +90°) with ȳ, = x̄ × ȳ
 double inner_i(const Vec2& x, const Vec2& y) { return cross(x, y); }
 
-// Solves eqs. 22 and 27 at the angles and rates of `s` (taken as independent). Unknowns
+// eq. 22's terms from the link vectors and the opened-loop vectors of the same angles
+// (opened_loop_terms() without the trigonometry)
+OpenedLoopTerms terms(const FourBar& model, const LinkVectors& l, const OpenedLoopVectors& a);
+
+// Solves eqs. 22 and 27 at the angles and rates of `s` (taken as independent), whose link vectors
+// are `l` (computed once by the caller). Unknowns
 // x = [u, θ̈2, θ̈3, RA3x, RA3y] with u = θ̈1 (forward, tau = 0) or u = tau (inverse, θ̈1 given in
 // s.alpha1). Fills the acceleration stage, the reactions and tau.
-Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, FourBarState s, Unknown unknown,
+Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, FourBarState s,
+                                              const LinkVectors& l, Unknown unknown,
                                               const Vec2& closure_bias) {
   // the 5x5 matrix [M D; Dᵀ 0] is regular iff D = [i l̄1; i l̄2; i l̄3] has rank 2 (M is positive
   // definite), i.e. unless all three moving links are parallel
-  const double sin12 = std::abs(std::sin(s.theta2 - s.theta1));
-  const double sin13 = std::abs(std::sin(s.theta3 - s.theta1));
-  const double sin23 = std::abs(std::sin(s.theta3 - s.theta2));
+  // |sin(theta_k - theta_j)| = |l̄j × l̄k| / (lj lk)
+  const double l1 = model.crank.length, l2 = model.coupler.length, l3 = model.rocker.length;
+  const double sin12 = std::abs(cross(l.l1, l.l2)) / (l1 * l2);
+  const double sin13 = std::abs(cross(l.l1, l.l3)) / (l1 * l3);
+  const double sin23 = std::abs(cross(l.l2, l.l3)) / (l2 * l3);
   if (!(std::max({sin12, sin13, sin23}) >= kSingularSin)) {
     char buf[160];
     std::snprintf(buf, sizeof buf,
@@ -38,11 +46,9 @@ Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, FourBarState
   }
 
   // eq. 22 (three rows) and eq. 27 (two rows): [M D; Dᵀ 0] [θ̈; R̄A3] = [Q - C θ̇²; Σ l̄k θ̇k²]
-  const Pose pose = pose_of(s);
-  const OpenedLoopTerms t = opened_loop_terms(model, pose);
+  const OpenedLoopVectors a = opened_loop_vectors(model, l);  // eqs. 12-13, also for eq. 28
+  const OpenedLoopTerms t = terms(model, l, a);
   const Eigen::Vector3d omega_sq(s.omega1 * s.omega1, s.omega2 * s.omega2, s.omega3 * s.omega3);
-  const Vec2 l1 = model.crank.length * unit(s.theta1), l2 = model.coupler.length * unit(s.theta2),
-             l3 = model.rocker.length * unit(s.theta3);
   Mat5 A = Mat5::Zero();
   A.topLeftCorner<3, 3>() = t.M;
   A.topRightCorner<3, 2>() = t.D;
@@ -50,7 +56,7 @@ Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, FourBarState
   Vec5 b;
   b.head<3>() = t.Q - t.C * omega_sq;
   // eq. 27: Σ l̄k (i θ̈k - θ̇k²) = 0, i.e. Σ (i l̄k) θ̈k = Σ l̄k θ̇k² (+ the stabilisation bias)
-  b.tail<2>() = l1 * omega_sq(0) + l2 * omega_sq(1) + l3 * omega_sq(2) + closure_bias;
+  b.tail<2>() = l.l1 * omega_sq(0) + l.l2 * omega_sq(1) + l.l3 * omega_sq(2) + closure_bias;
 
   if (unknown == Unknown::kTau) {
     // θ̈1 known: its column moves to the right-hand side; tau enters Q1, so the first equation
@@ -74,7 +80,7 @@ Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, FourBarState
   out.RA3 = x.tail<2>();
 
   // eq. 28: m_tot r̈_S = ΣF̄k - R̄A0 - R̄A3 (F̄k with the weights), r̈_S from eq. 16
-  const Vec2 a_S = centre_of_mass_opened_loop(model, s).a;
+  const Vec2 a_S = centre_of_mass_opened_loop(a, s).a;
   Vec2 applied = Vec2::Zero();
   for (int k = 1; k <= 3; ++k) {
     applied += link_load(model, k).force + link(model, k).mass * model.loads.gravity;
@@ -84,22 +90,10 @@ Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, FourBarState
   return completed_sample(model, out);
 }
 
-// the closed state at theta1 on the model's branch with its velocity stage
-Expected<FourBarState, DynamicsError> closed_state(const FourBar& model, double theta1,
-                                                   double omega1) {
-  const auto pose = nonsingular_pose(model, theta1);
-  if (!pose) return Unexpected(pose.error());
-  return solve_velocity(model, *pose, omega1);
-}
-
-}  // namespace
-
-OpenedLoopTerms opened_loop_terms(const FourBar& model, const Pose& pose) {
+OpenedLoopTerms terms(const FourBar& model, const LinkVectors& l, const OpenedLoopVectors& a) {
   const Link &L1 = model.crank, &L2 = model.coupler, &L3 = model.rocker;
   const double m1 = L1.mass, m2 = L2.mass, m3 = L3.mass, mt = m1 + m2 + m3;
-  const Vec2 l1 = L1.length * unit(pose.theta1), l2 = L2.length * unit(pose.theta2),
-             l3 = L3.length * unit(pose.theta3);
-  const OpenedLoopVectors a = opened_loop_vectors(model, pose);  // eqs. 12-13
+  const Vec2 &l1 = l.l1, &l2 = l.l2, &l3 = l.l3;
   OpenedLoopTerms t;
 
   // mass matrix (unnumbered equation after eq. 22). The diagonal uses the paper's simplified
@@ -152,20 +146,37 @@ OpenedLoopTerms opened_loop_terms(const FourBar& model, const Pose& pose) {
   return t;
 }
 
+// The link vectors of a state, from its angles. Also on a closed state, where the position
+// solve has them already: the state form (the DAE's right-hand side) must give bit for bit what
+// the closed form gives on the same state (opened_loop_test), so both take them from the angles,
+// three cos/sin pairs per evaluation.
+LinkVectors link_vectors_of(const FourBar& model, const FourBarState& s) {
+  return link_vectors(model, pose_of(s));
+}
+
+}  // namespace
+
+OpenedLoopTerms opened_loop_terms(const FourBar& model, const Pose& pose) {
+  const LinkVectors l = link_vectors(model, pose);
+  return terms(model, l, opened_loop_vectors(model, l));
+}
+
 Expected<DynamicsSample, DynamicsError> forward_dynamics_opened_loop(const FourBar& model,
                                                                      double theta1, double omega1) {
-  const auto s = closed_state(model, theta1, omega1);
-  if (!s) return Unexpected(s.error());
-  return solve(model, *s, Unknown::kAlpha1, Vec2::Zero());
+  const auto instant = nonsingular_instant(model, theta1, omega1);
+  if (!instant) return Unexpected(instant.error());
+  return solve(model, instant->state, link_vectors_of(model, instant->state), Unknown::kAlpha1,
+               Vec2::Zero());
 }
 
 Expected<DynamicsSample, DynamicsError> inverse_dynamics_opened_loop(const FourBar& model,
                                                                      double theta1, double omega1,
                                                                      double alpha1) {
-  auto s = closed_state(model, theta1, omega1);
-  if (!s) return Unexpected(s.error());
-  s->alpha1 = alpha1;
-  return solve(model, *s, Unknown::kTau, Vec2::Zero());
+  const auto instant = nonsingular_instant(model, theta1, omega1);
+  if (!instant) return Unexpected(instant.error());
+  FourBarState s = instant->state;
+  s.alpha1 = alpha1;
+  return solve(model, s, link_vectors_of(model, s), Unknown::kTau, Vec2::Zero());
 }
 
 Expected<DynamicsSample, DynamicsError> forward_dynamics_opened_loop(const FourBar& model,
@@ -173,7 +184,7 @@ Expected<DynamicsSample, DynamicsError> forward_dynamics_opened_loop(const FourB
                                                                      const Vec2& closure_bias) {
   FourBarState s = state;
   s.alpha1 = s.alpha2 = s.alpha3 = 0.0;
-  return solve(model, s, Unknown::kAlpha1, closure_bias);
+  return solve(model, s, link_vectors_of(model, s), Unknown::kAlpha1, closure_bias);
 }
 
 }  // namespace bd::core

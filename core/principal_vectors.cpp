@@ -4,9 +4,6 @@ namespace bd::core {
 
 namespace {
 
-// l̄_k as a complex number
-Complex link_vector(double length, double theta) { return std::polar(length, theta); }
-
 // s̄_k / l_k
 Complex relative_com(const Link& l) { return Complex(l.e, l.f) / l.length; }
 
@@ -55,18 +52,23 @@ FrameFactors frame_factors(const FourBar& m) {
 }
 
 OpenedLoopVectors opened_loop_vectors(const FourBar& m, const Pose& p) {
+  return opened_loop_vectors(m, link_vectors(m, p));
+}
+
+OpenedLoopVectors opened_loop_vectors(const FourBar& m, const LinkVectors& l) {
   const OpenedLoopFactors f = opened_loop_factors(m);
-  const Complex l1 = link_vector(m.crank.length, p.theta1),
-                l2 = link_vector(m.coupler.length, p.theta2),
-                l3 = link_vector(m.rocker.length, p.theta3);
+  const Complex l1 = to_complex(l.l1), l2 = to_complex(l.l2), l3 = to_complex(l.l3);
   return {to_vec(f.a12 * l1),  to_vec(f.a21 * l2),  to_vec(f.a23 * l2),
           to_vec(f.a32 * l3),  to_vec(f.a14p * l1), to_vec(f.a34p * l3)};
 }
 
 FrameVectors frame_vectors(const FourBar& m, const Pose& p) {
+  return frame_vectors(m, link_vectors(m, p));
+}
+
+FrameVectors frame_vectors(const FourBar& m, const LinkVectors& l) {
   const FrameFactors f = frame_factors(m);
-  const Complex l1 = link_vector(m.crank.length, p.theta1),
-                l3 = link_vector(m.rocker.length, p.theta3), l4(-m.frame_length, 0.0);
+  const Complex l1 = to_complex(l.l1), l3 = to_complex(l.l3), l4(-m.frame_length, 0.0);
   return {to_vec(f.a14 * l1), to_vec(f.a41 * l4),  to_vec(f.a43 * l4),
           to_vec(f.a34 * l3), to_vec(f.a12p * l1), to_vec(f.a32p * l3)};
 }
@@ -84,8 +86,11 @@ FramePrincipalPoints frame_principal_points(const FourBar& m, const Pose& p) {
 }
 
 PointKinematics centre_of_mass_opened_loop(const FourBar& m, const FourBarState& s) {
+  return centre_of_mass_opened_loop(opened_loop_vectors(m, pose_of(s)), s);
+}
+
+PointKinematics centre_of_mass_opened_loop(const OpenedLoopVectors& a, const FourBarState& s) {
   // eq. 16 with r̄_A0 = 0: r̄_S = -ā14' - ā21 - ā32
-  const OpenedLoopVectors a = opened_loop_vectors(m, pose_of(s));
   PointKinematics S;
   S.r = -a.a14p - a.a21 - a.a32;
   S.v = -rate(a.a14p, s.omega1) - rate(a.a21, s.omega2) - rate(a.a32, s.omega3);
@@ -95,8 +100,11 @@ PointKinematics centre_of_mass_opened_loop(const FourBar& m, const FourBarState&
 }
 
 PointKinematics centre_of_mass_frame(const FourBar& m, const FourBarState& s) {
+  return centre_of_mass_frame(frame_vectors(m, pose_of(s)), s);
+}
+
+PointKinematics centre_of_mass_frame(const FrameVectors& a, const FourBarState& s) {
   // eq. 32: r̄_S = -ā14 - ā41 - ā34, with ā41 fixed in the frame
-  const FrameVectors a = frame_vectors(m, pose_of(s));
   PointKinematics S;
   S.r = -a.a14 - a.a41 - a.a34;
   S.v = -rate(a.a14, s.omega1) - rate(a.a34, s.omega3);

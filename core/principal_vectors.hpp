@@ -33,6 +33,8 @@ struct OpenedLoopVectors {
   Vec2 a12, a21, a23, a32, a14p, a34p;
 };
 OpenedLoopVectors opened_loop_vectors(const FourBar& model, const Pose& pose);
+/// The same from the link vectors of the pose (no trigonometry).
+OpenedLoopVectors opened_loop_vectors(const FourBar& model, const LinkVectors& l);
 
 /// The frame set (eqs. 30-31, Fig. 4): ā14, ā41, ā43, ā34 and the derived ā12', ā32', in ground
 /// axes [m]. ā41 and ā43 are constant; S is stationary iff ā14 = ā34 = 0 (eq. 57).
@@ -40,6 +42,8 @@ struct FrameVectors {
   Vec2 a14, a41, a43, a34, a12p, a32p;
 };
 FrameVectors frame_vectors(const FourBar& model, const Pose& pose);
+/// The same from the link vectors of the pose (no trigonometry).
+FrameVectors frame_vectors(const FourBar& model, const LinkVectors& l);
 
 /// The same vectors as constant complex factors c with ā = c·l̄_k (c depends on the masses and
 /// centres of mass only). Used by the formulations and the balance conditions.
@@ -69,7 +73,11 @@ struct PointKinematics {
 /// S by the opened-loop construction (eq. 16): r̄_S = -ā14' - ā21 - ā32, differentiated with the
 /// link rates; needs the state's acceleration stage.
 PointKinematics centre_of_mass_opened_loop(const FourBar& model, const FourBarState& s);
+/// The same from the state's opened-loop vectors, when the caller has them already.
+PointKinematics centre_of_mass_opened_loop(const OpenedLoopVectors& a, const FourBarState& s);
 /// S by the frame construction (eq. 32): r̄_S = -ā14 - ā41 - ā34; only links 1 and 3 move it.
 PointKinematics centre_of_mass_frame(const FourBar& model, const FourBarState& s);
+/// The same from the state's frame vectors, when the caller has them already.
+PointKinematics centre_of_mass_frame(const FrameVectors& a, const FourBarState& s);
 
 }  // namespace bd::core
