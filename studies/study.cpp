@@ -79,10 +79,11 @@ MethodChoice choose_method(const Study& study) {
     choice.reason = limits + "; the opened-loop DAE (projected onto the loop closure) passes "
                              "through them, the reduced equation in theta1 would stop at the first";
   } else {
-    choice.formulation = core::Formulation::kComplexMasses;
+    choice.formulation = core::Formulation::kMassMatrix;
     choice.reason =
-        "the cheapest exact formulation per evaluation (about half the mass matrix's cost, "
-        "bench/dynamics_bench.cpp); all three agree to round-off";
+        "the cheapest exact formulation per evaluation (about 2.1k instructions against 2.6k "
+        "for complex-masses and 3.9k for opened-loop, docs/performance.md); all three agree to "
+        "round-off";
   }
   if (!free) {
     choice.reason += "; no integrator: kinetostatics per sample";

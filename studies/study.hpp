@@ -68,7 +68,7 @@ struct MethodChoice {
 /// never one inside its failure domain; docs/failure-domains.md "What auto must avoid"):
 /// - a free scene whose crank cannot turn fully: opened-loop, whose DAE passes the crank's limit
 ///   positions (the reduced equation in theta1 would stop at the first one);
-/// - otherwise complex-masses, the cheapest exact formulation per evaluation.
+/// - otherwise mass-matrix, the cheapest exact formulation per evaluation (docs/performance.md).
 /// An explicit method is used as asked; the reason then notes what auto would do differently.
 MethodChoice choose_method(const Study& study);
 

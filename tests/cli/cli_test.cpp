@@ -72,7 +72,7 @@ TEST_F(CliTest, RunWritesTheOutputsAndExitsZero) {
   EXPECT_TRUE(err_.empty()) << err_;
   EXPECT_TRUE(fs::exists(dir_ / "res" / "timeseries.csv"));
   EXPECT_TRUE(fs::exists(dir_ / "res" / "summary.json"));
-  EXPECT_NE(out_.find("complex-masses (auto: "), std::string::npos) << out_;
+  EXPECT_NE(out_.find("mass-matrix (auto: "), std::string::npos) << out_;
   EXPECT_NE(out_.find("timeseries.csv"), std::string::npos) << out_;
 }
 

@@ -113,7 +113,7 @@ TEST_F(ReportTest, BalanceRunWritesASelfContainedReport) {
   ASSERT_TRUE(fs::exists(page));
   const std::string html = read(page);
   EXPECT_NE(html.find("<title>" + study.name), std::string::npos);
-  EXPECT_NE(html.find("complex-masses"), std::string::npos);  // the method used, and why
+  EXPECT_NE(html.find("mass-matrix"), std::string::npos);  // the method used, and why
   EXPECT_NE(html.find(r.method.reason), std::string::npos);
   EXPECT_NE(html.find(">completed<"), std::string::npos);
 

@@ -117,7 +117,7 @@ TEST_F(RunnerTest, FreeSceneWritesTheContractFiles) {
   const std::string json = read(r.summary);
   for (const char* key : {"\"study\": \"paper-fourbar\"",
                           "\"method\"",
-                          "\"used\": \"complex-masses\"",
+                          "\"used\": \"mass-matrix\"",
                           "\"reason\"",
                           "\"scene\": {\"type\": \"free\"",
                           "\"duration\": 5",

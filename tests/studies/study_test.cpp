@@ -19,7 +19,7 @@ Study study_of(const core::FourBar& model, Scene scene) {
 TEST(ChooseMethod, FreeTurningCrankTakesTheCheapestExactFormulation) {
   const MethodChoice c = choose_method(
       study_of(core::samples::paper_fourbar(), core::FreeScene{1.0, 0.0, 5.0, 501}));
-  EXPECT_EQ(c.formulation, core::Formulation::kComplexMasses);
+  EXPECT_EQ(c.formulation, core::Formulation::kMassMatrix);
   EXPECT_NE(c.reason.find("cheapest exact formulation"), std::string::npos) << c.reason;
   EXPECT_NE(c.reason.find("reduced equation in theta1"), std::string::npos) << c.reason;
 }
@@ -27,7 +27,7 @@ TEST(ChooseMethod, FreeTurningCrankTakesTheCheapestExactFormulation) {
 TEST(ChooseMethod, DrivenSceneNeedsNoIntegrator) {
   const MethodChoice c = choose_method(
       study_of(core::samples::paper_fourbar(), core::DrivenScene{0.0, 6.28, 1, 360}));
-  EXPECT_EQ(c.formulation, core::Formulation::kComplexMasses);
+  EXPECT_EQ(c.formulation, core::Formulation::kMassMatrix);
   EXPECT_NE(c.reason.find("no integrator"), std::string::npos) << c.reason;
 }
 
