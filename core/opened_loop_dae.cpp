@@ -22,6 +22,7 @@
 #include "core/energy.hpp"
 #include "core/formulation_support.hpp"
 #include "core/input_error.hpp"
+#include "core/cvode_support.hpp"
 #include "core/kinematics.hpp"
 #include "core/opened_loop.hpp"
 
@@ -163,39 +164,6 @@ int project(sunrealtype /*t*/, N_Vector ycur, N_Vector corr, sunrealtype /*eps_p
     }
   }
   return 0;
-}
-
-void keep_cvode_error(int error_code, const char* /*module*/, const char* function, char* msg,
-                      void* user_data) {
-  if (error_code >= 0) return;
-  auto& motion = *static_cast<DaeMotion*>(user_data);
-  motion.cvode_text = std::string(function) + ": " + msg;
-}
-
-// SUNDIALS objects, freed in reverse order of creation.
-struct Cvode {
-  SUNContext context{};
-  N_Vector y{}, atol{};
-  SUNMatrix matrix{};
-  SUNLinearSolver linear{};
-  SUNNonlinearSolver nonlinear{};
-  void* memory{};
-  Cvode() = default;
-  Cvode(const Cvode&) = delete;
-  Cvode& operator=(const Cvode&) = delete;
-  ~Cvode() {
-    if (memory != nullptr) CVodeFree(&memory);
-    if (nonlinear != nullptr) SUNNonlinSolFree(nonlinear);
-    if (linear != nullptr) SUNLinSolFree(linear);
-    if (matrix != nullptr) SUNMatDestroy(matrix);
-    if (atol != nullptr) N_VDestroy(atol);
-    if (y != nullptr) N_VDestroy(y);
-    if (context != nullptr) SUNContext_Free(&context);
-  }
-};
-
-void check_setup(int flag, const char* call) {
-  if (flag != CV_SUCCESS) throw std::runtime_error(std::string("CVODE setup failed in ") + call);
 }
 
 SimulationStatus status_of(DynamicsError::Kind kind) {
@@ -371,11 +339,11 @@ OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FreeSce
   // CVODE's projection interface (CVodeSetProjFn) exists for BDF only, which needs a Newton
   // corrector: dense 6x6 linear solver, difference-quotient Jacobian.
   const bool bdf = out.method == DaeMethod::kBdf;
-  Cvode cv;
-  check_setup(SUNContext_Create(nullptr, &cv.context), "SUNContext_Create");
+  cvode::Session cv;
+  cvode::check_setup(SUNContext_Create(nullptr, &cv.context), "SUNContext_Create");
   cv.y = N_VNew_Serial(kStates, cv.context);
   cv.atol = N_VNew_Serial(kStates, cv.context);
-  if (cv.y == nullptr || cv.atol == nullptr) check_setup(CV_MEM_FAIL, "N_VNew_Serial");
+  if (cv.y == nullptr || cv.atol == nullptr) cvode::check_setup(CV_MEM_FAIL, "N_VNew_Serial");
   double* y = N_VGetArrayPointer(cv.y);
   y[0] = start.theta1;
   y[1] = start.theta2;
@@ -385,25 +353,25 @@ OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FreeSce
   y[5] = start.omega3;
   N_VConst(options.absolute_tolerance, cv.atol);
   cv.memory = CVodeCreate(bdf ? CV_BDF : CV_ADAMS, cv.context);
-  if (cv.memory == nullptr) check_setup(CV_MEM_FAIL, "CVodeCreate");
-  check_setup(CVodeSetErrHandlerFn(cv.memory, keep_cvode_error, &motion), "CVodeSetErrHandlerFn");
-  check_setup(CVodeInit(cv.memory, dae_rhs, 0.0, cv.y), "CVodeInit");
-  check_setup(CVodeSetUserData(cv.memory, &motion), "CVodeSetUserData");
-  check_setup(CVodeSVtolerances(cv.memory, options.tolerance, cv.atol), "CVodeSVtolerances");
+  if (cv.memory == nullptr) cvode::check_setup(CV_MEM_FAIL, "CVodeCreate");
+  cvode::check_setup(CVodeSetErrHandlerFn(cv.memory, cvode::keep_error, &motion.cvode_text), "CVodeSetErrHandlerFn");
+  cvode::check_setup(CVodeInit(cv.memory, dae_rhs, 0.0, cv.y), "CVodeInit");
+  cvode::check_setup(CVodeSetUserData(cv.memory, &motion), "CVodeSetUserData");
+  cvode::check_setup(CVodeSVtolerances(cv.memory, options.tolerance, cv.atol), "CVodeSVtolerances");
   if (bdf) {
     cv.matrix = SUNDenseMatrix(kStates, kStates, cv.context);
-    if (cv.matrix == nullptr) check_setup(CV_MEM_FAIL, "SUNDenseMatrix");
+    if (cv.matrix == nullptr) cvode::check_setup(CV_MEM_FAIL, "SUNDenseMatrix");
     cv.linear = SUNLinSol_Dense(cv.y, cv.matrix, cv.context);
-    if (cv.linear == nullptr) check_setup(CV_MEM_FAIL, "SUNLinSol_Dense");
-    check_setup(CVodeSetLinearSolver(cv.memory, cv.linear, cv.matrix), "CVodeSetLinearSolver");
+    if (cv.linear == nullptr) cvode::check_setup(CV_MEM_FAIL, "SUNLinSol_Dense");
+    cvode::check_setup(CVodeSetLinearSolver(cv.memory, cv.linear, cv.matrix), "CVodeSetLinearSolver");
   } else {
     cv.nonlinear = SUNNonlinSol_FixedPoint(cv.y, 0, cv.context);
-    if (cv.nonlinear == nullptr) check_setup(CV_MEM_FAIL, "SUNNonlinSol_FixedPoint");
-    check_setup(CVodeSetNonlinearSolver(cv.memory, cv.nonlinear), "CVodeSetNonlinearSolver");
+    if (cv.nonlinear == nullptr) cvode::check_setup(CV_MEM_FAIL, "SUNNonlinSol_FixedPoint");
+    cvode::check_setup(CVodeSetNonlinearSolver(cv.memory, cv.nonlinear), "CVodeSetNonlinearSolver");
   }
   const bool projection = options.stabilisation == Stabilisation::kProjection;
-  if (projection) check_setup(CVodeSetProjFn(cv.memory, project), "CVodeSetProjFn");
-  check_setup(CVodeSetStopTime(cv.memory, scene.duration), "CVodeSetStopTime");
+  if (projection) cvode::check_setup(CVodeSetProjFn(cv.memory, project), "CVodeSetProjFn");
+  cvode::check_setup(CVodeSetStopTime(cv.memory, scene.duration), "CVodeSetStopTime");
 
   traj.status = SimulationStatus::kCompleted;
   traj.message = "completed";

@@ -18,6 +18,7 @@
 #include "core/counter_rotation.hpp"
 #include "core/formulation_support.hpp"
 #include "core/opened_loop.hpp"
+#include "core/cvode_support.hpp"
 #include "core/kinematics.hpp"
 #include "core/opened_loop_dae.hpp"
 
@@ -176,37 +177,6 @@ int dead_centre_root(sunrealtype /*t*/, N_Vector y, sunrealtype* g, void* user_d
   return 0;
 }
 
-// CVODE prints its errors by default; core never prints, so keep the text for the message.
-void keep_cvode_error(int error_code, const char* /*module*/, const char* function, char* msg,
-                      void* user_data) {
-  if (error_code >= 0) return;  // warnings (e.g. t + h == t) are not failures
-  auto& motion = *static_cast<FreeMotion*>(user_data);
-  motion.cvode_text = std::string(function) + ": " + msg;
-}
-
-// SUNDIALS objects, freed in reverse order of creation.
-struct Cvode {
-  SUNContext context{};
-  N_Vector y{}, atol{};
-  SUNNonlinearSolver solver{};
-  void* memory{};
-  Cvode() = default;
-  Cvode(const Cvode&) = delete;
-  Cvode& operator=(const Cvode&) = delete;
-  ~Cvode() {
-    if (memory != nullptr) CVodeFree(&memory);
-    if (solver != nullptr) SUNNonlinSolFree(solver);
-    if (atol != nullptr) N_VDestroy(atol);
-    if (y != nullptr) N_VDestroy(y);
-    if (context != nullptr) SUNContext_Free(&context);
-  }
-};
-
-void check_setup(int flag, const char* call) {
-  // with valid options the setup calls cannot fail except by running out of memory
-  if (flag != CV_SUCCESS) throw std::runtime_error(std::string("CVODE setup failed in ") + call);
-}
-
 void validate(const FreeScene& scene, const SimulateOptions& options) {
   if (const std::string problem = options.validate(); !problem.empty()) throw InputError(problem);
   if (!std::isfinite(scene.theta1)) {
@@ -337,26 +307,26 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
   // Newton iteration: the fixed-point corrector converges in one or two right-hand sides per
   // step without Jacobians or linear solves (the CVODE guide's recommendation for non-stiff
   // problems).
-  Cvode cv;
-  check_setup(SUNContext_Create(nullptr, &cv.context), "SUNContext_Create");
+  cvode::Session cv;
+  cvode::check_setup(SUNContext_Create(nullptr, &cv.context), "SUNContext_Create");
   cv.y = N_VNew_Serial(2, cv.context);
   cv.atol = N_VNew_Serial(2, cv.context);
-  if (cv.y == nullptr || cv.atol == nullptr) check_setup(CV_MEM_FAIL, "N_VNew_Serial");
+  if (cv.y == nullptr || cv.atol == nullptr) cvode::check_setup(CV_MEM_FAIL, "N_VNew_Serial");
   NV_Ith_S(cv.y, 0) = scene.theta1;
   NV_Ith_S(cv.y, 1) = scene.omega1;
   NV_Ith_S(cv.atol, 0) = options.absolute_tolerance;  // theta1 [rad]
   NV_Ith_S(cv.atol, 1) = options.absolute_tolerance;  // omega1 [rad/s]
   cv.memory = CVodeCreate(CV_ADAMS, cv.context);
-  if (cv.memory == nullptr) check_setup(CV_MEM_FAIL, "CVodeCreate");
-  check_setup(CVodeSetErrHandlerFn(cv.memory, keep_cvode_error, &motion), "CVodeSetErrHandlerFn");
-  check_setup(CVodeInit(cv.memory, free_rhs, 0.0, cv.y), "CVodeInit");
-  check_setup(CVodeSetUserData(cv.memory, &motion), "CVodeSetUserData");
-  check_setup(CVodeSVtolerances(cv.memory, options.tolerance, cv.atol), "CVodeSVtolerances");
-  cv.solver = SUNNonlinSol_FixedPoint(cv.y, 0, cv.context);
-  if (cv.solver == nullptr) check_setup(CV_MEM_FAIL, "SUNNonlinSol_FixedPoint");
-  check_setup(CVodeSetNonlinearSolver(cv.memory, cv.solver), "CVodeSetNonlinearSolver");
-  check_setup(CVodeSetStopTime(cv.memory, scene.duration), "CVodeSetStopTime");
-  check_setup(CVodeRootInit(cv.memory, 1, dead_centre_root), "CVodeRootInit");
+  if (cv.memory == nullptr) cvode::check_setup(CV_MEM_FAIL, "CVodeCreate");
+  cvode::check_setup(CVodeSetErrHandlerFn(cv.memory, cvode::keep_error, &motion.cvode_text), "CVodeSetErrHandlerFn");
+  cvode::check_setup(CVodeInit(cv.memory, free_rhs, 0.0, cv.y), "CVodeInit");
+  cvode::check_setup(CVodeSetUserData(cv.memory, &motion), "CVodeSetUserData");
+  cvode::check_setup(CVodeSVtolerances(cv.memory, options.tolerance, cv.atol), "CVodeSVtolerances");
+  cv.nonlinear = SUNNonlinSol_FixedPoint(cv.y, 0, cv.context);
+  if (cv.nonlinear == nullptr) cvode::check_setup(CV_MEM_FAIL, "SUNNonlinSol_FixedPoint");
+  cvode::check_setup(CVodeSetNonlinearSolver(cv.memory, cv.nonlinear), "CVodeSetNonlinearSolver");
+  cvode::check_setup(CVodeSetStopTime(cv.memory, scene.duration), "CVodeSetStopTime");
+  cvode::check_setup(CVodeRootInit(cv.memory, 1, dead_centre_root), "CVodeRootInit");
 
   // each output by CVODE's own interpolant (CV_NORMAL), then the dynamics at that state
   out.status = SimulationStatus::kCompleted;
