@@ -15,11 +15,8 @@
 
 #include <Eigen/LU>
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <new>
 #include <numbers>
 #include <random>
 #include <string>
@@ -31,21 +28,19 @@
 #include "core/principal_vectors.hpp"
 #include "core/samples.hpp"
 #include "tests/reference/newton_euler.hpp"
+#include "tests/support/scales.hpp"
+#include "tests/support/allocation_counter.hpp"
 
-// heap allocations counted for the no-allocation test (as in no_allocation_test.cpp)
-namespace {
-std::atomic<long> g_allocations{0};
-}
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace bd::core {
 namespace {
+
+using testing::acceleration_scale;
+using testing::force_scale;
+using testing::longest_link;
+using testing::moment_scale;
+using testing::other;
+using testing::rate_scale;
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr double kRel = 1e-10;  // see the file comment
@@ -54,22 +49,7 @@ constexpr Complex kI{0.0, 1.0};
 double uniform(std::mt19937_64& rng, double a, double b) {
   return std::uniform_real_distribution<double>(a, b)(rng);
 }
-Branch other(Branch b) { return b == Branch::kPlus ? Branch::kMinus : Branch::kPlus; }
 double inner(const Complex& x, const Complex& y) { return std::real(std::conj(x) * y); }
-
-double longest_link(const FourBar& m) {
-  return std::max({m.crank.length, m.coupler.length, m.rocker.length, m.frame_length});
-}
-double force_scale(const DynamicsSample& s) {
-  return std::max({1.0, s.RA0.norm(), s.RA3.norm(), s.Fsh.norm()});
-}
-double moment_scale(const FourBar& m, const DynamicsSample& s) {
-  return force_scale(s) * std::max(1.0, longest_link(m));
-}
-double acceleration_scale(const DynamicsSample& s) {
-  return std::max(
-      {1.0, std::abs(s.state.alpha1), std::abs(s.state.alpha2), std::abs(s.state.alpha3)});
-}
 std::string where(const FourBar& m, double theta1, double omega1) {
   return "branch " + std::to_string(static_cast<int>(m.branch)) +
          ", theta1 = " + std::to_string(theta1) + ", omega1 = " + std::to_string(omega1);
@@ -394,14 +374,14 @@ TEST(ComplexMasses, ReportsAnUnreachableCrankAngle) {
 TEST(ComplexMasses, DynamicsOfOneInstantAllocatesNothing) {
   const FourBar m = samples::paper_fourbar();
   double sink = 0;
-  const long before = g_allocations.load();
+  const long before = testing::allocations();
   for (int i = 0; i < 360; ++i) {
     const double theta1 = kTwoPi * i / 360;
     const auto f = forward_dynamics_complex_masses(m, theta1, 2.0);
     const auto g = inverse_dynamics_complex_masses(m, theta1, 2.0, 0.5);
     sink += f->state.alpha1 + g->tau + f->RA0.x() + g->RA3.y();
   }
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(testing::allocations() - before, 0);
   EXPECT_TRUE(std::isfinite(sink));
 }
 

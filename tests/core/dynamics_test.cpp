@@ -24,32 +24,21 @@
 #include "core/model.hpp"
 #include "core/samples.hpp"
 #include "tests/reference/newton_euler.hpp"
+#include "tests/support/scales.hpp"
 
 namespace bd::core {
 namespace {
 
+using testing::acceleration_scale;
+using testing::force_scale;
+using testing::longest_link;
+using testing::moment_scale;
+using testing::other;
+using testing::rate_scale;
+
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr double kRel = 1e-10;  // see the file comment
 
-Branch other(Branch b) { return b == Branch::kPlus ? Branch::kMinus : Branch::kPlus; }
-
-double longest_link(const FourBar& m) {
-  return std::max({m.crank.length, m.coupler.length, m.rocker.length, m.frame_length});
-}
-double force_scale(const DynamicsSample& s) {
-  return std::max({1.0, s.RA0.norm(), s.RA3.norm(), s.Fsh.norm()});
-}
-double moment_scale(const FourBar& m, const DynamicsSample& s) {
-  return force_scale(s) * std::max(1.0, longest_link(m));
-}
-double acceleration_scale(const DynamicsSample& s) {
-  return std::max(
-      {1.0, std::abs(s.state.alpha1), std::abs(s.state.alpha2), std::abs(s.state.alpha3)});
-}
-double rate_scale(const DynamicsSample& s) {
-  return std::max(
-      {1.0, std::abs(s.state.omega1), std::abs(s.state.omega2), std::abs(s.state.omega3)});
-}
 // angles may be reported in different 2pi ranges
 double angle_gap(double a, double b) { return std::abs(std::remainder(a - b, kTwoPi)); }
 

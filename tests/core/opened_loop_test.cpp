@@ -16,11 +16,8 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <new>
 #include <numbers>
 #include <random>
 #include <string>
@@ -30,40 +27,23 @@
 #include "core/principal_vectors.hpp"
 #include "core/samples.hpp"
 #include "tests/reference/newton_euler.hpp"
+#include "tests/support/scales.hpp"
+#include "tests/support/allocation_counter.hpp"
 
-// heap allocations of the whole program, counted to check that one instant allocates nothing
-namespace {
-std::atomic<long> g_allocations{0};
-}
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace bd::core {
 namespace {
 
+using testing::acceleration_scale;
+using testing::force_scale;
+using testing::longest_link;
+using testing::moment_scale;
+using testing::other;
+using testing::rate_scale;
+
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr double kRel = 1e-10;  // see the file comment
 
-Branch other(Branch b) { return b == Branch::kPlus ? Branch::kMinus : Branch::kPlus; }
-
-double longest_link(const FourBar& m) {
-  return std::max({m.crank.length, m.coupler.length, m.rocker.length, m.frame_length});
-}
-double force_scale(const DynamicsSample& s) {
-  return std::max({1.0, s.RA0.norm(), s.RA3.norm(), s.Fsh.norm()});
-}
-double moment_scale(const FourBar& m, const DynamicsSample& s) {
-  return force_scale(s) * std::max(1.0, longest_link(m));
-}
-double acceleration_scale(const DynamicsSample& s) {
-  return std::max(
-      {1.0, std::abs(s.state.alpha1), std::abs(s.state.alpha2), std::abs(s.state.alpha3)});
-}
 double angle_gap(double a, double b) { return std::abs(std::remainder(a - b, kTwoPi)); }
 std::string scientific(double x) {
   char buf[32];
@@ -362,7 +342,7 @@ TEST(OpenedLoop, UnreachableAndDeadCentreAnglesAreErrors) {
 TEST(OpenedLoop, OneInstantAllocatesNothing) {
   const FourBar m = samples::paper_fourbar();
   double sink = 0;
-  const long before = g_allocations.load();
+  const long before = testing::allocations();
   for (int i = 0; i < 360; ++i) {
     const double theta1 = kTwoPi * i / 360;
     const auto f = forward_dynamics_opened_loop(m, theta1, 2.0);
@@ -370,7 +350,7 @@ TEST(OpenedLoop, OneInstantAllocatesNothing) {
     const auto h = forward_dynamics_opened_loop(m, f->state, Vec2(1e-3, -2e-3));
     sink += f->state.alpha1 + g->tau + h->state.alpha2;
   }
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(testing::allocations() - before, 0);
   EXPECT_TRUE(std::isfinite(sink));
 }
 
