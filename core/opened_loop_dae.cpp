@@ -33,7 +33,6 @@ namespace {
 using Mat23 = Eigen::Matrix<double, 2, 3>;
 
 constexpr int kStates = 6;  // theta1..3 [rad], omega1..3 [rad/s]
-constexpr long long kMaxSamples = 100'000'000;
 // Gauss-Newton iterations of one projection onto the closure; from an integrator step off the
 // closure by ~tolerance, two or three reach round-off (quadratic convergence)
 constexpr int kMaxProjectionIterations = 10;
@@ -166,18 +165,6 @@ int project(sunrealtype /*t*/, N_Vector ycur, N_Vector corr, sunrealtype /*eps_p
   return 0;
 }
 
-SimulationStatus status_of(DynamicsError::Kind kind) {
-  switch (kind) {
-    case DynamicsError::Kind::kAssembly:
-      return SimulationStatus::kAssemblyFailed;
-    case DynamicsError::Kind::kSingular:
-      return SimulationStatus::kSingular;
-    case DynamicsError::Kind::kNonFinite:
-      return SimulationStatus::kIntegratorFailed;
-  }
-  return SimulationStatus::kIntegratorFailed;
-}
-
 void fail(Trajectory& out, const DynamicsError& error, double t) {
   out.status = status_of(error.kind);
   out.message = error.what() + " (t = " + number(t) + " s)";
@@ -185,19 +172,7 @@ void fail(Trajectory& out, const DynamicsError& error, double t) {
 
 void validate(const FreeScene& scene, const OpenedLoopDaeOptions& options) {
   if (const std::string problem = options.validate(); !problem.empty()) throw InputError(problem);
-  if (!std::isfinite(scene.theta1)) {
-    throw InputError("scene.theta1 must be finite, got " + number(scene.theta1));
-  }
-  if (!std::isfinite(scene.omega1)) {
-    throw InputError("scene.omega1 must be finite, got " + number(scene.omega1));
-  }
-  if (!(scene.duration > 0.0) || !std::isfinite(scene.duration)) {
-    throw InputError("scene.duration must be > 0 s, got " + number(scene.duration));
-  }
-  if (scene.samples < 2 || scene.samples > kMaxSamples) {
-    throw InputError("scene.samples must be >= 2 (and <= 1e8), got " +
-                     std::to_string(scene.samples));
-  }
+  validate_scene(scene);
 }
 
 // appends a sample with its drift, energy and branch

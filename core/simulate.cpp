@@ -80,18 +80,6 @@ void continue_angles(const FourBar& model, const FourBarState& prev, FourBarStat
   next.theta3 = nearest_turn(next.theta3, theta3);
 }
 
-SimulationStatus status_of(DynamicsError::Kind kind) {
-  switch (kind) {
-    case DynamicsError::Kind::kAssembly:
-      return SimulationStatus::kAssemblyFailed;
-    case DynamicsError::Kind::kSingular:
-      return SimulationStatus::kSingular;
-    case DynamicsError::Kind::kNonFinite:
-      return SimulationStatus::kIntegratorFailed;
-  }
-  return SimulationStatus::kIntegratorFailed;
-}
-
 // One line naming the condition, the time and the crank angle, e.g.
 // "singular position at t = 1.234 s, theta1 = 2.345 rad: sin(theta3 - theta2) = 1e-17".
 std::string failure_message(const DynamicsError& error, double t, double theta1) {
@@ -179,19 +167,7 @@ int dead_centre_root(sunrealtype /*t*/, N_Vector y, sunrealtype* g, void* user_d
 
 void validate(const FreeScene& scene, const SimulateOptions& options) {
   if (const std::string problem = options.validate(); !problem.empty()) throw InputError(problem);
-  if (!std::isfinite(scene.theta1)) {
-    throw InputError("scene.theta1 must be finite, got " + number(scene.theta1));
-  }
-  if (!std::isfinite(scene.omega1)) {
-    throw InputError("scene.omega1 must be finite, got " + number(scene.omega1));
-  }
-  if (!(scene.duration > 0.0) || !std::isfinite(scene.duration)) {
-    throw InputError("scene.duration must be > 0 s, got " + number(scene.duration));
-  }
-  if (scene.samples < 2 || scene.samples > kMaxSamples) {
-    throw InputError("scene.samples must be >= 2 (and <= 1e8), got " +
-                     std::to_string(scene.samples));
-  }
+  validate_scene(scene);
 }
 
 void validate(const DrivenScene& scene, const SimulateOptions& options) {
@@ -233,6 +209,34 @@ std::string SimulateOptions::validate() const {
       return "formulation " + std::to_string(static_cast<int>(formulation)) + " is unknown";
   }
   return {};
+}
+
+SimulationStatus status_of(DynamicsError::Kind kind) {
+  switch (kind) {
+    case DynamicsError::Kind::kAssembly:
+      return SimulationStatus::kAssemblyFailed;
+    case DynamicsError::Kind::kSingular:
+      return SimulationStatus::kSingular;
+    case DynamicsError::Kind::kNonFinite:
+      return SimulationStatus::kIntegratorFailed;
+  }
+  return SimulationStatus::kIntegratorFailed;
+}
+
+void validate_scene(const FreeScene& scene) {
+  if (!std::isfinite(scene.theta1)) {
+    throw InputError("scene.theta1 must be finite, got " + number(scene.theta1));
+  }
+  if (!std::isfinite(scene.omega1)) {
+    throw InputError("scene.omega1 must be finite, got " + number(scene.omega1));
+  }
+  if (!(scene.duration > 0.0) || !std::isfinite(scene.duration)) {
+    throw InputError("scene.duration must be > 0 s, got " + number(scene.duration));
+  }
+  if (scene.samples < 2 || scene.samples > kMaxSamples) {
+    throw InputError("scene.samples must be >= 2 (and <= 1e8), got " +
+                     std::to_string(scene.samples));
+  }
 }
 
 const char* to_string(SimulationStatus s) {

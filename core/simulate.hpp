@@ -46,6 +46,13 @@ enum class SimulationStatus {
   kIntegratorFailed,  // CVODE gave up (step-size underflow, too many steps, ...)
 };
 const char* to_string(SimulationStatus s);
+/// The status a run stops with when the dynamics fails with `kind`.
+SimulationStatus status_of(DynamicsError::Kind kind);
+
+/// Checks a free scene (what both free-motion integrators need).
+/// @throws bd::InputError if theta1 or omega1 is not finite, duration is not > 0, or samples is
+///         outside [2, 1e8]; the message names the key, its unit and the value.
+void validate_scene(const FreeScene& scene);
 
 /// The samples computed, in time order, and why the run stopped. On failure every sample
 /// before the failure is kept.
