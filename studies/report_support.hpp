@@ -1,0 +1,80 @@
+#pragma once
+/// The pieces every report page is built from (studies/report.cpp and the pages of sweeps and
+/// work-precision runs): reading a run's data files back, HTML escaping and tables, and drawing
+/// charts with gnuplot into inline SVG. Internal to bd_studies.
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace bd::studies::report_support {
+
+/// The whole file at `p`. @throws std::runtime_error naming the file if it cannot be read.
+std::string read_file(const std::filesystem::path& p);
+
+/// A JSON value as summary.json writes it; numbers keep their text exactly as written.
+struct Json {
+  enum class Kind { kNull, kBool, kNumber, kString, kArray, kObject } kind = Kind::kNull;
+  std::string text;                                  // number as written, string, "true"/"false"
+  std::vector<Json> items;                           // array
+  std::vector<std::pair<std::string, Json>> fields;  // object, in file order
+
+  const Json* get(const std::string& key) const {
+    for (const auto& [k, v] : fields)
+      if (k == key) return &v;
+    return nullptr;
+  }
+  std::string str(const std::string& key) const {
+    const Json* v = get(key);
+    return v ? v->text : std::string();
+  }
+};
+/// Parses JSON text; `name` names it in errors. @throws std::runtime_error on malformed text.
+Json parse_json(const std::string& text, const std::string& name);
+
+/// A CSV file: its header's fields and its rows' fields as written (quoted fields unquoted).
+struct Csv {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+};
+/// The fields of one CSV line (RFC 4180 quoting; a trailing '\r' is dropped).
+std::vector<std::string> csv_fields(const std::string& line);
+/// @throws std::runtime_error if the file cannot be read.
+Csv read_csv(const std::filesystem::path& p);
+/// The numbers of a CSV row (an empty field is NaN).
+std::vector<double> numbers(const std::vector<std::string>& row);
+
+/// `text` with & < > " escaped for HTML.
+std::string esc(const std::string& text);
+/// `v` formatted by printf format `f`.
+std::string fmt(double v, const char* f = "%.6g");
+/// A number as written in a data file as a table cell: 6 significant digits, the exact text on
+/// hover; a non-number as escaped text; an empty field as a dash.
+std::string num_cell(const std::string& written);
+/// An object as a two-column table, an array of objects as a table with a column per key.
+std::string json_table(const Json& v);
+/// A JSON value as a table cell.
+std::string json_cell(const Json& v);
+/// A CSV file as an HTML table (numbers through num_cell()).
+std::string csv_table(const Csv& csv);
+/// The pages' style sheet (inline CSS).
+extern const char* const kStyle;
+
+/// `text` as a gnuplot single-quoted string.
+std::string gp_string(const std::string& text);
+/// True when `p` is a regular file this process may execute.
+bool executable(const std::filesystem::path& p);
+
+/// One chart: its file stem (unique on the page), heading, caption and gnuplot commands (ending
+/// in a plot).
+struct Chart {
+  std::string id, heading, caption, commands;
+  bool square = false;  // taller canvas (equal-axis plots)
+};
+/// Runs `gnuplot` once for all charts, after `datablocks` (gnuplot text defining $name data
+/// blocks, may be empty); returns each chart's inline SVG, in order.
+/// @throws std::runtime_error if gnuplot fails (with its first error line) or writes no SVG.
+std::vector<std::string> draw(const std::string& gnuplot, const std::string& datablocks,
+                              const std::vector<Chart>& charts);
+
+}  // namespace bd::studies::report_support
