@@ -274,6 +274,13 @@ Run run_nlopt(nlopt_algorithm algorithm, bool mma, TrackedNlp& tracked, const Ve
     }
   }
   check(nlopt_set_maxeval(ctx.opt, std::max(1, max_evaluations)));
+  // MMA solves a dual subproblem per iteration, one multiplier per inequality, by default to
+  // ftol_rel 1e-14 within as many steps as the outer budget (up to 100 000). With a peak term
+  // (one inequality per sample, nearly dependent) that dual never gets there, and a run on the
+  // 72-sample min Fsh_max took from 22 s to over 10 minutes for ~60 evaluations; capped at
+  // 1000 steps it takes 0.4 s, and the runs whose duals converge are unchanged (measured,
+  // docs/performance.md)
+  if (mma) check(nlopt_set_param(ctx.opt, "dual_maxeval", 1000));
   if (stop_on_tolerances) {
     check(nlopt_set_xtol_rel(ctx.opt, options.relative_tolerance));
     check(nlopt_set_ftol_rel(ctx.opt, options.relative_tolerance));
@@ -293,6 +300,35 @@ Run run_nlopt(nlopt_algorithm algorithm, bool mma, TrackedNlp& tracked, const Ve
     if (const char* msg = nlopt_get_errmsg(ctx.opt)) run.error = msg;
   }
   nlopt_destroy(ctx.opt);
+  return run;
+}
+
+// SLSQP, restarted from its last iterate while it stops on a tolerance with a last iterate
+// better than the point it returns (nlopt_driver.hpp says why)
+Run run_slsqp(TrackedNlp& tracked, const VectorXd& x0, const VectorXd& lower,
+              const VectorXd& upper, int max_evaluations, const OptimizeOptions& options) {
+  const int first = tracked.evaluations();
+  Run run = run_nlopt(NLOPT_LD_SLSQP, false, tracked, x0, lower, upper, max_evaluations, options,
+                      true);
+  for (int restart = 0; restart < 3; ++restart) {
+    const int left = max_evaluations - (tracked.evaluations() - first);
+    const VectorXd last = tracked.last_x();
+    if (termination_of(run.result) != Termination::kConverged || left <= 0 ||
+        last.size() != run.x.size() || last == run.x || !(tracked.last_objective() < run.f)) {
+      break;
+    }
+    Run next = run_nlopt(NLOPT_LD_SLSQP, false, tracked, last, lower, upper, left, options, true);
+    // keep the better of the two by NLopt's own account (its f is of a feasible point when it
+    // saw one); an error ends the restarts
+    if (!next.error.empty() || next.result < 0) break;
+    if (next.f <= run.f || termination_of(next.result) == Termination::kConverged) run = next;
+  }
+  // a restart that ended early may still have visited a better feasible point
+  if (tracked.has_best() && tracked.best_objective() < run.f &&
+      termination_of(run.result) == Termination::kConverged) {
+    run.x = tracked.best_x();
+    run.f = tracked.best_objective();
+  }
   return run;
 }
 
@@ -378,8 +414,7 @@ DriverOutcome multistart(const Nlp& nlp, const VectorXd& x0, const OptimizeOptio
       }
     }
     tracked.reset_best();
-    Run run = run_nlopt(NLOPT_LD_SLSQP, false, tracked, start, nlp.lower(), nlp.upper(), budget,
-                        options, true);
+    Run run = run_slsqp(tracked, start, nlp.lower(), nlp.upper(), budget, options);
     ++runs;
     std::string note;
     run.x = chosen_point(run, tracked, options.constraint_tolerance, note);
@@ -444,8 +479,10 @@ DriverOutcome solve_with_nlopt(const Nlp& nlp, const VectorXd& x0,
   }
   TrackedNlp tracked(nlp, options.constraint_tolerance);
   // ISRES is stochastic: it runs to its budget rather than stopping on a quiet generation
-  Run run = run_nlopt(algorithm, options.algorithm == Algorithm::kMma, tracked, x0, lower, upper,
-                      options.max_evaluations, options, !global);
+  Run run = options.algorithm == Algorithm::kSlsqp
+                ? run_slsqp(tracked, x0, lower, upper, options.max_evaluations, options)
+                : run_nlopt(algorithm, options.algorithm == Algorithm::kMma, tracked, x0, lower,
+                            upper, options.max_evaluations, options, !global);
   if (global) nlopt_srand_time();
 
   DriverOutcome out;

@@ -36,6 +36,9 @@ class TrackedNlp {
   void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac);
 
   int evaluations() const { return evaluations_; }
+  /// The point of the last objective evaluation and its value (empty before the first).
+  const Eigen::VectorXd& last_x() const { return x_f_; }
+  double last_objective() const { return f_; }
   bool has_best() const { return has_best_; }
   const Eigen::VectorXd& best_x() const { return best_x_; }
   double best_objective() const { return best_f_; }
@@ -64,6 +67,13 @@ double constraint_violation(const Nlp& nlp, const Eigen::VectorXd& x, int* worst
 /// Runs the NLopt algorithm of options.algorithm (slsqp, mma, mlsl, isres, cobyla) from x0.
 /// - slsqp, cobyla, isres: NLopt's LD_SLSQP, LN_COBYLA, GN_ISRES with the equalities and
 ///   inequalities as vector constraints (tolerance 0.1 · options.constraint_tolerance each).
+///   NLopt's SLSQP tests ftol_rel and xtol_rel at every iterate, feasible or not, once any
+///   feasible point has been seen, and then returns the best feasible point it visited: when
+///   the iterates approach the constraints from outside it can stop next to the optimum yet
+///   return a point far from it (measured: min Fsh_max with smoothing 1e-3 returned 0.35 x the
+///   original while its last iterate was at 1e-3 x, violating a constraint by 8e-9). So an
+///   SLSQP run that stops on a tolerance with a last iterate better than the point returned is
+///   restarted from that iterate, up to three times within the budget (mlsl's runs too).
 /// - mma: LD_MMA takes inequalities only (optimize() refuses equalities: as pairs ±c <= δ they
 ///   stall MMA far from the optimum); they are tightened to c + δ <= 0 with
 ///   δ = 0.5 · options.constraint_tolerance, as MMA's last iterates may lie just outside.

@@ -9,24 +9,38 @@
 ///   inequality. Cartesian rather than polar: an angle bound would cut the circle at ±π (a local
 ///   solver could not pass through it) and the polar form is degenerate at the pivot;
 /// - per link parameter (problem order): its value within its bounds;
-/// - driven scenes only: one bound variable t per peak metric of the objective, in [0, t_max]
-///   with t_max a proven upper bound of that peak over the variable box: the peak enters as the
-///   smooth constraints |y_i(x)|² <= t² over the samples, never as a non-smooth max. Free scenes
-///   have no bound variables (their peaks are evaluated directly; the solvers there are
+/// - driven scenes only: one bound variable t per peak metric of the objective [N or N m]: the
+///   peak enters through smooth constraints on t at every sample, never as a non-smooth max.
+///   t_max is a proven upper bound of that peak over the variable box; t lies in [0, t_max]
+///   (squared form) or [-t_max, t_max] (linear form, where its constraints alone keep it > 0; a
+///   bound at 0 would stall NLopt's SLSQP, see bound_peaks() in nlp.cpp). Free scenes have no
+///   bound variables (their peaks are evaluated directly; the solvers there are
 ///   derivative-free).
 ///
-/// Objective: Σ_k w_k (metric_k / metric_k(original))² over the reaction metrics (RMS and peak;
-/// a peak term uses its bound variable t), plus w · added_mass / (original total mass): a
-/// weighted sum of the SQUARED normalised metrics. The squares make each RMS term a quadratic
-/// form in the inertial parameters (below), smooth also where the metric reaches 0 (a
-/// force-balanced design has Fsh_rms = 0, where |·| has a kink). For a single metric the
-/// minimiser is that of metric/original; with several, the squares weigh a term's large ratios
-/// more. The linear form Σ w metric/original through bound variables (min t s.t. RMS² <= t²)
-/// was tried and rejected: at a balanced optimum t = 0 the constraint's gradient vanishes and
-/// SLSQP stalls at the start while Ipopt exhausts its budget (measured; docs/performance.md).
-/// Limits: (metric / (value · original))² - 1 <= 0 (RMS: one constraint; peak: one per sample,
-/// |y_i|² against the limit; free scenes: one, on the directly evaluated peak);
-/// (added_mass - value) / (original total mass) <= 0.
+/// Objective (problem.objective_form), with r_k = metric_k / metric_k(original) and
+/// ε = problem.smoothing:
+/// - linear (the default): Σ_k w_k · s(r_k) + w · added_mass / (original total mass), the
+///   weighted sum of the normalised metrics, with each magnitude smoothed as
+///   s(r) = sqrt(r² + ε²). |·| has a kink where it reaches 0 (a force-balanced design has
+///   Fsh = 0), so s keeps the objective smooth there: its curvature at r = 0 is 1/ε. An RMS term
+///   is s(sqrt(|R q|² / N) / o) (o the original's value); a peak term is w t / o with the
+///   constraints (sqrt(|y_i|² + (ε o)²) - t) / o <= 0 at every sample i (linear in t, so their
+///   gradient never vanishes; the earlier |y_i|² <= t² has none at t = 0, where it stalled
+///   SLSQP and Ipopt at force-balanced optima). Free scenes: RMS terms s(r), peak terms r.
+///   Accuracy: r <= s(r) <= r + min(ε, ε² / (2 r)), so with f the exact weighted sum and
+///   f~ this objective, f <= f~ <= f + ε Σ w at every design, and at the minimiser x~ of f~
+///       f(x*) <= f(x~) <= f~(x~) <= f(x*) + Σ_k w_k min(ε, ε² / (2 r_k(x*)))
+///   for any minimiser x* of f: the reported objective brackets the exact optimum to ε Σ w
+///   (terms that vanish at x*), or to O(ε²) when none does. With a single term f~ is a
+///   monotone function of f, so both have the same minimisers.
+/// - squared: Σ_k w_k r_k² + w · added_mass / (original total mass) (a peak term (t / o)² with
+///   the constraints (|y_i|² - t²) / o² <= 0). Smooth everywhere, the same minimisers as the
+///   linear form for a single term, but it weighs a term's large ratios more when there are
+///   several (docs/performance.md, "The objective's form").
+/// Limits (either form): (metric / (value · original))² - 1 <= 0 (RMS: one constraint; peak:
+/// one per sample, |y_i|² against the limit; free scenes: one, on the directly evaluated
+/// peak); (added_mass - value) / (original total mass) <= 0. A limit's value is > 0, so its
+/// gradient does not vanish on its boundary.
 /// Force balance (eq. 57): four linear equalities in the inertial parameters, divided by the
 /// original total mass.
 ///
@@ -95,7 +109,9 @@ class Nlp {
   void equalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac) const;
   /// The inequality constraints c_in(x) <= 0 (size n_ineq), Jacobian n_ineq x n, in this order:
   /// the counterweight envelopes (x² + y²)/distance_max² - 1, the limits (problem order), then
-  /// the peak-bound constraints (|y_i|² - t²)/original² per sample for each peak objective term.
+  /// the peak-bound constraints per sample for each peak objective term:
+  /// (sqrt(|y_i|² + (ε original)²) - t)/original (linear form) or (|y_i|² - t²)/original²
+  /// (squared form).
   /// Gradients (objective, equalities, inequalities) are exact where has_gradients(); asking for
   /// one otherwise throws std::logic_error. A wrong x.size() throws bd::InputError.
   void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac) const;

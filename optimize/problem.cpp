@@ -113,6 +113,23 @@ bool is_peak(Metric m) {
          m == Metric::kRA0Max || m == Metric::kRA3Max;
 }
 
+const char* to_string(ObjectiveForm f) {
+  switch (f) {
+    case ObjectiveForm::kLinear:
+      return "linear";
+    case ObjectiveForm::kSquared:
+      return "squared";
+  }
+  return "?";
+}
+
+std::optional<ObjectiveForm> objective_form_named(const std::string& name) {
+  for (ObjectiveForm f : {ObjectiveForm::kLinear, ObjectiveForm::kSquared}) {
+    if (name == to_string(f)) return f;
+  }
+  return std::nullopt;
+}
+
 std::string DesignProblem::validate() const {
   // the original design
   try {
@@ -222,6 +239,12 @@ std::string DesignProblem::validate() const {
     }
   }
   if (!positive) return "objective: at least one term needs a weight > 0, all are 0";
+  if (objective_form != ObjectiveForm::kLinear && objective_form != ObjectiveForm::kSquared) {
+    return "objective_form must be linear or squared";
+  }
+  if (!(smoothing > 0 && smoothing <= 0.1)) {
+    return must_be("smoothing", "in (0, 0.1]", "", smoothing);
+  }
   for (std::size_t i = 0; i < limits.size(); ++i) {
     const Limit& l = limits[i];
     const std::string name = "limits[" + std::to_string(i) + "]";

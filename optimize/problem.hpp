@@ -36,9 +36,29 @@ inline constexpr Metric kMetrics[] = {
 /// True for the peak metrics (handled by a bound variable, never by a non-smooth max).
 bool is_peak(Metric m);
 
-/// One term of the objective: weight · (metric(design) / metric(original))² for the reaction
-/// metrics (squared so that the objective stays smooth where an RMS reaches 0; see
-/// optimize/nlp.hpp), weight · added_mass / (original total mass) for added_mass.
+/// How the objective sums its terms (optimize/nlp.hpp has the exact formulas).
+enum class ObjectiveForm {
+  /// Σ w · metric(design) / metric(original): the weighted sum of the normalised metrics, each
+  /// magnitude smoothed where it reaches 0 (DesignProblem::smoothing). The default.
+  kLinear,
+  /// Σ w · (metric(design) / metric(original))² over the reaction metrics: smooth everywhere,
+  /// the same minimiser for a single term, but weighing a term's large ratios more.
+  kSquared,
+};
+/// "linear", "squared".
+const char* to_string(ObjectiveForm f);
+std::optional<ObjectiveForm> objective_form_named(const std::string& name);
+
+/// The default smoothing ε of the linear form's magnitudes (DesignProblem::smoothing), chosen
+/// from measurements (docs/performance.md, "The objective's form"): every gradient solver
+/// converges on optima where a metric vanishes, and the objective is within 1e-6 per unit of
+/// weight of the exact sum. At 1e-9 Ipopt runs out of budget on a vanishing peak, at 1e-12 on
+/// a vanishing RMS too.
+inline constexpr double kDefaultSmoothing = 1e-6;
+
+/// One term of the objective: weight · metric(design) / metric(original) for the reaction
+/// metrics (squared in ObjectiveForm::kSquared), weight · added_mass / (original total mass)
+/// for added_mass (linear in both forms).
 struct Term {
   Metric metric = Metric::kFshRms;
   double weight = 1.0;  // >= 0
@@ -82,6 +102,12 @@ struct DesignProblem {
   std::vector<Term> objective;  // at least one term
   std::vector<Limit> limits;
   bool force_balance = false;  // the two complex conditions of eq. 57 as four equalities
+  ObjectiveForm objective_form = ObjectiveForm::kLinear;
+  /// Linear form: each normalised magnitude r = |y| / original (an RMS, or one sample of a peak)
+  /// enters as sqrt(r² + ε²) with ε = smoothing, in (0, 0.1]: smooth where r = 0, and within
+  /// min(ε, ε²/(2r)) above r, so the objective is within ε · Σ weights above the exact sum
+  /// (optimize/nlp.hpp has the bound on the optimum).
+  double smoothing = kDefaultSmoothing;
   /// Empty when valid, else the problem in words (no variables, bad bounds, no objective, ...),
   /// e.g. "counterweights[1].link must be 1 (crank) or 3 (rocker), got 2".
   std::string validate() const;

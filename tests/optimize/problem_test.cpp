@@ -28,6 +28,17 @@ TEST(Problem, MetricNamesRoundTrip) {
   EXPECT_FALSE(metric_named(""));
 }
 
+TEST(Problem, ObjectiveFormNamesRoundTripAndTheDefaultIsLinear) {
+  for (ObjectiveForm f : {ObjectiveForm::kLinear, ObjectiveForm::kSquared}) {
+    EXPECT_EQ(objective_form_named(to_string(f)), f);
+  }
+  EXPECT_STREQ(to_string(ObjectiveForm::kLinear), "linear");
+  EXPECT_STREQ(to_string(ObjectiveForm::kSquared), "squared");
+  EXPECT_FALSE(objective_form_named("Linear"));
+  EXPECT_EQ(DesignProblem{}.objective_form, ObjectiveForm::kLinear);  // the weighted sum
+  EXPECT_EQ(DesignProblem{}.smoothing, kDefaultSmoothing);
+}
+
 DesignProblem valid_problem() {
   DesignProblem p;
   p.original = core::samples::paper_fourbar();
@@ -110,6 +121,19 @@ TEST(Problem, ValidateNamesEachMistake) {
             "objective[1].weight (Msh_max) must be >= 0, got -1");
   EXPECT_EQ(message_after([](DesignProblem& p) { p.objective[0].weight = 0; }),
             "objective: at least one term needs a weight > 0, all are 0");
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.smoothing = 0; }),
+            "smoothing must be in (0, 0.1], got 0");
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.smoothing = 0.5; }),
+            "smoothing must be in (0, 0.1], got 0.5");
+  EXPECT_EQ(message_after([nan](DesignProblem& p) { p.smoothing = nan; }),
+            "smoothing must be in (0, 0.1], got nan");
+  EXPECT_EQ(message_after([](DesignProblem& p) { p.objective_form = ObjectiveForm{7}; }),
+            "objective_form must be linear or squared");
+  EXPECT_EQ(message_after([](DesignProblem& p) {
+              p.objective_form = ObjectiveForm::kSquared;
+              p.smoothing = 1e-3;
+            }),
+            "");
   EXPECT_EQ(message_after([](DesignProblem& p) { p.limits[0].value = 0; }),
             "limits[0].value (tau_max) must be > 0 (a fraction of the original), got 0");
   EXPECT_EQ(message_after([](DesignProblem& p) {
