@@ -1,15 +1,24 @@
 // A fixed amount of dynamics work for instruction counting under callgrind (docs/performance.md,
 // "Dynamics evaluation"); wall-clock timings are bench_dynamics' job. Usage:
 //   dynamics_instructions KIND N
-// KIND: none, or mass-matrix / opened-loop / complex-masses followed by :forward or :inverse
-// (N evaluations on the paper's four-bar, theta1 from 1 rad in steps of 1e-3 rad, omega1 2 rad/s,
-// alpha1 0.5 rad/s^2), or driven (N driven revolutions of 360 samples, as BM_DrivenRevolution).
-// Instructions per evaluation = (count(KIND, N) - count(none, 0)) / N.
+// KIND:
+//   none                      nothing (the program's own start-up, to subtract)
+//   position                  N position solves (core::solve_position)
+//   F:forward, F:inverse      N evaluations by formulation F (mass-matrix, opened-loop,
+//                             complex-masses) through the one-instant calls, which compute the
+//                             model's constants each time
+//   F:forward:constants, F:inverse:constants
+//                             the same with core::DynamicsConstants computed once, as a
+//                             simulation or a sweep calls them
+//   driven                    N driven revolutions of 360 samples (as BM_DrivenRevolution)
+// The instants: the paper's four-bar, theta1 from 1 rad in steps of 1e-3 rad, omega1 2 rad/s,
+// alpha1 0.5 rad/s^2. Instructions per evaluation = (count(KIND, N) - count(none, 0)) / N.
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
 #include "core/dynamics.hpp"
+#include "core/kinematics.hpp"
 #include "core/samples.hpp"
 #include "core/simulate.hpp"
 
@@ -27,18 +36,36 @@ int main(int argc, char** argv) {
     const DrivenScene scene{
         .theta1 = 0.0, .omega1 = 6.283185307179586, .revolutions = 1, .samples = 360};
     for (int i = 0; i < n; ++i) checksum += simulate_driven(model, scene).samples.back().tau;
+  } else if (kind == "position") {
+    const FourBar model = samples::paper_fourbar();
+    double theta1 = 1.0;
+    for (int i = 0; i < n; ++i) {
+      const auto pose = solve_position(model, theta1);
+      if (pose) checksum += pose->theta2;
+      theta1 += 1e-3;
+    }
   } else if (kind != "none") {
     const FourBar model = samples::paper_fourbar();
     const std::string name = kind.substr(0, kind.find(':'));
-    const bool inverse = kind.ends_with(":inverse");
+    const bool inverse = kind.find(":inverse") != std::string::npos;
+    const bool with_constants = kind.ends_with(":constants");
     Formulation f = Formulation::kMassMatrix;
+    bool known = false;
     for (Formulation g : kFormulations) {
-      if (name == to_string(g)) f = g;
+      if (name == to_string(g)) f = g, known = true;
     }
+    if (!known) {
+      std::fprintf(stderr, "dynamics_instructions: unknown KIND %s\n", kind.c_str());
+      return 2;
+    }
+    const DynamicsConstants constants = dynamics_constants(model);
     double theta1 = 1.0;
     for (int i = 0; i < n; ++i) {
-      const auto s = inverse ? inverse_dynamics(model, theta1, 2.0, 0.5, f)
-                             : forward_dynamics(model, theta1, 2.0, f);
+      const auto s = with_constants
+                         ? (inverse ? inverse_dynamics(model, constants, theta1, 2.0, 0.5, f)
+                                    : forward_dynamics(model, constants, theta1, 2.0, f))
+                         : (inverse ? inverse_dynamics(model, theta1, 2.0, 0.5, f)
+                                    : forward_dynamics(model, theta1, 2.0, f));
       if (s) checksum += s->RA0.x();
       theta1 += 1e-3;
     }

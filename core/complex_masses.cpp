@@ -53,23 +53,46 @@ constexpr Complex kI{0.0, 1.0};
 double inner(const Complex& x, const Complex& y) { return std::real(std::conj(x) * y); }
 
 // applied force on link k plus its weight, F̄_k + m_k ḡ [N]
-Complex applied_force(const FourBar& model, int k) {
-  return to_complex(link_load(model, k).force + link(model, k).mass * model.loads.gravity);
+Vec2 applied_force(const FourBar& model, int k) {
+  return link_load(model, k).force + link(model, k).mass * model.loads.gravity;
 }
 
 // s̄ = e + i f of a link [m]
 Complex com_offset(const Link& l) { return {l.e, l.f}; }
 
-// the link vectors l̄1, l̄2, l̄3 as complex numbers [m]
-struct ComplexLinks {
-  Complex l1, l2, l3;
-};
-ComplexLinks complex_links(const LinkVectors& l) {
-  return {to_complex(l.l1), to_complex(l.l2), to_complex(l.l3)};
-}
+// eqs. 37-39 at the link vectors l (complex_mass_equations() without the trigonometry). With
+// the coupler's complex masses per unit mass on their lever arms, p = m̄2p l̄1/m2 =
+// (1 - s̄2/l2) l̄1 at A1 and q = m̄2q l̄3/m2 = (s̄2/l2) l̄3 at A2 (c.w2 = s̄2/l2), eqs. 37-39 print
+// |m̄2p|²/m2, <m̄2p l̄1, m̄2q l̄3>/m2, ...; written with these unit-mass weights they are the same
+// numbers without the division, which loses accuracy when m2 is subnormal (measured: 25 % at
+// m2 = 4.9e-324 kg). The pose enters only through ζ13 = conj(l̄1) l̄3 = (l̄1·l̄3, l̄1 × l̄3):
+// m2 conj(p) q = kappa ζ13 with the constant kappa = m2 conj(1 - s̄2/l2) s̄2/l2.
+ComplexMassEquations equations(const FourBar& model, const ComplexMassConstants& c, const Xy& l1,
+                               const Xy& l3) {
+  ComplexMassEquations eq;
+  // eq. 37, last lines: I1 + m1 s1² + l1² |m̄2p|²/m2 and I3 + m3 s3'² + l3² |m̄2q|²/m2 with
+  // s3' = |l3 - s̄3| the distance of S3 from A3, constant (the first, principal-vector lines
+  // divide by m1 and m3; principal_vector_forms() keeps them for the tests)
+  eq.M.setZero();
+  eq.M(0, 0) = c.M11;
+  eq.M(1, 1) = model.coupler.inertia;
+  eq.M(2, 2) = c.M33;
+  // M13 = -<m̄2p l̄1, m̄2q l̄3>/m2 = -m2 Re(conj(p) q) (the cos/sin line of eq. 37 is the same);
+  // eq. 38: C13 = <i m̄2p l̄1, m̄2q l̄3>/m2 = m2 Im(conj(p) q)
+  const Xy kz = cmul(c.kappa, cmul_conj(l1, l3));
+  eq.M(0, 2) = eq.M(2, 0) = -kz.x;
+  eq.C13 = kz.y;
 
-// eqs. 37-39 from the link vectors (complex_mass_equations() without the trigonometry)
-ComplexMassEquations equations(const FourBar& model, const ComplexLinks& l);
+  // eq. 39. Q1: the moment about A0 of F̄1 at S1 = s̄1 l̄1/l1 (the simplified line; the
+  // principal-vector line divides by m1) and of the coupler's share m̄2p/m2 of F̄2 at A1.
+  // Q3 likewise about A3, with S3 - A3 = -(l3 - s̄3) l̄3/l3 and the share m̄2q/m2 of F̄2 at A2.
+  // Each is the moment of one constant force about its link (a × F = l̄ × conj(w) F for
+  // a = w l̄): Q1 = M1 + l̄1 × G1, Q3 = M3 + l̄3 × G3.
+  eq.Q(0) = model.loads.crank.moment + cross(l1, c.G1);
+  eq.Q(1) = model.loads.coupler.moment;
+  eq.Q(2) = model.loads.rocker.moment + cross(l3, c.G3);
+  return eq;
+}
 
 // the convective terms Σ_k C_jk θ̇_k² of eq. 36 (only C13 = -C31 is nonzero) [N m]
 Eigen::Vector3d convective_terms(const ComplexMassEquations& eq, const FourBarState& s) {
@@ -85,136 +108,130 @@ Eigen::Vector3d constraint_forces(const ComplexMassEquations& eq, const FourBarS
   return Qc;
 }
 
-// Solves the complex-mass formulation at one instant. Forward when `alpha1_given` is null
-// (tau = 0), inverse otherwise.
-Expected<DynamicsSample, DynamicsError> solve(const FourBar& model, double theta1, double omega1,
-                                              const double* alpha1_given) {
-  // position and velocity stages and the velocity-product accelerations θ̈_k = Θ_k θ̈1 + γ_k,
-  // once for the whole instant
-  const auto instant = nonsingular_instant(model, theta1, omega1);
-  if (!instant) return Unexpected(instant.error());
-  const ComplexLinks l = complex_links(instant->l);
-  const ComplexMassEquations eq = equations(model, l);
-  const TransferFunctions& tf = instant->tf;
-  const AccelerationBias& bias = instant->bias;
-  const Eigen::Vector3d convective = convective_terms(eq, instant->state);
-  const Eigen::Vector3d Theta(1.0, tf.Theta2, tf.Theta3);
-  const Eigen::Vector3d gamma(0.0, bias.gamma2, bias.gamma3);
+Expected<DynamicsSample, DynamicsError> one_instant(const FourBar& model, double theta1,
+                                                    double omega1, CrankInput input) {
+  const ComplexMassConstants c = complex_mass_constants(model);
+  return evaluated(model, theta1, omega1, [&](const ClosedInstant& instant, DynamicsSample& out) {
+    return complex_masses_at(model, c, instant, input, out);
+  });
+}
 
-  // reduced equation: δθ = Θ δθ1 keeps the loop closed, so Σ_j Θ_j Q^c_j = 0 and
-  // (Θᵀ M Θ) θ̈1 = Θᵀ (Q - M γ - C θ̇²) + τ   (τ enters Q1, Θ1 = 1)
-  const double inertia = Theta.dot(eq.M * Theta);
-  const double rhs = Theta.dot(eq.Q - eq.M * gamma - convective);
-  double alpha1 = 0.0, tau = 0.0;
-  if (alpha1_given == nullptr) {
-    alpha1 = rhs / inertia;
-  } else {
-    alpha1 = *alpha1_given;
-    tau = inertia * alpha1 - rhs;
-  }
-  const FourBarState s = instant->accelerated(alpha1);
+}  // namespace
 
-  // mass centre accelerations times masses (eq. 35 in the complex masses; the principal-vector
-  // brackets of m1 r̈1 and m3 r̈3 equal m̄1q l̄1 and -m̄3p l̄3 and divide by no mass either)
+ComplexMassConstants complex_mass_constants(const FourBar& model) {
   const Link &L1 = model.crank, &L2 = model.coupler, &L3 = model.rocker;
+  const double m2 = L2.mass;
   const EquivalentMasses e1 = equivalent_masses(L1), e2 = equivalent_masses(L2),
                          e3 = equivalent_masses(L3);
-  const Complex turn1 = kI * s.alpha1 - s.omega1 * s.omega1;  // l̄1'' = l̄1 (iθ̈1 - θ̇1²)
-  const Complex turn3 = kI * s.alpha3 - s.omega3 * s.omega3;
-  const Complex m1a1 = e1.mq * l.l1 * turn1;
-  const Complex m2a2 = e2.mp * l.l1 * turn1 - e2.mq * l.l3 * turn3;
-  const Complex m3a3 = -e3.mp * l.l3 * turn3;
-  const Complex F1 = applied_force(model, 1), F2 = applied_force(model, 2),
-                F3 = applied_force(model, 3);
+  const FrameFactors f = frame_factors(model);
+  const Xy one{1.0, 0.0};
+  ComplexMassConstants c;
+  c.w1 = xy(com_offset(L1) / L1.length);
+  c.w2 = xy(com_offset(L2) / L2.length);
+  c.w3 = xy(com_offset(L3) / L3.length);
+  c.mq1 = xy(e1.mq);
+  c.mp2 = xy(e2.mp);
+  c.mq2 = xy(e2.mq);
+  c.mp3 = xy(e3.mp);
+  c.F1 = xy(applied_force(model, 1));
+  c.F2 = xy(applied_force(model, 2));
+  c.F3 = xy(applied_force(model, 3));
+  c.F_sum = c.F1 + c.F2 + c.F3;
+  c.M11 = L1.inertia + L1.mass * std::norm(com_offset(L1)) +
+          m2 * squared_norm(one - c.w2) * (L1.length * L1.length);
+  c.M33 = L3.inertia + L3.mass * std::norm(L3.length - com_offset(L3)) +
+          m2 * squared_norm(c.w2) * (L3.length * L3.length);
+  c.kappa = m2 * cmul_conj(one - c.w2, c.w2);
+  c.G1 = cmul_conj(c.w1, c.F1) + cmul_conj(one - c.w2, c.F2);
+  c.G3 = -(cmul_conj(one - c.w3, c.F3) + cmul_conj(c.w2, c.F2));
+  c.a14 = xy(f.a14);
+  c.a34 = xy(f.a34);
+  c.a41 = xy(f.a41 * Complex(-model.frame_length, 0.0));  // ā41 = a41 l̄4, l̄4 = -l4
+  c.total_mass = total_mass(model);
+  return c;
+}
 
-  // (a) translation of S: the resultant of the reactions
-  const FrameVectors a = frame_vectors(model, instant->l);
-  const PointKinematics S = centre_of_mass_frame(a, s);
-  const Complex Fsh = F1 + F2 + F3 - total_mass(model) * to_complex(S.a);
+std::optional<Failure> complex_masses_at(const FourBar& model, const ComplexMassConstants& c,
+                                         const ClosedInstant& instant, CrankInput input,
+                                         DynamicsSample& out) {
+  // the instant gives the rates and the dependent accelerations θ̈_k = Θ_k θ̈1 + γ_k
+  const ComplexMassEquations eq = equations(model, c, instant.l1, instant.l3);
+  const double Theta2 = instant.tf.Theta2, Theta3 = instant.tf.Theta3;
+  const double gamma2 = instant.bias.gamma2, gamma3 = instant.bias.gamma3;
+  const double omega1_sq = instant.state.omega1 * instant.state.omega1,
+               omega3_sq = instant.state.omega3 * instant.state.omega3;
+  const double M13 = eq.M(0, 2), I2 = eq.M(1, 1);
+
+  // reduced equation: δθ = Θ δθ1 keeps the loop closed, so Σ_j Θ_j Q^c_j = 0 and
+  // (Θᵀ M Θ) θ̈1 = Θᵀ (Q - M γ - C θ̇²) + τ   (τ enters Q1, Θ1 = 1), with M12 = M23 = 0
+  const double inertia =
+      c.M11 + 2.0 * M13 * Theta3 + I2 * Theta2 * Theta2 + c.M33 * Theta3 * Theta3;
+  const double rhs = (eq.Q(0) - M13 * gamma3 - eq.C13 * omega3_sq) +
+                     Theta2 * (eq.Q(1) - I2 * gamma2) +
+                     Theta3 * (eq.Q(2) - c.M33 * gamma3 + eq.C13 * omega1_sq);
+  double alpha1 = 0.0, tau = 0.0;
+  if (!input.torque_unknown) {
+    alpha1 = rhs / inertia;
+  } else {
+    alpha1 = input.alpha1;
+    tau = inertia * alpha1 - rhs;
+  }
+
+  set_state(instant, alpha1, out.state);
+  const FourBarState& s = out.state;
+
+  // mass centre accelerations times masses (eq. 35 in the complex masses; the principal-vector
+  // brackets of m1 r̈1 and m3 r̈3 equal m̄1q l̄1 and -m̄3p l̄3 and divide by no mass either),
+  // with l̄1'' = l̄1 (iθ̈1 - θ̇1²) and l̄3'' likewise
+  const Xy l1_acc = s.alpha1 * perp(instant.l1) - omega1_sq * instant.l1;
+  const Xy l3_acc = s.alpha3 * perp(instant.l3) - omega3_sq * instant.l3;
+  const Xy m1a1 = cmul(c.mq1, l1_acc);
+  const Xy m2a2 = cmul(c.mp2, l1_acc) - cmul(c.mq2, l3_acc);
+  const Xy m3a3 = -cmul(c.mp3, l3_acc);
+
+  // (a) translation of S: the resultant of the reactions; S = -ā14 - ā41 - ā34 (eq. 32) with
+  // ā14 = a14 l̄1, ā34 = a34 l̄3 turning with the crank and the rocker
+  const Xy a_S = -(cmul(c.a14, l1_acc) + cmul(c.a34, l3_acc));
+  const Xy Fsh = c.F_sum - c.total_mass * a_S;
 
   // (b) rotation about S: eq. 40 gives each centre of mass's lever c̄_k about S times m_k; the
   // virtual work uses c̄_k/m_k = r̄_k - r̄_S (the rigid-rotation identity the corrected eq. 40
   // satisfies, tested). Taken directly, it divides by no mass; c̄_k/m_k would lose
   // ~eps·m_tot/m_k at a small m_k (measured: 56 % at m1 = 1e-16 kg). It gives R_A3y.
-  const Complex rS = to_complex(S.r);
-  double W_S = tau + model.loads.crank.moment - L1.inertia * s.alpha1 +
-               model.loads.coupler.moment - L2.inertia * s.alpha2 + model.loads.rocker.moment -
-               L3.inertia * s.alpha3;
+  const Xy rS = -(cmul(c.a14, instant.l1) + c.a41 + cmul(c.a34, instant.l3));
+  double W_S = tau + model.loads.crank.moment - model.crank.inertia * s.alpha1 +
+               model.loads.coupler.moment - I2 * s.alpha2 + model.loads.rocker.moment -
+               model.rocker.inertia * s.alpha3;
   // centres of mass along the chain from A0: r̄1 = (s̄1/l1) l̄1, r̄2 = l̄1 + (s̄2/l2) l̄2,
-  // r̄3 = l̄1 + l̄2 + (s̄3/l3) l̄3
-  const Complex r1 = com_offset(L1) / L1.length * l.l1;
-  const Complex r2 = l.l1 + com_offset(L2) / L2.length * l.l2;
-  const Complex r3 = l.l1 + l.l2 + com_offset(L3) / L3.length * l.l3;
-  W_S += inner(kI * (r1 - rS), F1 - m1a1) + inner(kI * (r2 - rS), F2 - m2a2) +
-         inner(kI * (r3 - rS), F3 - m3a3);
-  const Complex p_SA0 = to_complex(a.a14 + a.a41 + a.a34);  // r̄_A0 - r̄_S
-  const double RA3y = (W_S - inner(kI * p_SA0, Fsh)) / model.frame_length;
+  // r̄3 = l̄1 + l̄2 + (s̄3/l3) l̄3; ⟨i x̄, ȳ⟩ = x̄ × ȳ
+  const Xy r1 = cmul(c.w1, instant.l1);
+  const Xy r2 = instant.l1 + cmul(c.w2, instant.l2);
+  const Xy r3 = instant.l1 + instant.l2 + cmul(c.w3, instant.l3);
+  W_S += cross(r1 - rS, c.F1 - m1a1) + cross(r2 - rS, c.F2 - m2a2) + cross(r3 - rS, c.F3 - m3a3);
+  // r̄_A0 - r̄_S = -r̄_S
+  const double RA3y = (W_S + cross(rS, Fsh)) / model.frame_length;
 
   // (c) the loop-closure force μ̄ from rows 2 and 3 of eq. 36, then the rocker side's
   // translation along the frame gives R_A3x
-  const Eigen::Vector3d Qc = constraint_forces(eq, s, tau);
-  const Complex mu = (Qc(1) * l.l3 - Qc(2) * l.l2) / inner(kI * l.l2, l.l3);
-  const Complex RA3_rocker_side =
-      F3 - m3a3 + std::conj(com_offset(L2) / L2.length) * (F2 - m2a2) - mu;
+  const double Qc2 = I2 * s.alpha2 - eq.Q(1);
+  const double Qc3 = M13 * s.alpha1 + c.M33 * s.alpha3 - eq.C13 * omega1_sq - eq.Q(2);
+  const Xy mu = (Qc2 * instant.l3 - Qc3 * instant.l2) * instant.inv_l2_x_l3;
+  const Xy RA3_rocker_side = c.F3 - m3a3 + cmul_conj(c.w2, c.F2 - m2a2) - mu;
 
-  DynamicsSample out;
-  out.state = s;
-  out.tau = tau;
-  out.RA3 = Vec2(RA3_rocker_side.real(), RA3y);
-  out.RA0 = to_vec(Fsh) - out.RA3;
-  return completed_sample(model, out);
+  const Xy RA3{RA3_rocker_side.x, RA3y};
+  return complete_sample(model, Fsh - RA3, RA3, tau, out);
 }
-
-}  // namespace
 
 ComplexMassEquations complex_mass_equations(const FourBar& model, const Pose& pose) {
-  return equations(model, complex_links(link_vectors(model, pose)));
+  const LinkVectors l = link_vectors(model, pose);
+  return equations(model, complex_mass_constants(model), xy(l.l1), xy(l.l3));
 }
-
-namespace {
-
-ComplexMassEquations equations(const FourBar& model, const ComplexLinks& l) {
-  const Link &L1 = model.crank, &L2 = model.coupler, &L3 = model.rocker;
-  const double m2 = L2.mass;
-  // the coupler's complex masses per unit mass on their lever arms: m̄2p l̄1/m2 at A1 and
-  // m̄2q l̄3/m2 at A2. Eqs. 37-39 print |m̄2p|²/m2, <m̄2p l̄1, m̄2q l̄3>/m2, ...; written with the
-  // unit-mass weights (1 - s̄2/l2) and s̄2/l2 they are the same numbers without the division,
-  // which loses accuracy when m2 is subnormal (measured: 25 % at m2 = 4.9e-324 kg).
-  const Complex w2 = com_offset(L2) / L2.length;
-  const Complex p = (1.0 - w2) * l.l1, q = w2 * l.l3;
-
-  ComplexMassEquations eq;
-  // eq. 37, last lines: I1 + m1 s1² + l1² |m̄2p|²/m2 and I3 + m3 s3'² + l3² |m̄2q|²/m2 with
-  // s3' = |l3 - s̄3| the distance of S3 from A3 (the first, principal-vector lines divide by m1
-  // and m3; principal_vector_forms() keeps them for the tests)
-  eq.M.setZero();
-  eq.M(0, 0) = L1.inertia + L1.mass * std::norm(com_offset(L1)) + m2 * std::norm(p);
-  eq.M(1, 1) = L2.inertia;
-  eq.M(2, 2) = L3.inertia + L3.mass * std::norm(L3.length - com_offset(L3)) + m2 * std::norm(q);
-  // M13 = -<m̄2p l̄1, m̄2q l̄3>/m2 (the cos/sin line of eq. 37 is the same)
-  eq.M(0, 2) = eq.M(2, 0) = -m2 * inner(p, q);
-  // eq. 38: C13 = <i m̄2p l̄1, m̄2q l̄3>/m2
-  eq.C13 = m2 * inner(kI * p, q);
-
-  // eq. 39. Q1: the moment about A0 of F̄1 at S1 = s̄1 l̄1/l1 (the simplified line; the
-  // principal-vector line divides by m1) and of the coupler's share m̄2p/m2 of F̄2 at A1.
-  // Q3 likewise about A3, with S3 - A3 = -(l3 - s̄3) l̄3/l3 and the share m̄2q/m2 of F̄2 at A2.
-  const Complex F1 = applied_force(model, 1), F2 = applied_force(model, 2),
-                F3 = applied_force(model, 3);
-  const Complex p_A0S1 = com_offset(L1) / L1.length * l.l1;
-  const Complex p_A3S3 = -(L3.length - com_offset(L3)) / L3.length * l.l3;
-  eq.Q(0) = model.loads.crank.moment + inner(kI * p_A0S1, F1) + inner(kI * p, F2);
-  eq.Q(1) = model.loads.coupler.moment;
-  eq.Q(2) = model.loads.rocker.moment + inner(kI * p_A3S3, F3) + inner(-kI * q, F2);
-  return eq;
-}
-
-}  // namespace
 
 PrincipalVectorForms principal_vector_forms(const FourBar& model, const Pose& pose) {
   const Link &L1 = model.crank, &L2 = model.coupler, &L3 = model.rocker;
   const double m1 = L1.mass, m2 = L2.mass, m3 = L3.mass;
-  const ComplexLinks l = complex_links(link_vectors(model, pose));
+  const LinkVectors l = link_vectors(model, pose);
+  const Complex l1 = to_complex(l.l1), l3 = to_complex(l.l3);
   const EquivalentMasses e2 = equivalent_masses(L2);
   const FrameVectors v = frame_vectors(model, pose);
   const Complex a14 = to_complex(v.a14), a34 = to_complex(v.a34), a12p = to_complex(v.a12p),
@@ -222,20 +239,20 @@ PrincipalVectorForms principal_vector_forms(const FourBar& model, const Pose& po
   // the complex masses that eq. 33 puts on the principal vectors
   const Complex k14 = m1 + e2.mq + m3;  // m1 + m2b + i m2c + m3, on ā14
   const Complex k34 = m1 + e2.mp + m3;  // m1 + m2a - i m2c + m3, on ā34
-  const Complex F1 = applied_force(model, 1), F2 = applied_force(model, 2),
-                F3 = applied_force(model, 3);
+  const Complex F1 = to_complex(applied_force(model, 1)), F2 = to_complex(applied_force(model, 2)),
+                F3 = to_complex(applied_force(model, 3));
   const double sq_mp = std::norm(e2.mp), sq_mq = std::norm(e2.mq);  // (m2a)²+(m2c)², (m2b)²+..
 
   PrincipalVectorForms f;
   f.M11 = L1.inertia + std::norm(a14) / m1 * std::norm(k14) +
-          (std::norm(a12p) / m1 + std::norm(l.l1) / m2) * sq_mp +
+          (std::norm(a12p) / m1 + std::norm(l1) / m2) * sq_mp +
           2.0 * inner(k14 * a14, e2.mp * a12p) / m1;
   f.M33 = L3.inertia + std::norm(a34) / m3 * std::norm(k34) +
-          (std::norm(a32p) / m3 + std::norm(l.l3) / m2) * sq_mq +
+          (std::norm(a32p) / m3 + std::norm(l3) / m2) * sq_mq +
           2.0 * inner(k34 * a34, e2.mq * a32p) / m3;
   f.Q1 = model.loads.crank.moment - inner(kI * (k14 * a14 + e2.mp * a12p), F1 / m1) +
-         inner(kI * e2.mp * l.l1, F2 / m2);
-  f.Q3 = model.loads.rocker.moment + inner(-kI * l.l3 * e2.mq, F2 / m2) -
+         inner(kI * e2.mp * l1, F2 / m2);
+  f.Q3 = model.loads.rocker.moment + inner(-kI * l3 * e2.mq, F2 / m2) -
          inner(kI * (k34 * a34 + e2.mq * a32p), F3 / m3);
   return f;
 }
@@ -263,14 +280,14 @@ Eigen::Vector3d generalised_constraint_forces(const FourBar& model, const FourBa
 Expected<DynamicsSample, DynamicsError> forward_dynamics_complex_masses(const FourBar& model,
                                                                         double theta1,
                                                                         double omega1) {
-  return solve(model, theta1, omega1, nullptr);
+  return one_instant(model, theta1, omega1, CrankInput::forward());
 }
 
 Expected<DynamicsSample, DynamicsError> inverse_dynamics_complex_masses(const FourBar& model,
                                                                         double theta1,
                                                                         double omega1,
                                                                         double alpha1) {
-  return solve(model, theta1, omega1, &alpha1);
+  return one_instant(model, theta1, omega1, CrankInput::inverse(alpha1));
 }
 
 }  // namespace bd::core

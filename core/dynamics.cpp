@@ -4,6 +4,8 @@
 
 #include "core/complex_masses.hpp"
 #include "core/counter_rotation.hpp"
+#include "core/formulation_support.hpp"
+#include "core/instant_dynamics.hpp"
 #include "core/mass_matrix.hpp"
 #include "core/opened_loop.hpp"
 
@@ -21,9 +23,12 @@ std::string DynamicsError::what() const {
 
 const char* to_string(Formulation f) {
   switch (f) {
-    case Formulation::kMassMatrix: return "mass-matrix";
-    case Formulation::kOpenedLoop: return "opened-loop";
-    case Formulation::kComplexMasses: return "complex-masses";
+    case Formulation::kMassMatrix:
+      return "mass-matrix";
+    case Formulation::kOpenedLoop:
+      return "opened-loop";
+    case Formulation::kComplexMasses:
+      return "complex-masses";
   }
   return "?";
 }
@@ -32,10 +37,12 @@ Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model, d
                                                          double omega1, Formulation f) {
   if (has_counter_rotations(model)) return forward_dynamics_with_discs(model, theta1, omega1, f);
   switch (f) {
-    case Formulation::kOpenedLoop: return forward_dynamics_opened_loop(model, theta1, omega1);
+    case Formulation::kOpenedLoop:
+      return forward_dynamics_opened_loop(model, theta1, omega1);
     case Formulation::kComplexMasses:
       return forward_dynamics_complex_masses(model, theta1, omega1);
-    case Formulation::kMassMatrix: break;
+    case Formulation::kMassMatrix:
+      break;
   }
   return forward_dynamics_mass_matrix(model, theta1, omega1);
 }
@@ -51,9 +58,37 @@ Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model, d
       return inverse_dynamics_opened_loop(model, theta1, omega1, alpha1);
     case Formulation::kComplexMasses:
       return inverse_dynamics_complex_masses(model, theta1, omega1, alpha1);
-    case Formulation::kMassMatrix: break;
+    case Formulation::kMassMatrix:
+      break;
   }
   return inverse_dynamics_mass_matrix(model, theta1, omega1, alpha1);
+}
+
+DynamicsConstants dynamics_constants(const FourBar& model) {
+  return {mass_matrix_constants(model), opened_loop_constants(model), complex_mass_constants(model),
+          has_counter_rotations(model)};
+}
+
+Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model,
+                                                         const DynamicsConstants& constants,
+                                                         double theta1, double omega1,
+                                                         Formulation f) {
+  if (constants.counter_rotations) return forward_dynamics_with_discs(model, theta1, omega1, f);
+  return evaluated(model, theta1, omega1, [&](const ClosedInstant& instant, DynamicsSample& out) {
+    return dynamics_at(model, constants, instant, CrankInput::forward(), f, out);
+  });
+}
+
+Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model,
+                                                         const DynamicsConstants& constants,
+                                                         double theta1, double omega1,
+                                                         double alpha1, Formulation f) {
+  if (constants.counter_rotations) {
+    return inverse_dynamics_with_discs(model, theta1, omega1, alpha1, f);
+  }
+  return evaluated(model, theta1, omega1, [&](const ClosedInstant& instant, DynamicsSample& out) {
+    return dynamics_at(model, constants, instant, CrankInput::inverse(alpha1), f, out);
+  });
 }
 
 }  // namespace bd::core

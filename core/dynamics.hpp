@@ -3,6 +3,7 @@
 /// accelerations, the support reactions, the shaking force and moment, and the drive torque.
 #include <string>
 
+#include "core/dynamics_constants.hpp"
 #include "core/expected.hpp"
 #include "core/kinematics.hpp"
 #include "core/model.hpp"
@@ -20,7 +21,7 @@ struct DynamicsSample {
   Vec2 Fsh{0, 0};      // shaking force RA0 + RA3 + RC1 + RC3 [N]
   /// shaking moment on the frame about A0: l4·RA3y - tau + at1 × RC1 + at3 × RC3 [N m]
   double Msh{};
-  double tau{};        // drive torque on the crank from the frame [N m] (0 in free motion)
+  double tau{};  // drive torque on the crank from the frame [N m] (0 in free motion)
 };
 
 /// Why the dynamics could not be evaluated at an instant.
@@ -61,6 +62,20 @@ Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model, d
 /// theta1 [rad], omega1 [rad/s], with everything else.
 Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model, double theta1,
                                                          double omega1, double alpha1,
+                                                         Formulation f = Formulation::kMassMatrix);
+
+/// The same two with the model's constants computed once by dynamics_constants(model): what a
+/// loop over many instants of one model calls (a simulation's right-hand side, a sweep), at
+/// about two thirds of the cost of the calls above (docs/performance.md). `constants` must come
+/// from this `model`. Models with counter-rotations take the one-instant route.
+Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model,
+                                                         const DynamicsConstants& constants,
+                                                         double theta1, double omega1,
+                                                         Formulation f = Formulation::kMassMatrix);
+Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model,
+                                                         const DynamicsConstants& constants,
+                                                         double theta1, double omega1,
+                                                         double alpha1,
                                                          Formulation f = Formulation::kMassMatrix);
 
 }  // namespace bd::core

@@ -5,11 +5,11 @@
 #include <cstdio>
 #include <limits>
 
+#include "core/loop_closure.hpp"
+
 namespace bd::core {
 
 namespace {
-
-constexpr double kEps = std::numeric_limits<double>::epsilon();
 
 // s̄_k turned into ground axes at link angle theta: R(theta)·(e, f) [m]
 Vec2 com_offset(const Link& l, double theta) {
@@ -55,40 +55,15 @@ LinkVectors link_vectors(const FourBar& m, const Pose& p) {
 }
 
 Expected<ClosedLoop, AssemblyError> solve_loop(const FourBar& model, double theta1, Branch branch) {
-  const double l1 = model.crank.length, l2 = model.coupler.length, l3 = model.rocker.length,
-               l4 = model.frame_length;
-  // l̄23 = l̄2 + l̄3 = -l̄1 - l̄4 = A3 - A1 (eq. 2)
-  const Vec2 l1v = l1 * unit(theta1);
-  const Vec2 l23v(l4 - l1v.x(), -l1v.y());
-  const double l23 = l23v.norm();
-  if (!(l23 > 0)) return Unexpected(AssemblyError{theta1, 0.0});
+  return solve_loop(model, theta1, model.crank.length * unit(theta1), branch);
+}
 
-  // triangle l2, l3, l23: Kahan's stable Heron formula, sides sorted a >= b >= c;
-  // the only factor that can turn negative is c - (a - b) (triangle inequality violated)
-  double a = l2, b = l3, c = l23;
-  if (a < b) std::swap(a, b);
-  if (b < c) std::swap(b, c);
-  if (a < b) std::swap(a, b);
-  double slack = c - (a - b);
-  if (slack < 0) {
-    // within round-off of a flat triangle: accept as flat
-    if (slack >= -8 * kEps * a) {
-      slack = 0;
-    } else {
-      const double gap = (a == l23) ? l23 - (l2 + l3) : l23 - std::abs(l2 - l3);
-      return Unexpected(AssemblyError{theta1, gap});
-    }
-  }
-  const double area4 = std::sqrt((a + (b + c)) * slack * (c + (a - b)) * (a + (b - c)));
-  // eq. 3: d23 along l̄23 from A1, h23 to its left (branch +1)
-  const double d23 = (l23 * l23 + (l2 - l3) * (l2 + l3)) / (2 * l23);
-  const double h23 = sign(branch) * area4 / (2 * l23);
-  // eq. 4: l̄2 = (d23 + i h23) l̄23 / l23, l̄3 = l̄23 - l̄2
-  const Vec2 u = l23v / l23;
-  const Vec2 l2v = d23 * u + h23 * perp(u);
-  const Vec2 l3v = l23v - l2v;
-  return ClosedLoop{Pose{theta1, std::atan2(l2v.y(), l2v.x()), std::atan2(l3v.y(), l3v.x())},
-                    LinkVectors{l1v, l2v, l3v}};
+Expected<ClosedLoop, AssemblyError> solve_loop(const FourBar& model, double theta1, const Vec2& l1,
+                                               Branch branch) {
+  LoopXy loop;
+  if (const auto error = close_loop(model, theta1, xy(l1), branch, loop)) return Unexpected(*error);
+  return ClosedLoop{Pose{theta1, link_angle(loop.l2), link_angle(loop.l3)},
+                    LinkVectors{l1, to_vec2(loop.l2), to_vec2(loop.l3)}};
 }
 
 Expected<Pose, AssemblyError> solve_position(const FourBar& model, double theta1, Branch branch) {
@@ -107,7 +82,7 @@ TransferFunctions transfer_functions(const FourBar& model, const Pose& p) {
 
 TransferFunctions transfer_functions(const LinkVectors& v) {
   // eq. 7 via cross products: l̄1 Θ1 + l̄2 Θ2 + l̄3 Θ3 = 0 (eq. 5), crossed with l̄3 and l̄2
-  return {-cross(v.l3, v.l1) / cross(v.l3, v.l2), -cross(v.l2, v.l1) / cross(v.l2, v.l3)};
+  return transfer_functions(v, 1.0 / cross(v.l2, v.l3));
 }
 
 FourBarState solve_velocity(const FourBar& model, const Pose& pose, double omega1) {
@@ -127,10 +102,7 @@ AccelerationBias acceleration_bias(const FourBar& model, const FourBarState& s) 
 }
 
 AccelerationBias acceleration_bias(const LinkVectors& v, const FourBarState& s) {
-  // eq. 8: Σ l̄k α_k = -i b with b = Σ l̄k ω_k²; crossed with l̄3 and l̄2 (eqs. 9-10)
-  const Vec2 b = v.l1 * (s.omega1 * s.omega1) + v.l2 * (s.omega2 * s.omega2) +
-                 v.l3 * (s.omega3 * s.omega3);
-  return {-v.l3.dot(b) / cross(v.l3, v.l2), -v.l2.dot(b) / cross(v.l2, v.l3)};
+  return acceleration_bias(v, s, 1.0 / cross(v.l2, v.l3));
 }
 
 FourBarState solve_acceleration(const FourBar& model, FourBarState s, double alpha1) {
@@ -144,8 +116,8 @@ FourBarState solve_acceleration(const FourBar& model, FourBarState s, double alp
 
 Joints joint_positions(const FourBar& model, double theta1, double theta3) {
   const Vec2 A3(model.frame_length, 0.0);
-  return {Vec2(0.0, 0.0), model.crank.length * unit(theta1), A3 - model.rocker.length * unit(theta3),
-          A3};
+  return {Vec2(0.0, 0.0), model.crank.length * unit(theta1),
+          A3 - model.rocker.length * unit(theta3), A3};
 }
 
 Vec2 centre_of_mass(const FourBar& model, int k, const Pose& p) {
@@ -159,8 +131,8 @@ Vec2 centre_of_mass_velocity(const FourBar& model, int k, const FourBarState& s)
   const Vec2 l1v = model.crank.length * unit(s.theta1);
   const Vec2 l3v = model.rocker.length * unit(s.theta3);
   // velocity of the link's first joint: A0 fixed, A1 turns about A0, A2 about A3
-  const Vec2 v_first = k == 1 ? Vec2(0, 0)
-                              : (k == 2 ? Vec2(s.omega1 * perp(l1v)) : Vec2(-s.omega3 * perp(l3v)));
+  const Vec2 v_first =
+      k == 1 ? Vec2(0, 0) : (k == 2 ? Vec2(s.omega1 * perp(l1v)) : Vec2(-s.omega3 * perp(l3v)));
   const Vec2 rho = com_offset(link(model, k), link_angle(s, k));
   return v_first + link_rate(s, k) * perp(rho);
 }

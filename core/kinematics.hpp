@@ -44,6 +44,10 @@ struct ClosedLoop {
 };
 /// solve_position() that also returns the link vectors; fails in the same way.
 Expected<ClosedLoop, AssemblyError> solve_loop(const FourBar& model, double theta1, Branch branch);
+/// The same with the crank vector l̄1 = l1·(cos theta1, sin theta1) [m] given, for a caller that
+/// has it already (a driven sweep turns it from sample to sample); theta1 is only recorded.
+Expected<ClosedLoop, AssemblyError> solve_loop(const FourBar& model, double theta1, const Vec2& l1,
+                                               Branch branch);
 
 /// First-order kinematic transfer functions Θ2 = dθ2/dθ1, Θ3 = dθ3/dθ1 (eq. 7) [-].
 struct TransferFunctions {
@@ -52,6 +56,11 @@ struct TransferFunctions {
 TransferFunctions transfer_functions(const FourBar& model, const Pose& pose);
 /// The same from the link vectors of a closed pose (no trigonometry).
 TransferFunctions transfer_functions(const LinkVectors& l);
+/// The same with 1/(l̄2 × l̄3) [1/m^2] given (the divisor of every dependent rate and acceleration).
+inline TransferFunctions transfer_functions(const LinkVectors& l, double inv_l2_x_l3) {
+  // eq. 7 via cross products: l̄1 + l̄2 Θ2 + l̄3 Θ3 = 0 (eq. 5) crossed with l̄3 and with l̄2
+  return {cross(l.l3, l.l1) * inv_l2_x_l3, cross(l.l1, l.l2) * inv_l2_x_l3};
+}
 
 /// Full kinematic state: the crank input and the dependent angles, rates and accelerations.
 struct FourBarState {
@@ -74,6 +83,14 @@ struct AccelerationBias {
 AccelerationBias acceleration_bias(const FourBar& model, const FourBarState& state);
 /// The same from the link vectors of the state's pose (no trigonometry).
 AccelerationBias acceleration_bias(const LinkVectors& l, const FourBarState& state);
+/// The same with 1/(l̄2 × l̄3) [1/m^2] given.
+inline AccelerationBias acceleration_bias(const LinkVectors& l, const FourBarState& state,
+                                          double inv_l2_x_l3) {
+  // eq. 8: Σ l̄k α_k = -i b with b = Σ l̄k ω_k²; crossed with l̄3 and l̄2 (eqs. 9-10)
+  const Vec2 b = l.l1 * (state.omega1 * state.omega1) + l.l2 * (state.omega2 * state.omega2) +
+                 l.l3 * (state.omega3 * state.omega3);
+  return {l.l3.dot(b) * inv_l2_x_l3, -l.l2.dot(b) * inv_l2_x_l3};
+}
 
 /// Joint positions in ground axes [m] (A0 is the origin, A3 = (l4, 0)).
 struct Joints {

@@ -1,28 +1,19 @@
 #include "core/opened_loop_dae.hpp"
 
-#include <cvode/cvode.h>
-#include <cvode/cvode_ls.h>
-#include <cvode/cvode_proj.h>
-#include <nvector/nvector_serial.h>
-#include <sundials/sundials_context.h>
-#include <sunlinsol/sunlinsol_dense.h>
-#include <sunmatrix/sunmatrix_dense.h>
-#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
-
 #include <Eigen/Core>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
-#include <cstdlib>
 #include <limits>
-#include <stdexcept>
+#include <optional>
 #include <string>
 
 #include "core/energy.hpp"
 #include "core/formulation_support.hpp"
 #include "core/input_error.hpp"
-#include "core/cvode_support.hpp"
+#include "core/integrators.hpp"
 #include "core/kinematics.hpp"
 #include "core/opened_loop.hpp"
 
@@ -33,6 +24,8 @@ namespace {
 using Mat23 = Eigen::Matrix<double, 2, 3>;
 
 constexpr int kStates = 6;  // theta1..3 [rad], omega1..3 [rad/s]
+// GGL: the six states, then lambda = RA3 [N] and the multiplier mu of the closure [1/(m s)]
+constexpr int kGglStates = 10;
 // Gauss-Newton iterations of one projection onto the closure; from an integrator step off the
 // closure by ~tolerance, two or three reach round-off (quadratic convergence)
 constexpr int kMaxProjectionIterations = 10;
@@ -76,18 +69,17 @@ Eigen::Vector3d least_norm(const Mat23& G, const Vec2& v) {
   return G.transpose() * GGt.inverse() * v;
 }
 
-// What the CVODE callbacks need, and what they saw when the dynamics failed.
+// What the integrator's callbacks need, and what they saw when the dynamics failed.
 struct DaeMotion {
   const FourBar* model{};
   Stabilisation stabilisation{};
   double alpha{}, beta{};  // Baumgarte [1/s]
   double length_scale{};   // l1 + l2 + l3 + l4 [m], for the projection's convergence test
-  long evaluations{};
+  long evaluations{};      // right-hand sides or residuals, and samples
   long projections{};
   bool rhs_failed{};
   DynamicsError error;
   double error_t{};
-  std::string cvode_text;
 };
 
 // closure_bias of eq. 27 for the chosen stabilisation [m/s^2]
@@ -103,7 +95,7 @@ int dae_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) {
   ++motion.evaluations;
   const auto sample = forward_dynamics_opened_loop(*motion.model, s, closure_bias(motion, s));
   if (!sample) {
-    // recoverable: CVODE retries with a smaller step
+    // recoverable: CVODE retries with a smaller step (ERKStep stops)
     motion.rhs_failed = true;
     motion.error = sample.error();
     motion.error_t = t;
@@ -119,33 +111,40 @@ int dae_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) {
   return 0;
 }
 
-// CVODE's projection (CVodeSetProjFn, BDF only): returns in `corr` the change that takes ycur
-// onto the closure manifold, c(θ) = 0 by Gauss-Newton least-norm steps, then ċ = G ω = 0 by an
-// orthogonal projection of the rates; the error estimate is projected onto the tangent space
-// (the part normal to it is removed by the projection and must not count in the error test).
-// Euclidean norms: angles and rates carry the same absolute tolerance. eps_proj (CVODE's
-// tolerance for an iterative projection) is not needed: the iteration runs to round-off.
-int project(sunrealtype /*t*/, N_Vector ycur, N_Vector corr, sunrealtype /*eps_proj*/, N_Vector err,
-            void* user_data) {
-  auto& motion = *static_cast<DaeMotion*>(user_data);
-  const FourBar& m = *motion.model;
-  const double* y = N_VGetArrayPointer(ycur);
-  Eigen::Vector3d theta(y[0], y[1], y[2]);
-  Eigen::Vector3d omega(y[3], y[4], y[5]);
-  ++motion.projections;
-
+// Takes angles and rates onto the closure manifold: c(θ) = 0 by Gauss-Newton least-norm steps
+// to round-off, then ċ = G ω = 0 by an orthogonal projection of the rates. Returns G at the
+// projected angles, or nothing when the iteration does not converge. Euclidean norms: angles
+// and rates carry the same absolute tolerance.
+std::optional<Mat23> project_onto_closure(const FourBar& m, double length_scale,
+                                          Eigen::Vector3d& theta, Eigen::Vector3d& omega) {
   // positions: θ <- θ - Gᵀ(GGᵀ)⁻¹ c(θ) until c is at round-off
-  const double converged = 16 * std::numeric_limits<double>::epsilon() * motion.length_scale;
+  const double converged = 16 * std::numeric_limits<double>::epsilon() * length_scale;
   Vec2 c = closure(m, theta);
   for (int i = 0; i < kMaxProjectionIterations && c.norm() > converged; ++i) {
     theta -= least_norm(closure_jacobian(m, theta), c);
     c = closure(m, theta);
   }
-  if (!(c.norm() <= 1e3 * converged)) return 1;  // recoverable: CVODE retries a smaller step
-
+  if (!(c.norm() <= 1e3 * converged)) return std::nullopt;
   // rates: ω <- ω - Gᵀ(GGᵀ)⁻¹ G ω
   const Mat23 G = closure_jacobian(m, theta);
   omega -= least_norm(G, G * omega);
+  return G;
+}
+
+// CVODE's projection (CVodeSetProjFn, BDF only): returns in `corr` the change that takes ycur
+// onto the closure manifold (project_onto_closure); the error estimate is projected onto the
+// tangent space (the part normal to it is removed by the projection and must not count in the
+// error test). eps_proj (CVODE's tolerance for an iterative projection) is not needed: the
+// iteration runs to round-off.
+int project(sunrealtype /*t*/, N_Vector ycur, N_Vector corr, sunrealtype /*eps_proj*/, N_Vector err,
+            void* user_data) {
+  auto& motion = *static_cast<DaeMotion*>(user_data);
+  const double* y = N_VGetArrayPointer(ycur);
+  Eigen::Vector3d theta(y[0], y[1], y[2]);
+  Eigen::Vector3d omega(y[3], y[4], y[5]);
+  ++motion.projections;
+  const auto G = project_onto_closure(*motion.model, motion.length_scale, theta, omega);
+  if (!G) return 1;  // recoverable: CVODE retries a smaller step
 
   double* dy = N_VGetArrayPointer(corr);
   for (int k = 0; k < 3; ++k) {
@@ -155,11 +154,52 @@ int project(sunrealtype /*t*/, N_Vector ycur, N_Vector corr, sunrealtype /*eps_p
   if (err != nullptr) {
     double* e = N_VGetArrayPointer(err);
     Eigen::Vector3d ep(e[0], e[1], e[2]), ev(e[3], e[4], e[5]);
-    ep -= least_norm(G, G * ep);
-    ev -= least_norm(G, G * ev);
+    ep -= least_norm(*G, *G * ep);
+    ev -= least_norm(*G, *G * ev);
     for (int k = 0; k < 3; ++k) {
       e[k] = ep(k);
       e[3 + k] = ev(k);
+    }
+  }
+  return 0;
+}
+
+// The GGL residual (Stabilisation::kGgl) for IDA, y = (θ, ω, λ, μ):
+//   θ' - ω - Gᵀμ = 0,   M ω' + C ω² + Gᵀλ - Q = 0 (eq. 22, λ = R̄A3),   c(θ) = 0,   G ω = 0,
+// with M, C, D = Gᵀ, Q of the opened loop at the angles θ (closed or not). A non-finite value
+// is a recoverable failure, as in dae_rhs.
+int ggl_residual(sunrealtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* user_data) {
+  auto& motion = *static_cast<DaeMotion*>(user_data);
+  const FourBar& m = *motion.model;
+  const double* y = N_VGetArrayPointer(yy);
+  const double* dy = N_VGetArrayPointer(yp);
+  double* r = N_VGetArrayPointer(rr);
+  const Eigen::Vector3d theta(y[0], y[1], y[2]), omega(y[3], y[4], y[5]);
+  const Vec2 lambda(y[6], y[7]), mu(y[8], y[9]);
+  const Eigen::Vector3d theta_dot(dy[0], dy[1], dy[2]), omega_dot(dy[3], dy[4], dy[5]);
+  ++motion.evaluations;
+  const OpenedLoopTerms terms = opened_loop_terms(m, Pose{theta(0), theta(1), theta(2)});
+  const Mat23 G = terms.D.transpose();
+  const Eigen::Vector3d kinematic = theta_dot - omega - G.transpose() * mu;
+  const Eigen::Vector3d dynamic =
+      terms.M * omega_dot + terms.C * omega.cwiseAbs2() + terms.D * lambda - terms.Q;
+  const Vec2 position = closure(m, theta);
+  const Vec2 velocity = G * omega;
+  for (int k = 0; k < 3; ++k) {
+    r[k] = kinematic(k);
+    r[3 + k] = dynamic(k);
+  }
+  r[6] = position.x();
+  r[7] = position.y();
+  r[8] = velocity.x();
+  r[9] = velocity.y();
+  for (int k = 0; k < kGglStates; ++k) {
+    if (!std::isfinite(r[k])) {
+      motion.rhs_failed = true;
+      motion.error = {DynamicsError::Kind::kNonFinite, y[0],
+                      "non-finite residual of the opened loop's DAE"};
+      motion.error_t = t;
+      return 1;
     }
   }
   return 0;
@@ -197,6 +237,8 @@ const char* to_string(Stabilisation s) {
       return "baumgarte";
     case Stabilisation::kProjection:
       return "projection";
+    case Stabilisation::kGgl:
+      return "ggl";
   }
   return "?";
 }
@@ -209,6 +251,20 @@ const char* to_string(DaeMethod m) {
       return "adams";
     case DaeMethod::kBdf:
       return "bdf";
+    case DaeMethod::kErk2:
+      return "erk2";
+    case DaeMethod::kErk3:
+      return "erk3";
+    case DaeMethod::kErk4:
+      return "erk4";
+    case DaeMethod::kErk5:
+      return "erk5";
+    case DaeMethod::kErk6:
+      return "erk6";
+    case DaeMethod::kErk8:
+      return "erk8";
+    case DaeMethod::kIda:
+      return "ida";
   }
   return "?";
 }
@@ -227,28 +283,92 @@ std::string OpenedLoopDaeOptions::validate() const {
   if (!(baumgarte_beta >= 0.0) || !std::isfinite(baumgarte_beta)) {
     return "baumgarte_beta must be >= 0 1/s, got " + number(baumgarte_beta);
   }
+  switch (method) {
+    case DaeMethod::kAuto:
+    case DaeMethod::kAdams:
+    case DaeMethod::kBdf:
+    case DaeMethod::kErk2:
+    case DaeMethod::kErk3:
+    case DaeMethod::kErk4:
+    case DaeMethod::kErk5:
+    case DaeMethod::kErk6:
+    case DaeMethod::kErk8:
+    case DaeMethod::kIda:
+      break;
+    default:
+      return "method " + std::to_string(static_cast<int>(method)) + " is unknown";
+  }
   switch (stabilisation) {
     case Stabilisation::kNone:
     case Stabilisation::kBaumgarte:
+      if (method == DaeMethod::kIda) {
+        return std::string("method ida needs stabilisation ggl, got ") + to_string(stabilisation) +
+               ": IDA integrates the DAE in its stabilised index-2 form";
+      }
       break;
     case Stabilisation::kProjection:
-      if (method == DaeMethod::kAdams) {
-        return "stabilisation projection needs method bdf (or auto): CVODE projects only with "
-               "BDF";
+      if (method != DaeMethod::kAuto && method != DaeMethod::kBdf) {
+        return std::string("stabilisation projection needs method bdf (or auto), got ") +
+               to_string(method) + ": CVODE projects only with BDF";
+      }
+      break;
+    case Stabilisation::kGgl:
+      if (method != DaeMethod::kAuto && method != DaeMethod::kIda) {
+        return std::string("stabilisation ggl needs method ida (or auto), got ") +
+               to_string(method) + ": the GGL form is a DAE with algebraic equations";
       }
       break;
     default:
       return "stabilisation " + std::to_string(static_cast<int>(stabilisation)) + " is unknown";
   }
-  switch (method) {
-    case DaeMethod::kAuto:
-    case DaeMethod::kAdams:
-    case DaeMethod::kBdf:
-      break;
-    default:
-      return "method " + std::to_string(static_cast<int>(method)) + " is unknown";
-  }
   return {};
+}
+
+OpenedLoopDaeOptions opened_loop_dae_options(const SimulateOptions& options) {
+  OpenedLoopDaeOptions dae;
+  dae.tolerance = options.tolerance;
+  dae.absolute_tolerance = options.absolute_tolerance;
+  dae.max_steps = options.max_steps;
+  dae.project_samples = true;
+  switch (options.integrator) {
+    case Integrator::kCvodeAdams:
+      dae.method = DaeMethod::kAdams;
+      dae.stabilisation = Stabilisation::kBaumgarte;
+      break;
+    case Integrator::kCvodeBdf:
+      dae.method = DaeMethod::kBdf;
+      dae.stabilisation = Stabilisation::kProjection;
+      break;
+    case Integrator::kErk2:
+      dae.method = DaeMethod::kErk2;
+      dae.stabilisation = Stabilisation::kBaumgarte;
+      break;
+    case Integrator::kErk3:
+      dae.method = DaeMethod::kErk3;
+      dae.stabilisation = Stabilisation::kBaumgarte;
+      break;
+    case Integrator::kErk4:
+      dae.method = DaeMethod::kErk4;
+      dae.stabilisation = Stabilisation::kBaumgarte;
+      break;
+    case Integrator::kErk5:
+      dae.method = DaeMethod::kErk5;
+      dae.stabilisation = Stabilisation::kBaumgarte;
+      break;
+    case Integrator::kErk6:
+      dae.method = DaeMethod::kErk6;
+      dae.stabilisation = Stabilisation::kBaumgarte;
+      break;
+    case Integrator::kErk8:
+      dae.method = DaeMethod::kErk8;
+      dae.stabilisation = Stabilisation::kBaumgarte;
+      break;
+    case Integrator::kIda:
+      dae.method = DaeMethod::kIda;
+      dae.stabilisation = Stabilisation::kGgl;
+      break;
+  }
+  return dae;
 }
 
 Vec2 closure_position_residual(const FourBar& model, const FourBarState& s) {
@@ -267,6 +387,36 @@ Branch branch_of(const FourBar& model, const FourBarState& s) {
   return cross(A3 - A1, A2 - A1) >= 0.0 ? Branch::kPlus : Branch::kMinus;
 }
 
+namespace {
+
+// the core::Integrator that runs a method (kAuto resolved before)
+Integrator integrator_of(DaeMethod method) {
+  switch (method) {
+    case DaeMethod::kAuto:
+    case DaeMethod::kAdams:
+      return Integrator::kCvodeAdams;
+    case DaeMethod::kBdf:
+      return Integrator::kCvodeBdf;
+    case DaeMethod::kErk2:
+      return Integrator::kErk2;
+    case DaeMethod::kErk3:
+      return Integrator::kErk3;
+    case DaeMethod::kErk4:
+      return Integrator::kErk4;
+    case DaeMethod::kErk5:
+      return Integrator::kErk5;
+    case DaeMethod::kErk6:
+      return Integrator::kErk6;
+    case DaeMethod::kErk8:
+      return Integrator::kErk8;
+    case DaeMethod::kIda:
+      return Integrator::kIda;
+  }
+  return Integrator::kCvodeAdams;
+}
+
+}  // namespace
+
 OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FreeScene& scene,
                                              const OpenedLoopDaeOptions& options) {
   validate(scene, options);
@@ -274,6 +424,7 @@ OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FreeSce
   OpenedLoopDaeResult out;
   out.method = options.method != DaeMethod::kAuto                    ? options.method
                : options.stabilisation == Stabilisation::kProjection ? DaeMethod::kBdf
+               : options.stabilisation == Stabilisation::kGgl        ? DaeMethod::kIda
                                                                      : DaeMethod::kAdams;
   Trajectory& traj = out.trajectory;
   for (auto* v : {&out.position_residual, &out.velocity_residual, &out.energy}) {
@@ -310,43 +461,61 @@ OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FreeSce
 
   // Method. kNone and kBaumgarte: the six-state ODE is non-stiff (the eigenvalues of a slow
   // oscillator, and with Baumgarte -α ± sqrt(α² - β²) ~ -10 1/s, far below 1/h at the tolerances
-  // used), so Adams-Moulton with a fixed-point corrector, as in core/simulate.cpp. kProjection:
-  // CVODE's projection interface (CVodeSetProjFn) exists for BDF only, which needs a Newton
-  // corrector: dense 6x6 linear solver, difference-quotient Jacobian.
-  const bool bdf = out.method == DaeMethod::kBdf;
-  cvode::Session cv;
-  cvode::check_setup(SUNContext_Create(nullptr, &cv.context), "SUNContext_Create");
-  cv.y = N_VNew_Serial(kStates, cv.context);
-  cv.atol = N_VNew_Serial(kStates, cv.context);
-  if (cv.y == nullptr || cv.atol == nullptr) cvode::check_setup(CV_MEM_FAIL, "N_VNew_Serial");
-  double* y = N_VGetArrayPointer(cv.y);
-  y[0] = start.theta1;
-  y[1] = start.theta2;
-  y[2] = start.theta3;
-  y[3] = start.omega1;
-  y[4] = start.omega2;
-  y[5] = start.omega3;
-  N_VConst(options.absolute_tolerance, cv.atol);
-  cv.memory = CVodeCreate(bdf ? CV_BDF : CV_ADAMS, cv.context);
-  if (cv.memory == nullptr) cvode::check_setup(CV_MEM_FAIL, "CVodeCreate");
-  cvode::check_setup(CVodeSetErrHandlerFn(cv.memory, cvode::keep_error, &motion.cvode_text), "CVodeSetErrHandlerFn");
-  cvode::check_setup(CVodeInit(cv.memory, dae_rhs, 0.0, cv.y), "CVodeInit");
-  cvode::check_setup(CVodeSetUserData(cv.memory, &motion), "CVodeSetUserData");
-  cvode::check_setup(CVodeSVtolerances(cv.memory, options.tolerance, cv.atol), "CVodeSVtolerances");
-  if (bdf) {
-    cv.matrix = SUNDenseMatrix(kStates, kStates, cv.context);
-    if (cv.matrix == nullptr) cvode::check_setup(CV_MEM_FAIL, "SUNDenseMatrix");
-    cv.linear = SUNLinSol_Dense(cv.y, cv.matrix, cv.context);
-    if (cv.linear == nullptr) cvode::check_setup(CV_MEM_FAIL, "SUNLinSol_Dense");
-    cvode::check_setup(CVodeSetLinearSolver(cv.memory, cv.linear, cv.matrix), "CVodeSetLinearSolver");
-  } else {
-    cv.nonlinear = SUNNonlinSol_FixedPoint(cv.y, 0, cv.context);
-    if (cv.nonlinear == nullptr) cvode::check_setup(CV_MEM_FAIL, "SUNNonlinSol_FixedPoint");
-    cvode::check_setup(CVodeSetNonlinearSolver(cv.memory, cv.nonlinear), "CVodeSetNonlinearSolver");
-  }
+  // used), so Adams-Moulton with a fixed-point corrector, as in core/simulate.cpp, or an explicit
+  // Runge-Kutta pair. kProjection: CVODE's projection interface (CVodeSetProjFn) exists for BDF
+  // only, which needs a Newton corrector: dense 6x6 linear solver, difference-quotient Jacobian.
+  // kGgl: IDA on the ten unknowns, started from the consistent values of the 5x5 solve
+  // (θ' = ω, ω' = α, λ = R̄A3, μ = 0); λ and μ are algebraic and take no part in the error test.
   const bool projection = options.stabilisation == Stabilisation::kProjection;
-  if (projection) cvode::check_setup(CVodeSetProjFn(cv.memory, project), "CVodeSetProjFn");
-  cvode::check_setup(CVodeSetStopTime(cv.memory, scene.duration), "CVodeSetStopTime");
+  const bool ggl = options.stabilisation == Stabilisation::kGgl;
+  integrators::Problem problem;
+  problem.integrator = integrator_of(out.method);
+  problem.y0 = {start.theta1, start.theta2, start.theta3, start.omega1, start.omega2, start.omega3};
+  problem.tolerance = options.tolerance;
+  problem.t_end = scene.duration;
+  problem.max_steps = options.max_steps;
+  problem.user_data = &motion;
+  if (ggl) {
+    const FourBarState& s = first->state;
+    problem.y0.insert(problem.y0.end(), {first->RA3.x(), first->RA3.y(), 0.0, 0.0});
+    problem.yp0 = {s.omega1, s.omega2, s.omega3, s.alpha1, s.alpha2, s.alpha3, 0, 0, 0, 0};
+    problem.differential = {true, true, true, true, true, true, false, false, false, false};
+    problem.residual = ggl_residual;
+    // IDA's own first step keeps |h y'| at the tolerance level (h ~ 1e-12 s at 1e-10 when the
+    // linkage moves), where the Newton iteration on the index-2 system fails: the multipliers'
+    // round-off grows like 1/h (measured: no first step at tolerance 1e-10 with omega1 != 0).
+    // The first step of the order-1 BDF has the local error h² |θ̈| / 2: take the h that puts
+    // it at the tolerance, at most 1 % of the run.
+    double angle = 1.0, acceleration = 0.0;
+    for (double a : {s.theta1, s.theta2, s.theta3}) angle = std::max(angle, std::abs(a));
+    for (double a : {s.alpha1, s.alpha2, s.alpha3})
+      acceleration = std::max(acceleration, std::abs(a));
+    const double error = options.tolerance * angle + options.absolute_tolerance;
+    problem.initial_step =
+        acceleration > 0 ? std::min(std::sqrt(2 * error / acceleration), 0.01 * scene.duration)
+                         : 0.01 * scene.duration;
+  } else {
+    problem.rhs = dae_rhs;
+    if (projection) problem.projection = project;
+  }
+  // angles [rad], rates [rad/s]
+  problem.absolute_tolerance.assign(problem.y0.size(), options.absolute_tolerance);
+  if (ggl) {
+    // The multipliers take no part in the error test; their tolerances decide when the Newton
+    // iteration may stop. Their round-off grows like 1/h (μ ≈ -(α/h)(G Gᵀ)⁻¹ c at the
+    // predictor; λ likewise from G ω = 0) and with the size of the angles (sin and cos of a
+    // crank that has turned 100 times), so tolerances near the angles' make the iteration fail,
+    // which IDA answers by smaller steps still until it gives up. Measured on the paper example:
+    // 1e-12 on μ stops it at t = 1.2e-6 s (tolerance 1e-10); λ to 1e-9 N fails after 35-90 s at
+    // omega1 = 3 rad/s (theta1 ~ 140-550 rad), 1e-7 N at tolerance 1e-11. λ to 1e-5 of its
+    // size (at least 1 N) and μ to 1 1/(m s) ran every case measured (the paper example from
+    // rest and at 3 rad/s for 100 s, the triple rocker through its limits, a double crank) at
+    // tolerances 1e-3 ... 1e-12, at the price of up to 1.8 times the steps of the tighter λ.
+    const double force_scale = std::max(1.0, first->RA3.norm());
+    problem.absolute_tolerance[6] = problem.absolute_tolerance[7] = 1e-5 * force_scale;
+    problem.absolute_tolerance[8] = problem.absolute_tolerance[9] = 1.0;
+  }
+  integrators::Integration integration(problem);
 
   traj.status = SimulationStatus::kCompleted;
   traj.message = "completed";
@@ -354,39 +523,46 @@ OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FreeSce
   for (std::size_t j = 1; j < samples; ++j) {
     const double t_out =
         j + 1 == samples ? scene.duration : scene.duration * static_cast<double>(j) / last;
-    long steps = 0;
-    CVodeGetNumSteps(cv.memory, &steps);
-    if (steps >= options.max_steps) {
-      traj.status = SimulationStatus::kIntegratorFailed;
-      traj.message = "integrator stopped at t = " + number(traj.t.back()) +
-                     " s: max_steps = " + std::to_string(options.max_steps) + " reached";
-      break;
-    }
-    CVodeSetMaxNumSteps(cv.memory, options.max_steps - steps);
+    motion.rhs_failed = false;
     // with projection, stop the steps at each output instant so that the sample is a projected
     // step end (CVODE's interpolant between projected steps is itself off the closure by the
     // local error)
-    if (projection) CVodeSetStopTime(cv.memory, t_out);
-
-    motion.rhs_failed = false;
-    sunrealtype t_reached = 0.0;
-    const int flag = CVode(cv.memory, t_out, cv.y, &t_reached, CV_NORMAL);
-    if (flag < 0) {
+    const auto outcome = integration.advance(t_out, projection);
+    const double t_reached = integration.t();
+    const double* y = integration.y();
+    if (outcome == integrators::Integration::Outcome::kMaxSteps) {
+      traj.status = SimulationStatus::kIntegratorFailed;
+      traj.message = "integrator stopped at t = " + number(t_reached) +
+                     " s, theta1 = " + number(y[0]) +
+                     " rad: max_steps = " + std::to_string(options.max_steps) + " reached";
+      break;
+    }
+    if (outcome != integrators::Integration::Outcome::kReached) {  // no root function here
       if (motion.rhs_failed) {
         fail(traj, motion.error, motion.error_t);
         traj.message += "; integration stopped at t = " + number(t_reached) + " s";
       } else {
-        char* flag_name = CVodeGetReturnFlagName(flag);  // mallocs its result
         traj.status = SimulationStatus::kIntegratorFailed;
         traj.message = "integrator failed at t = " + number(t_reached) +
-                       " s, theta1 = " + number(y[0]) + " rad: " + flag_name + ": " +
-                       motion.cvode_text;
-        std::free(flag_name);
+                       " s, theta1 = " + number(y[0]) + " rad: " + integration.failure();
       }
       break;
     }
 
-    const FourBarState s = state_of(y);
+    FourBarState s = state_of(y);
+    if (options.project_samples && !projection) {
+      // the sample on the closure; the integration goes on from its own state
+      Eigen::Vector3d theta(s.theta1, s.theta2, s.theta3), omega(s.omega1, s.omega2, s.omega3);
+      if (project_onto_closure(model, motion.length_scale, theta, omega)) {
+        s.theta1 = theta(0);
+        s.theta2 = theta(1);
+        s.theta3 = theta(2);
+        s.omega1 = omega(0);
+        s.omega2 = omega(1);
+        s.omega3 = omega(2);
+        ++motion.projections;
+      }  // (cannot fail this close to the closure; the unprojected state is kept if it does)
+    }
     ++motion.evaluations;
     const auto sample = forward_dynamics_opened_loop(model, s, closure_bias(motion, s));
     if (!sample) {
@@ -396,7 +572,7 @@ OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FreeSce
     record(out, model, t_reached, *sample);
   }
 
-  CVodeGetNumSteps(cv.memory, &traj.steps);
+  traj.steps = integration.steps();
   traj.rhs_evaluations = motion.evaluations;
   out.projections = motion.projections;
   return out;

@@ -1,10 +1,5 @@
 #include "core/simulate.hpp"
 
-#include <cvode/cvode.h>
-#include <nvector/nvector_serial.h>
-#include <sundials/sundials_context.h>
-#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
-
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
@@ -17,8 +12,9 @@
 #include "core/input_error.hpp"
 #include "core/counter_rotation.hpp"
 #include "core/formulation_support.hpp"
+#include "core/instant_dynamics.hpp"
 #include "core/opened_loop.hpp"
-#include "core/cvode_support.hpp"
+#include "core/integrators.hpp"
 #include "core/kinematics.hpp"
 #include "core/opened_loop_dae.hpp"
 
@@ -125,23 +121,24 @@ void fail(Trajectory& out, const DynamicsError& error, double t, double theta1) 
   out.message = failure_message(error, t, theta1);
 }
 
-// What the CVODE right-hand side needs, and what it saw when the dynamics failed.
+// What the integrator's right-hand side needs, and what it saw when the dynamics failed.
 struct FreeMotion {
   const FourBar* model{};
   Formulation formulation{};
-  long evaluations{};      // forward_dynamics calls (right-hand side and samples)
-  bool rhs_failed{};       // a right-hand side failed since the last reset
-  DynamicsError error;     // the latest failure of the dynamics
-  double error_t{};        // its time [s]
-  double error_theta1{};   // its crank angle [rad]
-  std::string cvode_text;  // CVODE's last error message
+  long evaluations{};     // forward_dynamics calls (right-hand side and samples)
+  bool rhs_failed{};      // a right-hand side failed since the last reset
+  DynamicsError error;    // the latest failure of the dynamics
+  double error_t{};       // its time [s]
+  double error_theta1{};  // its crank angle [rad]
 };
 
 // y = (theta1, omega1), y' = (omega1, alpha1(theta1, omega1)). A failure of the dynamics is
-// recoverable (1): CVODE then retries with a smaller step, and reports failure if it cannot.
+// recoverable (1): CVODE then retries with a smaller step, and reports failure if it cannot;
+// ERKStep (SUNDIALS 6.4) stops.
 int free_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) {
   auto& motion = *static_cast<FreeMotion*>(user_data);
-  const double theta1 = NV_Ith_S(y, 0), omega1 = NV_Ith_S(y, 1);
+  const double* x = N_VGetArrayPointer(y);
+  const double theta1 = x[0], omega1 = x[1];
   ++motion.evaluations;
   const auto sample = forward_dynamics(*motion.model, theta1, omega1, motion.formulation);
   if (!sample || at_dead_centre(*sample, 0.1 * kDeadCentreSin, motion.error)) {
@@ -151,15 +148,16 @@ int free_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) {
     motion.error_theta1 = theta1;
     return 1;
   }
-  NV_Ith_S(ydot, 0) = omega1;
-  NV_Ith_S(ydot, 1) = sample->state.alpha1;
+  double* d = N_VGetArrayPointer(ydot);
+  d[0] = omega1;
+  d[1] = sample->state.alpha1;
   return 0;
 }
 
 // g = |sin(theta3 - theta2)| - kDeadCentreSin: a root is the crank reaching a limit position.
 int dead_centre_root(sunrealtype /*t*/, N_Vector y, sunrealtype* g, void* user_data) {
   const auto& motion = *static_cast<const FreeMotion*>(user_data);
-  const auto pose = solve_position(*motion.model, NV_Ith_S(y, 0));
+  const auto pose = solve_position(*motion.model, N_VGetArrayPointer(y)[0]);
   g[0] = pose ? std::abs(std::sin(pose->theta3 - pose->theta2)) - kDeadCentreSin
               : -kDeadCentreSin;  // beyond the limit (only on an interpolated point)
   return 0;
@@ -208,7 +206,52 @@ std::string SimulateOptions::validate() const {
     default:
       return "formulation " + std::to_string(static_cast<int>(formulation)) + " is unknown";
   }
+  switch (integrator) {
+    case Integrator::kCvodeAdams:
+    case Integrator::kCvodeBdf:
+    case Integrator::kErk2:
+    case Integrator::kErk3:
+    case Integrator::kErk4:
+    case Integrator::kErk5:
+    case Integrator::kErk6:
+    case Integrator::kErk8:
+      break;
+    case Integrator::kIda:
+      if (formulation != Formulation::kOpenedLoop) {
+        return std::string("integrator ida needs formulation opened-loop, got ") +
+               to_string(formulation) +
+               ": IDA integrates the opened loop's DAE, while this formulation is an ODE in "
+               "theta1 (use cvode-adams, cvode-bdf or erk2 ... erk8)";
+      }
+      break;
+    default:
+      return "integrator " + std::to_string(static_cast<int>(integrator)) + " is unknown";
+  }
   return {};
+}
+
+const char* to_string(Integrator integrator) {
+  switch (integrator) {
+    case Integrator::kCvodeAdams:
+      return "cvode-adams";
+    case Integrator::kCvodeBdf:
+      return "cvode-bdf";
+    case Integrator::kErk2:
+      return "erk2";
+    case Integrator::kErk3:
+      return "erk3";
+    case Integrator::kErk4:
+      return "erk4";
+    case Integrator::kErk5:
+      return "erk5";
+    case Integrator::kErk6:
+      return "erk6";
+    case Integrator::kErk8:
+      return "erk8";
+    case Integrator::kIda:
+      return "ida";
+  }
+  return "?";
 }
 
 SimulationStatus status_of(DynamicsError::Kind kind) {
@@ -259,14 +302,13 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
                          const SimulateOptions& options) {
   validate(scene, options);
   if (options.formulation == Formulation::kOpenedLoop) {
-    // the opened loop's own form: the DAE in theta1..theta3, kept on the loop closure by
-    // projection; it has no singularity at a crank limit position and passes through it
-    OpenedLoopDaeOptions dae;
-    dae.stabilisation = Stabilisation::kProjection;
-    dae.tolerance = options.tolerance;
-    dae.absolute_tolerance = options.absolute_tolerance;
-    dae.max_steps = options.max_steps;
-    if (!has_counter_rotations(model)) return simulate_opened_loop_dae(model, scene, dae).trajectory;
+    // the opened loop's own form: the DAE in theta1..theta3, kept on the loop closure as the
+    // integrator allows (opened_loop_dae_options); it has no singularity at a crank limit
+    // position and passes through it
+    const OpenedLoopDaeOptions dae = opened_loop_dae_options(options);
+    if (!has_counter_rotations(model)) {
+      return simulate_opened_loop_dae(model, scene, dae).trajectory;
+    }
     // discs: the motion from the equations with I_k + J_k, then each sample's reactions from the
     // bare linkage loaded by the mesh forces at the sample's own state (core/counter_rotation.hpp)
     Trajectory out = simulate_opened_loop_dae(with_disc_inertia(model), scene, dae).trajectory;
@@ -304,82 +346,80 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
   out.t.push_back(0.0);
   out.samples.push_back(*first);
 
-  // Method: the crank equation is a smooth, non-stiff ODE of two states (its Jacobian has the
-  // eigenvalues of a slow oscillator, |lambda| ~ |omega1| + sqrt|d alpha1/d theta1|), solved
-  // at tight tolerances (1e-10). Variable-order Adams-Moulton (orders 1-12) reaches such
-  // tolerances with far fewer steps than BDF (orders <= 5), and a non-stiff problem needs no
-  // Newton iteration: the fixed-point corrector converges in one or two right-hand sides per
-  // step without Jacobians or linear solves (the CVODE guide's recommendation for non-stiff
-  // problems).
-  cvode::Session cv;
-  cvode::check_setup(SUNContext_Create(nullptr, &cv.context), "SUNContext_Create");
-  cv.y = N_VNew_Serial(2, cv.context);
-  cv.atol = N_VNew_Serial(2, cv.context);
-  if (cv.y == nullptr || cv.atol == nullptr) cvode::check_setup(CV_MEM_FAIL, "N_VNew_Serial");
-  NV_Ith_S(cv.y, 0) = scene.theta1;
-  NV_Ith_S(cv.y, 1) = scene.omega1;
-  NV_Ith_S(cv.atol, 0) = options.absolute_tolerance;  // theta1 [rad]
-  NV_Ith_S(cv.atol, 1) = options.absolute_tolerance;  // omega1 [rad/s]
-  cv.memory = CVodeCreate(CV_ADAMS, cv.context);
-  if (cv.memory == nullptr) cvode::check_setup(CV_MEM_FAIL, "CVodeCreate");
-  cvode::check_setup(CVodeSetErrHandlerFn(cv.memory, cvode::keep_error, &motion.cvode_text), "CVodeSetErrHandlerFn");
-  cvode::check_setup(CVodeInit(cv.memory, free_rhs, 0.0, cv.y), "CVodeInit");
-  cvode::check_setup(CVodeSetUserData(cv.memory, &motion), "CVodeSetUserData");
-  cvode::check_setup(CVodeSVtolerances(cv.memory, options.tolerance, cv.atol), "CVodeSVtolerances");
-  cv.nonlinear = SUNNonlinSol_FixedPoint(cv.y, 0, cv.context);
-  if (cv.nonlinear == nullptr) cvode::check_setup(CV_MEM_FAIL, "SUNNonlinSol_FixedPoint");
-  cvode::check_setup(CVodeSetNonlinearSolver(cv.memory, cv.nonlinear), "CVodeSetNonlinearSolver");
-  cvode::check_setup(CVodeSetStopTime(cv.memory, scene.duration), "CVodeSetStopTime");
-  cvode::check_setup(CVodeRootInit(cv.memory, 1, dead_centre_root), "CVodeRootInit");
+  // Method: options.integrator (docs/performance.md compares them). The crank equation is a
+  // smooth, non-stiff ODE of two states (its Jacobian has the eigenvalues of a slow oscillator,
+  // |lambda| ~ |omega1| + sqrt|d alpha1/d theta1|), solved at tight tolerances (1e-10): the
+  // default, variable-order Adams-Moulton (orders 1-12) with a fixed-point corrector, reaches
+  // them with few steps and no Jacobian; BDF (orders <= 5, Newton) and the explicit
+  // Runge-Kutta pairs are there to be compared. Every one of them locates a dead centre by
+  // root finding on |sin(theta3 - theta2)|, registered only where the coupler and rocker can
+  // align: in a crank-rocker or double crank |A1A3| stays strictly between |l2 - l3| and
+  // l2 + l3 at every crank angle, and there the root checks would only cost (an ERK pair's
+  // Hermite dense output evaluates the dynamics for each check).
+  integrators::Problem problem;
+  problem.integrator = options.integrator;
+  problem.y0 = {scene.theta1, scene.omega1};
+  problem.absolute_tolerance = {options.absolute_tolerance,   // theta1 [rad]
+                                options.absolute_tolerance};  // omega1 [rad/s]
+  problem.tolerance = options.tolerance;
+  problem.t_end = scene.duration;
+  problem.max_steps = options.max_steps;
+  problem.user_data = &motion;
+  problem.rhs = free_rhs;
+  const GrashofClass grashof = classify_grashof(model);
+  if (grashof != GrashofClass::kCrankRocker && grashof != GrashofClass::kDoubleCrank) {
+    problem.root = dead_centre_root;
+  }
+  integrators::Integration integration(problem);
 
-  // each output by CVODE's own interpolant (CV_NORMAL), then the dynamics at that state
+  // each output by the integrator's dense output, then the dynamics at that state
   out.status = SimulationStatus::kCompleted;
   out.message = "completed";
   const double last = static_cast<double>(samples - 1);
   for (std::size_t j = 1; j < samples; ++j) {
     const double t_out =
         j + 1 == samples ? scene.duration : scene.duration * static_cast<double>(j) / last;
-    // max_steps bounds the whole run, CVodeSetMaxNumSteps one call: give each call the rest
-    long steps = 0;
-    CVodeGetNumSteps(cv.memory, &steps);
-    if (steps >= options.max_steps) {
+    motion.rhs_failed = false;
+    const auto outcome = integration.advance(t_out);
+    const double t_reached = integration.t();
+    const double theta1 = integration.y()[0], omega1 = integration.y()[1];
+    if (outcome == integrators::Integration::Outcome::kMaxSteps) {
       out.status = SimulationStatus::kIntegratorFailed;
-      out.message = "integrator stopped at t = " + number(out.t.back()) +
-                    " s, theta1 = " + number(out.samples.back().state.theta1) +
+      out.message = "integrator stopped at t = " + number(t_reached) +
+                    " s, theta1 = " + number(theta1) +
                     " rad: max_steps = " + std::to_string(options.max_steps) + " reached";
       break;
     }
-    CVodeSetMaxNumSteps(cv.memory, options.max_steps - steps);
-
-    motion.rhs_failed = false;
-    sunrealtype t_reached = 0.0;
-    const int flag = CVode(cv.memory, t_out, cv.y, &t_reached, CV_NORMAL);
-    if (flag < 0) {
-      if (motion.rhs_failed) {
-        // the dynamics failed ahead of the last step and CVODE could not step around it
+    if (outcome == integrators::Integration::Outcome::kFailed) {
+      if (motion.rhs_failed && motion.error.kind != DynamicsError::Kind::kNonFinite) {
+        // a trial step went into a dead centre or beyond it, where the loop cannot close, and
+        // the integrator could not step around it (ERKStep cannot retry): in free motion from
+        // an assembled start that is the crank reaching a limit position
+        out.status = SimulationStatus::kSingular;
+        out.message = "limit position reached after t = " + number(t_reached) +
+                      " s, theta1 = " + number(theta1) +
+                      " rad: the crank reaches a limit position within the integrator's next "
+                      "step (a trial step found: " +
+                      motion.error.what() + ")";
+      } else if (motion.rhs_failed) {
+        // the dynamics failed ahead of the last step and the integrator could not step around it
         fail(out, motion.error, motion.error_t, motion.error_theta1);
         out.message += "; integration stopped at t = " + number(t_reached) + " s";
       } else {
-        // CVodeGetReturnFlagName mallocs its result
-        char* flag_name = CVodeGetReturnFlagName(flag);
         out.status = SimulationStatus::kIntegratorFailed;
         out.message = "integrator failed at t = " + number(t_reached) +
-                      " s, theta1 = " + number(NV_Ith_S(cv.y, 0)) + " rad: " + flag_name + ": " +
-                      motion.cvode_text;
-        std::free(flag_name);
+                      " s, theta1 = " + number(theta1) + " rad: " + integration.failure();
       }
       break;
     }
-    if (flag == CV_ROOT_RETURN) {
+    if (outcome == integrators::Integration::Outcome::kRoot) {
       // the crank reached a limit position before t_out: stop there
-      const double theta1 = NV_Ith_S(cv.y, 0);
       const auto pose = solve_position(model, theta1);
       const double sin_mu = pose ? std::sin(pose->theta3 - pose->theta2) : 0.0;
       fail(out, dead_centre_error(theta1, sin_mu), t_reached, theta1);
       break;
     }
 
-    const double theta1 = NV_Ith_S(cv.y, 0), omega1 = NV_Ith_S(cv.y, 1);
     ++motion.evaluations;
     auto sample = forward_dynamics(model, theta1, omega1, options.formulation);
     if (!sample || at_dead_centre(*sample, kDeadCentreSin, motion.error)) {
@@ -391,10 +431,23 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
     out.samples.push_back(*sample);
   }
 
-  CVodeGetNumSteps(cv.memory, &out.steps);
+  out.steps = integration.steps();
   out.rhs_evaluations = motion.evaluations;
   return out;
 }
+
+namespace {
+
+// x rounded to the nearest whole number by adding and subtracting 1.5·2^52, exact for
+// |x| < 2^51 and a few instructions where std::round() is a library call. A tie goes to even
+// where std::round() goes away from zero; in simulate_driven a tie would be a jump of exactly π
+// in a link angle between samples, which the short steps there exclude.
+double nearest_whole(double x) {
+  constexpr double kRound = 6755399441055744.0;  // 1.5·2^52
+  return (x + kRound) - kRound;
+}
+
+}  // namespace
 
 Trajectory simulate_driven(const FourBar& model, const DrivenScene& scene,
                            const SimulateOptions& options) {
@@ -409,18 +462,62 @@ Trajectory simulate_driven(const FourBar& model, const DrivenScene& scene,
   const double period = kTwoPi / std::abs(scene.omega1);
   out.status = SimulationStatus::kCompleted;
   out.message = "completed";
+  // The model's constants once; the crank vector turned from sample to sample (CrankSweep); each
+  // sample computed in its place in the trajectory by the inline kernels of
+  // core/instant_dynamics.hpp (a model with counter-rotations takes the one-instant route).
+  const DynamicsConstants constants = dynamics_constants(model);
+  CrankSweep crank(model.crank.length);
+  // samples at most kMaxUnwrapStep apart in theta1 (the usual case) need no intermediate
+  // positions to continue their angles (continue_angles)
+  const bool short_steps =
+      std::abs(scene.omega1) * period / static_cast<double>(per_revolution) <= kMaxUnwrapStep;
+  double turns2 = 0.0, turns3 = 0.0;        // whole turns added to the wrapped angles
+  double previous2 = 0.0, previous3 = 0.0;  // the previous sample's wrapped angles [rad]
   for (std::size_t j = 0; j < samples; ++j) {
     const double t = period * static_cast<double>(j) / static_cast<double>(per_revolution);
     const double theta1 = scene.theta1 + scene.omega1 * t;
     ++out.rhs_evaluations;
-    auto sample = inverse_dynamics(model, theta1, scene.omega1, 0.0, options.formulation);
-    if (!sample) {
-      fail(out, sample.error(), t, theta1);
+    DynamicsSample& sample = out.samples.emplace_back();
+    std::optional<DynamicsError> error;
+    if (constants.counter_rotations) {
+      const auto one = inverse_dynamics(model, theta1, scene.omega1, 0.0, options.formulation);
+      if (one) {
+        sample = *one;
+      } else {
+        error = one.error();
+      }
+    } else {
+      ClosedInstant instant;
+      std::optional<Failure> failure =
+          close_instant(model, theta1, crank.l1(theta1), scene.omega1, instant);
+      if (!failure) {
+        failure = dynamics_at(model, constants, instant, CrankInput::inverse(0.0),
+                              options.formulation, sample);
+      }
+      if (failure) error = failure->error();
+    }
+    if (error) {
+      out.samples.pop_back();
+      fail(out, *error, t, theta1);
       break;
     }
-    if (j > 0) continue_angles(model, out.samples.back().state, sample->state);
+    FourBarState& state = sample.state;
+    const double wrapped2 = state.theta2, wrapped3 = state.theta3;
+    if (j > 0 && short_steps) {
+      // continue_angles() by the count of whole turns: continuing the previous sample's angle
+      // adds the nearest whole turns of (previous - this)/2π, so the counts add up along the
+      // sweep and each angle is wrapped + 2π·turns, the number continue_angles() gives, without
+      // its serial chain through the previous continuous angle and its calls of std::round()
+      turns2 += nearest_whole((previous2 - wrapped2) / kTwoPi);
+      turns3 += nearest_whole((previous3 - wrapped3) / kTwoPi);
+      state.theta2 = wrapped2 + kTwoPi * turns2;
+      state.theta3 = wrapped3 + kTwoPi * turns3;
+    } else if (j > 0) {
+      continue_angles(model, out.samples[j - 1].state, state);
+    }
+    previous2 = wrapped2;
+    previous3 = wrapped3;
     out.t.push_back(t);
-    out.samples.push_back(*sample);
   }
   return out;
 }

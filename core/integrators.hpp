@@ -1,0 +1,112 @@
+#pragma once
+/// The SUNDIALS integrators of free motion behind one door (core/simulate.hpp `Integrator`):
+/// CVODE (Adams-Moulton, BDF), ARKODE ERKStep (embedded explicit Runge-Kutta pairs) for an ODE
+/// y' = f(t, y), and IDA for a DAE F(t, y, y') = 0. Used by core/simulate.cpp (the reduced
+/// equation in theta1) and core/opened_loop_dae.cpp (the opened loop's ODE and DAE). Internal to
+/// core: SUNDIALS types appear in no public header.
+///
+/// One Integration owns every SUNDIALS object of one run (context, vectors, matrix, solvers,
+/// integrator memory) and frees them in reverse order of creation; it captures the integrator's
+/// error text instead of letting SUNDIALS print it (core never prints); and it advances to each
+/// output instant with the same outcomes whatever the package, so the callers' output loops are
+/// written once.
+#include <sundials/sundials_context.h>
+#include <sundials/sundials_linearsolver.h>
+#include <sundials/sundials_matrix.h>
+#include <sundials/sundials_nonlinearsolver.h>
+#include <sundials/sundials_nvector.h>
+
+#include <string>
+#include <vector>
+
+#include "core/simulate.hpp"
+
+namespace bd::core::integrators {
+
+/// y' = f(t, y) as CVODE and ARKODE call it: 0 on success; > 0 a recoverable failure (CVODE
+/// retries with a smaller step; ERKStep in SUNDIALS 6.4 cannot and stops); < 0 stops the run.
+using RhsFn = int (*)(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data);
+/// g(t, y): the run stops where a component changes sign (root finding; CVODE and ERKStep).
+using RootFn = int (*)(sunrealtype t, N_Vector y, sunrealtype* g, void* user_data);
+/// CVODE's projection onto a constraint manifold (CVodeSetProjFn; BDF only).
+using ProjectionFn = int (*)(sunrealtype t, N_Vector y, N_Vector correction, sunrealtype eps,
+                             N_Vector error, void* user_data);
+/// F(t, y, y') of a DAE as IDA calls it; return values as RhsFn.
+using ResidualFn = int (*)(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void* user_data);
+
+/// What to integrate from t = 0 and how.
+struct Problem {
+  Integrator integrator = Integrator::kCvodeAdams;
+  std::vector<double> y0;                  // initial state
+  std::vector<double> absolute_tolerance;  // per component, as y0
+  double tolerance = 1e-10;                // relative, all components
+  double t_end{};                          // the run never steps past it [s]
+  long max_steps = 1000000;                // steps over the whole run
+  void* user_data{};                       // passed to every callback
+  RhsFn rhs{};                             // ODE integrators (all but kIda)
+  RootFn root{};                           // optional, one function (not with kIda)
+  ProjectionFn projection{};               // optional, kCvodeBdf only
+  /// ERK pairs only: steps of this fixed size [s] without error control (0: adaptive). For
+  /// order checks (tests/core/integrators_test.cpp); simulate_free never sets it.
+  double fixed_step{};
+  // kIda only
+  ResidualFn residual{};
+  std::vector<double> yp0;         // y'(0), consistent with y0 (F(0, y0, yp0) = 0)
+  std::vector<bool> differential;  // false: algebraic, excluded from the error test
+  double initial_step{};           // [s]; 0: IDA's own estimate
+};
+
+/// An integration in progress. Not copyable or movable (SUNDIALS keeps pointers into it).
+class Integration {
+ public:
+  /// Sets the integrator up at t = 0.
+  /// @throws std::runtime_error naming the SUNDIALS call if the setup fails (with a problem that
+  ///         core builds, only by running out of memory).
+  explicit Integration(const Problem& problem);
+  ~Integration();
+  Integration(const Integration&) = delete;
+  Integration& operator=(const Integration&) = delete;
+
+  enum class Outcome {
+    kReached,   // t() == t_out; y() is the solution there
+    kRoot,      // the root function changed sign at t() < t_out; y() is the solution there
+    kMaxSteps,  // the run's max_steps are used up; t(), y() where it stopped
+    kFailed,    // the integrator gave up (failure() says why); t(), y() where it stopped
+  };
+  /// Advances to t_out (> t(), <= t_end). The solution at t_out comes from the integrator's
+  /// dense output (CVODE's Nordsieck array, ARKODE's Hermite interpolant, IDA's BDF
+  /// polynomial: the interpolant CVodeGetDky, ERKStepGetDky and IDAGetDky evaluate), unless
+  /// `stop_at_output` or stops_at_outputs(), which end a step exactly at t_out.
+  Outcome advance(double t_out, bool stop_at_output = false);
+  /// True for the ERK pairs of order 6 and 8, whose steps always end at the output instants:
+  /// ARKODE's Hermite interpolant has degree at most 5 and needs the right-hand side at interior
+  /// points; between the long steps of these methods it is far less accurate than the steps
+  /// (paper example at tolerance 1e-10: 1.2e-6 rad (order 8) and 1.2e-8 rad (order 6) at the
+  /// samples against 1e-10 rad at the step ends), and costs four right-hand sides per output.
+  bool stops_at_outputs() const { return stop_at_outputs_; }
+
+  double t() const { return t_; }  // time reached [s]
+  const double* y() const;         // the state at t()
+  long steps() const;              // steps taken so far
+  /// After kFailed: the integrator's flag name and its last error message, e.g.
+  /// "CV_CONV_FAILURE: CVode: At t = 1.2 and h = 1e-15, the corrector convergence failed ...".
+  const std::string& failure() const { return failure_; }
+
+ private:
+  enum class Package { kCvode, kArkode, kIda };
+  Package package_;
+  bool stop_at_outputs_;
+  long max_steps_;
+  double t_{};
+  std::string error_text_;  // the integrator's last error message (its error handler)
+  std::string failure_;
+  // the SUNDIALS objects; members left null are not used by this integrator
+  SUNContext context_{};
+  N_Vector y_{}, yp_{}, atol_{}, id_{};
+  SUNMatrix matrix_{};
+  SUNLinearSolver linear_{};
+  SUNNonlinearSolver nonlinear_{};
+  void* memory_{};
+};
+
+}  // namespace bd::core::integrators
