@@ -1,7 +1,13 @@
 // balance-design: the command-line program. A thin layer over bd::studies: parse the command
 // line, load the study, run it, print a short summary, and map outcomes to exit codes.
 #include <CLI/CLI.hpp>
+#include <signal.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -13,6 +19,8 @@
 #include "studies/load_study.hpp"
 #include "studies/report.hpp"
 #include "studies/runner.hpp"
+#include "studies/sweep.hpp"
+#include "studies/work_precision.hpp"
 
 #ifndef BD_VERSION
 #define BD_VERSION "unknown"
@@ -29,6 +37,7 @@ constexpr int kExitInternal = 1;
 constexpr int kExitBadInput = 2;
 constexpr int kExitStoppedEarly = 3;
 constexpr int kExitNoOptimum = 4;
+constexpr int kExitInterrupted = 5;
 
 constexpr const char* kFooter = R"(
 Outputs (in DIR, default results/<name>/ with <name> the study's `name`):
@@ -56,6 +65,14 @@ Outputs (in DIR, default results/<name>/ with <name> the study's `name`):
                   network. Charts need gnuplot (BD_GNUPLOT names another program); without it
                   the page has the tables and says so. A report that cannot be written is one
                   warning line on stderr and does not change the exit code.
+  With a `sweep:` section the study runs once per point of the sweep, in parallel, and DIR has:
+  sweep.csv       one row per point, in point order: point, the swept values, the metrics (and
+                  balanced_ / optimized_ metrics, added_mass, added_inertia), status (ok,
+                  stopped-early, no-optimum, bad-input, error) and message; appended as points
+                  finish, so an interrupted sweep keeps its rows (run again with --resume)
+  sweep.json      the study, the design (points, parameters), status and counts
+  report.html     charts of the metrics against the parameters
+  Options of a sweep run: --resume, --threads N, --progress auto|bar|lines|none.
   Files are written under a temporary name and renamed, so none is ever half-written.
 
 Exit codes:
@@ -69,9 +86,41 @@ Exit codes:
   4  the optimiser found no design (infeasible, or it failed); the original's files and
      summary.json (with the optimiser's message) are kept, and one line naming the binding
      constraint is printed on stderr
+  5  sweep interrupted (Ctrl-C or SIGTERM): the rows of the points finished are kept in
+     sweep.csv; run again with --resume to compute the rest. A sweep whose points fail still
+     exits 0: each failure is its row's status
 
 The study-file format is described in docs/study-format.md; examples are in studies/examples/.
 )";
+
+// a sweep's design: how many points, and each parameter's values or range
+void print_sweep_design(const st::SweepRequest& sweep) {
+  const std::size_t points = st::sweep_points(sweep).size();
+  std::printf("  sweep    %s design, %zu point%s, %zu parameter%s", st::to_string(sweep.design),
+              points, points == 1 ? "" : "s", sweep.parameters.size(),
+              sweep.parameters.size() == 1 ? "" : "s");
+  if (sweep.design != st::SweepDesign::kGrid) {
+    std::printf(", seed %llu", static_cast<unsigned long long>(sweep.seed));
+  }
+  std::printf("\n");
+  for (const st::SweepParameter& p : sweep.parameters) {
+    std::printf("    %s: ", p.path.c_str());
+    if (sweep.design == st::SweepDesign::kGrid) {
+      std::printf("%zu value%s", p.values.size(), p.values.size() == 1 ? "" : "s");
+      for (std::size_t i = 0; i < p.values.size(); ++i) {
+        if (i == 3 && p.values.size() > 5) {  // first three, ..., last
+          std::printf(", ..., %g", p.values.back());
+          break;
+        }
+        std::printf("%s%g", i == 0 ? " (" : ", ", p.values[i]);
+      }
+      std::printf("%s", p.values.empty() ? "" : ")");
+    } else {
+      std::printf("drawn from %g to %g", p.from, p.to);
+    }
+    std::printf("%s\n", p.log_scale ? ", log scale" : "");
+  }
+}
 
 // `validate STUDY.yaml`: load and check only, write nothing
 int validate(const std::string& file) {
@@ -79,6 +128,7 @@ int validate(const std::string& file) {
     const st::Study study = st::load_study(file);
     std::printf("%s: ok (study %s, %s scene, method %s)\n", file.c_str(), study.name.c_str(),
                 st::scene_type(study.scene), study.method_name().c_str());
+    if (study.sweep) print_sweep_design(*study.sweep);
     return kExitOk;
   } catch (const bd::InputError& e) {
     std::fprintf(stderr, "%s\n", e.what());
@@ -106,9 +156,11 @@ std::string summary_source(const fs::path& summary) {
   return out;
 }
 
-// `report DIR`: rebuild DIR/report.html from DIR's data files and the study they came from
+// `report DIR`: rebuild DIR/report.html from DIR's data files and the study they came from (a
+// sweep's page when DIR holds sweep.json)
 int report(const std::string& dir) {
-  const fs::path summary = fs::path(dir) / "summary.json";
+  const bool sweep = fs::exists(fs::path(dir) / "sweep.json");
+  const fs::path summary = fs::path(dir) / (sweep ? "sweep.json" : "summary.json");
   if (!fs::exists(summary)) {
     std::fprintf(stderr, "%s: no summary.json here: not the output folder of a run\n", dir.c_str());
     return kExitBadInput;
@@ -128,7 +180,14 @@ int report(const std::string& dir) {
     std::fprintf(stderr, "%s (the study file of %s)\n", e.what(), summary.c_str());
     return kExitBadInput;
   }
-  const fs::path written = st::write_report(study, dir);  // errors: exit 1 with the message
+  if (sweep && !study.sweep) {
+    std::fprintf(stderr, "%s: the study has no sweep section now (the study file of %s)\n",
+                 source.c_str(), summary.c_str());
+    return kExitBadInput;
+  }
+  // errors: exit 1 with the message
+  const fs::path written =
+      sweep ? st::write_sweep_report(study, dir) : st::write_report(study, dir);
   const std::string gnuplot = st::find_gnuplot();
   std::printf("wrote %s%s\n", written.c_str(),
               gnuplot.empty() ? " (without charts: gnuplot not found)" : "");
@@ -138,6 +197,9 @@ int report(const std::string& dir) {
 struct RunArgs {
   std::string study;
   std::string out;
+  bool resume = false;            // sweeps: continue the sweep in the output folder
+  int threads = 0;                // sweeps: parallel points (0: the study's, else one per core)
+  std::string progress = "auto";  // sweeps: auto | bar | lines | none
 };
 
 // before / after / ratio of the main metrics, added mass and inertia
@@ -275,6 +337,75 @@ void print_summary(const st::Study& study, const st::RunResult& r) {
   if (fs::exists(page)) std::printf("  report   %s\n", page.string().c_str());
 }
 
+// set by the first SIGINT or SIGTERM during a sweep: no new point starts, the running ones
+// finish and are written
+std::atomic<bool> g_stop_sweep{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
+
+extern "C" void on_stop_signal(int) {
+  g_stop_sweep.store(true);
+  // a second signal has the default action: the process ends at once (the rows written so far
+  // are kept; at most a last line is cut short, which --resume drops)
+  struct sigaction dfl {};
+  dfl.sa_handler = SIG_DFL;
+  sigemptyset(&dfl.sa_mask);
+  sigaction(SIGINT, &dfl, nullptr);
+  sigaction(SIGTERM, &dfl, nullptr);
+  static const char kNote[] =
+      "\nbalance-design: stopping once the points running are done (again to stop at once)\n";
+  [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, kNote, sizeof kNote - 1);
+}
+
+void catch_stop_signals() {
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+// a study with a sweep section: run_sweep() into `out`, then one line saying what was done
+int run_sweep_study(const st::Study& study, const RunArgs& args, const fs::path& out) {
+  st::SweepOptions options;
+  options.resume = args.resume;
+  options.threads = args.threads;
+  options.progress = args.progress == "bar"     ? st::SweepProgress::kBar
+                     : args.progress == "lines" ? st::SweepProgress::kLines
+                     : args.progress == "none"  ? st::SweepProgress::kNone
+                                                : st::SweepProgress::kAuto;
+  options.stop = &g_stop_sweep;
+  catch_stop_signals();
+  const auto start = std::chrono::steady_clock::now();
+  st::SweepResult r;
+  try {
+    r = st::run_sweep(study, out, options);
+  } catch (const bd::InputError& e) {
+    std::fprintf(stderr, "%s: %s\n", args.study.c_str(), e.what());
+    return kExitBadInput;
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  std::fflush(stderr);
+  std::string resumed;
+  if (r.resumed > 0) resumed = " (" + std::to_string(r.resumed) + " resumed)";
+  const fs::path page = out / "report.html";
+  std::printf("%s: sweep %s, %d of %d points%s, %d failed, %.1f s; wrote %s, %s%s\n",
+              study.name.c_str(), r.complete() ? "complete" : "interrupted", r.done, r.points,
+              resumed.c_str(), r.failed, seconds, r.csv.string().c_str(),
+              r.summary.filename().string().c_str(), fs::exists(page) ? ", report.html" : "");
+  std::fflush(stdout);
+  if (r.interrupted) {
+    std::fprintf(stderr,
+                 "%s: sweep interrupted after %d of %d points: run again with --resume to "
+                 "compute the rest\n",
+                 args.study.c_str(), r.done, r.points);
+    return kExitInterrupted;
+  }
+  return kExitOk;
+}
+
 int run(const RunArgs& args) {
   // load and validate: any mistake is one line on stderr, and nothing is written
   st::Study study;
@@ -286,6 +417,12 @@ int run(const RunArgs& args) {
   }
 
   const fs::path out = args.out.empty() ? fs::path("results") / study.name : fs::path(args.out);
+  if (study.sweep) return run_sweep_study(study, args, out);
+  if (args.resume) {
+    std::fprintf(stderr, "%s: --resume continues a sweep, and this study has no sweep section\n",
+                 args.study.c_str());
+    return kExitBadInput;
+  }
   st::RunResult result;
   try {
     result = st::run_study(study, out);
@@ -331,6 +468,72 @@ void add_run_options(CLI::App& cmd, RunArgs& args) {
   cmd.add_option("-o,--out", args.out,
                  "output directory, created if needed (default: results/<name>/)")
       ->type_name("DIR");
+  cmd.add_flag("--resume", args.resume,
+               "sweeps: continue the sweep in DIR where it stopped (its rows are kept, the "
+               "missing points run)");
+  cmd.add_option("--threads", args.threads,
+                 "sweeps: points run in parallel (default: the study's sweep.threads, else one "
+                 "per core)")
+      ->check(CLI::Range(1, 1024))
+      ->type_name("N");
+  cmd.add_option("--progress", args.progress,
+                 "sweeps: progress on stderr: auto (a bar on a terminal, else a line every 10 s), "
+                 "bar, lines or none")
+      ->check(CLI::IsMember({"auto", "bar", "lines", "none"}))
+      ->type_name("MODE");
+}
+
+struct BenchArgs {
+  std::string study;
+  std::string out;
+  bool quick = false;
+  int repeats = 0;  // 0: 5, or 1 with --quick
+};
+
+// `bench STUDY.yaml`: run the study as `run` does, then measure speed against accuracy
+// (studies/work_precision.hpp): work-precision.csv or driven-convergence.csv, and report.html
+// with its section "Speed against accuracy". Progress on stderr, one line per method.
+int bench(const BenchArgs& args) {
+  st::Study study;
+  try {
+    study = st::load_study(args.study);
+  } catch (const bd::InputError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitBadInput;
+  }
+  if (study.sweep) {
+    std::fprintf(stderr, "%s: bench measures one scene, and this study has a sweep section\n",
+                 args.study.c_str());
+    return kExitBadInput;
+  }
+  st::BenchOptions options = args.quick ? st::BenchOptions::quick() : st::BenchOptions{};
+  if (args.repeats > 0) options.repeats = args.repeats;
+  options.progress = [](const std::string& line) {
+    std::fprintf(stderr, "%s\n", line.c_str());
+    std::fflush(stderr);
+  };
+  const fs::path out = args.out.empty() ? fs::path("results") / study.name : fs::path(args.out);
+  st::BenchResult result;
+  try {
+    result = st::run_bench(study, out, options);
+  } catch (const bd::InputError& e) {
+    std::fprintf(stderr, "%s: %s\n", args.study.c_str(), e.what());
+    return kExitBadInput;
+  }
+  std::fflush(stderr);
+  print_summary(study, result.run);
+  const std::size_t rows =
+      result.free_rows.empty() ? result.driven_rows.size() : result.free_rows.size();
+  std::printf("  bench    %zu rows (%s, %d repeat%s): %s\n", rows,
+              args.quick ? "quick" : "full", options.repeats, options.repeats == 1 ? "" : "s",
+              result.csv.string().c_str());
+  std::fflush(stdout);
+  if (!result.run.trajectory.ok()) {
+    std::fprintf(stderr, "%s: simulation stopped early: %s\n", args.study.c_str(),
+                 result.run.trajectory.message.c_str());
+    return kExitStoppedEarly;
+  }
+  return kExitOk;
 }
 
 // `balance-design STUDY.yaml ...` is short for `balance-design run STUDY.yaml ...`
@@ -339,6 +542,7 @@ std::vector<std::string> with_default_command(int argc, char** argv) {
   if (!args.empty()) {
     const std::string& first = args.front();
     const bool top_level = first == "run" || first == "validate" || first == "report" ||
+                           first == "bench" ||
                            first == "-h" || first == "--help" || first == "--version";
     if (!top_level) args.insert(args.begin(), "run");
   }
@@ -360,10 +564,17 @@ int main(int argc, char** argv) {
         "Commands:\n"
         "  balance-design run STUDY.yaml [--out DIR]   run a study, write its outputs into DIR\n"
         "  balance-design STUDY.yaml [--out DIR]       the same: run is the default command\n"
+        "  balance-design run STUDY.yaml --resume      continue an interrupted sweep (a study\n"
+        "                                              with a sweep section) where it stopped\n"
         "  balance-design validate STUDY.yaml          load and check the study only; prints\n"
         "                                              an ok line (exit 0) or the error (exit 2)\n"
         "  balance-design report DIR                   rebuild DIR/report.html from the data\n"
-        "                                              files of a run (and its study file)\n"
+        "                                              files of a run or sweep (and its study\n"
+        "                                              file)\n"
+        "  balance-design bench STUDY.yaml [--out DIR] [--quick] [--repeats N]\n"
+        "                                              run the study, then measure speed\n"
+        "                                              against accuracy (work-precision.csv or\n"
+        "                                              driven-convergence.csv, report.html)\n"
         "  balance-design run --help                   the options of run\n",
         "balance-design"};
     app.footer(kFooter);
@@ -389,6 +600,25 @@ int main(int argc, char** argv) {
         ->required()
         ->type_name("DIR");
 
+    BenchArgs bench_args;
+    CLI::App* bench_cmd = app.add_subcommand(
+        "bench",
+        "run STUDY.yaml as run does, then time every formulation and integrator against its "
+        "accuracy (free scene: tolerances 1e-3 ... 1e-13, work-precision.csv; driven scene: 4 ... "
+        "720 samples per revolution, driven-convergence.csv) and rewrite report.html");
+    bench_cmd->add_option("STUDY", bench_args.study, "the study file (free or driven scene)")
+        ->required()
+        ->type_name("FILE");
+    bench_cmd->add_option("-o,--out", bench_args.out,
+                          "output directory, created if needed (default: results/<name>/)")
+        ->type_name("DIR");
+    bench_cmd->add_flag("--quick", bench_args.quick,
+                        "tolerances 1e-4, 1e-7, 1e-10 only, one repeat (a few seconds)");
+    bench_cmd->add_option("--repeats", bench_args.repeats,
+                          "timed runs per point, the median reported (default 5; 1 with --quick)")
+        ->check(CLI::Range(1, 1000))
+        ->type_name("N");
+
     std::vector<std::string> argv_rest = with_default_command(argc, argv);
     if (argv_rest.empty()) {
       std::fputs(app.help().c_str(), stderr);
@@ -403,6 +633,7 @@ int main(int argc, char** argv) {
     }
     if (validate_cmd->parsed()) return validate(validate_file);
     if (report_cmd->parsed()) return report(report_dir);
+    if (bench_cmd->parsed()) return bench(bench_args);
     return run(args);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "balance-design: error: %s\n", e.what());

@@ -2,10 +2,12 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -14,7 +16,10 @@
 #include "core/kinematics.hpp"
 #include "core/model.hpp"
 #include "core/principal_vectors.hpp"
+#include "studies/load_study.hpp"
 #include "studies/report_support.hpp"
+#include "studies/runner.hpp"
+#include "studies/work_precision.hpp"
 
 namespace bd::studies {
 
@@ -34,6 +39,7 @@ struct PoseSample {
   core::Joints joints;
   core::PrincipalPoints principal;
   Vec2 S{0, 0};
+  Vec2 G[3];  // centres of mass of crank, coupler, rocker
 };
 
 core::FourBarState state_of(const std::vector<double>& x) {
@@ -59,6 +65,7 @@ PoseSample pose_sample(const core::FourBar& model, const std::vector<double>& x,
   p.joints = core::joint_positions(model, p.pose);
   p.principal = core::opened_loop_principal_points(model, p.pose);
   p.S = core::centre_of_mass_frame(model, s).r;
+  for (int k = 1; k <= 3; ++k) p.G[k - 1] = core::centre_of_mass(model, k, p.pose);
   return p;
 }
 
@@ -68,11 +75,153 @@ std::string vec_text(const Vec2& v) {
   return "(" + fmt(v.x(), "%.4g") + ", " + fmt(v.y(), "%.4g") + ")";
 }
 
+// a design drawn at four samples spread evenly over its run, and the path S traces over all
+struct Drawing {
+  std::vector<PoseSample> poses;
+  std::vector<Vec2> s_path;
+};
+
+Drawing drawing(const core::FourBar& model, const Csv& timeseries) {
+  std::vector<std::vector<double>> rows;
+  for (const auto& r : timeseries.rows) rows.push_back(numbers(r));
+  Drawing d;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (rows[i].size() < 18) continue;
+    d.s_path.push_back(pose_sample(model, rows[i], i).S);
+  }
+  const std::size_t n = rows.size();
+  for (std::size_t k = 0; k < 4 && k < n; ++k) {
+    const std::size_t i = k * n / std::min<std::size_t>(4, n);
+    if (rows[i].size() >= 18) d.poses.push_back(pose_sample(model, rows[i], i));
+  }
+  return d;
+}
+
+// The linkage chart of one design: joints and link lines per sample, the links' centres of mass
+// G1, G2, G3 (marker area in proportion to the link's mass, `mass_ref` [kg] drawn at a fixed
+// size so two designs compare) on thin lines from the joint they are measured from (A0, A1, A2),
+// the opened-loop principal points P1, P2, P3, the system centre of mass S and its path, and any
+// counter-rotation shafts. Each sample's markers are drawn in that sample's colour and each kind
+// has its own legend entry per sample, so the legend shows every marker as drawn (a filled
+// circle of the legend's own size for G). Data blocks are named $<tag>...
+Chart linkage_chart(const core::FourBar& model, const Drawing& d, const std::string& tag,
+                    double mass_ref, std::string& datablocks) {
+  const std::vector<PoseSample>& poses = d.poses;
+  const std::string b = "$" + tag;
+  datablocks += b + "links << EOD\n";
+  for (const PoseSample& p : poses) {
+    const core::Joints& j = p.joints;
+    for (const Vec2* q : {&j.A0, &j.A1, &j.A2, &j.A3}) datablocks += xy(*q) + "\n";
+    datablocks += "\n\n";  // a new data set per pose (index k)
+  }
+  datablocks += "EOD\n" + b + "principal << EOD\n";
+  for (const PoseSample& p : poses) {
+    for (const Vec2* q : {&p.principal.P1, &p.principal.P2, &p.principal.P3})
+      datablocks += xy(*q) + "\n";
+    datablocks += "\n\n";
+  }
+  datablocks += "EOD\n" + b + "S << EOD\n";
+  for (const PoseSample& p : poses) datablocks += xy(p.S) + "\n\n\n";
+  datablocks += "EOD\n" + b + "G << EOD\n";
+  const double m[3] = {model.crank.mass, model.coupler.mass, model.rocker.mass};
+  for (const PoseSample& p : poses) {
+    for (int k = 0; k < 3; ++k) {
+      datablocks +=
+          xy(p.G[k]) + "," + fmt(std::max(0.4, 2.6 * std::sqrt(m[k] / mass_ref)), "%.4g") + "\n";
+    }
+    datablocks += "\n\n";
+  }
+  // s̄k: from the joint each centre of mass is measured from to the centre of mass
+  datablocks += "EOD\n" + b + "arms << EOD\n";
+  for (const PoseSample& p : poses) {
+    const Vec2* from[3] = {&p.joints.A0, &p.joints.A1, &p.joints.A2};
+    for (int k = 0; k < 3; ++k) datablocks += xy(*from[k]) + "\n" + xy(p.G[k]) + "\n\n";
+    datablocks += "\n";
+  }
+  datablocks += "EOD\n" + b + "Spath << EOD\n";
+  for (const Vec2& v : d.s_path) datablocks += xy(v) + "\n";
+  datablocks +=
+      "EOD\n" + b + "frame << EOD\n0,0\n" + fmt(model.frame_length, "%.10g") + ",0\nEOD\n";
+  const bool shafts = core::has_counter_rotations(model);
+  if (shafts) {
+    datablocks += b + "shafts << EOD\n";
+    for (const core::CounterRotation* c :
+         {&model.counter_rotations.crank, &model.counter_rotations.rocker})
+      if (c->inertia > 0) datablocks += xy(c->at) + "\n";
+    datablocks += "EOD\n";
+  }
+
+  std::string cmd =
+      "set size ratio -1\nset xlabel 'x [m]'\nset ylabel 'y [m]'\n"
+      "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n"
+      "set key outside right top vertical Left reverse\n";
+  const core::Joints& j0 = poses.front().joints;
+  const char* jn[] = {"A0", "A1", "A2", "A3"};
+  const Vec2* jp[] = {&j0.A0, &j0.A1, &j0.A2, &j0.A3};
+  for (int i = 0; i < 4; ++i) {
+    cmd += "set label " + gp_string(jn[i]) + " at " + xy(*jp[i]) + " offset 0.6,0.6\n";
+  }
+  const core::PrincipalPoints& p0 = poses.front().principal;
+  const char* pn[] = {"P1", "P2", "P3"};
+  const Vec2* pp[] = {&p0.P1, &p0.P2, &p0.P3};
+  for (int i = 0; i < 3; ++i) {
+    cmd += "set label " + gp_string(pn[i]) + " at " + xy(*pp[i]) + " offset 0.6,-0.8 tc lt 1\n";
+  }
+  // the legend: per sample its links, P, S, G; then the one-off entries
+  std::string entries, arms;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const std::string index = " index " + std::to_string(k);
+    const std::string lt = " lt " + std::to_string(k + 1);
+    entries += b + "links" + index + " using 1:2 with linespoints lw 2 pt 7 ps 0.6" + lt +
+               " title " +
+               gp_string("θ1 = " + fmt(poses[k].pose.theta1, "%.3g") +
+                         " rad, t = " + fmt(poses[k].t, "%.3g") + " s") +
+               ", ";
+    arms += b + "arms" + index + " using 1:2 with lines lw 1 dt 3" + lt + " notitle, ";
+    entries += b + "principal" + index + " using 1:2 with points pt 6 ps 1.4" + lt +
+               " title '  P1 P2 P3', ";
+    entries += b + "S" + index + " using 1:2 with points pt 5 ps 1.2" + lt + " title '  S', ";
+    entries += b + "G" + index + " using 1:2:3 with points pt 7 ps variable" + lt +
+               " title '  G1 G2 G3', ";
+  }
+  cmd += "plot " + arms + entries + b +
+         "frame using 1:2 with lines lw 3 lc 'gray40' title 'frame A0-A3', " + b +
+         "Spath using 1:2 with lines lw 1.5 lc 'black' dt 3 title 'path of S'";
+  if (shafts) {
+    cmd += ", " + b +
+           "shafts using 1:2 with points pt 4 ps 2.2 lw 2 lc 'black' "
+           "title 'counter-rotation shafts'";
+  }
+  Chart c;
+  c.commands = cmd;
+  c.square = true;
+  return c;
+}
+
+// the drawn samples of a design as a table
+std::string poses_table(const Drawing& d) {
+  std::string h =
+      "<table><tr><th>sample</th><th>t [s]</th><th>&theta;1 [rad]</th><th>A1</th>"
+      "<th>A2</th><th>G1</th><th>G2</th><th>G3</th><th>P1</th><th>P2</th>"
+      "<th>P3</th><th>S</th></tr>";
+  for (const PoseSample& p : d.poses) {
+    h += "<tr><td class=\"n\">" + std::to_string(p.index + 1) + "</td><td class=\"n\">" + fmt(p.t) +
+         "</td><td class=\"n\">" + fmt(p.pose.theta1) + "</td><td>" + vec_text(p.joints.A1) +
+         "</td><td>" + vec_text(p.joints.A2) + "</td>";
+    for (const Vec2& g : p.G) h += "<td>" + vec_text(g) + "</td>";
+    h += "<td>" + vec_text(p.principal.P1) + "</td><td>" + vec_text(p.principal.P2) + "</td><td>" +
+         vec_text(p.principal.P3) + "</td><td>" + vec_text(p.S) + "</td></tr>";
+  }
+  return h + "</table>\n";
+}
+
 // ---------------------------------------------------------------------------------------------
 
 const char* branch_text(core::Branch b) { return b == core::Branch::kPlus ? "+1" : "-1"; }
 
-std::string linkage_tables(const Study& study) {
+}  // namespace
+
+std::string linkage_tables_html(const Study& study) {
   const core::FourBar& m = study.model;
   std::string h =
       "<table><tr><th>link</th><th>length l [m]</th><th>mass m [kg]</th>"
@@ -113,6 +262,8 @@ std::string linkage_tables(const Study& study) {
   }
   return h + "</table>";
 }
+
+namespace {
 
 // the run facts of summary.json (or of its balanced_run / optimized_run) as a table
 std::string run_table(const Json& run, const std::string& what) {
@@ -197,7 +348,7 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
     h += "<p>Integrator relative tolerance " + esc(summary.str("tolerance")) + ".</p>\n";
   }
 
-  h += "<h2>Linkage</h2>\n" + linkage_tables(study);
+  h += "<h2>Linkage</h2>\n" + linkage_tables_html(study);
 
   // metrics, side by side with the second design's when there is one
   h += "<h2>Metrics</h2>\n<table><tr><th>metric</th><th>original</th>";
@@ -232,22 +383,22 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
     pareto = read_csv(dir / "pareto.csv");
   }
 
-  // the linkage at four samples evenly spread over the run, and the path of S
-  std::vector<std::vector<double>> rows;
-  for (const auto& r : ts.rows) rows.push_back(numbers(r));
-  std::vector<PoseSample> poses;
-  std::vector<Vec2> s_path;
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    if (rows[i].size() < 18) continue;
-    s_path.push_back(pose_sample(study.model, rows[i], i).S);
-  }
-  if (!rows.empty()) {
-    const std::size_t n = rows.size();
-    for (std::size_t k = 0; k < 4 && k < n; ++k) {
-      const std::size_t i = k * n / std::min<std::size_t>(4, n);
-      if (rows[i].size() >= 18) poses.push_back(pose_sample(study.model, rows[i], i));
+  // the linkage at four samples evenly spread over the run, and the path of S; the second
+  // design's alike, from its own model (counterweights merged into its links) and samples
+  const Drawing original = drawing(study.model, ts);
+  const std::vector<PoseSample>& poses = original.poses;
+  std::optional<core::FourBar> second_model;
+  if (second == "balanced" && study.balance) {
+    second_model = study.balance->model;
+  } else if (second == "optimized" && fs::exists(dir / "optimized.yaml")) {
+    try {
+      second_model = load_study((dir / "optimized.yaml").string()).model;
+    } catch (const std::exception& e) {
+      throw std::runtime_error("cannot draw the optimised design: " + std::string(e.what()));
     }
   }
+  Drawing second_drawing;
+  if (second_model) second_drawing = drawing(*second_model, read_csv(dir / second_file));
 
   // charts
   const fs::path abs_dir = fs::absolute(dir);
@@ -257,7 +408,7 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
                                   ? "t [s] (crank driven at constant speed)"
                                   : "t [s]";
   std::vector<Chart> charts;
-  if (!rows.empty()) {
+  if (!ts.rows.empty()) {
     charts.push_back(
         {"angles", "Link angles",
          "theta1, theta2, theta3 over the run (cf. paper Fig. 7), from timeseries.csv.",
@@ -329,66 +480,48 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
                       drive});
   }
   std::string datablocks;
+  // one scale of marker size for the links' masses of both designs
+  double mass_ref =
+      std::max({study.model.crank.mass, study.model.coupler.mass, study.model.rocker.mass});
+  if (second_model) {
+    mass_ref = std::max({mass_ref, second_model->crank.mass, second_model->coupler.mass,
+                         second_model->rocker.mass});
+  }
+  const std::string masses_caption =
+      ", the links' centres of mass G1, G2, G3 (filled circles, area in proportion to the "
+      "link's mass, on dotted lines from the joint each is measured from: A0, A1, A2), the "
+      "opened-loop principal points P1, P2, P3 (open circles) and the system centre of mass S "
+      "(filled squares), with the path S traces over all ";
   if (!poses.empty()) {
-    datablocks += "$links << EOD\n";
-    for (std::size_t k = 0; k < poses.size(); ++k) {
-      const core::Joints& j = poses[k].joints;
-      for (const Vec2* p : {&j.A0, &j.A1, &j.A2, &j.A3}) datablocks += xy(*p) + "\n";
-      datablocks += "\n\n";  // a new data set per pose (index k)
-    }
-    datablocks += "EOD\n$frame << EOD\n0,0\n" + fmt(study.model.frame_length, "%.10g") + ",0\n";
-    datablocks += "EOD\n$principal << EOD\n";
-    for (std::size_t k = 0; k < poses.size(); ++k) {
-      const core::PrincipalPoints& p = poses[k].principal;
-      for (const Vec2* q : {&p.P1, &p.P2, &p.P3})
-        datablocks += xy(*q) + "," + std::to_string(k + 1) + "\n";
-    }
-    datablocks += "EOD\n$S << EOD\n";
-    for (std::size_t k = 0; k < poses.size(); ++k)
-      datablocks += xy(poses[k].S) + "," + std::to_string(k + 1) + "\n";
-    datablocks += "EOD\n$Spath << EOD\n";
-    for (const Vec2& s : s_path) datablocks += xy(s) + "\n";
-    datablocks += "EOD\n";
-    std::string cmd = "set title 'The linkage at " + std::to_string(poses.size()) +
-                      " samples, principal points and the centre of mass S'\n"
-                      "set size ratio -1\nset xlabel 'x [m]'\nset ylabel 'y [m]'\n"
-                      "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n";
-    const core::Joints& j0 = poses.front().joints;
-    const char* jn[] = {"A0", "A1", "A2", "A3"};
-    const Vec2* jp[] = {&j0.A0, &j0.A1, &j0.A2, &j0.A3};
-    for (int i = 0; i < 4; ++i) {
-      cmd += "set label " + gp_string(jn[i]) + " at " + xy(*jp[i]) + " offset 0.6,0.6\n";
-    }
-    const core::PrincipalPoints& p0 = poses.front().principal;
-    const char* pn[] = {"P1", "P2", "P3"};
-    const Vec2* pp[] = {&p0.P1, &p0.P2, &p0.P3};
-    for (int i = 0; i < 3; ++i) {
-      cmd += "set label " + gp_string(pn[i]) + " at " + xy(*pp[i]) + " offset 0.6,-0.8 tc lt 1\n";
-    }
-    cmd += "plot ";
-    for (std::size_t k = 0; k < poses.size(); ++k) {
-      cmd += "$links index " + std::to_string(k) +
-             " using 1:2 with linespoints lw 2 pt 7 ps 0.8 lt " + std::to_string(k + 1) +
-             " title " +
-             gp_string("θ1 = " + fmt(poses[k].pose.theta1, "%.3g") +
-                       " rad, t = " + fmt(poses[k].t, "%.3g") + " s") +
-             ", ";
-    }
-    cmd +=
-        "$frame using 1:2 with lines lw 3 lc 'gray40' title 'frame A0-A3', "
-        "$principal using 1:2:3 with points pt 6 ps 1.4 lc variable notitle, "
-        "$S using 1:2:3 with points pt 5 ps 1.2 lc variable notitle, "
-        "NaN with points pt 6 ps 1.4 lc 'black' title 'principal points P1 P2 P3 (opened loop)', "
-        "NaN with points pt 5 ps 1.2 lc 'black' title 'S (system centre of mass)', "
-        "$Spath using 1:2 with lines lw 1.5 lc 'black' dt 3 title 'path of S'";
-    charts.push_back({"linkage", "The linkage",
-                      "Joints and link lines at " + std::to_string(poses.size()) +
-                          " samples spread evenly over the run (same colour per sample), the "
-                          "opened-loop principal points P1, P2, P3 (open circles) and the system "
-                          "centre of mass S (filled squares), with the path S traces over all " +
-                          std::to_string(s_path.size()) +
-                          " samples; computed from the model and timeseries.csv (original design).",
-                      cmd, true});
+    Chart c = linkage_chart(study.model, original, "o", mass_ref, datablocks);
+    c.id = "linkage";
+    c.heading = "The linkage";
+    c.commands = "set title 'The linkage at " + std::to_string(poses.size()) +
+                 " samples: joints, centres of mass, principal points and S'\n" + c.commands;
+    c.caption = "Joints and link lines at " + std::to_string(poses.size()) +
+                " samples spread evenly over the run (one colour per sample)" + masses_caption +
+                std::to_string(original.s_path.size()) +
+                " samples; computed from the model and timeseries.csv (original design).";
+    charts.push_back(c);
+  }
+  if (!second_drawing.poses.empty()) {
+    const std::string what = second == "balanced" ? "balanced" : "optimised";
+    Chart c = linkage_chart(*second_model, second_drawing, "s", mass_ref, datablocks);
+    c.id = "linkage-" + second;
+    c.heading = "The " + what + " linkage";
+    c.commands =
+        "set title " +
+        gp_string("The " + what + " design at " + std::to_string(second_drawing.poses.size()) +
+                  (second == "balanced" ? " samples: its counterweights merged into its links"
+                                        : " samples: counterweights and link changes merged")) +
+        "\n" + c.commands;
+    c.caption = "The " + what + " design drawn as the original above, from " + second_file +
+                ": joints and link lines at " + std::to_string(second_drawing.poses.size()) +
+                " samples" + masses_caption + std::to_string(second_drawing.s_path.size()) +
+                " samples. A counterweight shows as its link's centre of mass moved towards or "
+                "past the pivot and grown with the added mass; where the shaking force is "
+                "balanced, S stays in one place.";
+    charts.push_back(c);
   }
   if (has_pareto && pareto.header.size() >= 3) {
     charts.push_back({"pareto", "Pareto front",
@@ -415,17 +548,11 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
     }
   }
   if (!poses.empty()) {
-    h += "<h3>The linkage at the drawn samples</h3><table><tr><th>sample</th><th>t [s]</th>"
-         "<th>&theta;1 [rad]</th><th>A1</th><th>A2</th><th>P1</th><th>P2</th><th>P3</th>"
-         "<th>S</th></tr>";
-    for (const PoseSample& p : poses) {
-      h += "<tr><td class=\"n\">" + std::to_string(p.index + 1) + "</td><td class=\"n\">" +
-           fmt(p.t) + "</td><td class=\"n\">" + fmt(p.pose.theta1) + "</td><td>" +
-           vec_text(p.joints.A1) + "</td><td>" + vec_text(p.joints.A2) + "</td><td>" +
-           vec_text(p.principal.P1) + "</td><td>" + vec_text(p.principal.P2) + "</td><td>" +
-           vec_text(p.principal.P3) + "</td><td>" + vec_text(p.S) + "</td></tr>";
-    }
-    h += "</table>\n";
+    h += "<h3>The linkage at the drawn samples</h3>" + poses_table(original);
+  }
+  if (!second_drawing.poses.empty()) {
+    h += "<h3>The " + std::string(second == "balanced" ? "balanced" : "optimised") +
+         " linkage at the drawn samples</h3>" + poses_table(second_drawing);
   }
 
   if (!second.empty()) {
@@ -444,6 +571,8 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
     h += "<h2>Pareto front</h2>\n<p>From <a href=\"pareto.csv\">pareto.csv</a>.</p>" +
          csv_table(pareto);
   }
+  // the measurements of `balance-design bench` when the folder has them (work_precision.hpp)
+  h += work_precision_section(dir, gnuplot);
   h += "<h2>Data files</h2>\n<ul>\n";
   for (const char* f :
        {"timeseries.csv", "summary.json", "balanced-timeseries.csv", "balanced.yaml",
@@ -461,23 +590,7 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
 fs::path write_report(const Study& study, const fs::path& dir) {
   const std::string html = report_html(study, dir, find_gnuplot());
   const fs::path target = dir / "report.html";
-  const fs::path temp = dir / (".report.html." + std::to_string(::getpid()) + ".tmp");
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    out << html;
-    out.close();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(temp, ec);
-      throw std::runtime_error("cannot write " + temp.string());
-    }
-  }
-  std::error_code ec;
-  fs::rename(temp, target, ec);
-  if (ec) {
-    fs::remove(temp, ec);
-    throw std::runtime_error("cannot rename " + temp.string() + " to " + target.string());
-  }
+  write_text_file(html, target);  // whole or not at all (runner.hpp)
   return target;
 }
 

@@ -25,6 +25,10 @@ std::string find_gnuplot();
 std::string report_html(const Study& study, const std::filesystem::path& dir,
                         const std::string& gnuplot);
 
+/// The study's linkage as HTML tables: links (l, m, s, σ, e, f, I), frame, branch, Grashof class,
+/// counter-rotations and loads; the study page and the sweep page show them.
+std::string linkage_tables_html(const Study& study);
+
 /// Writes `dir/report.html` (report_html() with find_gnuplot()), under a temporary name renamed
 /// into place, and returns its path.
 /// @throws std::runtime_error as report_html(), or if the file cannot be written.

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <mutex>
 #include <stdexcept>
 #include <system_error>
 #include <utility>
@@ -299,6 +300,7 @@ std::string run_json_fields(const core::Trajectory& tr, const std::string& inden
 core::Trajectory simulate(const Study& study, const MethodChoice& method) {
   core::SimulateOptions options;
   options.formulation = method.formulation;
+  options.integrator = method.integrator;
   options.tolerance = study.tolerance;
   if (const auto* free = std::get_if<core::FreeScene>(&study.scene)) {
     return core::simulate_free(study.model, *free, options);
@@ -314,6 +316,9 @@ void write_text(const std::string& text, const fs::path& file) {
   out.commit();
 }
 
+// held around every Ipopt solve (see optimize_study())
+std::mutex ipopt_mutex;
+
 // solves an optimize study's problem and simulates the optimum; not run when the original's
 // simulation stopped early (its metrics are the normalisers)
 OptimizedRun optimize_study(const Study& study, const RunResult& original) {
@@ -325,7 +330,12 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original) {
   }
   const OptimizeRequest& req = *study.optimize;
   const optimize::DesignProblem problem = design_problem(study);
+  // Ipopt 3.11 (Debian 12) calls MUMPS, which is not thread-safe, without a lock of its own:
+  // one Ipopt solve at a time in this process (compute_study() may run on several threads)
+  std::unique_lock<std::mutex> ipopt_lock(ipopt_mutex, std::defer_lock);
+  if (req.options.algorithm == optimize::Algorithm::kIpopt) ipopt_lock.lock();
   o.result = optimize::optimize(problem, req.options);
+  if (ipopt_lock.owns_lock()) ipopt_lock.unlock();
   {
     const optimize::Nlp nlp(problem);
     o.variable_names = nlp.variable_names();
@@ -339,6 +349,7 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original) {
   o.trajectory = simulate(best, o.method);
   o.metrics = core::metrics(o.trajectory);
   if (req.pareto) {
+    if (req.options.algorithm == optimize::Algorithm::kIpopt) ipopt_lock.lock();
     o.pareto = optimize::pareto_front(problem, req.pareto->first, req.pareto->second,
                                       req.pareto->points, req.options);
   }
@@ -612,11 +623,9 @@ std::string pareto_csv(const Study& study, const OptimizedRun& run) {
   return text;
 }
 
-RunResult run_study(const Study& study, const fs::path& out_dir) {
+RunResult compute_study(const Study& study) {
   RunResult result;
   result.method = choose_method(study);
-
-  // simulate first: an invalid scene throws before anything is created on disk
   result.trajectory = simulate(study, result.method);
   result.metrics = core::metrics(result.trajectory);
   std::optional<Study> balanced;
@@ -629,8 +638,13 @@ RunResult run_study(const Study& study, const fs::path& out_dir) {
     result.balanced = std::move(b);
   }
   if (study.optimize) result.optimized = optimize_study(study, result);
+  return result;
+}
 
-  // then the files, summary last: a summary.json means the other files are complete
+void write_text_file(const std::string& text, const fs::path& file) { write_text(text, file); }
+
+void write_run(const Study& study, RunResult& result, const fs::path& out_dir) {
+  // summary last: a summary.json means the other files are complete
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec) {
@@ -671,6 +685,12 @@ RunResult run_study(const Study& study, const fs::path& out_dir) {
     fs::remove(out_dir / "report.html", remove_ec);  // never a stale page of an earlier run
     std::fprintf(stderr, "balance-design: warning: report.html not written: %s\n", e.what());
   }
+}
+
+RunResult run_study(const Study& study, const fs::path& out_dir) {
+  // compute first: an invalid scene throws before anything is created on disk
+  RunResult result = compute_study(study);
+  write_run(study, result, out_dir);
   return result;
 }
 

@@ -98,6 +98,26 @@ struct ComparisonRow {
 /// optimum.
 std::vector<ComparisonRow> comparison(const Study& study, const RunResult& result);
 
+/// What run_study() computes, without writing anything: simulates the study's scene, and with a
+/// balance section the balanced design, with an optimize section solves the design problem and
+/// simulates the optimum (each as run_study() describes). The result's file paths stay empty.
+/// Pure: the same study gives the same result, bit for bit, and the call is safe from several
+/// threads at once (run_sweep() computes its points so). Ipopt solves are serialised by a
+/// mutex: Debian 12's Ipopt 3.11.9 calls MUMPS, which is not thread-safe, and has no lock of its
+/// own (Ipopt takes one around MUMPS from 3.14 on).
+/// @throws bd::InputError as run_study().
+RunResult compute_study(const Study& study);
+
+/// Writes the files of a computed run into out_dir as run_study() does (creating out_dir when
+/// needed, summary.json last, then report.html), and sets the result's file paths.
+/// @throws std::runtime_error if an output file cannot be written (the message names it).
+void write_run(const Study& study, RunResult& result, const std::filesystem::path& out_dir);
+
+/// Writes `text` to `file` under a temporary name in its directory renamed into place, so a
+/// reader sees the whole file or none.
+/// @throws std::runtime_error if the file cannot be written (the message names it).
+void write_text_file(const std::string& text, const std::filesystem::path& file);
+
 /// Simulates the study's scene (core::simulate_free or core::simulate_driven) and writes
 /// `timeseries.csv` and `summary.json` into out_dir, creating out_dir when needed (and only after
 /// the simulation, so an invalid study creates nothing). Each file is written to a temporary
@@ -115,6 +135,7 @@ std::vector<ComparisonRow> comparison(const Study& study, const RunResult& resul
 /// `optimized_run`, `optimized_metrics` and `reduction`. When the optimiser finds no design
 /// (infeasible or failed) only the original's files are written, summary.json says why, and the
 /// result's optimized->failed() is true. summary.json is always written last.
+/// It is compute_study() followed by write_run().
 /// @throws bd::InputError if the scene or options are invalid (core's checks), or if an optimize
 ///         study's problem is (the optimize layer's checks; load_study() has made them already).
 /// @throws std::runtime_error if an output file cannot be written (the message names it).

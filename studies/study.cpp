@@ -1,6 +1,8 @@
 #include "studies/study.hpp"
 
 #include <cassert>
+#include <string>
+#include <utility>
 
 namespace bd::studies {
 
@@ -56,6 +58,39 @@ optimize::DesignProblem design_problem(const Study& study) {
   return p;
 }
 
+namespace {
+
+// Below this tolerance the opened loop is integrated by the order-8 pair, above it by the
+// order-5 pair (docs/performance.md "Recommendation"). Through the triple rocker's limit
+// positions (20 s, 2001 samples): Dormand-Prince 5(4) gives 7.9 correct digits in 8.6 ms at
+// tolerance 1e-8, but no more at 1e-9 (12 ms) and 8.6 at 1e-10 (17 ms); Fehlberg 8(7), its steps
+// ending at every sample, 12 digits in 15 ms at any tolerance from 1e-3 to 1e-11. CVODE Adams
+// (Baumgarte) gives 4.1 / 5.0 / 6.3 digits in 5.8 / 7.0 / 9.5 ms at 1e-8 / 1e-9 / 1e-10, BDF
+// with projection 3.7 / 7.3 / 6.5 digits in 12 / 16 / 21 ms: both lie above the pairs' front.
+constexpr double kOpenedLoopErk8Below = 1e-8;
+
+// the integrator of formulation f at a tolerance, and why
+std::pair<core::Integrator, std::string> integrator_for(core::Formulation f, double tolerance) {
+  if (f != core::Formulation::kOpenedLoop) {
+    return {core::Integrator::kCvodeAdams,
+            "reduced equation in theta1 integrated by CVODE Adams, on the front of the "
+            "work-precision chart at every tolerance (paper example: 10.9 correct digits in "
+            "0.56 ms at tolerance 1e-12, docs/performance.md)"};
+  }
+  if (tolerance < kOpenedLoopErk8Below) {
+    return {core::Integrator::kErk8,
+            "DAE in theta1..theta3 integrated by the Fehlberg 8(7) Runge-Kutta pair (Baumgarte "
+            "stabilisation, steps ending at every sample): below tolerance 1e-8 the most "
+            "correct digits per CPU time through limit positions (docs/performance.md)"};
+  }
+  return {core::Integrator::kErk5,
+          "DAE in theta1..theta3 integrated by the Dormand-Prince 5(4) Runge-Kutta pair "
+          "(Baumgarte stabilisation): from tolerance 1e-8 up the most correct digits per CPU "
+          "time (docs/performance.md)"};
+}
+
+}  // namespace
+
 MethodChoice choose_method(const Study& study) {
   const bool free = std::holds_alternative<core::FreeScene>(study.scene);
   // a free crank that cannot turn fully reaches limit positions, where theta1 stops being a
@@ -76,8 +111,8 @@ MethodChoice choose_method(const Study& study) {
     }
   } else if (reaches_limits) {
     choice.formulation = core::Formulation::kOpenedLoop;
-    choice.reason = limits + "; the opened-loop DAE (projected onto the loop closure) passes "
-                             "through them, the reduced equation in theta1 would stop at the first";
+    choice.reason = limits + "; the opened-loop DAE passes through them, the reduced equation "
+                             "in theta1 would stop at the first";
   } else {
     choice.formulation = core::Formulation::kMassMatrix;
     choice.reason =
@@ -87,10 +122,10 @@ MethodChoice choose_method(const Study& study) {
   }
   if (!free) {
     choice.reason += "; no integrator: kinetostatics per sample";
-  } else if (choice.formulation == core::Formulation::kOpenedLoop) {
-    choice.reason += "; DAE in theta1..theta3 integrated by CVODE (BDF with projection)";
   } else {
-    choice.reason += "; reduced equation in theta1 integrated by CVODE (Adams)";
+    const auto [integrator, why] = integrator_for(choice.formulation, study.tolerance);
+    choice.integrator = integrator;
+    choice.reason += "; " + why;
   }
   return choice;
 }

@@ -11,6 +11,7 @@
 #include "optimize/problem.hpp"
 #include "studies/balance_study.hpp"
 #include "studies/optimize_study.hpp"
+#include "studies/sweep_request.hpp"
 
 namespace bd::studies {
 
@@ -41,6 +42,10 @@ struct Study {
   /// The study file's `optimize:` section, checked at load time and solved by the runner; empty
   /// when absent. A study has a balance section or an optimize section, never both.
   std::optional<OptimizeRequest> optimize;
+  /// The study file's `sweep:` section, checked at load time; empty when absent. A study with
+  /// a sweep is run point by point (run_sweep() in studies/sweep.hpp); its own model and scene
+  /// are the file's values, valid on their own.
+  std::optional<SweepRequest> sweep;
 
   /// "auto" or the requested formulation's name.
   std::string method_name() const;
@@ -59,17 +64,25 @@ Study optimized_study(const Study& study, const core::FourBar& design);
 /// uses (choose_method(study)). Precondition: study.optimize is set.
 optimize::DesignProblem design_problem(const Study& study);
 
-/// The formulation a run uses, and why (for the console and summary.json).
+/// The formulation and integrator a run uses, and why (for the console and summary.json).
 struct MethodChoice {
   core::Formulation formulation = core::Formulation::kMassMatrix;
+  /// Free scenes: the integrator of the formulation's equations (core::SimulateOptions);
+  /// unused in driven scenes.
+  core::Integrator integrator = core::Integrator::kCvodeAdams;
   std::string reason;
 };
 /// Resolves `auto` (DESIGN.md: the leanest formulation and evaluation path for the outputs,
-/// never one inside its failure domain; docs/failure-domains.md "What auto must avoid"):
+/// never one inside its failure domain; docs/failure-domains.md "What auto must avoid"), and the
+/// integrator of a free scene, as docs/performance.md "Recommendation" measured them:
 /// - a free scene whose crank cannot turn fully: opened-loop, whose DAE passes the crank's limit
-///   positions (the reduced equation in theta1 would stop at the first one);
-/// - otherwise mass-matrix, the cheapest exact formulation per evaluation (docs/performance.md).
-/// An explicit method is used as asked; the reason then notes what auto would do differently.
+///   positions (the reduced equation in theta1 would stop at the first one), integrated by
+///   kErk8 at tolerances below 1e-8 and by kErk5 from 1e-8 up (Baumgarte stabilisation);
+/// - otherwise mass-matrix, the cheapest exact formulation per evaluation, integrated by
+///   kCvodeAdams, on the front of the reduced equation's work-precision chart at every
+///   tolerance measured.
+/// An explicit method is used as asked, with the integrator auto would give that formulation;
+/// the reason then notes what auto would do differently.
 MethodChoice choose_method(const Study& study);
 
 }  // namespace bd::studies

@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Renders the report.html of every example study in headless Chromium and fails on a console
-# error, a missing image, an empty chart or a page that does not render.
+# error, a missing image, an empty chart or a page that does not render. A sweep example's page
+# is the sweep's (heat maps and tables from sweep.csv); it is also checked as an interrupted
+# sweep leaves it: its rows cut to the first few and a last line cut short, the page rebuilt by
+# `balance-design report DIR`.
 #   tests/report_browser_check.sh BALANCE_DESIGN [CHROMIUM] [KEEP_DIR]
 # KEEP_DIR, when given, keeps the runs and the screenshots (<example>.png) there.
 set -euo pipefail
@@ -22,23 +25,13 @@ fail() {
   failures=$((failures + 1))
 }
 
-for study in "$src"/studies/examples/*.yaml; do
-  name=$(basename "$study" .yaml)
-  out="$work/$name"
-  rc=0
-  "$exe" run "$study" --out "$out" >/dev/null 2>"$work/$name.run.err" || rc=$?
-  # exit 3 (stopped early) and 4 (no optimum) still write their report
-  if [ "$rc" -ne 0 ] && [ "$rc" -ne 3 ] && [ "$rc" -ne 4 ]; then
-    fail "$name: run failed with exit $rc: $(head -c 400 "$work/$name.run.err")"
-    continue
-  fi
-  page="$out/report.html"
+# check_page NAME OUT: the checks of OUT/report.html
+check_page() {
+  local name=$1 out=$2
+  local page="$out/report.html"
   if [ ! -s "$page" ]; then
     fail "$name: no report.html"
-    continue
-  fi
-  if grep -q 'warning' "$work/$name.run.err"; then
-    fail "$name: $(grep warning "$work/$name.run.err" | head -1)"
+    return
   fi
 
   # every chart has drawn something: each <svg> ... </svg> holds path elements
@@ -47,6 +40,14 @@ for study in "$src"/studies/examples/*.yaml; do
     inside && /<path/ { paths++ }
     inside && /<\/svg>/ { inside = 0; if (paths < 3) { print name ": chart " charts " is empty"; bad = 1 } }
     END { exit bad }' "$page" >&2 || fail "$name: an empty chart"
+  # one drawing per chart, none left out
+  if command -v gnuplot >/dev/null &&
+    [ "$(grep -c '<figure class="chart"' "$page")" -ne "$(grep -c '<svg' "$page")" ]; then
+    fail "$name: a chart without its drawing"
+  fi
+  if grep -qiE '[^a-z]nan[^a-z]' "$page"; then
+    fail "$name: NaN on the page: $(grep -oiE '.{30}[^a-z]nan[^a-z].{10}' "$page" | head -1)"
+  fi
 
   # every image points at a file that exists (or is inline data)
   while IFS= read -r src_attr; do
@@ -77,6 +78,41 @@ for study in "$src"/studies/examples/*.yaml; do
     fail "$name: no screenshot"
   fi
   echo "report_browser_check: $name ok ($(grep -c '<svg' "$page") charts)"
+}
+
+for study in "$src"/studies/examples/*.yaml; do
+  name=$(basename "$study" .yaml)
+  out="$work/$name"
+  rc=0
+  "$exe" run "$study" --out "$out" >/dev/null 2>"$work/$name.run.err" || rc=$?
+  # exit 3 (stopped early) and 4 (no optimum) still write their report
+  if [ "$rc" -ne 0 ] && [ "$rc" -ne 3 ] && [ "$rc" -ne 4 ]; then
+    fail "$name: run failed with exit $rc: $(head -c 400 "$work/$name.run.err")"
+    continue
+  fi
+  if grep -q 'warning' "$work/$name.run.err"; then
+    fail "$name: $(grep warning "$work/$name.run.err" | head -1)"
+  fi
+  check_page "$name" "$out"
+
+  # a sweep as an interruption leaves it: the first rows, a last line cut short, the page
+  # rebuilt from the files
+  if [ -f "$out/sweep.json" ]; then
+    cut_dir="$work/$name-interrupted"
+    rm -rf "$cut_dir"
+    mkdir -p "$cut_dir"
+    head -n 31 "$out/sweep.csv" >"$cut_dir/sweep.csv"
+    sed -n 32p "$out/sweep.csv" | head -c 40 >>"$cut_dir/sweep.csv"
+    sed -e 's/"status": "complete"/"status": "interrupted"/' -e 's/"done": [0-9]*/"done": 30/' \
+      "$out/sweep.json" >"$cut_dir/sweep.json"
+    if ! "$exe" report "$cut_dir" >/dev/null 2>"$work/$name-interrupted.err"; then
+      fail "$name-interrupted: report failed: $(head -c 400 "$work/$name-interrupted.err")"
+      continue
+    fi
+    grep -q 'Interrupted after 30 of' "$cut_dir/report.html" ||
+      fail "$name-interrupted: the page does not say the sweep was interrupted"
+    check_page "$name-interrupted" "$cut_dir"
+  fi
 done
 
 if [ "$failures" -ne 0 ]; then

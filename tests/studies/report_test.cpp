@@ -9,8 +9,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -134,9 +136,9 @@ TEST_F(ReportTest, BalanceRunWritesASelfContainedReport) {
 
   if (find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
   const std::vector<std::string> charts = svgs(html);
-  EXPECT_EQ(charts.size(), 6u);  // angles, reactions, hodograph, Msh, drive, linkage
-  for (const char* id :
-       {"angles", "reactions", "hodograph", "shaking-moment", "drive", "linkage"}) {
+  EXPECT_EQ(charts.size(), 7u);  // angles, reactions, hodograph, Msh, drive, both linkages
+  for (const char* id : {"angles", "reactions", "hodograph", "shaking-moment", "drive", "linkage",
+                         "linkage-balanced"}) {
     EXPECT_NE(html.find(std::string("id=\"chart-") + id + "\""), std::string::npos) << id;
   }
   for (const std::string& svg : charts) EXPECT_GT(count(svg, "<path"), 3u);
@@ -182,8 +184,101 @@ TEST_F(ReportTest, OptimizeRunWithParetoFrontHasItsChartAndTable) {
   EXPECT_NE(html.find("<h2>Comparison</h2>"), std::string::npos);
   EXPECT_NE(html.find("optimised"), std::string::npos);
   if (find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
-  EXPECT_EQ(svgs(html).size(), 7u);
+  EXPECT_EQ(svgs(html).size(), 8u);
   EXPECT_NE(html.find("id=\"chart-pareto\""), std::string::npos);
+  EXPECT_NE(html.find("id=\"chart-linkage-optimized\""), std::string::npos);
+  EXPECT_NE(html.find("The optimised linkage at the drawn samples"), std::string::npos);
+}
+
+// the cells' text of each row of the table that follows <h3>heading</h3>
+std::vector<std::vector<std::string>> table_after(const std::string& html,
+                                                  const std::string& heading) {
+  std::vector<std::vector<std::string>> rows;
+  const std::size_t at = html.find("<h3>" + heading + "</h3>");
+  if (at == std::string::npos) return rows;
+  const std::string table = html.substr(at, html.find("</table>", at) - at);
+  const std::regex row("<tr>(.*?)</tr>"), cell("<td[^>]*>([^<]*)</td>");
+  for (auto r = std::sregex_iterator(table.begin(), table.end(), row); r != std::sregex_iterator();
+       ++r) {
+    const std::string text = (*r)[1].str();
+    std::vector<std::string> cells;
+    for (auto c = std::sregex_iterator(text.begin(), text.end(), cell); c != std::sregex_iterator();
+         ++c) {
+      cells.push_back((*c)[1].str());
+    }
+    if (!cells.empty()) rows.push_back(cells);
+  }
+  return rows;
+}
+
+TEST_F(ReportTest, BalancedLinkageIsDrawnWithItsCounterweights) {
+  const Study study =
+      load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven-force-balanced.yaml");
+  ASSERT_TRUE(run_study(study, dir_).ok());
+  const std::string html = read(dir_ / "report.html");
+  // columns: sample, t, theta1, A1, A2, G1, G2, G3, P1, P2, P3, S
+  const auto original = table_after(html, "The linkage at the drawn samples");
+  const auto balanced = table_after(html, "The balanced linkage at the drawn samples");
+  ASSERT_EQ(original.size(), 4u);
+  ASSERT_EQ(balanced.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    ASSERT_EQ(balanced[i].size(), 12u);
+    // the same driven motion: the same joints
+    EXPECT_EQ(balanced[i][3], original[i][3]);
+    EXPECT_EQ(balanced[i][4], original[i][4]);
+    // force balanced: S stays where it is (to the 4 digits shown); the original's moves
+    EXPECT_EQ(balanced[i][11], balanced[0][11]);
+    if (i > 0) {
+      EXPECT_NE(original[i][11], original[0][11]);
+    }
+  }
+  // at theta1 = 0 the crank lies along +x: its centre of mass is ahead of A0, the balanced
+  // crank's (counterweight merged) behind it
+  ASSERT_EQ(original[0][2], "0");
+  EXPECT_EQ(original[0][5].rfind("(0.", 0), 0u) << original[0][5];
+  EXPECT_EQ(balanced[0][5].rfind("(-", 0), 0u) << balanced[0][5];
+  if (find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
+  EXPECT_NE(html.find("id=\"chart-linkage-balanced\""), std::string::npos);
+}
+
+// The legend of the linkage chart shows each marker as it is drawn: every legend entry of a
+// marker (P1 P2 P3, S, G1 G2 G3) is the plot of that marker, not a stand-in beside it, so its
+// key sample and its points share one symbol and one colour; one entry per sample, each in the
+// sample's colour.
+TEST_F(ReportTest, LinkageLegendShowsTheMarkersAsDrawn) {
+  if (find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
+  const Study study = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml");
+  ASSERT_TRUE(run_study(study, dir_).ok());
+  const std::string html = read(dir_ / "report.html");
+  const std::size_t at = html.find("id=\"chart-linkage\"");
+  ASSERT_NE(at, std::string::npos);
+  const std::string svg = html.substr(at, html.find("</svg>", at) - at);
+  const std::regex use("<use xlink:href='#linkage-gpPt([0-9]+)'[^>]*color='([^']*)'");
+  std::map<std::string, std::set<std::string>> colours;  // marker kind -> colours of entries
+  const std::string group = "<g id=\"linkage-gnuplot_plot_";
+  for (std::size_t g = svg.find(group); g != std::string::npos;) {
+    const std::size_t next = svg.find(group, g + 1);
+    const std::string body =
+        svg.substr(g, next == std::string::npos ? std::string::npos : next - g);
+    g = next;
+    std::string kind;
+    for (const char* k : {">  P1 P2 P3<", ">  S<", ">  G1 G2 G3<"})
+      if (body.find(k) != std::string::npos) kind = k;
+    if (kind.empty()) continue;
+    std::set<std::string> symbols, colour;
+    std::size_t uses = 0;
+    for (auto u = std::sregex_iterator(body.begin(), body.end(), use); u != std::sregex_iterator();
+         ++u, ++uses) {
+      symbols.insert((*u)[1].str());
+      colour.insert((*u)[2].str());
+    }
+    EXPECT_GE(uses, 2u) << kind << ": the legend's marker and at least one drawn";
+    EXPECT_EQ(symbols.size(), 1u) << kind;
+    EXPECT_EQ(colour.size(), 1u) << kind;
+    if (colour.size() == 1) colours[kind].insert(*colour.begin());
+  }
+  ASSERT_EQ(colours.size(), 3u);
+  for (const auto& [kind, c] : colours) EXPECT_EQ(c.size(), 4u) << kind;  // one per sample
 }
 
 TEST_F(ReportTest, ReportIsRebuiltFromTheDataFiles) {

@@ -48,6 +48,45 @@ TEST(ChooseMethod, RequestedMethodIsUsedAndTheReasonSaysWhatAutoWouldDo) {
   EXPECT_NE(c.reason.find("auto would take the opened-loop DAE"), std::string::npos) << c.reason;
 }
 
+TEST(ChooseMethod, FreeTurningCrankIsIntegratedByCvodeAdams) {
+  // the fastest integrator of the reduced equation at every tolerance (docs/performance.md)
+  for (double tolerance : {1e-4, 1e-10, 1e-13}) {
+    Study s = study_of(core::samples::paper_fourbar(), core::FreeScene{1.0, 0.0, 5.0, 501});
+    s.tolerance = tolerance;
+    const MethodChoice c = choose_method(s);
+    EXPECT_EQ(c.integrator, core::Integrator::kCvodeAdams) << tolerance;
+    EXPECT_NE(c.reason.find("integrated by CVODE Adams"), std::string::npos) << c.reason;
+  }
+}
+
+TEST(ChooseMethod, OpenedLoopIntegratorFollowsTheTolerance) {
+  // through limit positions: the order-8 pair below 1e-8, the order-5 pair from 1e-8 up
+  Study s = study_of(core::samples::triple_rocker(), core::FreeScene{0.0, 1.0, 20.0, 2001});
+  s.tolerance = 1e-10;
+  MethodChoice c = choose_method(s);
+  EXPECT_EQ(c.formulation, core::Formulation::kOpenedLoop);
+  EXPECT_EQ(c.integrator, core::Integrator::kErk8);
+  EXPECT_NE(c.reason.find("Fehlberg 8(7) Runge-Kutta pair"), std::string::npos) << c.reason;
+  s.tolerance = 1e-8;
+  c = choose_method(s);
+  EXPECT_EQ(c.integrator, core::Integrator::kErk5);
+  EXPECT_NE(c.reason.find("Dormand-Prince 5(4) Runge-Kutta pair"), std::string::npos)
+      << c.reason;
+  // a requested formulation gets the integrator auto would give it
+  Study paper = study_of(core::samples::paper_fourbar(), core::FreeScene{1.0, 0.0, 5.0, 501});
+  paper.formulation = core::Formulation::kOpenedLoop;
+  EXPECT_EQ(choose_method(paper).integrator, core::Integrator::kErk8);
+  paper.formulation = core::Formulation::kComplexMasses;
+  EXPECT_EQ(choose_method(paper).integrator, core::Integrator::kCvodeAdams);
+  // every choice is a valid combination
+  for (const Study& t : {s, paper}) {
+    core::SimulateOptions o;
+    o.formulation = choose_method(t).formulation;
+    o.integrator = choose_method(t).integrator;
+    EXPECT_EQ(o.validate(), "");
+  }
+}
+
 TEST(ChooseMethod, FormulationNames) {
   EXPECT_EQ(formulation_named("opened-loop"), core::Formulation::kOpenedLoop);
   EXPECT_EQ(formulation_named("complex-masses"), core::Formulation::kComplexMasses);

@@ -1,0 +1,353 @@
+// The balance-design executable running sweeps: killed midway (a real SIGKILL, and the test
+// hook BD_SWEEP_KILL_AFTER_ROWS) and resumed to the rows of an uninterrupted run, Ctrl-C
+// (SIGINT) ending with exit code 5 and the rows kept, the progress output, validate and report
+// of a sweep study. Needs the executable built (target balance-design).
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+extern char** environ;
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kExe = BD_BINARY_DIR "/bin/balance-design";
+const std::string kExamples = BD_SOURCE_DIR "/studies/examples";
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// rows of a sweep.csv: its whole lines after the header
+long rows(const fs::path& csv) {
+  const std::string text = read(csv);
+  const long lines = std::count(text.begin(), text.end(), '\n');
+  return lines > 0 ? lines - 1 : 0;
+}
+
+// the paper's loaded linkage in free motion over 20 s, `count` points of a Latin hypercube: a
+// few milliseconds a point, so one thread takes a second or two
+std::string free_sweep(int count) {
+  return "name: free\n"
+         "linkage:\n"
+         "  type: fourbar\n"
+         "  frame: 3.2\n"
+         "  branch: 1\n"
+         "  crank:   {length: 1.0, mass: 2.1, s: 0.6, sigma: 0.3, inertia: 1.1}\n"
+         "  coupler: {length: 3.0, mass: 3.0, s: 1.45, sigma: 0.4, inertia: 3.1}\n"
+         "  rocker:  {length: 2.0, mass: 2.2, s: 1.66, sigma: -0.4, inertia: 2.1}\n"
+         "loads:\n"
+         "  crank:   {force: [1.1, 1.2],  moment: 0.37}\n"
+         "  coupler: {force: [1.3, -1.4], moment: 0.28}\n"
+         "  rocker:  {force: [1.5, 1.6],  moment: 0.19}\n"
+         "scene: {type: free, theta1: 1.0, omega1: 0.0, duration: 20.0, samples: 201}\n"
+         "sweep:\n"
+         "  design: lhs\n"
+         "  points: " +
+         std::to_string(count) +
+         "\n"
+         "  parameters:\n"
+         "    - {path: linkage.coupler.mass, from: 1.0, to: 5.0}\n"
+         "    - {path: scene.omega1, from: -2.0, to: 2.0}\n";
+}
+
+class SweepCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(fs::exists(kExe)) << kExe << " not built (cmake --build build --target "
+                                  << "balance-design)";
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("bd_sweep_cli_test_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    // the sweep's page without charts: gnuplot's time is not what these tests are about
+    ::setenv("BD_GNUPLOT", "/nonexistent", 1);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // runs `balance-design ARGS` in dir_, keeping stdout and stderr; returns the exit code, or
+  // 128 + the signal that ended it
+  int run(const std::string& args, const std::string& env = "") {
+    const std::string cmd = "cd " + quote(dir_.string()) + " && " + env + " " + quote(kExe) + " " +
+                            args + " >" + quote((dir_ / "stdout.txt").string()) + " 2>" +
+                            quote((dir_ / "stderr.txt").string());
+    const int status = std::system(cmd.c_str());
+    out_ = read(dir_ / "stdout.txt");
+    err_ = read(dir_ / "stderr.txt");
+    fs::remove(dir_ / "stdout.txt");
+    fs::remove(dir_ / "stderr.txt");
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  }
+
+  // starts `balance-design ARGS...` (absolute paths) in the background, its output to files
+  pid_t start(const std::vector<std::string>& args) {
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    const std::string out = (dir_ / "child-stdout.txt").string();
+    const std::string err = (dir_ / "child-stderr.txt").string();
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out.c_str(),
+                                     O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err.c_str(),
+                                     O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    std::vector<std::string> all = {kExe};
+    all.insert(all.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& a : all) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    pid_t pid = -1;
+    const int rc = posix_spawn(&pid, kExe.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    EXPECT_EQ(rc, 0) << "posix_spawn failed";
+    return rc == 0 ? pid : -1;
+  }
+
+  // waits until `csv` has at least `wanted` rows (true), or the child has ended (false)
+  bool wait_for_rows(pid_t pid, const fs::path& csv, long wanted) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (rows(csv) >= wanted) return true;
+      int status = 0;
+      if (::waitpid(pid, &status, WNOHANG) == pid) {
+        ended_ = status;
+        return false;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return false;
+  }
+
+  // the child's wait status
+  int finish(pid_t pid) {
+    if (ended_ >= 0) return ended_;
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    return status;
+  }
+
+  fs::path dir_;
+  std::string out_, err_;
+  int ended_ = -1;
+};
+
+TEST_F(SweepCli, KilledSweepResumesToTheRowsOfAnUninterruptedRun) {
+  std::ofstream(dir_ / "free.yaml") << free_sweep(300);
+  const std::string study = (dir_ / "free.yaml").string();
+  ASSERT_EQ(run("free.yaml --out full --progress none"), 0) << err_;
+  const std::string full = read(dir_ / "full" / "sweep.csv");
+  ASSERT_EQ(rows(dir_ / "full" / "sweep.csv"), 300);
+
+  // one thread, killed (SIGKILL: no handler runs) once three rows are written
+  const pid_t pid =
+      start({study, "--out", (dir_ / "killed").string(), "--threads", "1", "--progress", "none"});
+  ASSERT_GT(pid, 0);
+  const fs::path csv = dir_ / "killed" / "sweep.csv";
+  const bool midway = wait_for_rows(pid, csv, 3);
+  if (midway) ::kill(pid, SIGKILL);
+  const int status = finish(pid);
+  ASSERT_TRUE(midway) << "the sweep ended before the kill";
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
+  const long kept = rows(csv);
+  EXPECT_GE(kept, 3);
+  EXPECT_LT(kept, 300);
+  EXPECT_NE(read(dir_ / "killed" / "sweep.json").find("\"status\": \"running\""),
+            std::string::npos);
+
+  // without --resume the unfinished sweep is kept and refused
+  EXPECT_EQ(run("free.yaml --out killed --progress none"), 2);
+  EXPECT_NE(err_.find("killed holds an unfinished sweep ("), std::string::npos) << err_;
+  EXPECT_NE(err_.find("pass --resume to continue it"), std::string::npos) << err_;
+  EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
+
+  // resumed: every row once, the same bytes as the uninterrupted run
+  ASSERT_EQ(run("free.yaml --out killed --resume --progress none"), 0) << err_;
+  EXPECT_NE(out_.find("free: sweep complete, 300 of 300 points ("), std::string::npos) << out_;
+  EXPECT_NE(out_.find(" resumed), 0 failed, "), std::string::npos) << out_;
+  EXPECT_EQ(read(csv), full);
+  EXPECT_NE(read(dir_ / "killed" / "sweep.json").find("\"status\": \"complete\""),
+            std::string::npos);
+}
+
+TEST_F(SweepCli, KillHookStopsAfterNRowsAndResumeCompletesTheExample) {
+  const std::string example = quote(kExamples + "/paper-fourbar-sweep.yaml");
+  ASSERT_EQ(run(example + " --out full --progress none"), 0) << err_;
+  const std::string full = read(dir_ / "full" / "sweep.csv");
+  ASSERT_EQ(rows(dir_ / "full" / "sweep.csv"), 441);
+
+  // the test hook: the process kills itself right after the 57th row
+  EXPECT_EQ(run(example + " --out part --progress none", "BD_SWEEP_KILL_AFTER_ROWS=57"),
+            128 + SIGKILL);
+  EXPECT_EQ(rows(dir_ / "part" / "sweep.csv"), 57);
+  EXPECT_EQ(
+      full.compare(0, read(dir_ / "part" / "sweep.csv").size(), read(dir_ / "part" / "sweep.csv")),
+      0);
+  ASSERT_EQ(run(example + " --out part --resume --progress none"), 0) << err_;
+  EXPECT_NE(out_.find("441 of 441 points (57 resumed)"), std::string::npos) << out_;
+  EXPECT_EQ(read(dir_ / "part" / "sweep.csv"), full);
+}
+
+TEST_F(SweepCli, InterruptExitsFiveAndKeepsTheRows) {
+  std::ofstream(dir_ / "free.yaml") << free_sweep(300);
+  const std::string study = (dir_ / "free.yaml").string();
+  const pid_t pid =
+      start({study, "--out", (dir_ / "stopped").string(), "--threads", "1", "--progress", "lines"});
+  ASSERT_GT(pid, 0);
+  const fs::path csv = dir_ / "stopped" / "sweep.csv";
+  const bool midway = wait_for_rows(pid, csv, 3);
+  if (midway) ::kill(pid, SIGINT);
+  const int status = finish(pid);
+  ASSERT_TRUE(midway) << "the sweep ended before the interrupt";
+  ASSERT_TRUE(WIFEXITED(status)) << "ended by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 5);
+
+  const long kept = rows(csv);
+  EXPECT_GE(kept, 3);
+  EXPECT_LT(kept, 300);
+  const std::string text = read(csv);
+  EXPECT_EQ(text.back(), '\n');  // whole rows only
+  EXPECT_NE(read(dir_ / "stopped" / "sweep.json").find("\"status\": \"interrupted\""),
+            std::string::npos);
+  const std::string err = read(dir_ / "child-stderr.txt");
+  const std::string n = std::to_string(kept);
+  EXPECT_NE(err.find(study + ": sweep interrupted after " + n +
+                     " of 300 points: run again with --resume to compute the rest\n"),
+            std::string::npos)
+      << err;
+  EXPECT_NE(err.find("stopping once the points running are done"), std::string::npos) << err;
+  EXPECT_NE(
+      read(dir_ / "child-stdout.txt").find("free: sweep interrupted, " + n + " of 300 points"),
+      std::string::npos);
+
+  // the rows kept are the first of the sweep, and --resume completes it
+  ASSERT_EQ(run("free.yaml --out full --progress none"), 0) << err_;
+  const std::string full = read(dir_ / "full" / "sweep.csv");
+  EXPECT_EQ(full.compare(0, text.size(), text), 0);
+  ASSERT_EQ(run("free.yaml --out stopped --resume --progress none"), 0) << err_;
+  EXPECT_EQ(read(csv), full);
+}
+
+TEST_F(SweepCli, ProgressOutputAndSummaryLine) {
+  const std::string example = quote(kExamples + "/paper-fourbar-sweep.yaml");
+  // stderr is a file, not a terminal: auto gives plain lines (one at the end of a short sweep)
+  ASSERT_EQ(run(example + " --out res"), 0) << err_;
+  EXPECT_TRUE(std::regex_match(
+      err_, std::regex(R"(sweep: 441/441 points \(100\.0 %\), [0-9]+\.[0-9] points/s, ETA 0 s\n)")))
+      << err_;
+  EXPECT_TRUE(std::regex_match(
+      out_, std::regex(R"(paper-fourbar-sweep: sweep complete, 441 of 441 points, 0 failed, )"
+                       R"([0-9]+\.[0-9] s; wrote res/sweep\.csv, sweep\.json, report\.html\n)")))
+      << out_;
+  for (const char* file : {"sweep.csv", "sweep.json", "report.html"}) {
+    EXPECT_TRUE(fs::exists(dir_ / "res" / file)) << file;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "res" / "timeseries.csv"));
+
+  // the bar, forced: redrawn in place with '\r', ending with a newline
+  ASSERT_EQ(run(example + " --out bar --progress bar --threads 1"), 0) << err_;
+  EXPECT_EQ(err_.rfind("\r  sweep [", 0), 0u) << err_;
+  const std::size_t last = err_.rfind('\r');
+  ASSERT_NE(last, std::string::npos);
+  EXPECT_TRUE(std::regex_match(
+      err_.substr(last),
+      std::regex(
+          R"(\r  sweep \[#{20}\]  441/441  100\.0%   [0-9]+\.[0-9] points/s  ETA 0:00 *\n)")))
+      << err_.substr(last);
+
+  ASSERT_EQ(run(example + " --out none --progress none"), 0) << err_;
+  EXPECT_TRUE(err_.empty()) << err_;
+
+  // the same rows whatever the threads
+  EXPECT_EQ(read(dir_ / "bar" / "sweep.csv"), read(dir_ / "res" / "sweep.csv"));
+}
+
+TEST_F(SweepCli, ValidatePrintsTheDesignAndWritesNothing) {
+  ASSERT_EQ(run("validate " + quote(kExamples + "/paper-fourbar-sweep.yaml")), 0) << err_;
+  EXPECT_TRUE(err_.empty()) << err_;
+  EXPECT_NE(out_.find(": ok (study paper-fourbar-sweep, driven scene, method auto)\n"
+                      "  sweep    grid design, 441 points, 2 parameters\n"
+                      "    linkage.coupler.mass: 21 values (1, 1.2, 1.4, ..., 5)\n"
+                      "    linkage.coupler.s: 21 values (0.5, 0.6, 0.7, ..., 2.5)\n"),
+            std::string::npos)
+      << out_;
+  EXPECT_TRUE(fs::is_empty(dir_));
+
+  std::ofstream(dir_ / "free.yaml") << free_sweep(50);
+  ASSERT_EQ(run("validate free.yaml"), 0) << err_;
+  EXPECT_NE(out_.find("  sweep    lhs design, 50 points, 2 parameters, seed 1\n"
+                      "    linkage.coupler.mass: drawn from 1 to 5\n"
+                      "    scene.omega1: drawn from -2 to 2\n"),
+            std::string::npos)
+      << out_;
+}
+
+TEST_F(SweepCli, ReportRebuildsTheSweepPage) {
+  ASSERT_EQ(run(quote(kExamples + "/paper-fourbar-sweep.yaml") + " --out res --progress none"), 0)
+      << err_;
+  ASSERT_TRUE(fs::exists(dir_ / "res" / "report.html"));
+  const std::string first = read(dir_ / "res" / "report.html");
+  fs::remove(dir_ / "res" / "report.html");
+  EXPECT_EQ(run("report res"), 0) << err_;
+  EXPECT_NE(out_.find("wrote res/report.html"), std::string::npos) << out_;
+  EXPECT_EQ(read(dir_ / "res" / "report.html"), first);
+
+  // the study file named by sweep.json's source is gone
+  fs::create_directories(dir_ / "orphan");
+  std::ofstream(dir_ / "orphan" / "sweep.json")
+      << "{\n  \"study\": \"x\",\n  \"source\": \"gone.yaml\"\n}\n";
+  EXPECT_EQ(run("report orphan"), 2);
+  EXPECT_NE(err_.find("gone.yaml: cannot open the study file"), std::string::npos) << err_;
+  EXPECT_NE(err_.find("orphan/sweep.json"), std::string::npos) << err_;
+  EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
+}
+
+TEST_F(SweepCli, SweepOptionsAreChecked) {
+  const std::string example = quote(kExamples + "/paper-fourbar-sweep.yaml");
+  EXPECT_EQ(run(example + " --threads 0"), 2);
+  EXPECT_EQ(run(example + " --progress fancy"), 2);
+  EXPECT_FALSE(fs::exists(dir_ / "results"));
+  // --resume is for sweeps
+  EXPECT_EQ(run(quote(kExamples + "/paper-fourbar-driven.yaml") + " --out res --resume"), 2);
+  EXPECT_NE(err_.find("--resume continues a sweep, and this study has no sweep section"),
+            std::string::npos)
+      << err_;
+  EXPECT_FALSE(fs::exists(dir_ / "res"));
+}
+
+TEST_F(SweepCli, HelpDescribesSweeps) {
+  EXPECT_EQ(run("--help"), 0);
+  for (const char* text : {"sweep.csv", "sweep.json", "--resume", "  5  sweep interrupted",
+                           "stopped-early", "bad-input"}) {
+    EXPECT_NE(out_.find(text), std::string::npos) << text;
+  }
+  EXPECT_EQ(run("run --help"), 0);
+  for (const char* text : {"--resume", "--threads", "--progress"}) {
+    EXPECT_NE(out_.find(text), std::string::npos) << text;
+  }
+}
+
+}  // namespace

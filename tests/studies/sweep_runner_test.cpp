@@ -1,0 +1,523 @@
+// run_sweep(): the sweep.csv columns, one row per point equal to the study run on its own, the
+// same file whatever the number of threads, failing points as rows, and resuming an interrupted
+// sweep to the same bytes as an uninterrupted run.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "studies/load_study.hpp"
+#include "studies/report_support.hpp"
+#include "studies/runner.hpp"
+#include "studies/sweep.hpp"
+
+namespace bd::studies {
+namespace {
+
+namespace fs = std::filesystem;
+namespace rs = report_support;
+
+// the driven paper linkage, unloaded (lines 1-9); a test appends its sections
+const std::string kDriven =
+    "name: driven\n"
+    "linkage:\n"
+    "  type: fourbar\n"
+    "  frame: 3.2\n"
+    "  branch: 1\n"
+    "  crank:   {length: 1.0, mass: 2.1, s: 0.6, sigma: 0.3, inertia: 1.1}\n"
+    "  coupler: {length: 3.0, mass: 3.0, s: 1.45, sigma: 0.4, inertia: 3.1}\n"
+    "  rocker:  {length: 2.0, mass: 2.2, s: 1.66, sigma: -0.4, inertia: 2.1}\n"
+    "scene: {type: driven, theta1: 0.0, omega1: 6.283185307179586, samples: 90}\n";
+
+// a 3 x 3 grid of the coupler's mass and centre-of-mass distance
+const std::string kGrid3x3 =
+    "sweep:\n"
+    "  parameters:\n"
+    "    - {path: linkage.coupler.mass, from: 1.0, to: 5.0, count: 3}\n"
+    "    - {path: linkage.coupler.s, values: [0.5, 1.45, 2.5]}\n";
+
+// the paper's loaded linkage in free motion over 20 s: a few milliseconds a point, so a sweep
+// of many points runs long enough to be stopped midway
+std::string free_sweep(int count) {
+  return "name: free\n"
+         "linkage:\n"
+         "  type: fourbar\n"
+         "  frame: 3.2\n"
+         "  branch: 1\n"
+         "  crank:   {length: 1.0, mass: 2.1, s: 0.6, sigma: 0.3, inertia: 1.1}\n"
+         "  coupler: {length: 3.0, mass: 3.0, s: 1.45, sigma: 0.4, inertia: 3.1}\n"
+         "  rocker:  {length: 2.0, mass: 2.2, s: 1.66, sigma: -0.4, inertia: 2.1}\n"
+         "loads:\n"
+         "  crank:   {force: [1.1, 1.2],  moment: 0.37}\n"
+         "  coupler: {force: [1.3, -1.4], moment: 0.28}\n"
+         "  rocker:  {force: [1.5, 1.6],  moment: 0.19}\n"
+         "scene: {type: free, theta1: 1.0, omega1: 0.0, duration: 20.0, samples: 201}\n"
+         "sweep:\n"
+         "  design: lhs\n"
+         "  points: " +
+         std::to_string(count) +
+         "\n"
+         "  seed: 7\n"
+         "  parameters:\n"
+         "    - {path: linkage.coupler.mass, from: 1.0, to: 5.0}\n"
+         "    - {path: scene.omega1, from: -2.0, to: 2.0}\n";
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write(const fs::path& p, const std::string& text) {
+  std::ofstream(p, std::ios::binary) << text;
+}
+
+std::vector<std::string> lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+SweepOptions quiet(int threads = 0) {
+  SweepOptions o;
+  o.threads = threads;
+  o.progress = SweepProgress::kNone;
+  return o;
+}
+
+class SweepRunner : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::path(BD_BINARY_DIR) / "test-output" / "sweep_runner" / test->name();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    // the sweep's report without charts: gnuplot's time is not what these tests are about
+    ::setenv("BD_GNUPLOT", "/nonexistent", 1);
+  }
+  fs::path dir_;
+};
+
+TEST_F(SweepRunner, ColumnsOfAPlainABalanceAndAnOptimizeStudy) {
+  const std::vector<std::string> metrics = {"Fsh_rms", "Fsh_max", "Msh_rms", "Msh_max", "tau_rms",
+                                            "tau_max", "RA0_max", "RA3_max", "RA0_rms", "RA3_rms"};
+  std::vector<std::string> plain = {"point", "linkage.coupler.mass", "linkage.coupler.s"};
+  plain.insert(plain.end(), metrics.begin(), metrics.end());
+  std::vector<std::string> balanced = plain, optimized = plain;
+  for (const std::string& m : metrics) balanced.push_back("balanced_" + m);
+  for (const std::string& m : metrics) optimized.push_back("optimized_" + m);
+  for (auto* c : {&plain, &balanced, &optimized}) {
+    if (c != &plain) c->insert(c->end(), {"added_mass", "added_inertia"});
+    c->insert(c->end(), {"status", "message"});
+  }
+
+  EXPECT_EQ(sweep_columns(parse_study(kDriven + kGrid3x3, "s.yaml")), plain);
+  EXPECT_EQ(sweep_columns(parse_study(kDriven + "balance: {force: full}\n" + kGrid3x3, "s.yaml")),
+            balanced);
+  EXPECT_EQ(sweep_columns(parse_study(kDriven +
+                                          "optimize:\n"
+                                          "  objective: {Msh_rms: 1}\n"
+                                          "  constraints: {force_balance: true}\n"
+                                          "  variables: {counterweights: {crank: , rocker: }}\n" +
+                                          kGrid3x3,
+                                      "s.yaml")),
+            optimized);
+  // a study without a sweep: the metrics alone
+  std::vector<std::string> none = {"point"};
+  none.insert(none.end(), metrics.begin(), metrics.end());
+  none.insert(none.end(), {"status", "message"});
+  EXPECT_EQ(sweep_columns(parse_study(kDriven, "s.yaml")), none);
+}
+
+TEST_F(SweepRunner, EachRowIsThePointsStudyRunOnItsOwn) {
+  const Study study = parse_study(kDriven + "balance: {force: full}\n" + kGrid3x3, "s.yaml");
+  const SweepResult r = run_sweep(study, dir_, quiet(2));
+  EXPECT_EQ(r.points, 9);
+  EXPECT_EQ(r.done, 9);
+  EXPECT_EQ(r.resumed, 0);
+  EXPECT_EQ(r.failed, 0);
+  EXPECT_FALSE(r.interrupted);
+  EXPECT_TRUE(r.complete());
+  EXPECT_EQ(r.csv, dir_ / "sweep.csv");
+  EXPECT_EQ(r.summary, dir_ / "sweep.json");
+
+  const std::vector<std::string> rows = lines(read(r.csv));
+  ASSERT_EQ(rows.size(), 10u);
+  const std::vector<std::string> columns = sweep_columns(study);
+  EXPECT_EQ(rs::csv_fields(rows[0]), columns);
+  const auto points = sweep_points(*study.sweep);
+  ASSERT_EQ(points.size(), 9u);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    SCOPED_TRACE("point " + std::to_string(i));
+    const std::vector<std::string> f = rs::csv_fields(rows[i + 1]);
+    ASSERT_EQ(f.size(), columns.size());
+    // the same computation as a run of the point's study: the same numbers, bit for bit
+    const Study at = point_study(study, points[i]);
+    const RunResult one = compute_study(at);
+    std::vector<double> expected;
+    for (const core::Metrics& m : {one.metrics, one.balanced->metrics}) {
+      expected.insert(expected.end(), {m.Fsh_rms, m.Fsh_max, m.Msh_rms, m.Msh_max, m.tau_rms,
+                                       m.tau_max, m.RA0_max, m.RA3_max, m.RA0_rms, m.RA3_rms});
+    }
+    expected.push_back(at.balance->added_mass);
+    expected.push_back(at.balance->added_inertia);
+    EXPECT_EQ(f[0], std::to_string(i));
+    EXPECT_EQ(f[1], number(points[i][0]));
+    EXPECT_EQ(f[2], number(points[i][1]));
+    for (std::size_t k = 0; k < expected.size(); ++k) {
+      EXPECT_EQ(f[3 + k], number(expected[k])) << columns[3 + k];
+    }
+    EXPECT_EQ(f[columns.size() - 2], "ok");
+    EXPECT_EQ(f[columns.size() - 1], "");
+  }
+  // the grid: first parameter slowest; the values as given
+  EXPECT_EQ(rs::csv_fields(rows[4])[1], "3");
+  EXPECT_EQ(rs::csv_fields(rows[4])[2], "0.5");
+  EXPECT_EQ(rs::csv_fields(rows[9])[2], "2.5");
+
+  // run_study() of a point writes what compute_study() computes
+  const Study at = point_study(study, points[4]);
+  const RunResult written = run_study(at, dir_ / "point-4");
+  EXPECT_EQ(number(written.metrics.Msh_rms), rs::csv_fields(rows[5])[5]);
+  EXPECT_TRUE(fs::exists(dir_ / "point-4" / "summary.json"));
+
+  // sweep.json: the design and the counts
+  const rs::Json j = rs::parse_json(read(r.summary), "sweep.json");
+  EXPECT_EQ(j.str("study"), "driven");
+  EXPECT_EQ(j.str("source"), "s.yaml");
+  EXPECT_EQ(j.str("fingerprint").size(), 16u);
+  EXPECT_EQ(j.str("design"), "grid");
+  EXPECT_EQ(j.str("points"), "9");
+  EXPECT_EQ(j.str("threads"), "2");
+  EXPECT_EQ(j.str("status"), "complete");
+  EXPECT_EQ(j.str("done"), "9");
+  EXPECT_EQ(j.str("resumed"), "0");
+  EXPECT_EQ(j.str("failed"), "0");
+  const rs::Json* params = j.get("parameters");
+  ASSERT_TRUE(params && params->items.size() == 2);
+  EXPECT_EQ(params->items[0].str("path"), "linkage.coupler.mass");
+  EXPECT_EQ(params->items[0].str("scale"), "linear");
+  EXPECT_EQ(params->items[0].str("from"), "1");
+  EXPECT_EQ(params->items[0].str("to"), "5");
+  ASSERT_EQ(params->items[0].get("values")->items.size(), 3u);
+  EXPECT_EQ(params->items[0].get("values")->items[1].text, "3");
+  // a values list: from and to are its least and greatest
+  EXPECT_EQ(params->items[1].str("from"), "0.5");
+  EXPECT_EQ(params->items[1].str("to"), "2.5");
+}
+
+TEST_F(SweepRunner, OneThreadAndTwoThreadsWriteTheSameFile) {
+  const Study grid = parse_study(kDriven + "balance: {force: full}\n" + kGrid3x3, "s.yaml");
+  run_sweep(grid, dir_ / "grid-1", quiet(1));
+  run_sweep(grid, dir_ / "grid-2", quiet(2));
+  EXPECT_EQ(read(dir_ / "grid-1" / "sweep.csv"), read(dir_ / "grid-2" / "sweep.csv"));
+  // free motion: the points take different times, so two threads finish them out of order
+  const Study free = parse_study(free_sweep(24), "free.yaml");
+  run_sweep(free, dir_ / "free-1", quiet(1));
+  run_sweep(free, dir_ / "free-2", quiet(2));
+  const std::string one = read(dir_ / "free-1" / "sweep.csv");
+  EXPECT_EQ(lines(one).size(), 25u);
+  EXPECT_EQ(one, read(dir_ / "free-2" / "sweep.csv"));
+}
+
+TEST_F(SweepRunner, IpoptPointsOnTwoThreadsGiveTheRowsOfOne) {
+  // Debian 12's Ipopt (3.11) calls MUMPS, which is not thread-safe: unserialised, two points
+  // solved at once crashed (a Fortran runtime error in dmumps_load.F, a segmentation fault) or
+  // gave other numbers. compute_study() holds a lock around each Ipopt solve.
+  const Study study = parse_study(kDriven +
+                                      "optimize:\n"
+                                      "  algorithm: ipopt\n"
+                                      "  objective: {Msh_rms: 1}\n"
+                                      "  constraints: {force_balance: true}\n"
+                                      "  variables:\n"
+                                      "    counterweights: {crank: {mass_max: 10, distance_max: 1},"
+                                      " rocker: {mass_max: 10, distance_max: 2}}\n"
+                                      "    links: {coupler: {mass: [2, 4], inertia: [1, 8]}}\n"
+                                      "sweep:\n"
+                                      "  parameters:\n"
+                                      "    - {path: linkage.crank.mass, from: 1.0, to: 4.0, "
+                                      "count: 8}\n",
+                                  "ipopt.yaml");
+  const SweepResult one = run_sweep(study, dir_ / "one", quiet(1));
+  const SweepResult two = run_sweep(study, dir_ / "two", quiet(2));
+  EXPECT_EQ(one.failed, 0);
+  EXPECT_EQ(two.failed, 0);
+  EXPECT_EQ(read(dir_ / "one" / "sweep.csv"), read(dir_ / "two" / "sweep.csv"));
+}
+
+TEST_F(SweepRunner, PointsThatCannotRunAreRowsAndTheSweepGoesOn) {
+  // a coupler of 0.1 m cannot reach across |A1A3| = 2.2 m at theta1 = 0 (bad input); one of
+  // 1.5 m assembles there but not over the whole turn (the driven run stops early); -1 kg is
+  // bad input
+  const Study study = parse_study(kDriven +
+                                      "sweep:\n"
+                                      "  parameters:\n"
+                                      "    - {path: linkage.coupler.length, values: [0.1, 1.5, "
+                                      "3.0]}\n"
+                                      "    - {path: linkage.coupler.mass, values: [-1, 3]}\n",
+                                  "bad.yaml");
+  const SweepResult r = run_sweep(study, dir_, quiet(2));
+  EXPECT_TRUE(r.complete());
+  EXPECT_EQ(r.failed, 5);
+  const std::vector<std::string> rows = lines(read(r.csv));
+  ASSERT_EQ(rows.size(), 7u);
+  const auto points = sweep_points(*study.sweep);
+  const std::size_t n = sweep_columns(study).size();
+  const char* expected[] = {"bad-input",     "bad-input", "bad-input",
+                            "stopped-early", "bad-input", "ok"};
+  for (std::size_t i = 0; i < 6; ++i) {
+    SCOPED_TRACE("point " + std::to_string(i));
+    const std::vector<std::string> f = rs::csv_fields(rows[i + 1]);
+    ASSERT_EQ(f.size(), n);
+    EXPECT_EQ(f[n - 2], expected[i]);
+    if (f[n - 2] == "bad-input") {
+      // the loader's own message for the point's study, every metric empty
+      std::string what;
+      try {
+        point_study(study, points[i]);
+      } catch (const StudyError& e) {
+        what = e.what();
+      }
+      ASSERT_FALSE(what.empty());
+      EXPECT_EQ(f[n - 1], what);
+      // the place: the swept mass's value, or the scene's theta1 where the loop cannot close
+      EXPECT_EQ(what.rfind(i % 2 == 0 ? "bad.yaml:7:32: " : "bad.yaml:9:", 0), 0u) << what;
+      for (std::size_t k = 3; k < n - 2; ++k) EXPECT_EQ(f[k], "") << k;
+    }
+  }
+  // -1 kg: the mass's message; 0.1 m: the assembly's
+  EXPECT_NE(rs::csv_fields(rows[1]).back().find("linkage.coupler.mass must be > 0 kg, got -1"),
+            std::string::npos)
+      << rows[1];
+  EXPECT_NE(rs::csv_fields(rows[2]).back().find("cannot be assembled"), std::string::npos)
+      << rows[2];
+  // stopped early: the simulation's message (time and crank angle), the metrics over the samples
+  const std::vector<std::string> stopped = rs::csv_fields(rows[4]);
+  const RunResult alone = compute_study(point_study(study, points[3]));
+  ASSERT_FALSE(alone.trajectory.ok());
+  EXPECT_EQ(stopped[n - 1], alone.trajectory.message);
+  EXPECT_EQ(stopped[3], number(alone.metrics.Fsh_rms));
+  // the message is quoted CSV text
+  EXPECT_NE(rows[1].find(",bad-input,\"bad.yaml:7:"), std::string::npos) << rows[1];
+  const rs::Json j = rs::parse_json(read(r.summary), "sweep.json");
+  EXPECT_EQ(j.str("failed"), "5");
+}
+
+TEST_F(SweepRunner, NoOptimumIsARowWithTheOptimisersMessage) {
+  // a full force balance needs far more than 0.01 kg of counterweight on each side
+  const Study study = parse_study(kDriven +
+                                      "optimize:\n"
+                                      "  objective: {Msh_rms: 1}\n"
+                                      "  constraints: {force_balance: true}\n"
+                                      "  variables:\n"
+                                      "    counterweights: {crank: {mass_max: 0.01}, rocker: "
+                                      "{mass_max: 0.01}}\n"
+                                      "sweep:\n"
+                                      "  parameters:\n"
+                                      "    - {path: linkage.coupler.mass, values: [2, 3]}\n",
+                                  "opt.yaml");
+  const SweepResult r = run_sweep(study, dir_, quiet());
+  EXPECT_EQ(r.failed, 2);
+  const std::vector<std::string> rows = lines(read(r.csv));
+  ASSERT_EQ(rows.size(), 3u);
+  const std::size_t n = sweep_columns(study).size();
+  const auto points = sweep_points(*study.sweep);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const std::vector<std::string> f = rs::csv_fields(rows[i + 1]);
+    ASSERT_EQ(f.size(), n);
+    EXPECT_EQ(f[n - 2], "no-optimum");
+    const RunResult alone = compute_study(point_study(study, points[i]));
+    ASSERT_TRUE(alone.optimized && alone.optimized->failed());
+    std::string message = alone.optimized->result.message;
+    for (char& c : message) c = c == '\n' ? ' ' : c;
+    EXPECT_EQ(f[n - 1], message);
+    EXPECT_NE(f[n - 1].find("force balance"), std::string::npos) << f[n - 1];
+    EXPECT_EQ(f[2], number(alone.metrics.Fsh_rms));  // the original's metrics are there
+    EXPECT_EQ(f[11], number(alone.metrics.RA3_rms));
+    for (std::size_t k = 12; k < n - 2; ++k) EXPECT_EQ(f[k], "") << k;  // the optimum's not
+  }
+}
+
+TEST_F(SweepRunner, ResumeCompletesACutShortFileToTheSameBytes) {
+  const Study study = parse_study(free_sweep(30), "free.yaml");
+  run_sweep(study, dir_ / "full", quiet());
+  const std::string full = read(dir_ / "full" / "sweep.csv");
+  const std::vector<std::string> rows = lines(full);
+  ASSERT_EQ(rows.size(), 31u);
+
+  // the first 11 lines (header and 10 rows) and half of the next: as a kill can leave it
+  for (const bool cut : {true, false}) {
+    const fs::path part = dir_ / (cut ? "cut" : "whole-lines");
+    fs::create_directories(part);
+    std::string text;
+    for (int i = 0; i < 11; ++i) text += rows[static_cast<std::size_t>(i)] + "\n";
+    if (cut) text += rows[11].substr(0, rows[11].size() / 2);
+    write(part / "sweep.csv", text);
+    fs::copy_file(dir_ / "full" / "sweep.json", part / "sweep.json");
+
+    SweepOptions o = quiet();
+    o.resume = true;
+    const SweepResult r = run_sweep(study, part, o);
+    EXPECT_EQ(r.resumed, 10);
+    EXPECT_EQ(r.done, 30);
+    EXPECT_TRUE(r.complete());
+    EXPECT_EQ(read(part / "sweep.csv"), full) << part;
+    const rs::Json j = rs::parse_json(read(part / "sweep.json"), "sweep.json");
+    EXPECT_EQ(j.str("status"), "complete");
+    EXPECT_EQ(j.str("resumed"), "10");
+    EXPECT_EQ(j.str("done"), "30");
+  }
+
+  // resuming a complete sweep runs nothing and keeps the file
+  SweepOptions o = quiet();
+  o.resume = true;
+  const SweepResult again = run_sweep(study, dir_ / "full", o);
+  EXPECT_EQ(again.resumed, 30);
+  EXPECT_EQ(read(dir_ / "full" / "sweep.csv"), full);
+  // --resume where there is nothing yet starts the sweep
+  const SweepResult fresh = run_sweep(study, dir_ / "fresh", o);
+  EXPECT_EQ(fresh.resumed, 0);
+  EXPECT_EQ(read(dir_ / "fresh" / "sweep.csv"), full);
+}
+
+TEST_F(SweepRunner, ResumeRefusesAnotherDesignOrAlteredRows) {
+  const Study study = parse_study(kDriven + kGrid3x3, "s.yaml");
+  run_sweep(study, dir_ / "full", quiet());
+  const std::string full = read(dir_ / "full" / "sweep.csv");
+  const std::vector<std::string> rows = lines(full);
+  auto partial = [&](const std::string& name, std::vector<std::string> kept) {
+    const fs::path p = dir_ / name;
+    fs::create_directories(p);
+    std::string text;
+    for (const std::string& line : kept) text += line + "\n";
+    write(p / "sweep.csv", text);
+    fs::copy_file(dir_ / "full" / "sweep.json", p / "sweep.json");
+    return p;
+  };
+  SweepOptions resume = quiet();
+  resume.resume = true;
+  auto message = [&](const Study& s, const fs::path& p, const SweepOptions& o) {
+    try {
+      run_sweep(s, p, o);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+
+  // another design: the study file's text differs (a fourth value)
+  const Study other =
+      parse_study(kDriven +
+                      "sweep:\n  parameters:\n"
+                      "    - {path: linkage.coupler.mass, from: 1.0, to: 5.0, count: 4}\n"
+                      "    - {path: linkage.coupler.s, values: [0.5, 1.45, 2.5]}\n",
+                  "s.yaml");
+  fs::path p = partial("other", {rows.begin(), rows.begin() + 4});
+  std::string m = message(other, p, resume);
+  EXPECT_EQ(m.rfind(p.string() + " holds a sweep of another study or design: the study file "
+                                 "differs (fingerprint ",
+                    0),
+            0u)
+      << m;
+  EXPECT_NE(m.find("; remove the folder to start over"), std::string::npos) << m;
+  EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  EXPECT_EQ(lines(read(p / "sweep.csv")).size(), 4u);  // untouched
+
+  // a sweep.json of another design beside this study's rows
+  p = partial("json", {rows.begin(), rows.begin() + 4});
+  std::string json = read(p / "sweep.json");
+  json.replace(json.find("\"points\": 9"), 11, "\"points\": 8");
+  write(p / "sweep.json", json);
+  m = message(study, p, resume);
+  EXPECT_NE(m.find("holds a sweep of another study or design: points 9, was 8"), std::string::npos)
+      << m;
+
+  // a row whose values are not the design's
+  std::vector<std::string> altered(rows.begin(), rows.begin() + 5);
+  altered[2].replace(altered[2].find(",1.45,"), 6, ",1.46,");
+  p = partial("altered", altered);
+  m = message(study, p, resume);
+  EXPECT_EQ(m, (p / "sweep.csv").string() +
+                   ": row 2 is not point 1 of this design (its parameter 2 is 1.46, the design's "
+                   "1.45); remove the folder to start over")
+      << m;
+  // a row out of place
+  std::vector<std::string> swapped(rows.begin(), rows.begin() + 5);
+  std::swap(swapped[2], swapped[3]);
+  p = partial("swapped", swapped);
+  m = message(study, p, resume);
+  EXPECT_NE(m.find("row 2 is not point 1 of this design (its point is '2')"), std::string::npos)
+      << m;
+
+  // an unfinished sweep is not overwritten without --resume
+  p = partial("unfinished", {rows.begin(), rows.begin() + 4});
+  m = message(study, p, quiet());
+  EXPECT_EQ(m, p.string() +
+                   " holds an unfinished sweep (3 of 9 points): pass --resume to continue it, or "
+                   "remove the folder to start over");
+  EXPECT_EQ(lines(read(p / "sweep.csv")).size(), 4u);
+  // a finished one is replaced
+  EXPECT_EQ(message(study, dir_ / "full", quiet()), "no error");
+  EXPECT_EQ(read(dir_ / "full" / "sweep.csv"), full);
+}
+
+TEST_F(SweepRunner, StopKeepsAPrefixAndResumeCompletesIt) {
+  const Study study = parse_study(free_sweep(300), "free.yaml");
+  run_sweep(study, dir_ / "full", quiet(2));
+  const std::string full = read(dir_ / "full" / "sweep.csv");
+  ASSERT_EQ(lines(full).size(), 301u);
+
+  // one thread, a few milliseconds a point: the stop, once three rows are written, comes long
+  // before the end
+  std::atomic<bool> stop{false}, running{true};
+  const fs::path csv = dir_ / "stopped" / "sweep.csv";
+  std::thread watcher([&] {
+    while (running.load() && !stop.load()) {
+      if (lines(read(csv)).size() >= 4) stop = true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  });
+  SweepOptions o = quiet(1);
+  o.stop = &stop;
+  const SweepResult r = run_sweep(study, dir_ / "stopped", o);
+  running = false;
+  watcher.join();
+  ASSERT_TRUE(r.interrupted) << "the sweep ended before the stop";
+  EXPECT_FALSE(r.complete());
+  EXPECT_GE(r.done, 3);
+  EXPECT_LT(r.done, 300);
+  const std::string stopped = read(csv);
+  EXPECT_EQ(lines(stopped).size(), static_cast<std::size_t>(r.done) + 1);
+  EXPECT_EQ(full.compare(0, stopped.size(), stopped), 0) << "not the beginning of the sweep";
+  const rs::Json j = rs::parse_json(read(dir_ / "stopped" / "sweep.json"), "sweep.json");
+  EXPECT_EQ(j.str("status"), "interrupted");
+  EXPECT_EQ(j.str("done"), std::to_string(r.done));
+
+  // without --resume the unfinished sweep is refused; with it, completed to the same bytes
+  EXPECT_THROW(run_sweep(study, dir_ / "stopped", quiet(2)), InputError);
+  SweepOptions resume = quiet(2);
+  resume.resume = true;
+  const SweepResult rest = run_sweep(study, dir_ / "stopped", resume);
+  EXPECT_EQ(rest.resumed, r.done);
+  EXPECT_TRUE(rest.complete());
+  EXPECT_EQ(read(csv), full);
+}
+
+}  // namespace
+}  // namespace bd::studies
