@@ -1,6 +1,7 @@
 // The closed loop with complex equivalent masses (paper §4.1).
 //
 // Notation. Planar vectors are complex numbers; ⟨x̄, ȳ⟩ = Re(x̄* ȳ) (§2.1), so ⟨i x̄, ȳ⟩ = x̄ × ȳ.
+// In the per-instant code they are Xy (core/planar.hpp): x̄ ȳ is cmul(x, y), x̄* ȳ cmul_conj.
 // Link k has the complex masses m̄kp = m_k (1 - s̄k/lk) at its first joint and m̄kq = m_k s̄k/lk at
 // its second (eq. 29); for the coupler m̄2p = m2a - i m2c at A1 and m̄2q = m2b + i m2c at A2.
 // With A0 = 0 and A2 = A3 - l̄3 the mass centres, times their masses, are (eq. 33)

@@ -1,8 +1,9 @@
 #pragma once
 /// The opened kinematic loop with principal vectors (paper §3, eqs. 12-28): the mechanism freed
-/// at A3, link angles theta1..theta3 as coordinates, R̄A3 as a multiplier. One 5x5 linear solve
-/// per instant (eqs. 22 and 27) gives the three angular accelerations and R̄A3; R̄A0 follows from
-/// the motion of the centre of mass (eq. 28).
+/// at A3, link angles theta1..theta3 as coordinates, R̄A3 as a multiplier. One 5x5 linear system
+/// per instant (eqs. 22 and 27), solved exactly by eliminating its two constraint rows, gives the
+/// three angular accelerations and R̄A3; R̄A0 follows from the motion of the centre of mass
+/// (eq. 28).
 ///
 /// Signs (DESIGN.md): R̄A3 is the force of the mechanism ON the ground, so the ground pushes the
 /// mechanism with -R̄A3 and the virtual work of eq. 21 carries -<δr̄A3, R̄A3>; D_j = ∂r̄A3/∂θ_j.

@@ -116,8 +116,8 @@ MethodChoice choose_method(const Study& study) {
   } else {
     choice.formulation = core::Formulation::kMassMatrix;
     choice.reason =
-        "the cheapest exact formulation per evaluation (about 2.1k instructions against 2.6k "
-        "for complex-masses and 3.9k for opened-loop, docs/performance.md); all three agree to "
+        "the cheapest exact formulation per evaluation (about 1.2k instructions against 1.6k "
+        "for complex-masses and 1.85k for opened-loop, docs/performance.md); all three agree to "
         "round-off";
   }
   if (!free) {

@@ -60,8 +60,8 @@ TEST(DynamicsConstants, OverloadsWithConstantsGiveTheOneInstantResultsBitForBit)
     for (int k = 0; k < 24; ++k) {
       const double theta1 = -3.0 + 0.26 * k, omega1 = 1.7 - 0.2 * k, alpha1 = 0.4 - 0.1 * k;
       for (Formulation f : kFormulations) {
-        const std::string at = "model " + std::to_string(m) + ", theta1 = " +
-                               std::to_string(theta1) + ", " + to_string(f);
+        const std::string at = "model " + std::to_string(m) +
+                               ", theta1 = " + std::to_string(theta1) + ", " + to_string(f);
         const auto a = forward_dynamics(model, theta1, omega1, f);
         const auto b = forward_dynamics(model, constants, theta1, omega1, f);
         const auto c = inverse_dynamics(model, theta1, omega1, alpha1, f);
@@ -116,8 +116,8 @@ TEST(DynamicsConstants, CrankSweepGivesCosAndSinOfEachAngle) {
       for (int j = 0; j < 3 * per_revolution; ++j) {
         const double t = period * j / per_revolution, theta1 = 0.4 + omega1 * t;
         const Xy v = sweep.l1(theta1);
-        worst = std::max({worst, std::abs(v.x - l1 * std::cos(theta1)),
-                          std::abs(v.y - l1 * std::sin(theta1))});
+        worst = std::max(
+            {worst, std::abs(v.x - l1 * std::cos(theta1)), std::abs(v.y - l1 * std::sin(theta1))});
       }
       EXPECT_LE(worst, 2 * std::numeric_limits<double>::epsilon() * l1)
           << "omega1 = " << omega1 << ", " << per_revolution << " samples";
@@ -140,8 +140,8 @@ TEST(DynamicsConstants, DrivenSweepMatchesInverseDynamicsAtEverySample) {
       const Trajectory tr = simulate_driven(models[m], scene, options);
       ASSERT_TRUE(tr.ok()) << tr.message;
       for (std::size_t j = 0; j < tr.samples.size(); ++j) {
-        const std::string at = "model " + std::to_string(m) + ", " + to_string(f) +
-                               ", sample " + std::to_string(j);
+        const std::string at =
+            "model " + std::to_string(m) + ", " + to_string(f) + ", sample " + std::to_string(j);
         const DynamicsSample& got = tr.samples[j];
         const auto want = inverse_dynamics(models[m], got.state.theta1, scene.omega1, 0.0, f);
         ASSERT_TRUE(want.has_value()) << at;

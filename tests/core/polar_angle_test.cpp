@@ -19,18 +19,17 @@ double ulps(double a, long double ref) {
 }
 
 struct Worst {
-  double absolute{};       // [rad]
-  double ulps_small{};     // |angle| < 0.5 rad
-  double ulps_large{};     // |angle| >= 0.5 rad
-  double std_absolute{};   // std::atan2's [rad]
+  double absolute{};      // [rad]
+  double ulps_small{};    // |angle| < 0.5 rad
+  double ulps_large{};    // |angle| >= 0.5 rad
+  double std_absolute{};  // std::atan2's [rad]
 };
 
 void measure(double y, double x, Worst& w) {
   const long double ref = std::atan2(static_cast<long double>(y), static_cast<long double>(x));
   const double got = polar_angle(y, x);
   w.absolute = std::max(w.absolute, static_cast<double>(std::abs(got - ref)));
-  w.std_absolute =
-      std::max(w.std_absolute, static_cast<double>(std::abs(std::atan2(y, x) - ref)));
+  w.std_absolute = std::max(w.std_absolute, static_cast<double>(std::abs(std::atan2(y, x) - ref)));
   double& u = std::abs(ref) < 0.5L ? w.ulps_small : w.ulps_large;
   u = std::max(u, ulps(got, ref));
 }
@@ -76,10 +75,10 @@ TEST(PolarAngle, ExactWhereTheLibraryIsAndSymmetricInY) {
   // the diagonal, the axes and the special values are std::atan2's exactly (bit for bit)
   const double inf = std::numeric_limits<double>::infinity();
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const double special[][2] = {{1, 1},     {-1, 1},   {1, -1},   {-1, -1},    {0.0, 1},
-                               {-0.0, 1},  {0.0, -1}, {-0.0, -1}, {1, 0.0},   {1, -0.0},
-                               {-1, 0.0},  {0.0, 0.0}, {-0.0, -0.0}, {inf, 1}, {1, inf},
-                               {1, -inf},  {inf, inf}, {3e300, 1e300}, {1e-310, 1}};
+  const double special[][2] = {{1, 1},    {-1, 1},    {1, -1},        {-1, -1},   {0.0, 1},
+                               {-0.0, 1}, {0.0, -1},  {-0.0, -1},     {1, 0.0},   {1, -0.0},
+                               {-1, 0.0}, {0.0, 0.0}, {-0.0, -0.0},   {inf, 1},   {1, inf},
+                               {1, -inf}, {inf, inf}, {3e300, 1e300}, {1e-310, 1}};
   for (const auto& v : special) {
     const double got = polar_angle(v[0], v[1]), want = std::atan2(v[0], v[1]);
     EXPECT_EQ(got, want) << "y = " << v[0] << ", x = " << v[1];
