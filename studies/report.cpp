@@ -573,18 +573,10 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
   }
   // the measurements of `balance-design bench` when the folder has them (work_precision.hpp)
   h += work_precision_section(dir, gnuplot);
-  h += "<h2>Data files</h2>\n<ul>\n";
-  for (const char* f :
-       {"timeseries.csv", "summary.json", "balanced-timeseries.csv", "balanced.yaml",
-        "optimized-timeseries.csv", "optimized.yaml", "comparison.csv", "pareto.csv"}) {
-    std::error_code ec;
-    const auto size = fs::file_size(dir / f, ec);
-    if (ec) continue;
-    h += std::string("<li><a href=\"") + f + "\">" + f + "</a> (" + std::to_string(size) +
-         " bytes)</li>\n";
-  }
-  h += "</ul>\n</body>\n</html>\n";
-  return h;
+  return h + data_files_html(dir, {"timeseries.csv", "summary.json", "balanced-timeseries.csv",
+                                   "balanced.yaml", "optimized-timeseries.csv", "optimized.yaml",
+                                   "comparison.csv", "pareto.csv", "work-precision.csv",
+                                   "driven-convergence.csv"});
 }
 
 fs::path write_report(const Study& study, const fs::path& dir) {

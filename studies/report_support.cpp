@@ -299,6 +299,18 @@ std::string json_cell(const Json& v) {
   return "<td></td>";
 }
 
+std::string data_files_html(const fs::path& dir, const std::vector<std::string>& names) {
+  std::string h = "<h2>Data files</h2>\n<ul>\n";
+  for (const std::string& f : names) {
+    std::error_code ec;
+    const auto size = fs::file_size(dir / f, ec);
+    if (ec) continue;
+    h += "<li><a href=\"" + esc(f) + "\">" + esc(f) + "</a> (" + std::to_string(size) +
+         " bytes)</li>\n";
+  }
+  return h + "</ul>\n</body>\n</html>\n";
+}
+
 std::string csv_table(const Csv& csv) {
   std::string h = "<table><tr>";
   for (const std::string& k : csv.header) h += "<th>" + esc(k) + "</th>";

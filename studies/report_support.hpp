@@ -55,6 +55,10 @@ std::string num_cell(const std::string& written);
 std::string json_table(const Json& v);
 /// A JSON value as a table cell.
 std::string json_cell(const Json& v);
+/// The "Data files" section: a link and the size of each of `names` that exists in `dir`, in
+/// order, and the end of the page.
+std::string data_files_html(const std::filesystem::path& dir,
+                            const std::vector<std::string>& names);
 /// A CSV file as an HTML table (numbers through num_cell()).
 std::string csv_table(const Csv& csv);
 /// The pages' style sheet (inline CSS).

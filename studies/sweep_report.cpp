@@ -875,16 +875,7 @@ std::string sweep_report_html(const Study& study, const fs::path& dir, const std
   h += points_section(s);
   h += study_section(study, s);
 
-  h += "<h2>Data files</h2>\n<ul>\n";
-  for (const char* f : {"sweep.csv", "sweep.json"}) {
-    std::error_code ec;
-    const auto size = fs::file_size(dir / f, ec);
-    if (ec) continue;
-    h += std::string("<li><a href=\"") + f + "\">" + f + "</a> (" + std::to_string(size) +
-         " bytes)</li>\n";
-  }
-  h += "</ul>\n</body>\n</html>\n";
-  return h;
+  return h + data_files_html(dir, {"sweep.csv", "sweep.json"});
 }
 
 fs::path write_sweep_report(const Study& study, const fs::path& dir) {

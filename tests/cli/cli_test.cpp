@@ -11,6 +11,7 @@
 #include <string>
 
 #include "tests/support/csv.hpp"
+#include "tests/support/text.hpp"
 
 namespace {
 
@@ -19,18 +20,9 @@ namespace fs = std::filesystem;
 const std::string kExe = BD_BINARY_DIR "/bin/balance-design";
 const std::string kExamples = BD_SOURCE_DIR "/studies/examples";
 
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+using bd::testing::quote;
 
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using bd::testing::read;
 
 class CliTest : public ::testing::Test {
  protected:

@@ -21,6 +21,9 @@
 #include <thread>
 #include <vector>
 
+#include "tests/support/studies.hpp"
+#include "tests/support/text.hpp"
+
 extern char** environ;
 
 namespace {
@@ -30,18 +33,9 @@ namespace fs = std::filesystem;
 const std::string kExe = BD_BINARY_DIR "/bin/balance-design";
 const std::string kExamples = BD_SOURCE_DIR "/studies/examples";
 
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+using bd::testing::quote;
 
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using bd::testing::read;
 
 // rows of a sweep.csv: its whole lines after the header
 long rows(const fs::path& csv) {
@@ -52,29 +46,7 @@ long rows(const fs::path& csv) {
 
 // the paper's loaded linkage in free motion over 20 s, `count` points of a Latin hypercube: a
 // few milliseconds a point, so one thread takes a second or two
-std::string free_sweep(int count) {
-  return "name: free\n"
-         "linkage:\n"
-         "  type: fourbar\n"
-         "  frame: 3.2\n"
-         "  branch: 1\n"
-         "  crank:   {length: 1.0, mass: 2.1, s: 0.6, sigma: 0.3, inertia: 1.1}\n"
-         "  coupler: {length: 3.0, mass: 3.0, s: 1.45, sigma: 0.4, inertia: 3.1}\n"
-         "  rocker:  {length: 2.0, mass: 2.2, s: 1.66, sigma: -0.4, inertia: 2.1}\n"
-         "loads:\n"
-         "  crank:   {force: [1.1, 1.2],  moment: 0.37}\n"
-         "  coupler: {force: [1.3, -1.4], moment: 0.28}\n"
-         "  rocker:  {force: [1.5, 1.6],  moment: 0.19}\n"
-         "scene: {type: free, theta1: 1.0, omega1: 0.0, duration: 20.0, samples: 201}\n"
-         "sweep:\n"
-         "  design: lhs\n"
-         "  points: " +
-         std::to_string(count) +
-         "\n"
-         "  parameters:\n"
-         "    - {path: linkage.coupler.mass, from: 1.0, to: 5.0}\n"
-         "    - {path: scene.omega1, from: -2.0, to: 2.0}\n";
-}
+std::string free_sweep(int count) { return bd::testing::paper_free_lhs_sweep(count, ""); }
 
 class SweepCli : public ::testing::Test {
  protected:

@@ -8,6 +8,8 @@
 #include <string>
 #include <variant>
 
+#include "tests/support/study_errors.hpp"
+
 namespace bd::studies {
 namespace {
 
@@ -42,27 +44,12 @@ std::string edit(const std::string& from, const std::string& to) {
 
 // the StudyError thrown for `text`; fails the test when none is thrown
 StudyError error_of(const std::string& text) {
-  try {
-    parse_study(text, "study.yaml");
-  } catch (const StudyError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no error for:\n" << text;
-  return StudyError("none", 0, 0, "no error");
+  return bd::testing::study_error_of(text, "study.yaml");
 }
 
 // checks place and text, and that what() is the one-line "file:line:col: message"
 void expect_error(const std::string& text, int line, int column, const std::string& message) {
-  const StudyError e = error_of(text);
-  EXPECT_EQ(e.file(), "study.yaml");
-  EXPECT_EQ(e.line(), line) << e.what();
-  EXPECT_EQ(e.column(), column) << e.what();
-  EXPECT_NE(e.message().find(message), std::string::npos)
-      << "expected \"" << message << "\" in \"" << e.message() << "\"";
-  const std::string what = e.what();
-  EXPECT_EQ(what, "study.yaml:" + std::to_string(line) + ":" + std::to_string(column) + ": " +
-                      e.message());
-  EXPECT_EQ(what.find('\n'), std::string::npos) << "not one line: " << what;
+  bd::testing::expect_study_error(text, "study.yaml", line, column, message);
 }
 
 TEST(LoadStudy, BaseIsValid) { EXPECT_NO_THROW(parse_study(kBase, "study.yaml")); }

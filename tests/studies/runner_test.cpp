@@ -21,6 +21,7 @@
 #include "studies/load_study.hpp"
 #include "tests/support/csv.hpp"
 #include "tests/support/models.hpp"
+#include "tests/support/text.hpp"
 
 namespace bd::studies {
 namespace {
@@ -41,12 +42,7 @@ class RunnerTest : public ::testing::Test {
   fs::path dir_;
 };
 
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using bd::testing::read;
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> lines;

@@ -29,24 +29,16 @@
 #include "studies/report.hpp"
 #include "studies/report_support.hpp"
 #include "studies/sweep.hpp"
+#include "tests/support/text.hpp"
 
 namespace bd::studies {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using bd::testing::read;
 
-std::size_t count(const std::string& text, const std::string& what) {
-  std::size_t n = 0;
-  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
+using bd::testing::count;
 
 std::string g17(double v) {
   char buf[32];

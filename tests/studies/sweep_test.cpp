@@ -16,6 +16,7 @@
 
 #include "studies/load_study.hpp"
 #include "studies/study_yaml.hpp"
+#include "tests/support/study_errors.hpp"
 
 namespace bd::studies {
 namespace {
@@ -46,29 +47,9 @@ std::string one_parameter(const std::string& path,
   return with_sweep("  parameters:\n    - path: " + path + "\n" + rest);
 }
 
-// the StudyError thrown for `text`; fails the test when none is thrown
-StudyError error_of(const std::string& text) {
-  try {
-    parse_study(text, "sweep.yaml");
-  } catch (const StudyError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no error for:\n" << text;
-  return StudyError("none", 0, 0, "no error");
-}
-
 // checks place and text, and that what() is the one-line "file:line:col: message"
 void expect_error(const std::string& text, int line, int column, const std::string& message) {
-  const StudyError e = error_of(text);
-  EXPECT_EQ(e.file(), "sweep.yaml");
-  EXPECT_EQ(e.line(), line) << e.what();
-  EXPECT_EQ(e.column(), column) << e.what();
-  EXPECT_NE(e.message().find(message), std::string::npos)
-      << "expected \"" << message << "\" in \"" << e.message() << "\"";
-  const std::string what = e.what();
-  EXPECT_EQ(what, "sweep.yaml:" + std::to_string(line) + ":" + std::to_string(column) + ": " +
-                      e.message());
-  EXPECT_EQ(what.find('\n'), std::string::npos) << "not one line: " << what;
+  bd::testing::expect_study_error(text, "sweep.yaml", line, column, message);
 }
 
 SweepRequest request_of(const std::string& text) {

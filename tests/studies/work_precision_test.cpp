@@ -23,18 +23,14 @@
 #include "studies/load_study.hpp"
 #include "studies/report.hpp"
 #include "studies/report_support.hpp"
+#include "tests/support/text.hpp"
 
 namespace bd::studies {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using bd::testing::read;
 
 class WorkPrecisionTest : public ::testing::Test {
  protected:

@@ -1,0 +1,33 @@
+#pragma once
+// Test support: study-file texts the sweep tests share.
+#include <string>
+
+namespace bd::testing {
+
+/// The paper's loaded four-bar in free motion (20 s, 201 samples) with an LHS sweep of `points`
+/// points over coupler mass [1, 5] kg and initial crank speed [-2, 2] rad/s; `extra` (e.g.
+/// "  seed: 7\n") is added to the sweep section before its parameters.
+inline std::string paper_free_lhs_sweep(int points, const std::string& extra) {
+  return "name: free\n"
+         "linkage:\n"
+         "  type: fourbar\n"
+         "  frame: 3.2\n"
+         "  branch: 1\n"
+         "  crank:   {length: 1.0, mass: 2.1, s: 0.6, sigma: 0.3, inertia: 1.1}\n"
+         "  coupler: {length: 3.0, mass: 3.0, s: 1.45, sigma: 0.4, inertia: 3.1}\n"
+         "  rocker:  {length: 2.0, mass: 2.2, s: 1.66, sigma: -0.4, inertia: 2.1}\n"
+         "loads:\n"
+         "  crank:   {force: [1.1, 1.2],  moment: 0.37}\n"
+         "  coupler: {force: [1.3, -1.4], moment: 0.28}\n"
+         "  rocker:  {force: [1.5, 1.6],  moment: 0.19}\n"
+         "scene: {type: free, theta1: 1.0, omega1: 0.0, duration: 20.0, samples: 201}\n"
+         "sweep:\n"
+         "  design: lhs\n"
+         "  points: " +
+         std::to_string(points) + "\n" + extra +
+         "  parameters:\n"
+         "    - {path: linkage.coupler.mass, from: 1.0, to: 5.0}\n"
+         "    - {path: scene.omega1, from: -2.0, to: 2.0}\n";
+}
+
+}  // namespace bd::testing
