@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/number_text.hpp"
+
 namespace bd::balance {
 
 namespace {
@@ -12,12 +14,6 @@ using core::Complex;
 
 // s̄_k / l_k
 Complex relative_com(const core::Link& l) { return Complex(l.e, l.f) / l.length; }
-
-std::string format(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
 
 Condition make_condition(std::string name, std::string meaning, double residual, double scale,
                          std::string unit, double relative_tolerance) {
@@ -80,8 +76,8 @@ std::string BalanceReport::text() const {
   std::string out;
   auto add = [&out](const Condition& c) {
     out += "  " + c.name + ": " + (c.holds ? "holds" : "FAILS") + ", residual " +
-           format(c.residual) + " " + c.unit + " of " + format(c.scale) + " " + c.unit + " (" +
-           c.meaning + ")\n";
+           text::digits(c.residual, 3) + " " + c.unit + " of " + text::digits(c.scale, 3) + " " +
+           c.unit + " (" + c.meaning + ")\n";
   };
   out += std::string("shaking force: ") + (force_balanced() ? "balanced" : "not balanced") + "\n";
   for (const Condition& c : force) add(c);
@@ -122,14 +118,14 @@ BalanceReport check_balance(const core::FourBar& model, double relative_toleranc
       l3.inertia + l3.mass * (de3 * de3 + l3.f * l3.f) + std::abs(mb) * l3.length * l3.length;
   const double J1 = model.counter_rotations.crank.inertia;
   const double J3 = model.counter_rotations.rocker.inertia;
-  r.moment.push_back(
-      make_condition("counter_rotation.crank",
-                     "J1 = I1 + m1 |s1|^2 + m2 (1 - e2/l2) l1^2 = " + format(K.crank) + " kg m^2",
-                     std::abs(J1 - K.crank), std::max(scale1, J1), "kg m^2", relative_tolerance));
-  r.moment.push_back(
-      make_condition("counter_rotation.rocker",
-                     "J3 = I3 + m3 |l3 - s3|^2 + m2 (e2/l2) l3^2 = " + format(K.rocker) + " kg m^2",
-                     std::abs(J3 - K.rocker), std::max(scale3, J3), "kg m^2", relative_tolerance));
+  r.moment.push_back(make_condition(
+      "counter_rotation.crank",
+      "J1 = I1 + m1 |s1|^2 + m2 (1 - e2/l2) l1^2 = " + text::digits(K.crank, 3) + " kg m^2",
+      std::abs(J1 - K.crank), std::max(scale1, J1), "kg m^2", relative_tolerance));
+  r.moment.push_back(make_condition(
+      "counter_rotation.rocker",
+      "J3 = I3 + m3 |l3 - s3|^2 + m2 (e2/l2) l3^2 = " + text::digits(K.rocker, 3) + " kg m^2",
+      std::abs(J3 - K.rocker), std::max(scale3, J3), "kg m^2", relative_tolerance));
   return r;
 }
 

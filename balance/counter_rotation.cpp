@@ -1,5 +1,7 @@
 #include "balance/counter_rotation.hpp"
 
+#include <fmt/printf.h>
+
 #include <cstdio>
 
 #include "balance/conditions.hpp"
@@ -13,9 +15,8 @@ namespace {
 constexpr double kInputTolerance = 1e-9;
 
 std::string describe(const Condition& c) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, ": residual %.6g %s exceeds %.0e of %.6g %s", c.residual,
-                c.unit.c_str(), kInputTolerance, c.scale, c.unit.c_str());
+  const std::string buf = fmt::sprintf(": residual %.6g %s exceeds %.0e of %.6g %s", c.residual,
+                                       c.unit.c_str(), kInputTolerance, c.scale, c.unit.c_str());
   return c.name + " (" + c.meaning + ")" + buf;
 }
 
@@ -33,11 +34,9 @@ MomentBalancedDesign moment_balance(const core::FourBar& force_balanced, Vec2 cr
   const core::Link& coupler = checked.coupler;
   for (const Condition& c : report.moment) {
     if (c.name.rfind("coupler.", 0) != 0 || c.holds) continue;
-    char values[200];
-    std::snprintf(values, sizeof values,
-                  "; got f2 = %.17g m, I2 = %.17g kg m^2, m2 e2 (l2 - e2) = %.17g kg m^2",
-                  coupler.f, coupler.inertia,
-                  coupler.mass * coupler.e * (coupler.length - coupler.e));
+    const std::string values = fmt::sprintf(
+        "; got f2 = %.17g m, I2 = %.17g kg m^2, m2 e2 (l2 - e2) = %.17g kg m^2", coupler.f,
+        coupler.inertia, coupler.mass * coupler.e * (coupler.length - coupler.e));
     throw InputError("moment_balance needs a Berkof coupler: " + describe(c) + values);
   }
 

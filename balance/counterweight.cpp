@@ -6,6 +6,7 @@
 
 #include "balance/conditions.hpp"
 #include "core/input_error.hpp"
+#include "core/number_text.hpp"
 #include "core/principal_vectors.hpp"
 
 namespace bd::balance {
@@ -14,16 +15,10 @@ namespace {
 
 using core::Complex;
 
-std::string format(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 // "" when v is finite and > 0, else "<what> must be > 0 <unit>, got <v>"
 std::string positive(const char* what, const char* unit, double v) {
   if (std::isfinite(v) && v > 0) return "";
-  return std::string(what) + " must be > 0 " + unit + ", got " + format(v);
+  return std::string(what) + " must be > 0 " + unit + ", got " + text::exact(v);
 }
 
 // A counterweight of mass mc at `position` (link axes, from its pivot) whose mass moment is
@@ -60,9 +55,9 @@ std::string CounterweightSpec::validate() const {
   if (given > 1) {
     std::string what;
     auto add = [&what](const std::string& s) { what += (what.empty() ? "" : " and ") + s; };
-    if (mass) add("mass = " + format(*mass) + " kg");
-    if (distance) add("distance = " + format(*distance) + " m");
-    if (radius) add("radius = " + format(*radius) + " m");
+    if (mass) add("mass = " + text::exact(*mass) + " kg");
+    if (distance) add("distance = " + text::exact(*distance) + " m");
+    if (radius) add("radius = " + text::exact(*radius) + " m");
     return "give at most one of mass, distance and radius (the others are solved), got " + what;
   }
   if (shape != CounterweightShape::kPoint && shape != CounterweightShape::kDisc) {

@@ -11,23 +11,28 @@ namespace bd::core {
 namespace {
 
 // the formulations' own entry points (they know nothing of discs)
-Expected<DynamicsSample, DynamicsError> bare_forward(const FourBar& m, double theta1,
-                                                     double omega1, Formulation f) {
+Expected<DynamicsSample, DynamicsError> bare_forward(const FourBar& m, double theta1, double omega1,
+                                                     Formulation f) {
   switch (f) {
-    case Formulation::kOpenedLoop: return forward_dynamics_opened_loop(m, theta1, omega1);
-    case Formulation::kComplexMasses: return forward_dynamics_complex_masses(m, theta1, omega1);
-    case Formulation::kMassMatrix: break;
+    case Formulation::kOpenedLoop:
+      return forward_dynamics_opened_loop(m, theta1, omega1);
+    case Formulation::kComplexMasses:
+      return forward_dynamics_complex_masses(m, theta1, omega1);
+    case Formulation::kMassMatrix:
+      break;
   }
   return forward_dynamics_mass_matrix(m, theta1, omega1);
 }
 
-Expected<DynamicsSample, DynamicsError> bare_inverse(const FourBar& m, double theta1,
-                                                     double omega1, double alpha1, Formulation f) {
+Expected<DynamicsSample, DynamicsError> bare_inverse(const FourBar& m, double theta1, double omega1,
+                                                     double alpha1, Formulation f) {
   switch (f) {
-    case Formulation::kOpenedLoop: return inverse_dynamics_opened_loop(m, theta1, omega1, alpha1);
+    case Formulation::kOpenedLoop:
+      return inverse_dynamics_opened_loop(m, theta1, omega1, alpha1);
     case Formulation::kComplexMasses:
       return inverse_dynamics_complex_masses(m, theta1, omega1, alpha1);
-    case Formulation::kMassMatrix: break;
+    case Formulation::kMassMatrix:
+      break;
   }
   return inverse_dynamics_mass_matrix(m, theta1, omega1, alpha1);
 }
@@ -71,7 +76,8 @@ FourBar with_mesh_loads(const FourBar& model, const FourBarState& s, const MeshF
   // centres of mass along the open chain from A0 (the state's own angles)
   const Vec2 r1 = centre_of_mass(model, 1, pose);
   const Vec2 A2_from_A3 = A3 - model.rocker.length * unit(s.theta3);
-  const Vec2 r3 = A2_from_A3 + model.rocker.e * unit(s.theta3) + model.rocker.f * perp(unit(s.theta3));
+  const Vec2 r3 =
+      A2_from_A3 + model.rocker.e * unit(s.theta3) + model.rocker.f * perp(unit(s.theta3));
   if (c.crank.inertia > 0) add_load(m.loads.crank, f.crank, (A0 + c.crank.at) / 2, r1);
   if (c.rocker.inertia > 0) add_load(m.loads.rocker, f.rocker, (A3 + c.rocker.at) / 2, r3);
   return m;

@@ -1,5 +1,7 @@
 #include "core/dynamics.hpp"
 
+#include <fmt/printf.h>
+
 #include <cstdio>
 
 #include "core/complex_masses.hpp"
@@ -16,8 +18,7 @@ std::string DynamicsError::what() const {
   const char* kind_text = kind == Kind::kAssembly   ? "assembly failure"
                           : kind == Kind::kSingular ? "singular position"
                                                     : "non-finite result";
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "%s at theta1 = %.6g rad: ", kind_text, theta1);
+  const std::string buf = fmt::sprintf("%s at theta1 = %.6g rad: ", kind_text, theta1);
   return buf + detail;
 }
 

@@ -1,24 +1,25 @@
 #include "core/formulation_support.hpp"
 
+#include <fmt/printf.h>
+
 #include <cstdio>
 
 namespace bd::core {
 
 DynamicsError Failure::error() const {
-  char buf[200];
+  std::string buf;
   switch (reason) {
     case Reason::kAssembly:
       return {DynamicsError::Kind::kAssembly, theta1, AssemblyError{theta1, value}.what()};
     case Reason::kDeadCentre:
-      std::snprintf(buf, sizeof buf,
-                    "sin(theta3 - theta2) = %.3g: coupler and rocker are aligned (dead centre)",
-                    value);
+      buf = fmt::sprintf(
+          "sin(theta3 - theta2) = %.3g: coupler and rocker are aligned (dead centre)", value);
       return {DynamicsError::Kind::kSingular, theta1, buf};
     case Reason::kAllParallel:
-      std::snprintf(buf, sizeof buf,
-                    "all three moving links are parallel (largest |sin| of their relative angles "
-                    "%.3g): the opened-loop 5x5 system is singular",
-                    value);
+      buf = fmt::sprintf(
+          "all three moving links are parallel (largest |sin| of their relative angles "
+          "%.3g): the opened-loop 5x5 system is singular",
+          value);
       return {DynamicsError::Kind::kSingular, theta1, buf};
     case Reason::kNonFinite:
       break;

@@ -1,5 +1,7 @@
 #include "core/kinematics.hpp"
 
+#include <fmt/printf.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -30,21 +32,20 @@ double link_acceleration(const FourBarState& s, int k) {
 }  // namespace
 
 std::string AssemblyError::what() const {
-  char buf[200];
+  std::string buf;
   if (gap > 0) {
-    std::snprintf(buf, sizeof buf,
-                  "loop cannot close at theta1 = %.6g rad: |A1A3| exceeds l2 + l3 by %.3g m",
-                  theta1, gap);
+    buf = fmt::sprintf("loop cannot close at theta1 = %.6g rad: |A1A3| exceeds l2 + l3 by %.3g m",
+                       theta1, gap);
   } else if (gap < 0) {
-    std::snprintf(buf, sizeof buf,
-                  "loop cannot close at theta1 = %.6g rad: |A1A3| falls short of |l2 - l3| by "
-                  "%.3g m",
-                  theta1, -gap);
+    buf = fmt::sprintf(
+        "loop cannot close at theta1 = %.6g rad: |A1A3| falls short of |l2 - l3| by "
+        "%.3g m",
+        theta1, -gap);
   } else {
-    std::snprintf(buf, sizeof buf,
-                  "loop cannot close at theta1 = %.6g rad: A1 coincides with A3, the coupler "
-                  "direction is undefined",
-                  theta1);
+    buf = fmt::sprintf(
+        "loop cannot close at theta1 = %.6g rad: A1 coincides with A3, the coupler "
+        "direction is undefined",
+        theta1);
   }
   return buf;
 }

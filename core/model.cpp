@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "core/input_error.hpp"
+#include "core/number_text.hpp"
 
 namespace bd::core {
 
@@ -43,18 +44,12 @@ double total_mass(const FourBar& model) {
 
 namespace {
 
-std::string format_value(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 // throws "<what> must be <expected> <unit>, got <value>" unless ok
 void require(bool ok, const std::string& what, const char* expected, const char* unit,
              double value) {
   if (!ok) {
     throw InputError(what + " must be " + expected + (unit[0] ? " " : "") + unit + ", got " +
-                     format_value(value));
+                     text::exact(value));
   }
 }
 
@@ -66,8 +61,7 @@ void check_finite(const std::string& what, const char* unit, double value) {
 
 FourBar make_fourbar(const FourBar& candidate) {
   const FourBar& m = candidate;
-  require(std::isfinite(m.frame_length) && m.frame_length > 0, "frame", "> 0", "m",
-          m.frame_length);
+  require(std::isfinite(m.frame_length) && m.frame_length > 0, "frame", "> 0", "m", m.frame_length);
   for (int k = 1; k <= 3; ++k) {
     const Link& l = link(m, k);
     const std::string name = link_name(k);
@@ -122,12 +116,18 @@ GrashofClass classify_grashof(const FourBar& model) {
 
 const char* to_string(GrashofClass c) {
   switch (c) {
-    case GrashofClass::kCrankRocker: return "crank-rocker";
-    case GrashofClass::kDoubleCrank: return "double-crank";
-    case GrashofClass::kRockerCrank: return "rocker-crank";
-    case GrashofClass::kDoubleRocker: return "double-rocker";
-    case GrashofClass::kChangePoint: return "change-point";
-    case GrashofClass::kNonGrashof: return "non-Grashof";
+    case GrashofClass::kCrankRocker:
+      return "crank-rocker";
+    case GrashofClass::kDoubleCrank:
+      return "double-crank";
+    case GrashofClass::kRockerCrank:
+      return "rocker-crank";
+    case GrashofClass::kDoubleRocker:
+      return "double-rocker";
+    case GrashofClass::kChangePoint:
+      return "change-point";
+    case GrashofClass::kNonGrashof:
+      return "non-Grashof";
   }
   return "?";
 }

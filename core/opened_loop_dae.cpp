@@ -15,6 +15,7 @@
 #include "core/input_error.hpp"
 #include "core/integrators.hpp"
 #include "core/kinematics.hpp"
+#include "core/number_text.hpp"
 #include "core/opened_loop.hpp"
 
 namespace bd::core {
@@ -29,12 +30,6 @@ constexpr int kGglStates = 10;
 // Gauss-Newton iterations of one projection onto the closure; from an integrator step off the
 // closure by ~tolerance, two or three reach round-off (quadratic convergence)
 constexpr int kMaxProjectionIterations = 10;
-
-std::string number(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.10g", x);
-  return buf;
-}
 
 // the state of the CVODE vector y = (theta1, theta2, theta3, omega1, omega2, omega3)
 FourBarState state_of(const double* y) {
@@ -207,7 +202,7 @@ int ggl_residual(sunrealtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* use
 
 void fail(Trajectory& out, const DynamicsError& error, double t) {
   out.status = status_of(error.kind);
-  out.message = error.what() + " (t = " + number(t) + " s)";
+  out.message = error.what() + " (t = " + text::digits(t, 10) + " s)";
 }
 
 void validate(const FreeScene& scene, const OpenedLoopDaeOptions& options) {
@@ -271,17 +266,17 @@ const char* to_string(DaeMethod m) {
 
 std::string OpenedLoopDaeOptions::validate() const {
   if (!(tolerance > 0.0 && tolerance < 1.0)) {
-    return "tolerance must be > 0 and < 1, got " + number(tolerance);
+    return "tolerance must be > 0 and < 1, got " + text::digits(tolerance, 10);
   }
   if (!(absolute_tolerance > 0.0) || !std::isfinite(absolute_tolerance)) {
-    return "absolute_tolerance must be > 0, got " + number(absolute_tolerance);
+    return "absolute_tolerance must be > 0, got " + text::digits(absolute_tolerance, 10);
   }
   if (max_steps < 1) return "max_steps must be >= 1, got " + std::to_string(max_steps);
   if (!(baumgarte_alpha >= 0.0) || !std::isfinite(baumgarte_alpha)) {
-    return "baumgarte_alpha must be >= 0 1/s, got " + number(baumgarte_alpha);
+    return "baumgarte_alpha must be >= 0 1/s, got " + text::digits(baumgarte_alpha, 10);
   }
   if (!(baumgarte_beta >= 0.0) || !std::isfinite(baumgarte_beta)) {
-    return "baumgarte_beta must be >= 0 1/s, got " + number(baumgarte_beta);
+    return "baumgarte_beta must be >= 0 1/s, got " + text::digits(baumgarte_beta, 10);
   }
   switch (method) {
     case DaeMethod::kAuto:
@@ -532,19 +527,19 @@ OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FreeSce
     const double* y = integration.y();
     if (outcome == integrators::Integration::Outcome::kMaxSteps) {
       traj.status = SimulationStatus::kIntegratorFailed;
-      traj.message = "integrator stopped at t = " + number(t_reached) +
-                     " s, theta1 = " + number(y[0]) +
+      traj.message = "integrator stopped at t = " + text::digits(t_reached, 10) +
+                     " s, theta1 = " + text::digits(y[0], 10) +
                      " rad: max_steps = " + std::to_string(options.max_steps) + " reached";
       break;
     }
     if (outcome != integrators::Integration::Outcome::kReached) {  // no root function here
       if (motion.rhs_failed) {
         fail(traj, motion.error, motion.error_t);
-        traj.message += "; integration stopped at t = " + number(t_reached) + " s";
+        traj.message += "; integration stopped at t = " + text::digits(t_reached, 10) + " s";
       } else {
         traj.status = SimulationStatus::kIntegratorFailed;
-        traj.message = "integrator failed at t = " + number(t_reached) +
-                       " s, theta1 = " + number(y[0]) + " rad: " + integration.failure();
+        traj.message = "integrator failed at t = " + text::digits(t_reached, 10) +
+                       " s, theta1 = " + text::digits(y[0], 10) + " rad: " + integration.failure();
       }
       break;
     }

@@ -58,8 +58,8 @@ OpenedLoopVectors opened_loop_vectors(const FourBar& m, const Pose& p) {
 OpenedLoopVectors opened_loop_vectors(const FourBar& m, const LinkVectors& l) {
   const OpenedLoopFactors f = opened_loop_factors(m);
   const Complex l1 = to_complex(l.l1), l2 = to_complex(l.l2), l3 = to_complex(l.l3);
-  return {to_vec(f.a12 * l1),  to_vec(f.a21 * l2),  to_vec(f.a23 * l2),
-          to_vec(f.a32 * l3),  to_vec(f.a14p * l1), to_vec(f.a34p * l3)};
+  return {to_vec(f.a12 * l1), to_vec(f.a21 * l2),  to_vec(f.a23 * l2),
+          to_vec(f.a32 * l3), to_vec(f.a14p * l1), to_vec(f.a34p * l3)};
 }
 
 FrameVectors frame_vectors(const FourBar& m, const Pose& p) {

@@ -1,5 +1,7 @@
 #include "core/simulate.hpp"
 
+#include <fmt/printf.h>
+
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
@@ -9,13 +11,14 @@
 #include <string>
 #include <string_view>
 
-#include "core/input_error.hpp"
 #include "core/counter_rotation.hpp"
 #include "core/formulation_support.hpp"
+#include "core/input_error.hpp"
 #include "core/instant_dynamics.hpp"
-#include "core/opened_loop.hpp"
 #include "core/integrators.hpp"
 #include "core/kinematics.hpp"
+#include "core/number_text.hpp"
+#include "core/opened_loop.hpp"
 #include "core/opened_loop_dae.hpp"
 
 namespace bd::core {
@@ -43,13 +46,6 @@ constexpr double kDeadCentreSin = 2 * kSingularSin;
 
 // Upper bound on the number of samples of one run, so the size arithmetic cannot overflow.
 constexpr long long kMaxSamples = 100'000'000;
-
-// "%.10g" of a value, for messages
-std::string number(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.10g", x);
-  return buf;
-}
 
 // The representative of `wrapped` (mod 2π) nearest to `reference`.
 double nearest_turn(double wrapped, double reference) {
@@ -90,7 +86,7 @@ std::string failure_message(const DynamicsError& error, double t, double theta1)
     }
   }
   std::string message = what;
-  message += " at t = " + number(t) + " s, theta1 = " + number(theta1) + " rad";
+  message += " at t = " + text::digits(t, 10) + " s, theta1 = " + text::digits(theta1, 10) + " rad";
   if (!detail.empty()) {
     message += ": ";
     message += detail;
@@ -100,11 +96,10 @@ std::string failure_message(const DynamicsError& error, double t, double theta1)
 
 // The error for a crank at a limit position, coupler and rocker aligned to sin_mu.
 DynamicsError dead_centre_error(double theta1, double sin_mu) {
-  char detail[160];
-  std::snprintf(detail, sizeof detail,
-                "sin(theta3 - theta2) = %.3g: coupler and rocker aligned, the crank has reached a "
-                "limit position",
-                sin_mu);
+  const std::string detail = fmt::sprintf(
+      "sin(theta3 - theta2) = %.3g: coupler and rocker aligned, the crank has reached a "
+      "limit position",
+      sin_mu);
   return {DynamicsError::Kind::kSingular, theta1, detail};
 }
 
@@ -171,10 +166,11 @@ void validate(const FreeScene& scene, const SimulateOptions& options) {
 void validate(const DrivenScene& scene, const SimulateOptions& options) {
   if (const std::string problem = options.validate(); !problem.empty()) throw InputError(problem);
   if (!std::isfinite(scene.theta1)) {
-    throw InputError("scene.theta1 must be finite, got " + number(scene.theta1));
+    throw InputError("scene.theta1 must be finite, got " + text::digits(scene.theta1, 10));
   }
   if (!(scene.omega1 != 0.0) || !std::isfinite(scene.omega1)) {
-    throw InputError("scene.omega1 must be finite and != 0 rad/s, got " + number(scene.omega1));
+    throw InputError("scene.omega1 must be finite and != 0 rad/s, got " +
+                     text::digits(scene.omega1, 10));
   }
   if (scene.revolutions < 1) {
     throw InputError("scene.revolutions must be >= 1, got " + std::to_string(scene.revolutions));
@@ -192,10 +188,10 @@ void validate(const DrivenScene& scene, const SimulateOptions& options) {
 
 std::string SimulateOptions::validate() const {
   if (!(tolerance > 0.0 && tolerance < 1.0)) {
-    return "tolerance must be > 0 and < 1, got " + number(tolerance);
+    return "tolerance must be > 0 and < 1, got " + text::digits(tolerance, 10);
   }
   if (!(absolute_tolerance > 0.0) || !std::isfinite(absolute_tolerance)) {
-    return "absolute_tolerance must be > 0, got " + number(absolute_tolerance);
+    return "absolute_tolerance must be > 0, got " + text::digits(absolute_tolerance, 10);
   }
   if (max_steps < 1) return "max_steps must be >= 1, got " + std::to_string(max_steps);
   switch (formulation) {
@@ -268,13 +264,13 @@ SimulationStatus status_of(DynamicsError::Kind kind) {
 
 void validate_scene(const FreeScene& scene) {
   if (!std::isfinite(scene.theta1)) {
-    throw InputError("scene.theta1 must be finite, got " + number(scene.theta1));
+    throw InputError("scene.theta1 must be finite, got " + text::digits(scene.theta1, 10));
   }
   if (!std::isfinite(scene.omega1)) {
-    throw InputError("scene.omega1 must be finite, got " + number(scene.omega1));
+    throw InputError("scene.omega1 must be finite, got " + text::digits(scene.omega1, 10));
   }
   if (!(scene.duration > 0.0) || !std::isfinite(scene.duration)) {
-    throw InputError("scene.duration must be > 0 s, got " + number(scene.duration));
+    throw InputError("scene.duration must be > 0 s, got " + text::digits(scene.duration, 10));
   }
   if (scene.samples < 2 || scene.samples > kMaxSamples) {
     throw InputError("scene.samples must be >= 2 (and <= 1e8), got " +
@@ -385,8 +381,8 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
     const double theta1 = integration.y()[0], omega1 = integration.y()[1];
     if (outcome == integrators::Integration::Outcome::kMaxSteps) {
       out.status = SimulationStatus::kIntegratorFailed;
-      out.message = "integrator stopped at t = " + number(t_reached) +
-                    " s, theta1 = " + number(theta1) +
+      out.message = "integrator stopped at t = " + text::digits(t_reached, 10) +
+                    " s, theta1 = " + text::digits(theta1, 10) +
                     " rad: max_steps = " + std::to_string(options.max_steps) + " reached";
       break;
     }
@@ -396,19 +392,19 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
         // the integrator could not step around it (ERKStep cannot retry): in free motion from
         // an assembled start that is the crank reaching a limit position
         out.status = SimulationStatus::kSingular;
-        out.message = "limit position reached after t = " + number(t_reached) +
-                      " s, theta1 = " + number(theta1) +
+        out.message = "limit position reached after t = " + text::digits(t_reached, 10) +
+                      " s, theta1 = " + text::digits(theta1, 10) +
                       " rad: the crank reaches a limit position within the integrator's next "
                       "step (a trial step found: " +
                       motion.error.what() + ")";
       } else if (motion.rhs_failed) {
         // the dynamics failed ahead of the last step and the integrator could not step around it
         fail(out, motion.error, motion.error_t, motion.error_theta1);
-        out.message += "; integration stopped at t = " + number(t_reached) + " s";
+        out.message += "; integration stopped at t = " + text::digits(t_reached, 10) + " s";
       } else {
         out.status = SimulationStatus::kIntegratorFailed;
-        out.message = "integrator failed at t = " + number(t_reached) +
-                      " s, theta1 = " + number(theta1) + " rad: " + integration.failure();
+        out.message = "integrator failed at t = " + text::digits(t_reached, 10) +
+                      " s, theta1 = " + text::digits(theta1, 10) + " rad: " + integration.failure();
       }
       break;
     }

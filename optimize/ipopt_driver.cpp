@@ -198,39 +198,56 @@ Termination termination_of(Ipopt::ApplicationReturnStatus s, bool budget_spent) 
 
 std::string describe(Ipopt::ApplicationReturnStatus s) {
   switch (s) {
-    case Ipopt::Solve_Succeeded: return "optimal solution found";
-    case Ipopt::Solved_To_Acceptable_Level: return "solved to an acceptable level";
-    case Ipopt::Infeasible_Problem_Detected: return "converged to a point of local infeasibility";
+    case Ipopt::Solve_Succeeded:
+      return "optimal solution found";
+    case Ipopt::Solved_To_Acceptable_Level:
+      return "solved to an acceptable level";
+    case Ipopt::Infeasible_Problem_Detected:
+      return "converged to a point of local infeasibility";
     case Ipopt::Search_Direction_Becomes_Too_Small:
       return "search direction became too small (stationary to working precision)";
-    case Ipopt::Diverging_Iterates: return "iterates diverging";
-    case Ipopt::User_Requested_Stop: return "stopped";
-    case Ipopt::Feasible_Point_Found: return "feasible point found";
-    case Ipopt::Maximum_Iterations_Exceeded: return "maximum number of iterations exceeded";
-    case Ipopt::Restoration_Failed: return "restoration phase failed";
-    case Ipopt::Error_In_Step_Computation: return "error in step computation";
-    case Ipopt::Maximum_CpuTime_Exceeded: return "maximum CPU time exceeded";
-    case Ipopt::Not_Enough_Degrees_Of_Freedom: return "not enough degrees of freedom";
-    case Ipopt::Invalid_Problem_Definition: return "invalid problem definition";
-    case Ipopt::Invalid_Option: return "invalid option";
-    case Ipopt::Invalid_Number_Detected: return "invalid number detected";
-    case Ipopt::Unrecoverable_Exception: return "unrecoverable exception";
-    case Ipopt::NonIpopt_Exception_Thrown: return "non-Ipopt exception thrown";
-    case Ipopt::Insufficient_Memory: return "insufficient memory";
-    case Ipopt::Internal_Error: return "internal error";
+    case Ipopt::Diverging_Iterates:
+      return "iterates diverging";
+    case Ipopt::User_Requested_Stop:
+      return "stopped";
+    case Ipopt::Feasible_Point_Found:
+      return "feasible point found";
+    case Ipopt::Maximum_Iterations_Exceeded:
+      return "maximum number of iterations exceeded";
+    case Ipopt::Restoration_Failed:
+      return "restoration phase failed";
+    case Ipopt::Error_In_Step_Computation:
+      return "error in step computation";
+    case Ipopt::Maximum_CpuTime_Exceeded:
+      return "maximum CPU time exceeded";
+    case Ipopt::Not_Enough_Degrees_Of_Freedom:
+      return "not enough degrees of freedom";
+    case Ipopt::Invalid_Problem_Definition:
+      return "invalid problem definition";
+    case Ipopt::Invalid_Option:
+      return "invalid option";
+    case Ipopt::Invalid_Number_Detected:
+      return "invalid number detected";
+    case Ipopt::Unrecoverable_Exception:
+      return "unrecoverable exception";
+    case Ipopt::NonIpopt_Exception_Thrown:
+      return "non-Ipopt exception thrown";
+    case Ipopt::Insufficient_Memory:
+      return "insufficient memory";
+    case Ipopt::Internal_Error:
+      return "internal error";
   }
   return "unknown Ipopt status " + std::to_string(static_cast<int>(s));
 }
 
 }  // namespace
 
-DriverOutcome solve_with_ipopt(const Nlp& nlp, const VectorXd& x0,
-                               const OptimizeOptions& options) {
+DriverOutcome solve_with_ipopt(const Nlp& nlp, const VectorXd& x0, const OptimizeOptions& options) {
   DriverOutcome out;
   out.x = x0;
   TrackedNlp tracked(nlp, options.constraint_tolerance);
-  Ipopt::SmartPtr<Tnlp> problem = new Tnlp(tracked, x0.cwiseMax(nlp.lower()).cwiseMin(nlp.upper()),
-                                           options.max_evaluations);
+  Ipopt::SmartPtr<Tnlp> problem =
+      new Tnlp(tracked, x0.cwiseMax(nlp.lower()).cwiseMin(nlp.upper()), options.max_evaluations);
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
 
   // options: silent, quasi-Newton Hessian, our tolerances and budget

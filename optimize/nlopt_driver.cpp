@@ -63,8 +63,8 @@ void TrackedNlp::consider() {
   if (x_f_.size() == 0 || !std::isfinite(f_)) return;
   if (nlp_.n_eq() > 0 && !same_point(x_f_, x_eq_)) return;
   if (nlp_.n_ineq() > 0 && !same_point(x_f_, x_in_)) return;
-  const double violation = std::max(nlp_.n_eq() > 0 ? violation_eq_ : 0.0,
-                                    nlp_.n_ineq() > 0 ? violation_in_ : 0.0);
+  const double violation =
+      std::max(nlp_.n_eq() > 0 ? violation_eq_ : 0.0, nlp_.n_ineq() > 0 ? violation_in_ : 0.0);
   if (violation > tolerance_ || f_ >= best_f_) return;
   has_best_ = true;
   best_f_ = f_;
@@ -79,7 +79,8 @@ double constraint_violation(const Nlp& nlp, const VectorXd& x, int* worst, doubl
   if (nlp.n_eq() > 0) {
     nlp.equalities(x, c, nullptr);
     for (int i = 0; i < c.size(); ++i) {
-      const double v = std::isfinite(c[i]) ? std::abs(c[i]) : std::numeric_limits<double>::infinity();
+      const double v =
+          std::isfinite(c[i]) ? std::abs(c[i]) : std::numeric_limits<double>::infinity();
       if (v > largest) largest = v, index = i, at = c[i];
     }
   }
@@ -190,29 +191,47 @@ Termination termination_of(nlopt_result r) {
 
 std::string describe(nlopt_result r) {
   switch (r) {
-    case NLOPT_SUCCESS: return "success";
-    case NLOPT_STOPVAL_REACHED: return "stopval reached";
-    case NLOPT_FTOL_REACHED: return "ftol_rel reached";
-    case NLOPT_XTOL_REACHED: return "xtol_rel reached";
-    case NLOPT_MAXEVAL_REACHED: return "evaluation budget spent";
-    case NLOPT_MAXTIME_REACHED: return "time budget spent";
-    case NLOPT_FAILURE: return "generic failure";
-    case NLOPT_INVALID_ARGS: return "invalid arguments";
-    case NLOPT_OUT_OF_MEMORY: return "out of memory";
-    case NLOPT_ROUNDOFF_LIMITED: return "roundoff errors limited progress";
-    case NLOPT_FORCED_STOP: return "forced stop";
-    default: return "unknown NLopt result " + std::to_string(static_cast<int>(r));
+    case NLOPT_SUCCESS:
+      return "success";
+    case NLOPT_STOPVAL_REACHED:
+      return "stopval reached";
+    case NLOPT_FTOL_REACHED:
+      return "ftol_rel reached";
+    case NLOPT_XTOL_REACHED:
+      return "xtol_rel reached";
+    case NLOPT_MAXEVAL_REACHED:
+      return "evaluation budget spent";
+    case NLOPT_MAXTIME_REACHED:
+      return "time budget spent";
+    case NLOPT_FAILURE:
+      return "generic failure";
+    case NLOPT_INVALID_ARGS:
+      return "invalid arguments";
+    case NLOPT_OUT_OF_MEMORY:
+      return "out of memory";
+    case NLOPT_ROUNDOFF_LIMITED:
+      return "roundoff errors limited progress";
+    case NLOPT_FORCED_STOP:
+      return "forced stop";
+    default:
+      return "unknown NLopt result " + std::to_string(static_cast<int>(r));
   }
 }
 
 const char* nlopt_name(Algorithm a) {
   switch (a) {
-    case Algorithm::kSlsqp: return "NLopt LD_SLSQP";
-    case Algorithm::kMma: return "NLopt LD_MMA";
-    case Algorithm::kMlsl: return "multistart of NLopt LD_SLSQP";
-    case Algorithm::kIsres: return "NLopt GN_ISRES";
-    case Algorithm::kCobyla: return "NLopt LN_COBYLA";
-    case Algorithm::kIpopt: break;
+    case Algorithm::kSlsqp:
+      return "NLopt LD_SLSQP";
+    case Algorithm::kMma:
+      return "NLopt LD_MMA";
+    case Algorithm::kMlsl:
+      return "multistart of NLopt LD_SLSQP";
+    case Algorithm::kIsres:
+      return "NLopt GN_ISRES";
+    case Algorithm::kCobyla:
+      return "NLopt LN_COBYLA";
+    case Algorithm::kIpopt:
+      break;
   }
   return "NLopt";
 }
@@ -231,7 +250,7 @@ struct Run {
   nlopt_result result{NLOPT_FAILURE};
   VectorXd x;
   double f = HUGE_VAL;
-  std::string error;   // a callback's exception or NLopt's own error message
+  std::string error;  // a callback's exception or NLopt's own error message
 };
 
 Run run_nlopt(nlopt_algorithm algorithm, bool mma, TrackedNlp& tracked, const VectorXd& x0,
@@ -305,11 +324,11 @@ Run run_nlopt(nlopt_algorithm algorithm, bool mma, TrackedNlp& tracked, const Ve
 
 // SLSQP, restarted from its last iterate while it stops on a tolerance with a last iterate
 // better than the point it returns (nlopt_driver.hpp says why)
-Run run_slsqp(TrackedNlp& tracked, const VectorXd& x0, const VectorXd& lower,
-              const VectorXd& upper, int max_evaluations, const OptimizeOptions& options) {
+Run run_slsqp(TrackedNlp& tracked, const VectorXd& x0, const VectorXd& lower, const VectorXd& upper,
+              int max_evaluations, const OptimizeOptions& options) {
   const int first = tracked.evaluations();
-  Run run = run_nlopt(NLOPT_LD_SLSQP, false, tracked, x0, lower, upper, max_evaluations, options,
-                      true);
+  Run run =
+      run_nlopt(NLOPT_LD_SLSQP, false, tracked, x0, lower, upper, max_evaluations, options, true);
   for (int restart = 0; restart < 3; ++restart) {
     const int left = max_evaluations - (tracked.evaluations() - first);
     const VectorXd last = tracked.last_x();
@@ -441,8 +460,8 @@ DriverOutcome multistart(const Nlp& nlp, const VectorXd& x0, const OptimizeOptio
   out.evaluations = tracked.evaluations();
   out.iterations = out.evaluations;
   out.termination = have ? termination_of(best_run.result) : Termination::kMaxEvaluations;
-  if (out.termination == Termination::kConverged && tracked.evaluations() >= options.max_evaluations &&
-      runs < kStarts) {
+  if (out.termination == Termination::kConverged &&
+      tracked.evaluations() >= options.max_evaluations && runs < kStarts) {
     out.termination = Termination::kMaxEvaluations;
   }
   out.message = "multistart of NLopt LD_SLSQP (mlsl): " + std::to_string(runs) + " of " +
@@ -455,22 +474,28 @@ DriverOutcome multistart(const Nlp& nlp, const VectorXd& x0, const OptimizeOptio
 
 }  // namespace
 
-DriverOutcome solve_with_nlopt(const Nlp& nlp, const VectorXd& x0,
-                               const OptimizeOptions& options) {
+DriverOutcome solve_with_nlopt(const Nlp& nlp, const VectorXd& x0, const OptimizeOptions& options) {
   if (options.algorithm == Algorithm::kMlsl) return multistart(nlp, x0, options);
 
   nlopt_algorithm algorithm = NLOPT_LD_SLSQP;
   bool global = false;
   switch (options.algorithm) {
-    case Algorithm::kSlsqp: algorithm = NLOPT_LD_SLSQP; break;
-    case Algorithm::kMma: algorithm = NLOPT_LD_MMA; break;
-    case Algorithm::kCobyla: algorithm = NLOPT_LN_COBYLA; break;
+    case Algorithm::kSlsqp:
+      algorithm = NLOPT_LD_SLSQP;
+      break;
+    case Algorithm::kMma:
+      algorithm = NLOPT_LD_MMA;
+      break;
+    case Algorithm::kCobyla:
+      algorithm = NLOPT_LN_COBYLA;
+      break;
     case Algorithm::kIsres:
       algorithm = NLOPT_GN_ISRES;
       global = true;
       break;
     case Algorithm::kMlsl:
-    case Algorithm::kIpopt: break;
+    case Algorithm::kIpopt:
+      break;
   }
   VectorXd lower = nlp.lower(), upper = nlp.upper();
   if (global) {

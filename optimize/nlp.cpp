@@ -13,6 +13,7 @@
 
 #include "core/input_error.hpp"
 #include "core/kinematics.hpp"
+#include "core/number_text.hpp"
 
 namespace bd::optimize {
 
@@ -99,12 +100,6 @@ const char* unit_of(Metric m) {
 
 std::size_t metric_index(Metric m) { return static_cast<std::size_t>(m); }
 
-std::string number(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
 const char* parameter_name(LinkParameterVariable::Parameter p) {
   switch (p) {
     case LinkParameterVariable::Parameter::kMass:
@@ -166,8 +161,8 @@ struct Nlp::Impl {
 
   core::Metrics original_metrics;
   double original_mass{};
-  bool linear{};  // ObjectiveForm::kLinear
-  double eps{};   // its smoothing
+  bool linear{};                                     // ObjectiveForm::kLinear
+  double eps{};                                      // its smoothing
   std::array<double, std::size(kMetrics)> weight{};  // aggregated objective weights
   std::array<int, std::size(kMetrics)> bound_var{};  // -1 unless a peak objective term
 
@@ -255,8 +250,9 @@ void Nlp::Impl::check_normalisers() const {
     if (m == Metric::kAddedMass) return;
     const double v = value_of(o, m), scale = is_moment(m) ? moment : force;
     if (!(v > 1e-10 * scale)) {
-      throw InputError(where + ": the original design's " + to_string(m) + " is " + number(v) +
-                       " " + unit_of(m) + ", too small to normalise by (it is already minimal)");
+      throw InputError(where + ": the original design's " + to_string(m) + " is " +
+                       text::digits(v, 6) + " " + unit_of(m) +
+                       ", too small to normalise by (it is already minimal)");
     }
   };
   for (std::size_t i = 0; i < problem.objective.size(); ++i) {
@@ -441,20 +437,20 @@ void Nlp::Impl::set_up_constraints() {
 
   auto at_sample = [this](int i) {
     return " at sample " + std::to_string(i) +
-           " (theta1 = " + number(theta1[static_cast<std::size_t>(i)]) + " rad)";
+           " (theta1 = " + text::digits(theta1[static_cast<std::size_t>(i)], 6) + " rad)";
   };
   // envelopes
   for (std::size_t c = 0; c < problem.counterweights.size(); ++c) {
     const CounterweightVariables& cw = problem.counterweights[c];
     blocks.push_back({Block::Kind::kEnvelope, static_cast<int>(c), Metric::kAddedMass, 0.0, -1, 1});
-    constraint_names.push_back(std::string(core::link_name(cw.link)) +
-                               " counterweight within distance_max = " + number(cw.distance_max) +
-                               " m of " + (cw.link == 1 ? "A0" : "A3"));
+    constraint_names.push_back(
+        std::string(core::link_name(cw.link)) + " counterweight within distance_max = " +
+        text::digits(cw.distance_max, 6) + " m of " + (cw.link == 1 ? "A0" : "A3"));
   }
   // limits
   for (const Limit& l : problem.limits) {
     Block b{Block::Kind::kRmsLimit, group_of(l.metric), l.metric, l.value, -1, 1};
-    const std::string name = std::string(to_string(l.metric)) + " <= " + number(l.value) +
+    const std::string name = std::string(to_string(l.metric)) + " <= " + text::digits(l.value, 6) +
                              (l.metric == Metric::kAddedMass ? " kg" : " x original");
     if (l.metric == Metric::kAddedMass) {
       b.kind = Block::Kind::kAddedMassLimit;

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "core/input_error.hpp"
+#include "core/number_text.hpp"
 #include "optimize/ipopt_driver.hpp"
 #include "optimize/nlopt_driver.hpp"
 #include "optimize/nlp.hpp"
@@ -20,29 +21,34 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-std::string format(double v, const char* how = "%.6g") {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, how, v);
-  return buf;
-}
-
 constexpr Algorithm kAlgorithms[] = {Algorithm::kSlsqp, Algorithm::kMma,   Algorithm::kIpopt,
                                      Algorithm::kMlsl,  Algorithm::kIsres, Algorithm::kCobyla};
 
 // the value of a metric in core's summary (added_mass is not one of them)
 double value_of(const core::Metrics& m, Metric metric) {
   switch (metric) {
-    case Metric::kFshRms: return m.Fsh_rms;
-    case Metric::kFshMax: return m.Fsh_max;
-    case Metric::kMshRms: return m.Msh_rms;
-    case Metric::kMshMax: return m.Msh_max;
-    case Metric::kTauRms: return m.tau_rms;
-    case Metric::kTauMax: return m.tau_max;
-    case Metric::kRA0Rms: return m.RA0_rms;
-    case Metric::kRA0Max: return m.RA0_max;
-    case Metric::kRA3Rms: return m.RA3_rms;
-    case Metric::kRA3Max: return m.RA3_max;
-    case Metric::kAddedMass: break;
+    case Metric::kFshRms:
+      return m.Fsh_rms;
+    case Metric::kFshMax:
+      return m.Fsh_max;
+    case Metric::kMshRms:
+      return m.Msh_rms;
+    case Metric::kMshMax:
+      return m.Msh_max;
+    case Metric::kTauRms:
+      return m.tau_rms;
+    case Metric::kTauMax:
+      return m.tau_max;
+    case Metric::kRA0Rms:
+      return m.RA0_rms;
+    case Metric::kRA0Max:
+      return m.RA0_max;
+    case Metric::kRA3Rms:
+      return m.RA3_rms;
+    case Metric::kRA3Max:
+      return m.RA3_max;
+    case Metric::kAddedMass:
+      break;
   }
   return 0.0;
 }
@@ -125,16 +131,14 @@ std::string check_gradients(const Nlp& nlp, const VectorXd& x) {
     }
     compare(jac, numeric, nlp.constraint_names(), offset, nlp, worst);
   };
-  constraints(nlp.n_eq(), 0, [&](const VectorXd& y, VectorXd& c, MatrixXd* j) {
-    nlp.equalities(y, c, j);
-  });
-  constraints(nlp.n_ineq(), nlp.n_eq(), [&](const VectorXd& y, VectorXd& c, MatrixXd* j) {
-    nlp.inequalities(y, c, j);
-  });
+  constraints(nlp.n_eq(), 0,
+              [&](const VectorXd& y, VectorXd& c, MatrixXd* j) { nlp.equalities(y, c, j); });
+  constraints(nlp.n_ineq(), nlp.n_eq(),
+              [&](const VectorXd& y, VectorXd& c, MatrixXd* j) { nlp.inequalities(y, c, j); });
   if (worst.error <= 1e-5) return "";
-  return "gradient check failed: " + worst.what + " is " + format(worst.analytic, "%.9g") +
-         " analytically but " + format(worst.difference, "%.9g") +
-         " by central differences (relative error " + format(worst.error, "%.2g") + ")";
+  return "gradient check failed: " + worst.what + " is " + text::digits(worst.analytic, 9) +
+         " analytically but " + text::digits(worst.difference, 9) +
+         " by central differences (relative error " + text::digits(worst.error, 2) + ")";
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -154,15 +158,16 @@ core::Formulation other_than(core::Formulation f) {
 // metric over that floor.
 double verification_error(const core::Metrics& a, const core::Metrics& b, double frame_length) {
   const double force = std::max({a.RA0_max, a.RA3_max, b.RA0_max, b.RA3_max});
-  const double moment = std::max({a.tau_max, a.Msh_max, b.tau_max, b.Msh_max,
-                                  frame_length * force});
+  const double moment =
+      std::max({a.tau_max, a.Msh_max, b.tau_max, b.Msh_max, frame_length * force});
   double worst = 0.0;
   for (Metric m : kMetrics) {
     if (m == Metric::kAddedMass) continue;
     const double va = value_of(a, m), vb = value_of(b, m);
-    const bool is_moment = m == Metric::kMshRms || m == Metric::kMshMax ||
-                           m == Metric::kTauRms || m == Metric::kTauMax;
-    const double scale = std::max({std::abs(va), std::abs(vb), 1e-4 * (is_moment ? moment : force)});
+    const bool is_moment = m == Metric::kMshRms || m == Metric::kMshMax || m == Metric::kTauRms ||
+                           m == Metric::kTauMax;
+    const double scale =
+        std::max({std::abs(va), std::abs(vb), 1e-4 * (is_moment ? moment : force)});
     if (scale == 0.0) continue;  // zero in both, and nothing to be zero against
     const double error = std::abs(va - vb) / scale;
     if (!std::isfinite(error)) return std::numeric_limits<double>::infinity();
@@ -175,12 +180,18 @@ double verification_error(const core::Metrics& a, const core::Metrics& b, double
 
 const char* to_string(Algorithm a) {
   switch (a) {
-    case Algorithm::kSlsqp: return "slsqp";
-    case Algorithm::kMma: return "mma";
-    case Algorithm::kIpopt: return "ipopt";
-    case Algorithm::kMlsl: return "mlsl";
-    case Algorithm::kIsres: return "isres";
-    case Algorithm::kCobyla: return "cobyla";
+    case Algorithm::kSlsqp:
+      return "slsqp";
+    case Algorithm::kMma:
+      return "mma";
+    case Algorithm::kIpopt:
+      return "ipopt";
+    case Algorithm::kMlsl:
+      return "mlsl";
+    case Algorithm::kIsres:
+      return "isres";
+    case Algorithm::kCobyla:
+      return "cobyla";
   }
   return "unknown";
 }
@@ -206,21 +217,26 @@ std::string OptimizeOptions::validate() const {
     return "max_evaluations must be >= 1, got " + std::to_string(max_evaluations);
   }
   if (!(std::isfinite(relative_tolerance) && relative_tolerance > 0 && relative_tolerance < 1)) {
-    return "relative_tolerance must be in (0, 1), got " + format(relative_tolerance, "%.17g");
+    return "relative_tolerance must be in (0, 1), got " + text::exact(relative_tolerance);
   }
   if (!(std::isfinite(constraint_tolerance) && constraint_tolerance > 0)) {
-    return "constraint_tolerance must be > 0, got " + format(constraint_tolerance, "%.17g");
+    return "constraint_tolerance must be > 0, got " + text::exact(constraint_tolerance);
   }
   return "";
 }
 
 const char* to_string(Termination t) {
   switch (t) {
-    case Termination::kNotRun: return "not run";
-    case Termination::kConverged: return "converged";
-    case Termination::kMaxEvaluations: return "max evaluations";
-    case Termination::kInfeasible: return "infeasible";
-    case Termination::kFailed: return "failed";
+    case Termination::kNotRun:
+      return "not run";
+    case Termination::kConverged:
+      return "converged";
+    case Termination::kMaxEvaluations:
+      return "max evaluations";
+    case Termination::kInfeasible:
+      return "infeasible";
+    case Termination::kFailed:
+      return "failed";
   }
   return "unknown";
 }
@@ -228,14 +244,14 @@ const char* to_string(Termination t) {
 std::string OptimizeResult::brief_report() const {
   std::string s = std::string(to_string(algorithm)) + ": " + to_string(termination) + ", " +
                   std::to_string(iterations) + " iterations, " + std::to_string(evaluations) +
-                  " evaluations, " + format(seconds, "%.3g") + " s, objective " +
-                  format(objective, "%.9g") + ", constraint violation " +
-                  format(constraint_violation, "%.2g");
+                  " evaluations, " + text::digits(seconds, 3) + " s, objective " +
+                  text::digits(objective, 9) + ", constraint violation " +
+                  text::digits(constraint_violation, 2);
   if (termination == Termination::kNotRun || std::isnan(verification_error)) {
     s += ", not verified";
   } else {
     s += ", verified by " + std::string(core::to_string(verified_with)) + " to " +
-         format(verification_error, "%.2g");
+         text::digits(verification_error, 2);
   }
   return s;
 }
@@ -302,8 +318,8 @@ OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& opt
     const bool equality = worst < nlp.n_eq();
     r.termination = Termination::kInfeasible;
     r.message = "no feasible design found: the binding constraint is '" + name + "' at " +
-                format(worst_value, "%.6g") + (equality ? " (must be 0" : " (must be <= 0") +
-                ", tolerance " + format(options.constraint_tolerance, "%.2g") + ") [" +
+                text::digits(worst_value, 6) + (equality ? " (must be 0" : " (must be <= 0") +
+                ", tolerance " + text::digits(options.constraint_tolerance, 2) + ") [" +
                 outcome.message + "]";
   } else if (r.termination == Termination::kInfeasible) {
     // the solver gave up on feasibility yet stopped at a feasible point: say so plainly

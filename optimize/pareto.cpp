@@ -5,18 +5,13 @@
 #include <string>
 
 #include "core/input_error.hpp"
+#include "core/number_text.hpp"
 #include "optimize/nlp.hpp"
 #include "optimize/optimize.hpp"
 
 namespace bd::optimize {
 
 namespace {
-
-std::string format(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 // the value of `m` at a result, in the units of a Limit on it: the fraction of the original's
 // value, or kg for added_mass
@@ -28,17 +23,38 @@ double limit_value(const OptimizeResult& r, const DesignProblem& problem, const 
   const core::Metrics& v = r.metrics;
   double value = 0.0;
   switch (m) {
-    case Metric::kFshRms: value = v.Fsh_rms; break;
-    case Metric::kFshMax: value = v.Fsh_max; break;
-    case Metric::kMshRms: value = v.Msh_rms; break;
-    case Metric::kMshMax: value = v.Msh_max; break;
-    case Metric::kTauRms: value = v.tau_rms; break;
-    case Metric::kTauMax: value = v.tau_max; break;
-    case Metric::kRA0Rms: value = v.RA0_rms; break;
-    case Metric::kRA0Max: value = v.RA0_max; break;
-    case Metric::kRA3Rms: value = v.RA3_rms; break;
-    case Metric::kRA3Max: value = v.RA3_max; break;
-    case Metric::kAddedMass: break;
+    case Metric::kFshRms:
+      value = v.Fsh_rms;
+      break;
+    case Metric::kFshMax:
+      value = v.Fsh_max;
+      break;
+    case Metric::kMshRms:
+      value = v.Msh_rms;
+      break;
+    case Metric::kMshMax:
+      value = v.Msh_max;
+      break;
+    case Metric::kTauRms:
+      value = v.tau_rms;
+      break;
+    case Metric::kTauMax:
+      value = v.tau_max;
+      break;
+    case Metric::kRA0Rms:
+      value = v.RA0_rms;
+      break;
+    case Metric::kRA0Max:
+      value = v.RA0_max;
+      break;
+    case Metric::kRA3Rms:
+      value = v.RA3_rms;
+      break;
+    case Metric::kRA3Max:
+      value = v.RA3_max;
+      break;
+    case Metric::kAddedMass:
+      break;
   }
   return value / nlp.original(m);
 }
@@ -69,7 +85,7 @@ std::vector<ParetoPoint> pareto_front(const DesignProblem& problem, Metric first
   const Nlp nlp(problem);  // the original's metrics: the normalisers of the bounds
   if (second != Metric::kAddedMass && !(nlp.original(second) > 0)) {
     throw InputError(std::string("pareto_front: ") + to_string(second) +
-                     " of the original design is " + format(nlp.original(second)) +
+                     " of the original design is " + text::digits(nlp.original(second), 6) +
                      ", so no bound relative to it can be set");
   }
 
@@ -86,9 +102,10 @@ std::vector<ParetoPoint> pareto_front(const DesignProblem& problem, Metric first
   DesignProblem lexicographic = minimising(problem, second);
   lexicographic.limits.push_back(Limit{first, bound});
   const OptimizeResult loose = optimize(lexicographic, options);
-  const double a = loose.ok() ? limit_value(loose, problem, nlp, second)
+  const double a = loose.ok()
+                       ? limit_value(loose, problem, nlp, second)
                        : limit_value(best_first, problem, nlp, second);  // loosest useful bound
-  const double b = limit_value(best_second, problem, nlp, second);   // tightest reachable bound
+  const double b = limit_value(best_second, problem, nlp, second);       // tightest reachable bound
   const double hi = std::max(a, b), lo = std::min(a, b);
 
   // ε from hi down to lo; the tightest is kept 1e-3 of the span above lo, so the feasible set

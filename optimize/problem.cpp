@@ -6,20 +6,16 @@
 #include <utility>
 
 #include "core/input_error.hpp"
+#include "core/number_text.hpp"
 
 namespace bd::optimize {
 
 namespace {
 
-std::string format(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 // "<what> must be <expected> <unit>, got <value>"
 std::string must_be(const std::string& what, const char* expected, const char* unit, double v) {
-  return what + " must be " + expected + (unit[0] != '\0' ? " " : "") + unit + ", got " + format(v);
+  return what + " must be " + expected + (unit[0] != '\0' ? " " : "") + unit + ", got " +
+         text::exact(v);
 }
 
 const char* parameter_name(LinkParameterVariable::Parameter p) {
@@ -217,8 +213,8 @@ std::string DesignProblem::validate() const {
       return must_be(what + ".lower", ">= 0", unit, v.lower);
     }
     if (!(v.upper >= v.lower)) {
-      return what + ".upper must be >= lower = " + format(v.lower) + " " + unit + ", got " +
-             format(v.upper);
+      return what + ".upper must be >= lower = " + text::exact(v.lower) + " " + unit + ", got " +
+             text::exact(v.upper);
     }
   }
 

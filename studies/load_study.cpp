@@ -1,5 +1,6 @@
 #include "studies/load_study.hpp"
 
+#include <fmt/printf.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "core/kinematics.hpp"
+#include "core/number_text.hpp"
 #include "optimize/nlp.hpp"
 #include "optimize/optimize.hpp"
 #include "studies/load_study_internal.hpp"
@@ -42,12 +44,6 @@ constexpr double kMaxSweepPoints = 1e6;
 constexpr double kMaxSweepThreads = 1024;
 // a sweep's seed is a whole number below 2^53: every such number reads back exactly from its text
 constexpr double kSeedLimit = 9007199254740992.0;
-
-std::string format_number(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
 
 std::string join(const std::vector<std::string>& items) {
   std::string out;
@@ -207,8 +203,8 @@ int read_count(const Reporter& r, const MapReader::Entry& e, const std::string& 
   const double v = read_number(r, e, path, "");
   const YAML::Mark m = mark_of(e.value, e.key_mark);
   if (v != std::floor(v)) r.fail(m, path + " must be a whole number, got " + describe(e.value));
-  if (v < lo) r.fail(m, path + " must be >= " + format_number(lo) + ", got " + format_number(v));
-  if (v > hi) r.fail(m, path + " must be <= " + format_number(hi) + ", got " + format_number(v));
+  if (v < lo) r.fail(m, path + " must be >= " + text::exact(lo) + ", got " + text::exact(v));
+  if (v > hi) r.fail(m, path + " must be <= " + text::exact(hi) + ", got " + text::exact(v));
   return static_cast<int>(v);
 }
 
@@ -409,9 +405,9 @@ class StudyParser {
     const Vec2 p = read_vec2(r_, at, path, "m", marks);
     const Vec2 pivot = side == 0 ? Vec2(0, 0) : Vec2(frame, 0);
     if (p == pivot) {
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "'s pivot %s = (%.10g, %.10g) m, got [%.10g, %.10g]",
-                    side == 0 ? "A0" : "A3", pivot.x(), pivot.y(), p.x(), p.y());
+      const std::string buf =
+          fmt::sprintf("'s pivot %s = (%.10g, %.10g) m, got [%.10g, %.10g]",
+                       side == 0 ? "A0" : "A3", pivot.x(), pivot.y(), p.x(), p.y());
       r_.fail(mark_of(at.value, at.key_mark), path + " must differ from the " + kSides[side] + buf);
     }
     return p;
@@ -509,7 +505,7 @@ class StudyParser {
       const double v = read_number(r_, x, path + "." + x.key, unit);
       if (!(v > 0)) {
         r_.fail(mark_of(x.value, x.key_mark),
-                path + "." + x.key + " must be > 0 " + unit + ", got " + format_number(v));
+                path + "." + x.key + " must be > 0 " + unit + ", got " + text::exact(v));
       }
       return v;
     };
@@ -632,7 +628,7 @@ class StudyParser {
         r_.fail(tolerance_mark,
                 "optimize.tolerance must be > 0 and < 1 (relative, on the variables and the "
                 "objective), got " +
-                    format_number(tol));
+                    text::exact(tol));
       }
       req.options.relative_tolerance = tol;
     }
@@ -739,7 +735,7 @@ class StudyParser {
       const double w = read_number(r_, x, path, "");
       if (w < 0) {
         r_.fail(mark_of(x.value, x.key_mark),
-                path + " must be >= 0 (a weight), got " + format_number(w));
+                path + " must be >= 0 (a weight), got " + text::exact(w));
       }
       positive = positive || w > 0;
       req.objective.push_back({metric, w});
@@ -781,7 +777,7 @@ class StudyParser {
         const double v = read_number(r_, x, path, "");
         if (!(v > 0)) {
           r_.fail(vm, path + " must be > 0 (a fraction of the original design's value), got " +
-                          format_number(v));
+                          text::exact(v));
         }
         req.limits.push_back({metric, v});
         limit_marks_.push_back(x.key_mark);
@@ -844,7 +840,7 @@ class StudyParser {
       const double v = read_number(r_, x, path + "." + x.key, unit);
       if (!(v > 0)) {
         r_.fail(mark_of(x.value, x.key_mark),
-                path + "." + x.key + " must be > 0 " + unit + ", got " + format_number(v));
+                path + "." + x.key + " must be > 0 " + unit + ", got " + text::exact(v));
       }
       return v;
     };
@@ -880,16 +876,16 @@ class StudyParser {
       const double lo = read_number(r_, x.value[0], vm, xp + "[0]", unit);
       const double hi = read_number(r_, x.value[1], vm, xp + "[1]", unit);
       if (!(lo < hi)) {
-        r_.fail(vm, xp + " must have lower < upper, got [" + format_number(lo) + ", " +
-                        format_number(hi) + "]");
+        r_.fail(vm, xp + " must have lower < upper, got [" + text::exact(lo) + ", " +
+                        text::exact(hi) + "]");
       }
       if (p == P::kMass && !(lo > 0)) {
         r_.fail(mark_of(x.value[0], vm),
-                xp + " lower bound must be > 0 kg (a link has mass), got " + format_number(lo));
+                xp + " lower bound must be > 0 kg (a link has mass), got " + text::exact(lo));
       }
       if (p == P::kInertia && lo < 0) {
         r_.fail(mark_of(x.value[0], vm),
-                xp + " lower bound must be >= 0 kg m^2, got " + format_number(lo));
+                xp + " lower bound must be >= 0 kg m^2, got " + text::exact(lo));
       }
       optimize::LinkParameterVariable v;
       v.link = link;
@@ -1013,8 +1009,8 @@ class StudyParser {
         product += (product.empty() ? "" : " x ") + std::to_string(p.values.size());
       }
       if (n > kMaxSweepPoints) {
-        r_.fail(list.key_mark, "sweep: the grid has " + product + " = " + format_number(n) +
-                                   " points, more than the " + format_number(kMaxSweepPoints) +
+        r_.fail(list.key_mark, "sweep: the grid has " + product + " = " + text::exact(n) +
+                                   " points, more than the " + text::exact(kMaxSweepPoints) +
                                    " a sweep may have");
       }
       req.points = static_cast<int>(n);
@@ -1097,12 +1093,12 @@ class StudyParser {
     p.to = read_number(r_, to, where + ".to", "");
     if (!(p.from < p.to)) {
       r_.fail(mark_of(to.value, to.key_mark),
-              where + ": from must be < to, got from = " + format_number(p.from) +
-                  ", to = " + format_number(p.to));
+              where + ": from must be < to, got from = " + text::exact(p.from) +
+                  ", to = " + text::exact(p.to));
     }
     if (p.log_scale && !(p.from > 0)) {
       r_.fail(mark_of(from.value, from.key_mark),
-              where + ".from must be > 0 with scale: log, got " + format_number(p.from));
+              where + ".from must be > 0 with scale: log, got " + text::exact(p.from));
     }
     if (design == SweepDesign::kGrid) {
       const int n = read_count(r_, *count, where + ".count", 2, kMaxSweepPoints);
@@ -1110,8 +1106,8 @@ class StudyParser {
       for (std::size_t k = 1; k < p.values.size(); ++k) {
         if (p.values[k] > p.values[k - 1]) continue;
         r_.fail(mark_of(count->value, count->key_mark),
-                where + ".count: " + std::to_string(n) + " values from " + format_number(p.from) +
-                    " to " + format_number(p.to) +
+                where + ".count: " + std::to_string(n) + " values from " + text::exact(p.from) +
+                    " to " + text::exact(p.to) +
                     " are not distinct in double precision; give fewer");
       }
     }
@@ -1133,12 +1129,12 @@ class StudyParser {
       const std::string ip = path + "[" + std::to_string(k) + "]";
       const double v = read_number(r_, item, vm, ip, "");
       if (log_scale && !(v > 0)) {
-        r_.fail(mark_of(item, vm), ip + " must be > 0 with scale: log, got " + format_number(v));
+        r_.fail(mark_of(item, vm), ip + " must be > 0 with scale: log, got " + text::exact(v));
       }
       for (std::size_t j = 0; j < values.size(); ++j) {
         if (values[j] != v) continue;
         r_.fail(mark_of(item, vm), ip + " repeats values[" + std::to_string(j) + "] (" +
-                                       format_number(v) + "); a grid's values must be distinct");
+                                       text::exact(v) + "); a grid's values must be distinct");
       }
       values.push_back(v);
     }
@@ -1288,7 +1284,7 @@ class StudyParser {
         r_.fail(mark_of(s->value, s->key_mark), path +
                                                     ".s must be >= 0 m (sigma gives the "
                                                     "direction), got " +
-                                                    format_number(sv));
+                                                    text::exact(sv));
       }
       const double sg = number(*sigma, "rad");
       return core::link_from_polar(length, mass, sv, sg, inertia);
@@ -1379,7 +1375,7 @@ class StudyParser {
       free.duration = read_number(r_, d, "scene.duration", "s");
       if (free.duration <= 0) {
         r_.fail(mark_of(d.value, d.key_mark),
-                "scene.duration must be > 0 s, got " + format_number(free.duration));
+                "scene.duration must be > 0 s, got " + text::exact(free.duration));
       }
       if (const MapReader::Entry* n = sc.find("samples")) {
         free.samples = read_count(r_, *n, "scene.samples", 2, kMaxRows);
@@ -1406,9 +1402,9 @@ class StudyParser {
       }
       if (static_cast<double>(driven.samples) * driven.revolutions > kMaxRows) {
         r_.fail(e.key_mark,
-                "scene.samples x scene.revolutions must be <= " + format_number(kMaxRows) +
+                "scene.samples x scene.revolutions must be <= " + text::exact(kMaxRows) +
                     " rows, got " +
-                    format_number(static_cast<double>(driven.samples) * driven.revolutions));
+                    text::exact(static_cast<double>(driven.samples) * driven.revolutions));
       }
       return driven;
     }
@@ -1447,7 +1443,7 @@ class StudyParser {
     const double tol = read_number(r_, e, "tolerance", "");
     const YAML::Mark m = mark_of(e.value, e.key_mark);
     if (!(tol > 0 && tol < 1)) {
-      r_.fail(m, "tolerance must be > 0 and < 1 (a relative tolerance), got " + format_number(tol));
+      r_.fail(m, "tolerance must be > 0 and < 1 (a relative tolerance), got " + text::exact(tol));
     }
     core::SimulateOptions options;
     options.tolerance = tol;

@@ -2,16 +2,11 @@
 
 #include <cstdio>
 
+#include "core/number_text.hpp"
+
 namespace bd::studies {
 
 namespace {
-
-// %g with enough digits for a person, not for a round trip
-std::string short_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 // a link's inertia about the point p (link axes, from its first joint) [kg m^2]
 double inertia_about(const core::Link& l, const Vec2& p) {
@@ -87,7 +82,7 @@ std::string objective_text(const OptimizeRequest& request) {
   std::string text;
   for (const optimize::Term& t : request.objective) {
     if (!text.empty()) text += " + ";
-    text += short_number(t.weight) + " x " + optimize::to_string(t.metric);
+    text += text::digits(t.weight, 6) + " x " + optimize::to_string(t.metric);
   }
   return text + " (each / original)";
 }
@@ -98,9 +93,9 @@ std::string constraints_text(const OptimizeRequest& request) {
   if (request.force_balance) add("full force balance (eq. 57)");
   for (const optimize::Limit& l : request.limits) {
     if (l.metric == optimize::Metric::kAddedMass) {
-      add("added_mass <= " + short_number(l.value) + " kg");
+      add("added_mass <= " + text::digits(l.value, 6) + " kg");
     } else {
-      add(std::string(optimize::to_string(l.metric)) + " <= " + short_number(l.value) +
+      add(std::string(optimize::to_string(l.metric)) + " <= " + text::digits(l.value, 6) +
           " x original");
     }
   }

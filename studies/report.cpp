@@ -573,10 +573,10 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
   }
   // the measurements of `balance-design bench` when the folder has them (work_precision.hpp)
   h += work_precision_section(dir, gnuplot);
-  return h + data_files_html(dir, {"timeseries.csv", "summary.json", "balanced-timeseries.csv",
-                                   "balanced.yaml", "optimized-timeseries.csv", "optimized.yaml",
-                                   "comparison.csv", "pareto.csv", "work-precision.csv",
-                                   "driven-convergence.csv"});
+  return h + data_files_html(
+                 dir, {"timeseries.csv", "summary.json", "balanced-timeseries.csv", "balanced.yaml",
+                       "optimized-timeseries.csv", "optimized.yaml", "comparison.csv", "pareto.csv",
+                       "work-precision.csv", "driven-convergence.csv"});
 }
 
 fs::path write_report(const Study& study, const fs::path& dir) {

@@ -15,6 +15,7 @@
 #include <utility>
 #include <variant>
 
+#include "core/number_text.hpp"
 #include "optimize/nlp.hpp"
 #include "studies/report.hpp"
 #include "studies/study_yaml.hpp"
@@ -80,14 +81,8 @@ class AtomicFile {
   bool committed_ = false;
 };
 
-// "%.17g": round-trips every double
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
 // JSON has no inf or nan: those become null
-std::string json_number(double v) { return std::isfinite(v) ? number(v) : "null"; }
+std::string json_number(double v) { return std::isfinite(v) ? text::exact(v) : "null"; }
 
 std::string json_vec(const Vec2& v) {
   return "[" + json_number(v.x()) + ", " + json_number(v.y()) + "]";
@@ -511,8 +506,8 @@ std::vector<ComparisonRow> comparison(const Study& study, const RunResult& resul
 std::string comparison_csv(const Study& study, const RunResult& result) {
   std::string text = std::string(kComparisonHeader) + "\n";
   for (const ComparisonRow& row : comparison(study, result)) {
-    text += row.metric + "," + number(row.before) + "," + number(row.after) + "," +
-            (row.ratio ? number(*row.ratio) : std::string()) + "\n";
+    text += row.metric + "," + text::exact(row.before) + "," + text::exact(row.after) + "," +
+            (row.ratio ? text::exact(*row.ratio) : std::string()) + "\n";
   }
   return text;
 }
@@ -605,18 +600,18 @@ std::string pareto_csv(const Study& study, const OptimizedRun& run) {
   text += "\n";
   for (const optimize::ParetoPoint& point : run.pareto) {
     const optimize::OptimizeResult& r = point.result;
-    text += number(point.epsilon);
+    text += text::exact(point.epsilon);
     if (r.ok()) {
       const double mass = added_mass(study.model, r.design);
-      text += "," + number(metric_value(r.metrics, p.first, mass)) + "," +
-              number(metric_value(r.metrics, p.second, mass));
+      text += "," + text::exact(metric_value(r.metrics, p.first, mass)) + "," +
+              text::exact(metric_value(r.metrics, p.second, mass));
     } else {
       text += ",,";
     }
     text += std::string(",") + optimize::to_string(r.termination) + "," +
-            (r.ok() ? number(r.verification_error) : std::string());
+            (r.ok() ? text::exact(r.verification_error) : std::string());
     for (int k = 0; k < n; ++k) {
-      text += "," + (k < r.x.size() ? number(r.x[k]) : std::string());
+      text += "," + (k < r.x.size() ? text::exact(r.x[k]) : std::string());
     }
     text += "\n";
   }

@@ -111,8 +111,9 @@ MethodChoice choose_method(const Study& study) {
     }
   } else if (reaches_limits) {
     choice.formulation = core::Formulation::kOpenedLoop;
-    choice.reason = limits + "; the opened-loop DAE passes through them, the reduced equation "
-                             "in theta1 would stop at the first";
+    choice.reason = limits +
+                    "; the opened-loop DAE passes through them, the reduced equation "
+                    "in theta1 would stop at the first";
   } else {
     choice.formulation = core::Formulation::kMassMatrix;
     choice.reason =

@@ -4,30 +4,28 @@
 #include <sstream>
 #include <variant>
 
+#include "core/number_text.hpp"
+
 namespace bd::studies {
 
 namespace {
 
-// "%.17g": reads back to the same double
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
+std::string vec(const Vec2& v) {
+  return "[" + text::exact(v.x()) + ", " + text::exact(v.y()) + "]";
 }
-
-std::string vec(const Vec2& v) { return "[" + num(v.x()) + ", " + num(v.y()) + "]"; }
 
 // the paper's polar form s, sigma (what people read and what the issue asks for); reading it
 // back reproduces e, f to within a few ulps (s e^{i sigma} rounds), which the comment records
 std::string link_line(const char* name, const core::Link& l) {
-  return std::string("  ") + name + ": {length: " + num(l.length) + ", mass: " + num(l.mass) +
-         ", s: " + num(l.s()) + ", sigma: " + num(l.sigma()) + ", inertia: " + num(l.inertia) +
-         "}\n" + "    # e = " + num(l.e) + " m, f = " + num(l.f) + " m\n";
+  return std::string("  ") + name + ": {length: " + text::exact(l.length) +
+         ", mass: " + text::exact(l.mass) + ", s: " + text::exact(l.s()) +
+         ", sigma: " + text::exact(l.sigma()) + ", inertia: " + text::exact(l.inertia) + "}\n" +
+         "    # e = " + text::exact(l.e) + " m, f = " + text::exact(l.f) + " m\n";
 }
 
 std::string load_line(const char* name, const core::LinkLoad& l) {
-  return std::string("  ") + name + ": {force: " + vec(l.force) + ", moment: " + num(l.moment) +
-         "}\n";
+  return std::string("  ") + name + ": {force: " + vec(l.force) +
+         ", moment: " + text::exact(l.moment) + "}\n";
 }
 
 }  // namespace
@@ -46,7 +44,7 @@ std::string study_yaml(const Study& study, const std::string& header) {
   const core::FourBar& m = study.model;
   y += "linkage:\n";
   y += "  type: fourbar\n";
-  y += "  frame: " + num(m.frame_length) + "\n";
+  y += "  frame: " + text::exact(m.frame_length) + "\n";
   y += std::string("  branch: ") + (m.branch == core::Branch::kPlus ? "1" : "-1") + "\n";
   y += link_line("crank", m.crank);
   y += link_line("coupler", m.coupler);
@@ -57,7 +55,7 @@ std::string study_yaml(const Study& study, const std::string& header) {
     y += "  counter_rotations:\n";
     for (int i = 0; i < 2; ++i) {
       if (discs[i]->inertia <= 0) continue;
-      y += std::string("    ") + disc_names[i] + ": {inertia: " + num(discs[i]->inertia) +
+      y += std::string("    ") + disc_names[i] + ": {inertia: " + text::exact(discs[i]->inertia) +
            ", at: " + vec(discs[i]->at) + "}\n";
     }
   }
@@ -73,20 +71,20 @@ std::string study_yaml(const Study& study, const std::string& header) {
   y += "\nscene:\n";
   if (const auto* free = std::get_if<core::FreeScene>(&study.scene)) {
     y += "  type: free\n";
-    y += "  theta1: " + num(free->theta1) + "\n";
-    y += "  omega1: " + num(free->omega1) + "\n";
-    y += "  duration: " + num(free->duration) + "\n";
+    y += "  theta1: " + text::exact(free->theta1) + "\n";
+    y += "  omega1: " + text::exact(free->omega1) + "\n";
+    y += "  duration: " + text::exact(free->duration) + "\n";
     y += "  samples: " + std::to_string(free->samples) + "\n";
   } else {
     const auto& driven = std::get<core::DrivenScene>(study.scene);
     y += "  type: driven\n";
-    y += "  theta1: " + num(driven.theta1) + "\n";
-    y += "  omega1: " + num(driven.omega1) + "\n";
+    y += "  theta1: " + text::exact(driven.theta1) + "\n";
+    y += "  omega1: " + text::exact(driven.omega1) + "\n";
     y += "  revolutions: " + std::to_string(driven.revolutions) + "\n";
     y += "  samples: " + std::to_string(driven.samples) + "\n";
   }
   y += "\nmethod: " + study.method_name() + "\n";
-  y += "tolerance: " + num(study.tolerance) + "\n";
+  y += "tolerance: " + text::exact(study.tolerance) + "\n";
   return y;
 }
 

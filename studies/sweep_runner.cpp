@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "core/input_error.hpp"
+#include "core/number_text.hpp"
 #include "studies/report_support.hpp"
 #include "studies/runner.hpp"
 #include "studies/sweep.hpp"
@@ -53,13 +54,6 @@ std::vector<double> metric_values(const core::Metrics& m) {
 
 // the statuses a row may have (sweep.hpp, sweep_columns())
 constexpr const char* kStatuses[] = {"ok", "stopped-early", "no-optimum", "bad-input", "error"};
-
-// "%.17g": round-trips every double
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
 
 // a CSV field, quoted (RFC 4180) when it holds a comma, a quote or a line break
 std::string csv_field(const std::string& text) {
@@ -114,8 +108,8 @@ void second_design_cells(std::string& row, const core::Metrics* metrics, double 
     row.append(kMetrics + 2, ',');
     return;
   }
-  for (double v : metric_values(*metrics)) row += "," + number(v);
-  row += "," + number(added_mass) + "," + number(added_inertia);
+  for (double v : metric_values(*metrics)) row += "," + text::exact(v);
+  row += "," + text::exact(added_mass) + "," + text::exact(added_inertia);
 }
 
 // the added mass and inertia of the balanced or optimised design (comparison.csv's last rows)
@@ -133,13 +127,13 @@ std::pair<double, double> added(const Study& study, const RunResult& r) {
 PointRow point_row(const Study& base, int index, std::span<const double> values,
                    std::size_t cells) {
   std::string head = std::to_string(index);
-  for (double v : values) head += "," + number(v);
+  for (double v : values) head += "," + text::exact(v);
   std::string status = "ok", message;
   std::string body;
   try {
     const Study study = point_study(base, values);
     const RunResult r = compute_study(study);
-    for (double v : metric_values(r.metrics)) body += "," + number(v);
+    for (double v : metric_values(r.metrics)) body += "," + text::exact(v);
     if (base.balance) {
       const bool have = study.balance && r.balanced;
       const auto [mass, inertia] = have ? added(study, r) : std::pair<double, double>{};
@@ -205,10 +199,11 @@ std::string identity_json(const Study& study, int points) {
     const auto [from, to] = range_of(p, req.design);
     j += "    {\"path\": " + json_string(p.path) +
          ", \"scale\": " + (p.log_scale ? "\"log\"" : "\"linear\"") +
-         ", \"from\": " + number(from) + ", \"to\": " + number(to);
+         ", \"from\": " + text::exact(from) + ", \"to\": " + text::exact(to);
     if (req.design == SweepDesign::kGrid) {
       j += ", \"values\": [";
-      for (std::size_t i = 0; i < p.values.size(); ++i) j += (i ? ", " : "") + number(p.values[i]);
+      for (std::size_t i = 0; i < p.values.size(); ++i)
+        j += (i ? ", " : "") + text::exact(p.values[i]);
       j += "]";
     }
     j += std::string("}") + (k + 1 < req.parameters.size() ? ",\n" : "\n");
@@ -320,9 +315,9 @@ std::string row_problem(const std::string& line, std::size_t i, std::size_t colu
   }
   if (f[0] != std::to_string(i)) return "its point is '" + f[0] + "'";
   for (std::size_t j = 0; j < values.size(); ++j) {
-    if (f[1 + j] != number(values[j])) {
+    if (f[1 + j] != text::exact(values[j])) {
       return "its parameter " + std::to_string(j + 1) + " is " + f[1 + j] + ", the design's " +
-             number(values[j]);
+             text::exact(values[j]);
     }
   }
   const std::string& status = f[columns - 2];
