@@ -1,9 +1,9 @@
 // balance-design: the command-line program. A thin layer over bd::studies: parse the command
 // line, load the study, run it, print a short summary, and map outcomes to exit codes.
-#include <CLI/CLI.hpp>
 #include <signal.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -16,6 +16,7 @@
 #include <variant>
 #include <vector>
 
+#include "core/metrics.hpp"
 #include "studies/load_study.hpp"
 #include "studies/report.hpp"
 #include "studies/runner.hpp"
@@ -44,8 +45,8 @@ Outputs (in DIR, default results/<name>/ with <name> the study's `name`):
   timeseries.csv  one row per sample: t,theta1,theta2,theta3,omega1,omega2,omega3,
                   alpha1,alpha2,alpha3,RA0x,RA0y,RA3x,RA3y,Fshx,Fshy,Msh,tau (SI units, %.17g)
   summary.json    study name, method used and why, scene, samples, status, metrics
-                  (Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max, RA0_max, RA3_max,
-                  RA0_rms, RA3_rms); with a balance section also balance, balanced_run,
+                  (Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max, RA0_rms, RA0_max,
+                  RA3_rms, RA3_max); with a balance section also balance, balanced_run,
                   balanced_metrics and reduction (balanced / original)
   With a `balance:` section, besides (for the balanced design, same scene):
   balanced-timeseries.csv  the balanced design's samples, columns as timeseries.csv
@@ -311,12 +312,16 @@ void print_summary(const st::Study& study, const st::RunResult& r) {
                 r.trajectory.rhs_evaluations);
   }
   std::printf("\n");
-  std::printf("  |Fsh|    rms %.6g N, max %.6g N\n", m.Fsh_rms, m.Fsh_max);
-  std::printf("  |Msh|    rms %.6g N m, max %.6g N m\n", m.Msh_rms, m.Msh_max);
-  if (std::holds_alternative<bd::core::DrivenScene>(study.scene)) {
-    std::printf("  |tau|    rms %.6g N m, max %.6g N m\n", m.tau_rms, m.tau_max);
+  // the metric table's rows in pairs: each quantity's RMS, then its peak
+  const bool driven = std::holds_alternative<bd::core::DrivenScene>(study.scene);
+  for (std::size_t k = 0; k + 1 < bd::core::kMetricCount; k += 2) {
+    const bd::core::MetricInfo& rms = bd::core::kMetricTable[k];
+    const bd::core::MetricInfo& peak = bd::core::kMetricTable[k + 1];
+    if (rms.quantity == bd::core::Quantity::kDriveTorque && !driven) continue;  // 0 in free motion
+    const std::string symbol = std::string(rms.name).substr(0, std::string(rms.name).find('_'));
+    std::printf("  %-8s rms %.6g %s, max %.6g %s\n", ("|" + symbol + "|").c_str(), m.*rms.field,
+                rms.unit, m.*peak.field, peak.unit);
   }
-  std::printf("  |RA0|    max %.6g N;  |RA3| max %.6g N\n", m.RA0_max, m.RA3_max);
   if (study.balance && r.balanced) print_balance(study, r);
   if (study.optimize && r.optimized) print_optimize(study, r);
   std::printf("  wrote    %s\n", r.timeseries.string().c_str());
@@ -524,9 +529,8 @@ int bench(const BenchArgs& args) {
   print_summary(study, result.run);
   const std::size_t rows =
       result.free_rows.empty() ? result.driven_rows.size() : result.free_rows.size();
-  std::printf("  bench    %zu rows (%s, %d repeat%s): %s\n", rows,
-              args.quick ? "quick" : "full", options.repeats, options.repeats == 1 ? "" : "s",
-              result.csv.string().c_str());
+  std::printf("  bench    %zu rows (%s, %d repeat%s): %s\n", rows, args.quick ? "quick" : "full",
+              options.repeats, options.repeats == 1 ? "" : "s", result.csv.string().c_str());
   std::fflush(stdout);
   if (!result.run.trajectory.ok()) {
     std::fprintf(stderr, "%s: simulation stopped early: %s\n", args.study.c_str(),
@@ -542,8 +546,8 @@ std::vector<std::string> with_default_command(int argc, char** argv) {
   if (!args.empty()) {
     const std::string& first = args.front();
     const bool top_level = first == "run" || first == "validate" || first == "report" ||
-                           first == "bench" ||
-                           first == "-h" || first == "--help" || first == "--version";
+                           first == "bench" || first == "-h" || first == "--help" ||
+                           first == "--version";
     if (!top_level) args.insert(args.begin(), "run");
   }
   return args;
@@ -609,13 +613,15 @@ int main(int argc, char** argv) {
     bench_cmd->add_option("STUDY", bench_args.study, "the study file (free or driven scene)")
         ->required()
         ->type_name("FILE");
-    bench_cmd->add_option("-o,--out", bench_args.out,
-                          "output directory, created if needed (default: results/<name>/)")
+    bench_cmd
+        ->add_option("-o,--out", bench_args.out,
+                     "output directory, created if needed (default: results/<name>/)")
         ->type_name("DIR");
     bench_cmd->add_flag("--quick", bench_args.quick,
                         "tolerances 1e-4, 1e-7, 1e-10 only, one repeat (a few seconds)");
-    bench_cmd->add_option("--repeats", bench_args.repeats,
-                          "timed runs per point, the median reported (default 5; 1 with --quick)")
+    bench_cmd
+        ->add_option("--repeats", bench_args.repeats,
+                     "timed runs per point, the median reported (default 5; 1 with --quick)")
         ->check(CLI::Range(1, 1000))
         ->type_name("N");
 

@@ -2,10 +2,9 @@
 /// Internal to bd_optimize (included by optimize.cpp and ipopt_driver.cpp only): what a solver
 /// driver returns, the evaluation counter that remembers the best feasible point a solver has
 /// seen, and the NLopt driver. NLopt's own header appears only in nlopt_driver.cpp.
+#include <Eigen/Core>
 #include <limits>
 #include <string>
-
-#include <Eigen/Core>
 
 #include "optimize/nlp.hpp"
 #include "optimize/optimize.hpp"
@@ -43,7 +42,10 @@ class TrackedNlp {
   const Eigen::VectorXd& best_x() const { return best_x_; }
   double best_objective() const { return best_f_; }
   /// Forgets the best point (a new local run of a multistart keeps counting evaluations).
-  void reset_best() { has_best_ = false; best_f_ = std::numeric_limits<double>::infinity(); }
+  void reset_best() {
+    has_best_ = false;
+    best_f_ = std::numeric_limits<double>::infinity();
+  }
 
  private:
   void consider();  // a candidate when f, c_eq and c_in are known at one x

@@ -40,62 +40,22 @@ enum Group { kFsh, kMsh, kTau, kRA0, kRA3, kGroups };
 constexpr int kGroupFirst[kGroups] = {4, 6, 7, 0, 2};
 constexpr int kGroupRows[kGroups] = {2, 1, 1, 2, 2};
 
+// the output group of a reaction metric's quantity
 int group_of(Metric m) {
-  switch (m) {
-    case Metric::kFshRms:
-    case Metric::kFshMax:
+  if (m == Metric::kAddedMass) return -1;
+  switch (info(m).quantity) {
+    case core::Quantity::kShakingForce:
       return kFsh;
-    case Metric::kMshRms:
-    case Metric::kMshMax:
+    case core::Quantity::kShakingMoment:
       return kMsh;
-    case Metric::kTauRms:
-    case Metric::kTauMax:
+    case core::Quantity::kDriveTorque:
       return kTau;
-    case Metric::kRA0Rms:
-    case Metric::kRA0Max:
+    case core::Quantity::kReactionA0:
       return kRA0;
-    case Metric::kRA3Rms:
-    case Metric::kRA3Max:
+    case core::Quantity::kReactionA3:
       return kRA3;
-    case Metric::kAddedMass:
-      break;
   }
   return -1;
-}
-
-// true for the metrics of moments [N m] (against forces [N])
-bool is_moment(Metric m) { return group_of(m) == kMsh || group_of(m) == kTau; }
-
-double value_of(const core::Metrics& v, Metric m) {
-  switch (m) {
-    case Metric::kFshRms:
-      return v.Fsh_rms;
-    case Metric::kFshMax:
-      return v.Fsh_max;
-    case Metric::kMshRms:
-      return v.Msh_rms;
-    case Metric::kMshMax:
-      return v.Msh_max;
-    case Metric::kTauRms:
-      return v.tau_rms;
-    case Metric::kTauMax:
-      return v.tau_max;
-    case Metric::kRA0Rms:
-      return v.RA0_rms;
-    case Metric::kRA0Max:
-      return v.RA0_max;
-    case Metric::kRA3Rms:
-      return v.RA3_rms;
-    case Metric::kRA3Max:
-      return v.RA3_max;
-    case Metric::kAddedMass:
-      break;
-  }
-  return 0.0;
-}
-
-const char* unit_of(Metric m) {
-  return m == Metric::kAddedMass ? "kg" : (is_moment(m) ? "N m" : "N");
 }
 
 std::size_t metric_index(Metric m) { return static_cast<std::size_t>(m); }
@@ -116,10 +76,7 @@ const char* parameter_name(LinkParameterVariable::Parameter p) {
 
 core::Metrics infinite_metrics() {
   core::Metrics m;
-  for (double* v : {&m.Fsh_rms, &m.Fsh_max, &m.Msh_rms, &m.Msh_max, &m.tau_rms, &m.tau_max,
-                    &m.RA0_max, &m.RA3_max, &m.RA0_rms, &m.RA3_rms}) {
-    *v = kInf;
-  }
+  for (const core::MetricInfo& info : core::kMetricTable) m.*info.field = kInf;
   return m;
 }
 
@@ -248,10 +205,10 @@ void Nlp::Impl::check_normalisers() const {
   const double moment = std::max({o.tau_max, o.Msh_max, force * problem.original.frame_length});
   auto check = [&](Metric m, const std::string& where) {
     if (m == Metric::kAddedMass) return;
-    const double v = value_of(o, m), scale = is_moment(m) ? moment : force;
+    const double v = value(o, m), scale = is_moment(m) ? moment : force;
     if (!(v > 1e-10 * scale)) {
       throw InputError(where + ": the original design's " + to_string(m) + " is " +
-                       text::digits(v, 6) + " " + unit_of(m) +
+                       text::digits(v, 6) + " " + metric_unit(m) +
                        ", too small to normalise by (it is already minimal)");
     }
   };
@@ -290,7 +247,7 @@ void Nlp::Impl::set_up_variables() {
     for (Metric m : kMetrics) {
       if (is_peak(m) && weight[metric_index(m)] > 0) {
         bound_var[metric_index(m)] =
-            add(0.0, kInf, std::string("bound on ") + to_string(m) + " [" + unit_of(m) + "]");
+            add(0.0, kInf, std::string("bound on ") + to_string(m) + " [" + metric_unit(m) + "]");
       }
     }
   }
@@ -769,13 +726,13 @@ core::Metrics Nlp::Impl::free_metrics(const Eigen::VectorXd& x) const {
 
 double Nlp::Impl::metric(const Eigen::VectorXd& x, Metric m) const {
   if (m == Metric::kAddedMass) return added_mass(inertial(x, false).q);
-  if (!driven) return value_of(free_metrics(x), m);
+  if (!driven) return value(free_metrics(x), m);
   const VecQ q = inertial(x, false).q;
   return is_peak(m) ? peak(group_of(m), q) : std::sqrt(rms_squared(group_of(m), q));
 }
 
 double Nlp::Impl::normaliser(Metric m) const {
-  return m == Metric::kAddedMass ? original_mass : value_of(original_metrics, m);
+  return m == Metric::kAddedMass ? original_mass : value(original_metrics, m);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -852,7 +809,7 @@ double Nlp::objective(const Eigen::VectorXd& x, Eigen::VectorXd* grad) const {
       if (m == Metric::kAddedMass) {
         f += w * p.added_mass(p.inertial(x, false).q) / p.original_mass;
       } else {
-        const double r = value_of(v, m) / p.normaliser(m);
+        const double r = value(v, m) / p.normaliser(m);
         // linear: an RMS smoothed as in driven scenes, a peak exactly (no bound variable)
         f += w * (!p.linear ? r * r : is_peak(m) ? r : smoothed(r * r, p.eps));
       }
@@ -971,7 +928,7 @@ void Nlp::inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::Matr
       case Kind::kRmsLimit: {
         const double limit = b.value * p.normaliser(b.metric);
         if (!p.driven) {
-          const double r = value_of(free, b.metric) / limit;
+          const double r = value(free, b.metric) / limit;
           c(row) = r * r - 1;
           break;
         }
@@ -985,7 +942,7 @@ void Nlp::inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::Matr
       case Kind::kPeakBound: {
         const double o = p.normaliser(b.metric);
         if (!p.driven) {  // a peak limit in a free scene: the peak itself
-          const double r = value_of(free, b.metric) / (b.value * o);
+          const double r = value(free, b.metric) / (b.value * o);
           c(row) = r * r - 1;
           break;
         }

@@ -58,16 +58,15 @@
 ///
 /// Evaluations are const; free scenes keep the last simulation in a mutex-guarded cache, so the
 /// objective and the constraints at the same x simulate once.
+#include <Eigen/Core>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-
 #include "core/metrics.hpp"
 #include "core/model.hpp"
-#include "optimize/problem.hpp"
 #include "optimize/optimize.hpp"
+#include "optimize/problem.hpp"
 
 namespace bd::optimize {
 

@@ -24,35 +24,6 @@ using Eigen::VectorXd;
 constexpr Algorithm kAlgorithms[] = {Algorithm::kSlsqp, Algorithm::kMma,   Algorithm::kIpopt,
                                      Algorithm::kMlsl,  Algorithm::kIsres, Algorithm::kCobyla};
 
-// the value of a metric in core's summary (added_mass is not one of them)
-double value_of(const core::Metrics& m, Metric metric) {
-  switch (metric) {
-    case Metric::kFshRms:
-      return m.Fsh_rms;
-    case Metric::kFshMax:
-      return m.Fsh_max;
-    case Metric::kMshRms:
-      return m.Msh_rms;
-    case Metric::kMshMax:
-      return m.Msh_max;
-    case Metric::kTauRms:
-      return m.tau_rms;
-    case Metric::kTauMax:
-      return m.tau_max;
-    case Metric::kRA0Rms:
-      return m.RA0_rms;
-    case Metric::kRA0Max:
-      return m.RA0_max;
-    case Metric::kRA3Rms:
-      return m.RA3_rms;
-    case Metric::kRA3Max:
-      return m.RA3_max;
-    case Metric::kAddedMass:
-      break;
-  }
-  return 0.0;
-}
-
 // ---------------------------------------------------------------------------------------------
 // gradient check: analytic derivatives against central differences at x.
 // Step h = 1e-6 max(1, |x_i|) (the variables are O(1) in SI units): truncation ~h² |f'''|,
@@ -163,11 +134,9 @@ double verification_error(const core::Metrics& a, const core::Metrics& b, double
   double worst = 0.0;
   for (Metric m : kMetrics) {
     if (m == Metric::kAddedMass) continue;
-    const double va = value_of(a, m), vb = value_of(b, m);
-    const bool is_moment = m == Metric::kMshRms || m == Metric::kMshMax || m == Metric::kTauRms ||
-                           m == Metric::kTauMax;
+    const double va = value(a, m), vb = value(b, m);
     const double scale =
-        std::max({std::abs(va), std::abs(vb), 1e-4 * (is_moment ? moment : force)});
+        std::max({std::abs(va), std::abs(vb), 1e-4 * (is_moment(m) ? moment : force)});
     if (scale == 0.0) continue;  // zero in both, and nothing to be zero against
     const double error = std::abs(va - vb) / scale;
     if (!std::isfinite(error)) return std::numeric_limits<double>::infinity();

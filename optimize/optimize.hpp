@@ -1,11 +1,10 @@
 #pragma once
 /// Solving a DesignProblem with NLopt or Ipopt (Ceres-style: options in, result out). The
 /// solvers' headers appear only in optimize/nlopt_driver.cpp and optimize/ipopt_driver.cpp.
+#include <Eigen/Core>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "balance/counterweight.hpp"
 #include "core/metrics.hpp"
@@ -30,19 +29,19 @@ bool uses_gradients(Algorithm a);
 struct OptimizeOptions {
   Algorithm algorithm = Algorithm::kSlsqp;
   int max_evaluations = 2000;
-  double relative_tolerance = 1e-8;   // on x and on the objective
-  double constraint_tolerance = 1e-9; // feasibility of the reported optimum (scaled)
-  bool check_gradients = false;       // compare analytic gradients with central differences first
-  unsigned seed = 1;                  // global methods
+  double relative_tolerance = 1e-8;    // on x and on the objective
+  double constraint_tolerance = 1e-9;  // feasibility of the reported optimum (scaled)
+  bool check_gradients = false;        // compare analytic gradients with central differences first
+  unsigned seed = 1;                   // global methods
   std::string validate() const;
 };
 
 enum class Termination {
   kNotRun,
-  kConverged,        // a tolerance was met at a feasible point
-  kMaxEvaluations,   // stopped by the budget; the best feasible point so far is returned
-  kInfeasible,       // no feasible point found; the message names the binding constraint
-  kFailed,           // the solver failed (roundoff, invalid problem); the message says why
+  kConverged,       // a tolerance was met at a feasible point
+  kMaxEvaluations,  // stopped by the budget; the best feasible point so far is returned
+  kInfeasible,      // no feasible point found; the message names the binding constraint
+  kFailed,          // the solver failed (roundoff, invalid problem); the message says why
 };
 const char* to_string(Termination t);
 
@@ -56,21 +55,22 @@ struct OptimizeResult {
   Termination termination = Termination::kNotRun;
   std::string message = "optimize() was not called";
   Algorithm algorithm = Algorithm::kSlsqp;
-  Eigen::VectorXd x;                  // the optimum's variables
-  double objective{};                 // at x
-  double constraint_violation{};      // largest scaled violation at x (0 when feasible)
-  int iterations{}, evaluations{};    // solver iterations, objective evaluations
-  double seconds{};                   // wall time of the solve
-  core::FourBar design;               // the optimum as a model (counterweights merged in)
+  Eigen::VectorXd x;                // the optimum's variables
+  double objective{};               // at x
+  double constraint_violation{};    // largest scaled violation at x (0 when feasible)
+  int iterations{}, evaluations{};  // solver iterations, objective evaluations
+  double seconds{};                 // wall time of the solve
+  core::FourBar design;             // the optimum as a model (counterweights merged in)
   std::vector<PlacedCounterweight> counterweights;
-  core::Metrics metrics;              // of the optimum, as the optimiser evaluated them
-  core::Metrics verified;             // re-simulated with another formulation
+  core::Metrics metrics;   // of the optimum, as the optimiser evaluated them
+  core::Metrics verified;  // re-simulated with another formulation
   core::Formulation verified_with = core::Formulation::kMassMatrix;
-  double verification_error{};        // largest relative difference metrics vs verified
+  double verification_error{};  // largest relative difference metrics vs verified
   /// One line for the console and summary.json.
   std::string brief_report() const;
-  bool ok() const { return termination == Termination::kConverged ||
-                           termination == Termination::kMaxEvaluations; }
+  bool ok() const {
+    return termination == Termination::kConverged || termination == Termination::kMaxEvaluations;
+  }
 };
 
 /// Solves the problem from its natural start (every variable at its value in the original

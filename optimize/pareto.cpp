@@ -20,43 +20,7 @@ double limit_value(const OptimizeResult& r, const DesignProblem& problem, const 
   if (m == Metric::kAddedMass) {
     return core::total_mass(r.design) - core::total_mass(problem.original);
   }
-  const core::Metrics& v = r.metrics;
-  double value = 0.0;
-  switch (m) {
-    case Metric::kFshRms:
-      value = v.Fsh_rms;
-      break;
-    case Metric::kFshMax:
-      value = v.Fsh_max;
-      break;
-    case Metric::kMshRms:
-      value = v.Msh_rms;
-      break;
-    case Metric::kMshMax:
-      value = v.Msh_max;
-      break;
-    case Metric::kTauRms:
-      value = v.tau_rms;
-      break;
-    case Metric::kTauMax:
-      value = v.tau_max;
-      break;
-    case Metric::kRA0Rms:
-      value = v.RA0_rms;
-      break;
-    case Metric::kRA0Max:
-      value = v.RA0_max;
-      break;
-    case Metric::kRA3Rms:
-      value = v.RA3_rms;
-      break;
-    case Metric::kRA3Max:
-      value = v.RA3_max;
-      break;
-    case Metric::kAddedMass:
-      break;
-  }
-  return value / nlp.original(m);
+  return value(r.metrics, m) / nlp.original(m);
 }
 
 DesignProblem minimising(const DesignProblem& problem, Metric m) {

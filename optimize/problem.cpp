@@ -65,37 +65,15 @@ std::string check_scene(const core::DrivenScene& s) {
   return "";
 }
 
-bool is_torque(Metric m) { return m == Metric::kTauRms || m == Metric::kTauMax; }
+bool is_torque(Metric m) {
+  return m != Metric::kAddedMass && info(m).quantity == core::Quantity::kDriveTorque;
+}
 
 }  // namespace
 
-const char* to_string(Metric m) {
-  switch (m) {
-    case Metric::kFshRms:
-      return "Fsh_rms";
-    case Metric::kFshMax:
-      return "Fsh_max";
-    case Metric::kMshRms:
-      return "Msh_rms";
-    case Metric::kMshMax:
-      return "Msh_max";
-    case Metric::kTauRms:
-      return "tau_rms";
-    case Metric::kTauMax:
-      return "tau_max";
-    case Metric::kRA0Rms:
-      return "RA0_rms";
-    case Metric::kRA0Max:
-      return "RA0_max";
-    case Metric::kRA3Rms:
-      return "RA3_rms";
-    case Metric::kRA3Max:
-      return "RA3_max";
-    case Metric::kAddedMass:
-      return "added_mass";
-  }
-  return "?";
-}
+const core::MetricInfo& info(Metric m) { return core::kMetricTable[static_cast<std::size_t>(m)]; }
+
+const char* to_string(Metric m) { return m == Metric::kAddedMass ? "added_mass" : info(m).name; }
 
 std::optional<Metric> metric_named(const std::string& name) {
   for (Metric m : kMetrics) {
@@ -104,9 +82,14 @@ std::optional<Metric> metric_named(const std::string& name) {
   return std::nullopt;
 }
 
+const char* metric_unit(Metric m) { return m == Metric::kAddedMass ? "kg" : info(m).unit; }
+
+bool is_moment(Metric m) { return std::string_view(metric_unit(m)) == "N m"; }
+
+double value(const core::Metrics& metrics, Metric m) { return metrics.*info(m).field; }
+
 bool is_peak(Metric m) {
-  return m == Metric::kFshMax || m == Metric::kMshMax || m == Metric::kTauMax ||
-         m == Metric::kRA0Max || m == Metric::kRA3Max;
+  return m != Metric::kAddedMass && info(m).statistic == core::Statistic::kMax;
 }
 
 const char* to_string(ObjectiveForm f) {

@@ -2,6 +2,7 @@
 /// The optimisation problem: design variables on a four-bar, an objective and constraints built
 /// from the metrics of its simulated reactions (DESIGN.md "optimize"). Solver-agnostic: NLopt and
 /// Ipopt stay behind optimize() (optimize/optimize.hpp).
+#include <cstddef>
 #include <limits>
 #include <optional>
 #include <string>
@@ -10,12 +11,14 @@
 
 #include "balance/counterweight.hpp"
 #include "core/dynamics.hpp"
+#include "core/metrics.hpp"
 #include "core/model.hpp"
 #include "core/simulate.hpp"
 
 namespace bd::optimize {
 
-/// Metrics of a design in the scene (RMS over samples, peak = max of magnitudes).
+/// Metrics of a design in the scene: the rows of core's metric table (core/metrics.hpp, in its
+/// order), then the added mass.
 // clang-format off
 enum class Metric {
   kFshRms, kFshMax,  // |F̄sh| [N]
@@ -26,13 +29,28 @@ enum class Metric {
   kAddedMass,        // Σ (design mass - original mass) over the links [kg]
 };
 // clang-format on
+static_assert(static_cast<std::size_t>(Metric::kAddedMass) == core::kMetricCount,
+              "the reaction metrics are core::kMetricTable's rows, in its order");
+
+/// The row of core's metric table of a reaction metric (any but kAddedMass).
+const core::MetricInfo& info(Metric m);
+
 /// "Fsh_rms", "Fsh_max", ..., "added_mass" (the names of summary.json and comparison.csv).
 const char* to_string(Metric m);
 std::optional<Metric> metric_named(const std::string& name);
-inline constexpr Metric kMetrics[] = {
-    Metric::kFshRms, Metric::kFshMax, Metric::kMshRms, Metric::kMshMax, Metric::kTauRms,
-    Metric::kTauMax, Metric::kRA0Rms, Metric::kRA0Max, Metric::kRA3Rms, Metric::kRA3Max,
-    Metric::kAddedMass};
+/// "N", "N m" or "kg".
+const char* metric_unit(Metric m);
+/// True for the metrics of moments [N m] (the shaking moment and the drive torque).
+bool is_moment(Metric m);
+/// The value of a reaction metric (any but kAddedMass) in `metrics`.
+double value(const core::Metrics& metrics, Metric m);
+
+/// Every metric, in the table's order, added_mass last.
+inline constexpr Metric kMetrics[] = {Metric::kFshRms, Metric::kFshMax,   Metric::kMshRms,
+                                      Metric::kMshMax, Metric::kTauRms,   Metric::kTauMax,
+                                      Metric::kRA0Rms, Metric::kRA0Max,   Metric::kRA3Rms,
+                                      Metric::kRA3Max, Metric::kAddedMass};
+
 /// True for the peak metrics (handled by a bound variable, never by a non-smooth max).
 bool is_peak(Metric m);
 
@@ -80,8 +98,8 @@ struct CounterweightVariables {
   double mass_max = 10.0;     // [kg], mass in [0, mass_max], > 0
   double distance_max = 1.0;  // [m], |(x, y)| <= distance_max (the envelope), > 0
   balance::CounterweightShape shape = balance::CounterweightShape::kPoint;
-  double thickness = 0.02;    // disc [m], > 0
-  double density = 7850.0;    // disc [kg/m^3], > 0
+  double thickness = 0.02;  // disc [m], > 0
+  double density = 7850.0;  // disc [kg/m^3], > 0
 };
 
 /// One of the link's own mass parameters as a design variable, within bounds.

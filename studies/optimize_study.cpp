@@ -50,32 +50,7 @@ double added_inertia(const core::FourBar& original, const core::FourBar& design)
 }
 
 double metric_value(const core::Metrics& m, optimize::Metric metric, double added) {
-  using M = optimize::Metric;
-  switch (metric) {
-    case M::kFshRms:
-      return m.Fsh_rms;
-    case M::kFshMax:
-      return m.Fsh_max;
-    case M::kMshRms:
-      return m.Msh_rms;
-    case M::kMshMax:
-      return m.Msh_max;
-    case M::kTauRms:
-      return m.tau_rms;
-    case M::kTauMax:
-      return m.tau_max;
-    case M::kRA0Rms:
-      return m.RA0_rms;
-    case M::kRA0Max:
-      return m.RA0_max;
-    case M::kRA3Rms:
-      return m.RA3_rms;
-    case M::kRA3Max:
-      return m.RA3_max;
-    case M::kAddedMass:
-      return added;
-  }
-  return 0.0;
+  return metric == optimize::Metric::kAddedMass ? added : optimize::value(m, metric);
 }
 
 std::string objective_text(const OptimizeRequest& request) {

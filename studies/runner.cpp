@@ -88,12 +88,12 @@ std::string json_vec(const Vec2& v) {
   return "[" + json_number(v.x()) + ", " + json_number(v.y()) + "]";
 }
 
-// the metrics in summary.json order, with their names
+// the metrics in the table's order, with their names
 std::vector<std::pair<const char*, double>> metric_items(const core::Metrics& m) {
-  return {{"Fsh_rms", m.Fsh_rms}, {"Fsh_max", m.Fsh_max}, {"Msh_rms", m.Msh_rms},
-          {"Msh_max", m.Msh_max}, {"tau_rms", m.tau_rms}, {"tau_max", m.tau_max},
-          {"RA0_max", m.RA0_max}, {"RA3_max", m.RA3_max}, {"RA0_rms", m.RA0_rms},
-          {"RA3_rms", m.RA3_rms}};
+  std::vector<std::pair<const char*, double>> items;
+  for (const core::MetricInfo& info : core::kMetricTable)
+    items.emplace_back(info.name, m.*info.field);
+  return items;
 }
 
 // `"key": {...}` with one metric per line, indented by two spaces; `last` drops the comma
@@ -488,13 +488,12 @@ std::vector<ComparisonRow> comparison(const Study& study, const RunResult& resul
     mass = added_mass(study.model, result.optimized->result.design);
     inertia = added_inertia(study.model, result.optimized->result.design);
   }
-  const std::pair<const char*, std::pair<double, double>> items[] = {
-      {"Fsh_rms", {a.Fsh_rms, b.Fsh_rms}}, {"Fsh_max", {a.Fsh_max, b.Fsh_max}},
-      {"Msh_rms", {a.Msh_rms, b.Msh_rms}}, {"Msh_max", {a.Msh_max, b.Msh_max}},
-      {"tau_rms", {a.tau_rms, b.tau_rms}}, {"tau_max", {a.tau_max, b.tau_max}},
-      {"RA0_rms", {a.RA0_rms, b.RA0_rms}}, {"RA0_max", {a.RA0_max, b.RA0_max}},
-      {"RA3_rms", {a.RA3_rms, b.RA3_rms}}, {"RA3_max", {a.RA3_max, b.RA3_max}},
-      {"added_mass", {0.0, mass}},         {"added_inertia", {0.0, inertia}}};
+  std::vector<std::pair<std::string, std::pair<double, double>>> items;
+  for (const core::MetricInfo& info : core::kMetricTable) {
+    items.push_back({info.name, {a.*info.field, b.*info.field}});
+  }
+  items.push_back({"added_mass", {0.0, mass}});
+  items.push_back({"added_inertia", {0.0, inertia}});
   for (const auto& [name, values] : items) {
     ComparisonRow row{name, values.first, values.second, std::nullopt};
     if (row.before != 0) row.ratio = row.after / row.before;

@@ -42,14 +42,13 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-// the metrics in summary.json order: the sweep.csv columns after the parameters
-constexpr const char* kMetricNames[] = {"Fsh_rms", "Fsh_max", "Msh_rms", "Msh_max", "tau_rms",
-                                        "tau_max", "RA0_max", "RA3_max", "RA0_rms", "RA3_rms"};
-constexpr std::size_t kMetrics = std::size(kMetricNames);
+// the metrics in the table's order: the sweep.csv columns after the parameters
+constexpr std::size_t kMetrics = core::kMetricCount;
 
 std::vector<double> metric_values(const core::Metrics& m) {
-  return {m.Fsh_rms, m.Fsh_max, m.Msh_rms, m.Msh_max, m.tau_rms,
-          m.tau_max, m.RA0_max, m.RA3_max, m.RA0_rms, m.RA3_rms};
+  std::vector<double> values;
+  for (const core::MetricInfo& info : core::kMetricTable) values.push_back(m.*info.field);
+  return values;
 }
 
 // the statuses a row may have (sweep.hpp, sweep_columns())
@@ -502,10 +501,11 @@ std::vector<std::string> sweep_columns(const Study& study) {
   if (study.sweep) {
     for (const SweepParameter& p : study.sweep->parameters) columns.push_back(p.path);
   }
-  for (const char* m : kMetricNames) columns.push_back(m);
+  for (const core::MetricInfo& m : core::kMetricTable) columns.push_back(m.name);
   for (const char* prefix : {"balanced_", "optimized_"}) {
     if (prefix[0] == 'b' ? !study.balance : !study.optimize) continue;
-    for (const char* m : kMetricNames) columns.push_back(std::string(prefix) + m);
+    for (const core::MetricInfo& m : core::kMetricTable)
+      columns.push_back(std::string(prefix) + m.name);
     columns.push_back("added_mass");
     columns.push_back("added_inertia");
   }

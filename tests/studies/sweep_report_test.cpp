@@ -50,11 +50,11 @@ std::string g17(double v) {
 // a sweep folder as run_sweep() writes it (the spec's formats), from simulations at each point
 
 constexpr const char* kMetricNames[] = {"Fsh_rms", "Fsh_max", "Msh_rms", "Msh_max", "tau_rms",
-                                        "tau_max", "RA0_max", "RA3_max", "RA0_rms", "RA3_rms"};
+                                        "tau_max", "RA0_rms", "RA0_max", "RA3_rms", "RA3_max"};
 
 std::vector<double> metric_values(const core::Metrics& m) {
   return {m.Fsh_rms, m.Fsh_max, m.Msh_rms, m.Msh_max, m.tau_rms,
-          m.tau_max, m.RA0_max, m.RA3_max, m.RA0_rms, m.RA3_rms};
+          m.tau_max, m.RA0_rms, m.RA0_max, m.RA3_rms, m.RA3_max};
 }
 
 std::string csv_quoted(const std::string& text) {
