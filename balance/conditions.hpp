@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "core/model.hpp"
-#include "core/principal_vectors.hpp"
+#include "core/fourbar/model.hpp"
+#include "core/fourbar/principal_vectors.hpp"
 
 namespace bd::balance {
 

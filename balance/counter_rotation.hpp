@@ -3,7 +3,7 @@
 /// (Berkof 1973, paper §5.2).
 #include <string>
 
-#include "core/model.hpp"
+#include "core/fourbar/model.hpp"
 #include "core/types.hpp"
 
 namespace bd::balance {

@@ -7,7 +7,7 @@
 #include "balance/conditions.hpp"
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
-#include "core/principal_vectors.hpp"
+#include "core/fourbar/principal_vectors.hpp"
 
 namespace bd::balance {
 

@@ -5,7 +5,7 @@
 #include <optional>
 #include <string>
 
-#include "core/model.hpp"
+#include "core/fourbar/model.hpp"
 #include "core/types.hpp"
 
 namespace bd::balance {

@@ -4,10 +4,10 @@
 // per iteration, so every call is a new instant and nothing is hoisted out of the loop.
 #include <benchmark/benchmark.h>
 
-#include "core/dynamics.hpp"
-#include "core/kinematics.hpp"
-#include "core/samples.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 
 namespace {
 

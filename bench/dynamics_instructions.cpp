@@ -17,10 +17,10 @@
 #include <cstdlib>
 #include <string>
 
-#include "core/dynamics.hpp"
-#include "core/kinematics.hpp"
-#include "core/samples.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 
 int main(int argc, char** argv) {
   using namespace bd::core;

@@ -28,15 +28,15 @@
 #include <Eigen/Dense>
 
 #include "tests/reference/reference_ld.hpp"
-#include "core/dynamics.hpp"
-#include "core/kinematics.hpp"
-#include "core/mass_matrix.hpp"
-#include "core/model.hpp"
-#include "core/principal_vectors.hpp"
-#include "core/samples.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/mass_matrix.hpp"
+#include "core/fourbar/model.hpp"
+#include "core/fourbar/principal_vectors.hpp"
+#include "core/fourbar/samples.hpp"
 #include "tests/reference/newton_euler.hpp"
-#include "core/opened_loop.hpp"
-#include "core/complex_masses.hpp"
+#include "core/fourbar/opened_loop.hpp"
+#include "core/fourbar/complex_masses.hpp"
 
 namespace {
 

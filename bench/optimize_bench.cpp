@@ -11,8 +11,8 @@
 #include <numbers>
 
 #include "core/metrics.hpp"
-#include "core/samples.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 #include "optimize/nlp.hpp"
 #include "optimize/optimize.hpp"
 

@@ -17,11 +17,11 @@
 #include <vector>
 
 #include "core/metrics.hpp"
-#include "studies/load_study.hpp"
-#include "studies/report.hpp"
-#include "studies/runner.hpp"
-#include "studies/sweep.hpp"
-#include "studies/work_precision.hpp"
+#include "studies/study/load_study.hpp"
+#include "studies/report/report.hpp"
+#include "studies/run/runner.hpp"
+#include "studies/sweep/sweep.hpp"
+#include "studies/bench/work_precision.hpp"
 
 #ifndef BD_VERSION
 #define BD_VERSION "unknown"
@@ -218,7 +218,7 @@ void print_comparison(const st::Study& study, const st::RunResult& r) {
 
 // the balanced design: what was added, and before / after / ratio of the main metrics
 void print_balance(const st::Study& study, const st::RunResult& r) {
-  const st::BalancedDesign& b = *study.balance;
+  const bd::balance::BalancedDesign& b = *study.balance;
   const st::BalancedRun& run = *r.balanced;
   std::printf("  balance  force %s, moment %s: the balanced design is %s\n",
               b.request.force ? "full" : "none", b.request.moment ? "full" : "none",
@@ -235,7 +235,7 @@ void print_balance(const st::Study& study, const st::RunResult& r) {
     if (!cws[i]->has_value()) continue;
     const bd::balance::Counterweight& c = **cws[i];
     std::printf("  %-7s  counterweight (%s) %.6g kg at [%.6g, %.6g] m from %s (%.6g m)", sides[i],
-                st::to_string(specs[i]->shape), c.mass, c.position.x(), c.position.y(), pivots[i],
+                bd::balance::to_string(specs[i]->shape), c.mass, c.position.x(), c.position.y(), pivots[i],
                 c.distance);
     if (c.radius > 0) std::printf(", radius %.6g m", c.radius);
     std::printf("\n");

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "core/simulate.hpp"
+#include "core/fourbar/simulate.hpp"
 
 namespace bd::core::integrators {
 

@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <string_view>
 
-#include "core/simulate.hpp"
+#include "core/fourbar/simulate.hpp"
 
 namespace bd::core {
 

@@ -12,7 +12,7 @@
 #include <variant>
 
 #include "core/input_error.hpp"
-#include "core/kinematics.hpp"
+#include "core/fourbar/kinematics.hpp"
 #include "core/number_text.hpp"
 
 namespace bd::optimize {

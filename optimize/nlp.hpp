@@ -64,7 +64,7 @@
 #include <vector>
 
 #include "core/metrics.hpp"
-#include "core/model.hpp"
+#include "core/fourbar/model.hpp"
 #include "optimize/optimize.hpp"
 #include "optimize/problem.hpp"
 

@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "balance/counterweight.hpp"
-#include "core/dynamics.hpp"
+#include "core/fourbar/dynamics.hpp"
 #include "core/metrics.hpp"
-#include "core/model.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/model.hpp"
+#include "core/fourbar/simulate.hpp"
 
 namespace bd::optimize {
 

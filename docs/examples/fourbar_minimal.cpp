@@ -1,8 +1,8 @@
 // The library API in twenty lines: build the paper's four-bar, solve one instant, print it.
 #include <cstdio>
 
-#include "core/dynamics.hpp"
-#include "core/model.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/model.hpp"
 
 int main() {
   using namespace bd::core;

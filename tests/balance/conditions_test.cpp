@@ -13,11 +13,11 @@
 #include <string>
 
 #include "balance/counterweight.hpp"
-#include "core/kinematics.hpp"
-#include "core/model.hpp"
-#include "core/principal_vectors.hpp"
-#include "core/samples.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/model.hpp"
+#include "core/fourbar/principal_vectors.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 
 namespace bd::balance {
 namespace {

@@ -20,8 +20,8 @@
 #include "balance/counterweight.hpp"
 #include "core/input_error.hpp"
 #include "core/metrics.hpp"
-#include "core/model.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/model.hpp"
+#include "core/fourbar/simulate.hpp"
 
 namespace bd::balance {
 namespace {

@@ -27,14 +27,14 @@
 #include <vector>
 
 #include "balance/conditions.hpp"
-#include "core/dynamics.hpp"
-#include "core/energy.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/energy.hpp"
 #include "core/input_error.hpp"
-#include "core/kinematics.hpp"
+#include "core/fourbar/kinematics.hpp"
 #include "core/metrics.hpp"
-#include "core/model.hpp"
-#include "core/samples.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/model.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 
 namespace bd::balance {
 namespace {

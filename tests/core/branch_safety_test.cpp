@@ -6,9 +6,9 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/kinematics.hpp"
-#include "core/samples.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 
 namespace bd::core {
 namespace {

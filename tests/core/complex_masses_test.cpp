@@ -9,7 +9,7 @@
 // error (a sign, a lever arm, a mass) shows at order one. Sizes as in dynamics_test: forces
 // against max(1 N, |RA0|, |RA3|, |Fsh|), moments and torques against that times
 // max(1 m, longest link), accelerations against max(1 rad/s^2, |alpha_k|).
-#include "core/complex_masses.hpp"
+#include "core/fourbar/complex_masses.hpp"
 
 #include <gtest/gtest.h>
 
@@ -21,12 +21,12 @@
 #include <random>
 #include <string>
 
-#include "core/dynamics.hpp"
-#include "core/energy.hpp"
-#include "core/kinematics.hpp"
-#include "core/model.hpp"
-#include "core/principal_vectors.hpp"
-#include "core/samples.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/energy.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/model.hpp"
+#include "core/fourbar/principal_vectors.hpp"
+#include "core/fourbar/samples.hpp"
 #include "tests/reference/newton_euler.hpp"
 #include "tests/support/scales.hpp"
 #include "tests/support/allocation_counter.hpp"

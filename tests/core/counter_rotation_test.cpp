@@ -42,11 +42,11 @@
 #include <random>
 #include <string>
 
-#include "core/dynamics.hpp"
-#include "core/energy.hpp"
-#include "core/kinematics.hpp"
-#include "core/model.hpp"
-#include "core/samples.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/energy.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/model.hpp"
+#include "core/fourbar/samples.hpp"
 #include "tests/reference/newton_euler.hpp"
 
 namespace bd::core {

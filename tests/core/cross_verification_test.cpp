@@ -6,9 +6,9 @@
 
 #include <algorithm>
 
-#include "core/dynamics.hpp"
-#include "core/samples.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 #include "tests/reference/newton_euler.hpp"
 
 namespace bd::core {

@@ -8,7 +8,7 @@
 // amplified by the position solve's condition (~1e2 on the paper example away from its dead
 // centres): 1e-13 of each quantity's scale leaves a margin of ~100 while a wrong angle, branch
 // or turn count shows at order one.
-#include "core/dynamics_constants.hpp"
+#include "core/fourbar/dynamics_constants.hpp"
 
 #include <gtest/gtest.h>
 
@@ -18,11 +18,11 @@
 #include <random>
 #include <string>
 
-#include "core/dynamics.hpp"
-#include "core/formulation_support.hpp"
-#include "core/mass_matrix.hpp"
-#include "core/samples.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/formulation_support.hpp"
+#include "core/fourbar/mass_matrix.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 #include "tests/support/scales.hpp"
 
 namespace bd::core {

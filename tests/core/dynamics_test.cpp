@@ -9,7 +9,7 @@
 // (a wrong sign, lever arm or inertia term) shows at order one. Sizes: forces against
 // max(1 N, |RA0|, |RA3|, |Fsh|), moments and torques against that times the longest link,
 // accelerations against max(1 rad/s^2, |alpha_k|); never element by element near a zero crossing.
-#include "core/dynamics.hpp"
+#include "core/fourbar/dynamics.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,9 +20,9 @@
 #include <random>
 #include <string>
 
-#include "core/kinematics.hpp"
-#include "core/model.hpp"
-#include "core/samples.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/model.hpp"
+#include "core/fourbar/samples.hpp"
 #include "tests/reference/newton_euler.hpp"
 #include "tests/support/scales.hpp"
 

@@ -1,4 +1,4 @@
-#include "core/energy.hpp"
+#include "core/fourbar/energy.hpp"
 
 #include <gtest/gtest.h>
 
@@ -6,8 +6,8 @@
 #include <numbers>
 #include <random>
 
-#include "core/kinematics.hpp"
-#include "core/samples.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/samples.hpp"
 
 namespace bd::core {
 namespace {

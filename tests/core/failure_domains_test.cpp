@@ -22,13 +22,13 @@
 #include <vector>
 
 #include "tests/reference/reference_ld.hpp"
-#include "core/complex_masses.hpp"
-#include "core/dynamics.hpp"
-#include "core/formulation_support.hpp"
-#include "core/mass_matrix.hpp"
-#include "core/model.hpp"
-#include "core/opened_loop.hpp"
-#include "core/samples.hpp"
+#include "core/fourbar/complex_masses.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/formulation_support.hpp"
+#include "core/fourbar/mass_matrix.hpp"
+#include "core/fourbar/model.hpp"
+#include "core/fourbar/opened_loop.hpp"
+#include "core/fourbar/samples.hpp"
 #include "tests/reference/newton_euler.hpp"
 
 namespace bd::core {

@@ -15,12 +15,12 @@
 #include <string>
 #include <vector>
 
-#include "core/dynamics.hpp"
-#include "core/energy.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/energy.hpp"
 #include "core/input_error.hpp"
-#include "core/opened_loop_dae.hpp"
-#include "core/samples.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/opened_loop_dae.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 
 namespace bd::core {
 namespace {

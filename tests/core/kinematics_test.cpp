@@ -1,6 +1,6 @@
 // Closed-form kinematics (paper eqs. 2-10) against finite differences, loop closure, both
 // branches, Grashof classes, transmission angle and the assembly-failure error.
-#include "core/kinematics.hpp"
+#include "core/fourbar/kinematics.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <numbers>
 #include <random>
 
-#include "core/samples.hpp"
+#include "core/fourbar/samples.hpp"
 
 namespace bd::core {
 namespace {

@@ -1,14 +1,14 @@
 // The constant equivalent mass matrix (paper eq. 45), its assembly (eqs. 48, 53), the nodal
 // forces (eq. 46), and the evidence for the reaction-force erratum of eqs. 52-54.
-#include "core/mass_matrix.hpp"
+#include "core/fourbar/mass_matrix.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
-#include "core/dynamics.hpp"
-#include "core/samples.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/samples.hpp"
 
 namespace bd::core {
 namespace {

@@ -1,5 +1,5 @@
 // make_fourbar validation messages and the model helpers.
-#include "core/model.hpp"
+#include "core/fourbar/model.hpp"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <limits>
 
 #include "core/input_error.hpp"
-#include "core/samples.hpp"
+#include "core/fourbar/samples.hpp"
 
 namespace bd::core {
 namespace {

@@ -4,9 +4,9 @@
 
 #include <cmath>
 
-#include "core/dynamics.hpp"
-#include "core/samples.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 #include "tests/support/allocation_counter.hpp"
 
 namespace bd::core {

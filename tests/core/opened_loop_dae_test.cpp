@@ -9,7 +9,7 @@
 // converges, a drift that grows faster) fails. Energy drifts are measured against the largest
 // kinetic energy of the run, the energy that the motion actually exchanges (the load potential
 // has an arbitrary zero).
-#include "core/opened_loop_dae.hpp"
+#include "core/fourbar/opened_loop_dae.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,12 +20,12 @@
 #include <string>
 #include <vector>
 
-#include "core/dynamics.hpp"
-#include "core/energy.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/energy.hpp"
 #include "core/input_error.hpp"
-#include "core/kinematics.hpp"
-#include "core/samples.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 
 namespace bd::core {
 namespace {

@@ -10,7 +10,7 @@
 // orders of margin while any formula error (a sign, a lever arm, a missing mass) shows at order
 // one. Sizes as in dynamics_test.cpp: forces against max(1 N, |RA0|, |RA3|, |Fsh|), moments
 // against that times the longest link, accelerations against max(1 rad/s², |alpha_k|).
-#include "core/opened_loop.hpp"
+#include "core/fourbar/opened_loop.hpp"
 
 #include <gtest/gtest.h>
 
@@ -22,10 +22,10 @@
 #include <random>
 #include <string>
 
-#include "core/dynamics.hpp"
-#include "core/kinematics.hpp"
-#include "core/principal_vectors.hpp"
-#include "core/samples.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/principal_vectors.hpp"
+#include "core/fourbar/samples.hpp"
 #include "tests/reference/newton_euler.hpp"
 #include "tests/support/scales.hpp"
 #include "tests/support/allocation_counter.hpp"

@@ -7,8 +7,8 @@
 #include <numbers>
 #include <vector>
 
-#include "core/samples.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 #include "tests/reference/newton_euler.hpp"
 
 namespace bd::core {

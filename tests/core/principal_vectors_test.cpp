@@ -1,13 +1,13 @@
 // Principal vectors and points (eqs. 12-17, 30-33), equivalent masses (eq. 29), and the centre
 // of mass S by both constructions, against the definition Σ m_k r̄_k / m_tot.
-#include "core/principal_vectors.hpp"
+#include "core/fourbar/principal_vectors.hpp"
 
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "core/energy.hpp"
-#include "core/samples.hpp"
+#include "core/fourbar/energy.hpp"
+#include "core/fourbar/samples.hpp"
 
 namespace bd::core {
 namespace {

@@ -1,4 +1,4 @@
-#include "core/simulate.hpp"
+#include "core/fourbar/simulate.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,11 +8,11 @@
 #include <numbers>
 #include <string>
 
-#include "core/energy.hpp"
+#include "core/fourbar/energy.hpp"
 #include "core/input_error.hpp"
-#include "core/kinematics.hpp"
+#include "core/fourbar/kinematics.hpp"
 #include "core/metrics.hpp"
-#include "core/samples.hpp"
+#include "core/fourbar/samples.hpp"
 
 namespace bd::core {
 namespace {

@@ -31,12 +31,12 @@
 
 #include "balance/conditions.hpp"
 #include "balance/counterweight.hpp"
-#include "core/dynamics.hpp"
+#include "core/fourbar/dynamics.hpp"
 #include "core/input_error.hpp"
 #include "core/metrics.hpp"
-#include "core/model.hpp"
-#include "core/samples.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/model.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 
 namespace bd::optimize {
 namespace {

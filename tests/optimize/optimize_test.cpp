@@ -53,8 +53,8 @@
 #include "balance/counterweight.hpp"
 #include "core/input_error.hpp"
 #include "core/metrics.hpp"
-#include "core/samples.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 
 namespace bd::optimize {
 namespace {

@@ -19,8 +19,8 @@
 
 #include "core/input_error.hpp"
 #include "core/metrics.hpp"
-#include "core/samples.hpp"
-#include "core/simulate.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 #include "optimize/optimize.hpp"
 
 namespace bd::optimize {

@@ -8,7 +8,7 @@
 #include <limits>
 #include <string>
 
-#include "core/samples.hpp"
+#include "core/fourbar/samples.hpp"
 
 namespace bd::optimize {
 namespace {

@@ -7,9 +7,9 @@
 /// rigid bodies with their shaft bearing force and tangential mesh force as unknowns.
 #include <array>
 
-#include "core/dynamics.hpp"
-#include "core/kinematics.hpp"
-#include "core/model.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/model.hpp"
 #include "core/types.hpp"
 
 namespace bd::reference {

@@ -10,7 +10,7 @@
 /// error (it is ~2048 times smaller than the double instance's error, eps ratio).
 #include <optional>
 
-#include "core/model.hpp"
+#include "core/fourbar/model.hpp"
 
 namespace bd::reference {
 

@@ -3,9 +3,9 @@
 
 #include <filesystem>
 
-#include "studies/load_study.hpp"
-#include "studies/runner.hpp"
-#include "studies/sweep.hpp"
+#include "studies/study/load_study.hpp"
+#include "studies/run/runner.hpp"
+#include "studies/sweep/sweep.hpp"
 
 namespace bd::studies {
 namespace {

@@ -1,6 +1,6 @@
 // Loading and validating study files: every kind of mistake is one line FILE:LINE:COLUMN: message
 // with the place of the offending value, and valid files load with their defaults.
-#include "studies/load_study.hpp"
+#include "studies/study/load_study.hpp"
 
 #include <gtest/gtest.h>
 
@@ -325,7 +325,7 @@ std::string berkof() {
 TEST(LoadStudy, ForceBalanceAloneSynthesisesTheDesignAtLoadTime) {
   const Study s = parse_study(kBase + "balance: {force: full}\n", "study.yaml");
   ASSERT_TRUE(s.balance.has_value());
-  const BalancedDesign& b = *s.balance;
+  const balance::BalancedDesign& b = *s.balance;
   EXPECT_TRUE(b.request.force);
   EXPECT_FALSE(b.request.moment);
   EXPECT_TRUE(b.conditions.force_balanced()) << b.conditions.text();
@@ -377,7 +377,7 @@ TEST(LoadStudy, CounterweightSpecsReachTheSynthesis) {
                                   "density: 7850}\n"
                                   "    rocker: {shape: disc, distance: 0.8, thickness: 0.03}\n",
                               "study.yaml");
-  const BalanceRequest& q = d.balance->request;
+  const balance::BalanceRequest& q = d.balance->request;
   EXPECT_EQ(q.crank_counterweight.shape, balance::CounterweightShape::kDisc);
   EXPECT_EQ(q.crank_counterweight.radius, 0.12);
   EXPECT_EQ(q.crank_counterweight.thickness, 0.02);
@@ -396,7 +396,7 @@ TEST(LoadStudy, CounterweightSpecsReachTheSynthesis) {
 TEST(LoadStudy, MomentBalanceOfABerkofCoupler) {
   const Study s = parse_study(berkof() + "balance: {force: full, moment: full}\n", "study.yaml");
   ASSERT_TRUE(s.balance.has_value());
-  const BalancedDesign& b = *s.balance;
+  const balance::BalancedDesign& b = *s.balance;
   EXPECT_TRUE(b.conditions.moment_balanced()) << b.conditions.text();
   // default shafts (0, -l1) and (l4, -l3)
   EXPECT_EQ(b.model.counter_rotations.crank.at, Vec2(0, -1.0));

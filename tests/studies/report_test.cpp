@@ -1,7 +1,7 @@
 // The study report: every run writes a self-contained report.html with the study's name, the
 // metrics exactly as summary.json has them, a chart per figure when gnuplot is there (and a plain
 // notice when it is not), and no reference to the network.
-#include "studies/report.hpp"
+#include "studies/report/report.hpp"
 
 #include <gtest/gtest.h>
 #include <stdlib.h>
@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "studies/load_study.hpp"
-#include "studies/runner.hpp"
+#include "studies/study/load_study.hpp"
+#include "studies/run/runner.hpp"
 #include "tests/support/text.hpp"
 
 namespace bd::studies {

@@ -1,7 +1,7 @@
 // The study runner: timeseries.csv and summary.json follow the v1 output contract (exact header,
 // one row per sample, %.17g round-trip), files are written atomically, and a simulation that
 // stops early still leaves its samples and a summary saying why.
-#include "studies/runner.hpp"
+#include "studies/run/runner.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "core/metrics.hpp"
-#include "studies/load_study.hpp"
+#include "studies/study/load_study.hpp"
 #include "tests/support/csv.hpp"
 #include "tests/support/models.hpp"
 #include "tests/support/text.hpp"
@@ -402,7 +402,7 @@ TEST_F(RunnerTest, BalanceStudyStoppedEarlyKeepsEveryFile) {
   Study study =
       load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven-force-balanced.yaml");
   study.model.crank = core::link_from_polar(2.5, 2.1, 0.6, 0.3, 1.1);
-  study.balance = balance_design(study.model, study.balance->request);
+  study.balance = balance::balance_design(study.model, study.balance->request);
   std::get<core::DrivenScene>(study.scene).theta1 = M_PI / 2;
   const RunResult r = run_study(study, dir_);
   EXPECT_FALSE(r.ok());
@@ -460,7 +460,7 @@ TEST_F(RunnerTest, OptimizeStudyWritesTheOptimumAndTheComparison) {
   // force balanced (the equalities hold), and no worse in Msh_rms than the textbook
   // force balance (point masses at l1 and l3), which is one of the feasible designs
   EXPECT_LT(o.metrics.Fsh_max, 1e-6 * r.metrics.Fsh_max);
-  const BalancedDesign textbook = balance_design(study.model, BalanceRequest{});
+  const balance::BalancedDesign textbook = balance::balance_design(study.model, balance::BalanceRequest{});
   const core::Trajectory t = core::simulate_driven(
       textbook.model, std::get<core::DrivenScene>(study.scene), core::SimulateOptions{});
   const core::Metrics m = core::metrics(t);

@@ -1,9 +1,9 @@
 // The method chooser: what `auto` picks for each kind of scene and linkage, and why.
-#include "studies/study.hpp"
+#include "studies/study/study.hpp"
 
 #include <gtest/gtest.h>
 
-#include "core/samples.hpp"
+#include "core/fourbar/samples.hpp"
 
 namespace bd::studies {
 namespace {

@@ -2,7 +2,7 @@
 // and options bit for bit ("%.17g"), except e, f, which come back within a few ulps of the
 // polar form s, sigma the file gives, for every example and a study with loads,
 // counter-rotations and a free scene.
-#include "studies/study_yaml.hpp"
+#include "studies/study/study_yaml.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,8 +11,8 @@
 #include <string>
 #include <variant>
 
-#include "core/samples.hpp"
-#include "studies/load_study.hpp"
+#include "core/fourbar/samples.hpp"
+#include "studies/study/load_study.hpp"
 #include "tests/support/models.hpp"
 
 namespace bd::studies {

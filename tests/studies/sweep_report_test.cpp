@@ -24,11 +24,11 @@
 
 #include "core/input_error.hpp"
 #include "core/metrics.hpp"
-#include "studies/balance_study.hpp"
-#include "studies/load_study.hpp"
-#include "studies/report.hpp"
-#include "studies/report_support.hpp"
-#include "studies/sweep.hpp"
+#include "balance/synthesis.hpp"
+#include "studies/study/load_study.hpp"
+#include "studies/report/report.hpp"
+#include "studies/report/report_support.hpp"
+#include "studies/sweep/sweep.hpp"
 #include "tests/support/text.hpp"
 
 namespace bd::studies {
@@ -137,7 +137,7 @@ class SweepFolder {
     std::string status = t.ok() ? "ok" : "stopped-early";
     std::string message = t.ok() ? "" : t.message;
     if (study_.balance) {
-      const BalancedDesign b = balance_design(model, study_.balance->request);
+      const balance::BalancedDesign b = balance::balance_design(model, study_.balance->request);
       const core::Trajectory tb = simulate(b.model);
       for (const double v : metric_values(core::metrics(tb))) r += "," + g17(v);
       r += "," + g17(b.added_mass) + "," + g17(b.added_inertia);

@@ -13,10 +13,10 @@
 #include <thread>
 #include <vector>
 
-#include "studies/load_study.hpp"
-#include "studies/report_support.hpp"
-#include "studies/runner.hpp"
-#include "studies/sweep.hpp"
+#include "studies/study/load_study.hpp"
+#include "studies/report/report_support.hpp"
+#include "studies/run/runner.hpp"
+#include "studies/sweep/sweep.hpp"
 #include "tests/support/studies.hpp"
 #include "tests/support/text.hpp"
 

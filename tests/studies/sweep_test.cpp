@@ -2,7 +2,7 @@
 // FILE:LINE:COLUMN: message at the offending value, bad paths with what the file has there), the
 // points of grid, random and Latin-hypercube designs, and point_study(), which sets each path's
 // value in the study file and loads it as any study.
-#include "studies/sweep.hpp"
+#include "studies/sweep/sweep.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,8 +14,8 @@
 #include <variant>
 #include <vector>
 
-#include "studies/load_study.hpp"
-#include "studies/study_yaml.hpp"
+#include "studies/study/load_study.hpp"
+#include "studies/study/study_yaml.hpp"
 #include "tests/support/study_errors.hpp"
 
 namespace bd::studies {

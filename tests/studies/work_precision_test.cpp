@@ -3,7 +3,7 @@
 // tolerance, with errors that shrink as the tolerance tightens and references by another
 // formulation; the driven scene's RMS converges spectrally with the samples per revolution; the
 // report gets its section "Speed against accuracy".
-#include "studies/work_precision.hpp"
+#include "studies/bench/work_precision.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -20,9 +20,9 @@
 #include <vector>
 
 #include "core/input_error.hpp"
-#include "studies/load_study.hpp"
-#include "studies/report.hpp"
-#include "studies/report_support.hpp"
+#include "studies/study/load_study.hpp"
+#include "studies/report/report.hpp"
+#include "studies/report/report_support.hpp"
 #include "tests/support/text.hpp"
 
 namespace bd::studies {

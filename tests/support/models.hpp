@@ -5,7 +5,7 @@
 #include <limits>
 #include <string>
 
-#include "core/model.hpp"
+#include "core/fourbar/model.hpp"
 
 namespace bd::testing {
 

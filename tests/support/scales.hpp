@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/dynamics.hpp"
-#include "core/model.hpp"
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/model.hpp"
 
 namespace bd::testing {
 

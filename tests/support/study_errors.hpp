@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "studies/load_study.hpp"
+#include "studies/study/load_study.hpp"
 
 namespace bd::testing {
 

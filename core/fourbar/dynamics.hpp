@@ -1,0 +1,82 @@
+#pragma once
+/// Forward and inverse dynamics of the four-bar at one instant: all dependent angles, rates and
+/// accelerations, the support reactions, the shaking force and moment, and the drive torque.
+#include <string>
+
+#include "core/fourbar/dynamics_constants.hpp"
+#include "core/expected.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/model.hpp"
+#include "core/types.hpp"
+
+namespace bd::core {
+
+/// Everything the dynamics gives at one instant (DESIGN.md conventions).
+struct DynamicsSample {
+  FourBarState state;  // angles [rad], rates [rad/s], accelerations [rad/s^2]
+  Vec2 RA0{0, 0};      // force of the mechanism ON the ground at A0 [N]
+  Vec2 RA3{0, 0};      // force of the mechanism ON the ground at A3 [N]
+  Vec2 RC1{0, 0};      // force ON the ground at the crank's counter-rotation shaft [N]
+  Vec2 RC3{0, 0};      // force ON the ground at the rocker's counter-rotation shaft [N]
+  Vec2 Fsh{0, 0};      // shaking force RA0 + RA3 + RC1 + RC3 [N]
+  /// shaking moment on the frame about A0: l4·RA3y - tau + at1 × RC1 + at3 × RC3 [N m]
+  double Msh{};
+  double tau{};  // drive torque on the crank from the frame [N m] (0 in free motion)
+};
+
+/// Why the dynamics could not be evaluated at an instant.
+struct DynamicsError {
+  enum class Kind {
+    kAssembly,   // the loop cannot close at theta1
+    kSingular,   // a singular (dead-centre) position: the reduced inertia or a solve is singular
+    kNonFinite,  // a non-finite value appeared
+  };
+  Kind kind{Kind::kAssembly};
+  double theta1{};     // crank angle where it happened [rad]
+  std::string detail;  // the condition, in words, with numbers
+  /// One line, e.g. "singular position at theta1 = 1.234 rad: sin(theta3 - theta2) = 1e-17".
+  std::string what() const;
+};
+
+/// The formulations of the equations of motion (DESIGN.md "Formulations").
+enum class Formulation {
+  kMassMatrix,     // constant equivalent mass matrix / truss element (paper §4.2)
+  kOpenedLoop,     // opened kinematic loop with principal vectors, 5x5 solve (paper §3)
+  kComplexMasses,  // closed loop with complex equivalent masses (paper §4.1)
+};
+/// "mass-matrix", "opened-loop", "complex-masses" (the study file's method names).
+const char* to_string(Formulation f);
+/// Every formulation, in the order the docs list them.
+inline constexpr Formulation kFormulations[] = {Formulation::kMassMatrix, Formulation::kOpenedLoop,
+                                                Formulation::kComplexMasses};
+
+/// Forward dynamics (free motion, tau = 0): the crank acceleration and everything else for crank
+/// angle theta1 [rad] and rate omega1 [rad/s] under the model's loads, with the model's
+/// counter-rotations (core/counter_rotation.hpp). The formulations' own entry points
+/// (forward_dynamics_mass_matrix, ...) model the bare linkage and ignore counter-rotations.
+Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model, double theta1,
+                                                         double omega1,
+                                                         Formulation f = Formulation::kMassMatrix);
+
+/// Inverse dynamics: the drive torque tau that gives crank acceleration alpha1 [rad/s^2] at
+/// theta1 [rad], omega1 [rad/s], with everything else.
+Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model, double theta1,
+                                                         double omega1, double alpha1,
+                                                         Formulation f = Formulation::kMassMatrix);
+
+/// The same two with the model's constants computed once by dynamics_constants(model): what a
+/// loop over many instants of one model calls (a simulation's right-hand side, a sweep). The
+/// results are those of the calls above bit for bit, at 10-30 % less cost (docs/performance.md).
+/// `constants` must come from this `model`. Models with counter-rotations take the one-instant
+/// route.
+Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model,
+                                                         const DynamicsConstants& constants,
+                                                         double theta1, double omega1,
+                                                         Formulation f = Formulation::kMassMatrix);
+Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model,
+                                                         const DynamicsConstants& constants,
+                                                         double theta1, double omega1,
+                                                         double alpha1,
+                                                         Formulation f = Formulation::kMassMatrix);
+
+}  // namespace bd::core

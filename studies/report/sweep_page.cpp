@@ -1,0 +1,888 @@
+// The sweep's report.html: built from sweep.csv and sweep.json alone (plus the study for the
+// linkage's inputs), so an interrupted or still running sweep shows what it has, and
+// `balance-design report DIR` rebuilds the same page from the same files.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <initializer_list>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "studies/report/report.hpp"
+#include "studies/report/report_support.hpp"
+#include "studies/run/runner.hpp"
+#include "studies/sweep/sweep.hpp"
+
+namespace bd::studies {
+
+namespace fs = std::filesystem;
+
+using namespace report_support;  // NOLINT(google-build-using-namespace): the page builders
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// the data files
+
+// sweep.csv as written: records split at line ends outside quotes (a message may hold one);
+// a last record without its line end was cut short by a kill and is left out
+struct SweepCsv {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  bool cut_short = false;
+};
+
+SweepCsv read_sweep_csv(const fs::path& p) {
+  const std::string text = read_file(p);
+  std::vector<std::string> records;
+  std::string record;
+  bool quoted = false;
+  for (const char c : text) {
+    if (c == '"') quoted = !quoted;  // "" inside a quoted field toggles twice
+    if (c == '\n' && !quoted) {
+      records.push_back(std::move(record));
+      record.clear();
+    } else {
+      record += c;
+    }
+  }
+  SweepCsv csv;
+  csv.cut_short = !record.empty();
+  if (records.empty()) {
+    throw std::runtime_error(p.string() + " has no complete header line");
+  }
+  csv.header = csv_fields(records.front());
+  for (std::size_t i = 1; i < records.size(); ++i) {
+    if (records[i].empty() || records[i] == "\r") continue;
+    std::vector<std::string> row = csv_fields(records[i]);
+    if (row.size() != csv.header.size()) {
+      throw std::runtime_error(p.string() + ": record " + std::to_string(i + 1) + " has " +
+                               std::to_string(row.size()) + " fields, the header " +
+                               std::to_string(csv.header.size()));
+    }
+    csv.rows.push_back(std::move(row));
+  }
+  return csv;
+}
+
+// a field as a finite number, else nothing
+std::optional<double> number(const std::string& field) {
+  if (field.empty()) return std::nullopt;
+  char* end = nullptr;
+  const double v = std::strtod(field.c_str(), &end);
+  if (end == field.c_str() || *end != '\0' || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+struct Parameter {
+  std::string path;
+  bool log_scale = false;
+  std::vector<double> values;  // a grid's values, as sweep.json lists them
+};
+
+// the main metrics, charted and ranked: their RMS (and, against one parameter, their peak)
+struct MainMetric {
+  const char* base;  // column stem: <base>_rms, <base>_max
+  const char* what;  // axis label
+};
+constexpr MainMetric kMainMetrics[] = {{"Fsh", "shaking force |Fsh| [N]"},
+                                       {"Msh", "shaking moment |Msh| about A0 [N m]"},
+                                       {"tau", "drive torque |τ| [N m]"},
+                                       {"RA0", "bearing force |RA0| [N]"},
+                                       {"RA3", "bearing force |RA3| [N]"}};
+
+// one design's values of a metric: a line or panel of a chart, a row of the best points
+struct Series {
+  std::string label;    // "original", "balanced", "optimised"
+  std::string column;   // e.g. "balanced_Fsh_rms"
+  std::string peak;     // the peak's column, drawn dotted against one parameter ("" for none)
+  bool second = false;  // a column of the balanced or optimised design
+};
+// what one chart shows
+struct Metric {
+  std::string id;    // "Fsh", ..., "added_mass": names the chart
+  std::string name;  // "Fsh_rms", "added_mass"
+  std::string what;  // axis label, with the unit
+  std::vector<Series> series;
+};
+
+struct Sweep {
+  Json info;  // sweep.json
+  SweepCsv csv;
+  std::vector<Parameter> params;
+  std::string design;           // grid, random, lhs
+  std::string second;           // column prefix of the second design: "balanced_", "optimized_", ""
+  std::string second_label;     // "balanced", "optimised"
+  std::vector<Metric> metrics;  // the main metrics sweep.csv has, then the added mass
+  std::size_t status_col{}, message_col{};
+
+  std::optional<std::size_t> col(const std::string& name) const {
+    for (std::size_t i = 0; i < csv.header.size(); ++i)
+      if (csv.header[i] == name) return i;
+    return std::nullopt;
+  }
+  const std::string& status(std::size_t r) const { return csv.rows[r][status_col]; }
+  // a row's values count for the original design when all its simulations ran to the end; a
+  // point without an optimum keeps its original design's values (only the optimum's are empty)
+  bool usable(std::size_t r, bool second_design) const {
+    const std::string& s = status(r);
+    return s == "ok" || (!second_design && s == "no-optimum");
+  }
+  // column `name` of a series at row r, when the row counts for the series' design
+  std::optional<double> value(std::size_t r, const Series& se, const std::string& name) const {
+    const auto c = col(name);
+    if (!c || !usable(r, se.second)) return std::nullopt;
+    return number(csv.rows[r][*c]);
+  }
+  std::optional<double> value(std::size_t r, const Series& se) const {
+    return value(r, se, se.column);
+  }
+  // parameter j's value at row r (written for every point, failed ones too)
+  std::optional<double> x(std::size_t r, std::size_t j) const { return number(csv.rows[r][1 + j]); }
+  const std::string& x_text(std::size_t r, std::size_t j) const { return csv.rows[r][1 + j]; }
+  // every series of the metrics, the original design's first
+  std::vector<Series> all_series() const {
+    std::vector<Series> out;
+    for (const bool of_second : {false, true})
+      for (const Metric& m : metrics)
+        for (const Series& se : m.series)
+          if (se.second == of_second) out.push_back(se);
+    return out;
+  }
+};
+
+Sweep load_sweep(const Study& study, const fs::path& dir) {
+  const fs::path json_file = dir / "sweep.json";
+  const fs::path csv_file = dir / "sweep.csv";
+  if (!fs::exists(json_file)) {
+    throw std::runtime_error(json_file.string() + " not found: not the output folder of a sweep");
+  }
+  if (!fs::exists(csv_file)) {
+    throw std::runtime_error(csv_file.string() +
+                             " not found: the sweep has not written its rows (run it again with "
+                             "--resume)");
+  }
+  Sweep s;
+  s.info = parse_json(read_file(json_file), json_file.string());
+  s.design = s.info.str("design");
+  if (const Json* ps = s.info.get("parameters")) {
+    for (const Json& p : ps->items) {
+      Parameter q;
+      q.path = p.str("path");
+      q.log_scale = p.str("scale") == "log";
+      if (const Json* values = p.get("values")) {
+        for (const Json& v : values->items) {
+          if (const auto d = number(v.text)) q.values.push_back(*d);
+        }
+      }
+      s.params.push_back(std::move(q));
+    }
+  }
+  if (s.params.empty()) throw std::runtime_error(json_file.string() + " lists no parameters");
+
+  s.csv = read_sweep_csv(csv_file);
+  const auto& h = s.csv.header;
+  bool header_ok = h.size() >= s.params.size() + 3 && h.front() == "point" &&
+                   h[h.size() - 2] == "status" && h.back() == "message";
+  for (std::size_t j = 0; header_ok && j < s.params.size(); ++j)
+    header_ok = h[1 + j] == s.params[j].path;
+  if (!header_ok) {
+    std::string expected = "point";
+    for (const Parameter& p : s.params) expected += "," + p.path;
+    throw std::runtime_error(csv_file.string() + ": its header does not match " +
+                             json_file.string() + " (expected " + expected +
+                             ",<metrics>,status,message)");
+  }
+  s.status_col = h.size() - 2;
+  s.message_col = h.size() - 1;
+  if (s.col("balanced_Fsh_rms")) {
+    s.second = "balanced_";
+    s.second_label = "balanced";
+  } else if (s.col("optimized_Fsh_rms")) {
+    s.second = "optimized_";
+    s.second_label = "optimised";
+  }
+  // the drive torque is zero in free motion: no chart of it there
+  const bool driven = std::holds_alternative<core::DrivenScene>(study.scene);
+  for (const MainMetric& m : kMainMetrics) {
+    const std::string base = m.base;
+    if (base == "tau" && !driven) continue;
+    if (!s.col(base + "_rms")) continue;
+    Metric metric{base, base + "_rms", m.what, {{"original", base + "_rms", base + "_max", false}}};
+    if (!s.second.empty() && s.col(s.second + base + "_rms")) {
+      metric.series.push_back(
+          {s.second_label, s.second + base + "_rms", s.second + base + "_max", true});
+    }
+    s.metrics.push_back(std::move(metric));
+  }
+  // what the second design costs: the mass it adds (negative when it takes mass away)
+  if (!s.second.empty() && s.col("added_mass")) {
+    s.metrics.push_back({"added_mass",
+                         "added_mass",
+                         "added mass [kg]",
+                         {{s.second_label, "added_mass", "", true}}});
+  }
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// tables
+
+std::string td(const std::string& html) { return "<td>" + html + "</td>"; }
+
+std::string status_section(const Sweep& s, const fs::path& dir) {
+  const std::string status = s.info.str("status");
+  const std::size_t rows = s.csv.rows.size();
+  std::size_t failed = 0;
+  for (std::size_t r = 0; r < rows; ++r) failed += s.status(r) != "ok";
+  const std::string points = s.info.str("points");
+  const std::string source = s.info.str("source");
+  const std::string resume = "<code>balance-design run " +
+                             esc(source.empty() ? std::string("STUDY.yaml") : source) + " --out " +
+                             esc(dir.string()) + " --resume</code>";
+
+  std::string h = "<h2>Status</h2>\n";
+  if (status == "complete") {
+    h += "<p class=\"good\">Complete: " + std::to_string(rows) + " of " + esc(points) +
+         " points done.</p>\n";
+  } else if (status == "interrupted") {
+    h += "<p class=\"notice bad\">Interrupted after " + std::to_string(rows) + " of " +
+         esc(points) + " points. To run the missing points, keeping these rows: " + resume +
+         "</p>\n";
+  } else {
+    h += "<p class=\"notice bad\">Status &ldquo;" + esc(status) +
+         "&rdquo;: the sweep was "
+         "running when this page was written, or it was stopped without the chance to say so; " +
+         std::to_string(rows) + " of " + esc(points) +
+         " points are in sweep.csv. If it no longer runs, continue it with " + resume + "</p>\n";
+  }
+  if (s.csv.cut_short) {
+    h += "<p class=\"notice\">The last line of sweep.csv was cut short (the sweep was stopped "
+         "while writing it) and is left out; a resumed run writes that point again.</p>\n";
+  }
+  h += "<table><tr><th>points in the design</th>" + num_cell(points) + "</tr>";
+  h += "<tr><th>rows in sweep.csv</th>" + num_cell(std::to_string(rows)) + "</tr>";
+  h += "<tr><th>of which failed (status not ok)</th><td class=\"n" +
+       std::string(failed > 0 ? " bad" : "") + "\">" + std::to_string(failed) + "</td></tr>";
+  const std::pair<const char*, const char*> facts[] = {{"status", "status (sweep.json)"},
+                                                       {"done", "done (sweep.json)"},
+                                                       {"resumed", "rows kept from an earlier run"},
+                                                       {"failed", "failed (sweep.json)"},
+                                                       {"elapsed_s", "elapsed [s]"}};
+  for (const auto& [key, what] : facts) {
+    if (const Json* v = s.info.get(key))
+      h += std::string("<tr><th>") + what + "</th>" + json_cell(*v) + "</tr>";
+  }
+  return h + "</table>\n";
+}
+
+std::string values_text(const Json& values) {
+  const std::size_t n = values.items.size();
+  std::string t;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (n > 12 && i == 6) {
+      t += ", &hellip;";
+      i = n - 3;
+    }
+    const auto v = number(values.items[i].text);
+    t += (t.empty() ? "" : ", ") +
+         std::string("<span title=\"" + esc(values.items[i].text) + "\">") +
+         esc(v ? fmt(*v) : values.items[i].text) + "</span>";
+  }
+  if (n > 12) t += " (" + std::to_string(n) + " values)";
+  return t;
+}
+
+std::string design_section(const Sweep& s) {
+  const Json& j = s.info;
+  std::string h = "<h2>Design</h2>\n<table>";
+  h += "<tr><th>design</th><td>" + esc(s.design) + "</td></tr>";
+  if (s.design != "grid" && j.get("seed"))
+    h += "<tr><th>seed</th>" + json_cell(*j.get("seed")) + "</tr>";
+  if (const Json* v = j.get("points")) h += "<tr><th>points</th>" + json_cell(*v) + "</tr>";
+  if (const Json* v = j.get("threads")) h += "<tr><th>threads</th>" + json_cell(*v) + "</tr>";
+  if (const Json* v = j.get("fingerprint")) {
+    h += "<tr><th>study file fingerprint</th><td><code>" + esc(v->text) + "</code></td></tr>";
+  }
+  h += "</table>\n<table><tr><th>parameter (path in the study file)</th><th>scale</th>"
+       "<th>from</th><th>to</th><th>values</th></tr>";
+  if (const Json* ps = j.get("parameters")) {
+    for (const Json& p : ps->items) {
+      const Json* from = p.get("from");
+      const Json* to = p.get("to");
+      const Json* values = p.get("values");
+      h += "<tr><td><code>" + esc(p.str("path")) + "</code></td><td>" + esc(p.str("scale")) +
+           "</td>" + (from ? json_cell(*from) : "<td></td>") + (to ? json_cell(*to) : "<td></td>") +
+           td(values ? values_text(*values)
+                     : std::string(s.design == "lhs" ? "Latin hypercube draws"
+                                                     : "uniform random draws") +
+                           (p.str("scale") == "log" ? " (uniform in log)" : "")) +
+           "</tr>";
+    }
+  }
+  h += "</table>\n";
+  if (s.design == "grid" && s.params.size() > 1) {
+    h += "<p>Grid points run through the Cartesian product of the values, the first parameter "
+         "varying slowest.</p>\n";
+  }
+  return h;
+}
+
+// the parameters' header cells, and one row's parameter cells
+std::string param_headers(const Sweep& s) {
+  std::string h;
+  for (const Parameter& p : s.params) h += "<th><code>" + esc(p.path) + "</code></th>";
+  return h;
+}
+std::string param_cells(const Sweep& s, std::size_t r) {
+  std::string h;
+  for (std::size_t j = 0; j < s.params.size(); ++j) h += num_cell(s.x_text(r, j));
+  return h;
+}
+
+std::string best_section(const Sweep& s) {
+  bool added_mass = false;
+  for (const Metric& m : s.metrics) added_mass = added_mass || m.id == "added_mass";
+  std::string h =
+      "<h2>Best points</h2>\n<p>The point with the least value of each main metric "
+      "(RMS over the samples)" +
+      std::string(added_mass ? " and of the added mass" : "") +
+      ", among the points whose status is ok";
+  if (s.second == "optimized_") h += " (for the original design also those without an optimum)";
+  h += ".</p>\n<table><tr><th>metric</th><th>least value</th><th>at point</th>" + param_headers(s) +
+       "</tr>";
+  bool any = false;
+  for (const Series& se : s.all_series()) {
+    std::optional<std::size_t> best;
+    double least = std::numeric_limits<double>::infinity();
+    for (std::size_t r = 0; r < s.csv.rows.size(); ++r) {
+      const auto v = s.value(r, se);
+      if (v && *v < least) {
+        least = *v;
+        best = r;
+      }
+    }
+    if (!best) continue;
+    any = true;
+    h += "<tr><th>" + esc(se.column) + "</th>" + num_cell(s.csv.rows[*best][*s.col(se.column)]) +
+         num_cell(s.csv.rows[*best][0]) + param_cells(s, *best) + "</tr>";
+  }
+  if (!any) {
+    h += "<tr><td colspan=\"" + std::to_string(3 + s.params.size()) +
+         "\">no point has finished with status ok yet</td></tr>";
+  }
+  return h + "</table>\n";
+}
+
+constexpr std::size_t kFailedRows = 50;  // failed points listed; the rest are counted
+constexpr std::size_t kPointRows = 100;  // sweeps up to this size list every point
+
+std::string failed_section(const Sweep& s) {
+  std::vector<std::size_t> failed;
+  for (std::size_t r = 0; r < s.csv.rows.size(); ++r)
+    if (s.status(r) != "ok") failed.push_back(r);
+  if (failed.empty())
+    return "<h2>Failed points</h2>\n<p>None: every point ran with status ok.</p>\n";
+  std::string h = "<h2>Failed points</h2>\n<p>" + std::to_string(failed.size()) +
+                  " point(s) did not finish with status ok (stopped-early: a simulation stopped, "
+                  "no-optimum: the optimiser found no design, bad-input: the study at that point "
+                  "is invalid, error: an unexpected failure). They are left out of the charts and "
+                  "the best points (a point "
+                  "without an optimum keeps its original design's values there).</p>\n"
+                  "<table><tr><th>point</th>" +
+                  param_headers(s) + "<th>status</th><th>message</th></tr>";
+  for (std::size_t i = 0; i < failed.size() && i < kFailedRows; ++i) {
+    const std::size_t r = failed[i];
+    h += "<tr>" + num_cell(s.csv.rows[r][0]) + param_cells(s, r) + "<td class=\"bad\">" +
+         esc(s.status(r)) + "</td><td>" + esc(s.csv.rows[r][s.message_col]) + "</td></tr>";
+  }
+  h += "</table>\n";
+  if (failed.size() > kFailedRows) {
+    h += "<p>&hellip; and " + std::to_string(failed.size() - kFailedRows) +
+         " more (see <a href=\"sweep.csv\">sweep.csv</a>).</p>\n";
+  }
+  return h;
+}
+
+std::string points_section(const Sweep& s) {
+  std::string h = "<h2>Points</h2>\n";
+  if (s.csv.rows.size() > kPointRows) {
+    return h + "<p>" + std::to_string(s.csv.rows.size()) +
+           " points: every one, with every metric, is in <a "
+           "href=\"sweep.csv\">sweep.csv</a>.</p>\n";
+  }
+  h += "<p>The main metrics (RMS) of every point; all its metrics are in "
+       "<a href=\"sweep.csv\">sweep.csv</a>.</p>\n<table><tr><th>point</th>" +
+       param_headers(s);
+  std::vector<std::size_t> cols;
+  for (const Series& se : s.all_series()) {
+    cols.push_back(*s.col(se.column));
+    h += "<th>" + esc(se.column) + "</th>";
+  }
+  h += "<th>status</th></tr>";
+  for (std::size_t r = 0; r < s.csv.rows.size(); ++r) {
+    h += "<tr>" + num_cell(s.csv.rows[r][0]) + param_cells(s, r);
+    for (const std::size_t c : cols) h += num_cell(s.csv.rows[r][c]);
+    h += "<td" + std::string(s.status(r) == "ok" ? "" : " class=\"bad\"") + ">" + esc(s.status(r)) +
+         "</td></tr>";
+  }
+  return h + "</table>\n";
+}
+
+std::string study_section(const Study& study, const Sweep& s) {
+  std::string h = "<h2>Study</h2>\n<p>The study file's values; at each point the swept ";
+  std::string swept;
+  for (const Parameter& p : s.params)
+    swept += (swept.empty() ? "" : ", ") + ("<code>" + esc(p.path) + "</code>");
+  h += swept + " take the point's values instead.</p>\n<table>";
+  h += "<tr><th>scene</th><td>" + std::string(scene_type(study.scene)) + "</td></tr>";
+  if (const auto* free = std::get_if<core::FreeScene>(&study.scene)) {
+    h += "<tr><th>theta1 [rad]</th><td class=\"n\">" + fmt(free->theta1) + "</td></tr>";
+    h += "<tr><th>omega1 [rad/s] (initial)</th><td class=\"n\">" + fmt(free->omega1) + "</td></tr>";
+    h += "<tr><th>duration [s]</th><td class=\"n\">" + fmt(free->duration) + "</td></tr>";
+    h += "<tr><th>samples</th><td class=\"n\">" + std::to_string(free->samples) + "</td></tr>";
+    h += "<tr><th>tolerance</th><td class=\"n\">" + fmt(study.tolerance) + "</td></tr>";
+  } else if (const auto* driven = std::get_if<core::DrivenScene>(&study.scene)) {
+    h += "<tr><th>theta1 [rad] at t = 0</th><td class=\"n\">" + fmt(driven->theta1) + "</td></tr>";
+    h += "<tr><th>omega1 [rad/s] (constant)</th><td class=\"n\">" + fmt(driven->omega1) +
+         "</td></tr>";
+    h += "<tr><th>revolutions</th><td class=\"n\">" + std::to_string(driven->revolutions) +
+         "</td></tr>";
+    h += "<tr><th>samples per revolution</th><td class=\"n\">" + std::to_string(driven->samples) +
+         "</td></tr>";
+  }
+  h += "<tr><th>method</th><td>" + esc(study.method_name()) + "</td></tr>";
+  if (study.balance) {
+    const balance::BalanceRequest& b = study.balance->request;
+    h += std::string("<tr><th>balance</th><td>force ") + (b.force ? "full" : "none") + ", moment " +
+         (b.moment ? "full" : "none") + "</td></tr>";
+  }
+  if (study.optimize) {
+    h += "<tr><th>optimize</th><td>minimise " + esc(objective_text(*study.optimize)) +
+         "; constraints: " + esc(constraints_text(*study.optimize)) + "</td></tr>";
+  }
+  h += "</table>\n<h3>Linkage</h3>\n" + linkage_tables_html(study);
+  return h;
+}
+
+// ---------------------------------------------------------------------------------------------
+// charts
+
+std::string num(double v) { return fmt(v, "%.17g"); }
+
+// a perceptually uniform palette (viridis), readable in grey too
+const char* const kPalette =
+    "set palette defined (0 '#440154', 0.25 '#3b528b', 0.5 '#21918c', 0.75 '#5ec962', "
+    "1 '#fde725')\n";
+
+std::string axis_label(const Parameter& p) { return p.path + (p.log_scale ? " (log scale)" : ""); }
+
+// The cell of grid value v among a parameter's values: from halfway to the lower neighbour to
+// halfway to the upper one (halfway in log for a log-scale parameter), the end cells as wide
+// outside their value as inside, so a non-uniform list of values is drawn at its true places.
+std::pair<double, double> cell_edges(const Parameter& p, double v) {
+  const auto f = [&](double x) { return p.log_scale ? std::log(x) : x; };
+  const auto g = [&](double y) { return p.log_scale ? std::exp(y) : y; };
+  std::vector<double> u;
+  for (const double x : p.values) u.push_back(f(x));
+  std::sort(u.begin(), u.end());
+  u.erase(std::unique(u.begin(), u.end()), u.end());
+  const double fv = f(v);
+  if (u.size() < 2) {
+    const double half = p.log_scale || fv == 0 ? 0.5 : 0.05 * std::abs(fv);
+    return {g(fv - half), g(fv + half)};
+  }
+  std::size_t i = 0;  // the grid value nearest v
+  for (std::size_t k = 1; k < u.size(); ++k)
+    if (std::abs(u[k] - fv) < std::abs(u[i] - fv)) i = k;
+  const double lo = i > 0 ? 0.5 * (u[i - 1] + u[i]) : u[0] - 0.5 * (u[1] - u[0]);
+  const double hi = i + 1 < u.size() ? 0.5 * (u[i] + u[i + 1]) : u[i] + 0.5 * (u[i] - u[i - 1]);
+  return {g(lo), g(hi)};
+}
+
+struct Charts {
+  std::string datablocks;
+  std::vector<Chart> charts;
+  int blocks = 0;
+  // a new data block of `lines`; returns its name
+  std::string block(const std::vector<std::string>& lines) {
+    const std::string name = "$d" + std::to_string(blocks++);
+    datablocks += name + " << EOD\n";
+    for (const std::string& l : lines) datablocks += l + "\n";
+    datablocks += "EOD\n";
+    return name;
+  }
+};
+
+// The commands of one axis ("x" or "y") over [lo, hi]: its range and, on a log scale, tics at
+// 1, 2, 5 (or every digit, or only 1 over many decades) times the powers of ten inside it,
+// since gnuplot's own log tics sit at whole decades only and a range within a decade gets none.
+std::string axis(const char* a, double lo, double hi, bool log_scale) {
+  std::string c = std::string("set ") + a + "range [" + num(lo) + ":" + num(hi) + "]\n";
+  if (!log_scale || !(lo > 0) || !(lo < hi)) return c;
+  c += std::string("set logscale ") + a + "\n";
+  const auto tics = [&](std::initializer_list<double> digits) {
+    std::vector<double> t;
+    for (double decade = std::pow(10.0, std::floor(std::log10(lo))); decade <= hi; decade *= 10)
+      for (const double d : digits)
+        if (d * decade >= lo && d * decade <= hi) t.push_back(d * decade);
+    return t;
+  };
+  std::vector<double> t = tics({1, 2, 5});
+  if (t.size() < 3) t = tics({1, 2, 3, 4, 5, 6, 7, 8, 9});
+  if (t.size() > 10) t = tics({1});  // many decades: their powers of ten alone
+  if (t.size() < 2) return c;
+  c += std::string("set ") + a + "tics (";
+  for (std::size_t i = 0; i < t.size(); ++i) c += (i ? ", " : "") + fmt(t[i], "%.6g");
+  return c + ")\n";
+}
+
+// the axis of parameter j just around its values in sweep.csv (gnuplot's autoscale would round
+// out to the next tic, a whole decade on a log axis)
+std::string axis(const Sweep& s, std::size_t j, const char* a) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::size_t r = 0; r < s.csv.rows.size(); ++r) {
+    if (const auto v = s.x(r, j)) {
+      lo = std::min(lo, *v);
+      hi = std::max(hi, *v);
+    }
+  }
+  if (!(lo <= hi)) return {};
+  const bool log_scale = s.params[j].log_scale && lo > 0;
+  if (log_scale) {
+    const double pad = lo < hi ? std::pow(hi / lo, 0.03) : 1.1;
+    lo /= pad;
+    hi *= pad;
+  } else {
+    const double pad = lo < hi ? 0.03 * (hi - lo) : (lo != 0 ? 0.1 * std::abs(lo) : 1.0);
+    lo -= pad;
+    hi += pad;
+  }
+  return axis(a, lo, hi, log_scale);
+}
+
+// " the original design left, the balanced one right, each with its own colour scale" when a
+// metric has two designs
+std::string panels_text(const Metric& m) {
+  if (m.series.size() < 2) return {};
+  return "; the " + m.series[0].label + " design left, the " + m.series[1].label +
+         " one right, each with its own colour scale";
+}
+
+// one parameter: each metric (RMS solid, peak dotted) against it, the designs overlaid
+void one_parameter(const Sweep& s, Charts& out) {
+  for (const Metric& m : s.metrics) {
+    std::string plot;
+    for (const Series& se : m.series) {
+      const std::string lt = se.second ? "2" : "1";  // one colour per design on every chart
+      std::vector<std::pair<double, std::string>> pts;
+      for (std::size_t r = 0; r < s.csv.rows.size(); ++r) {
+        const auto x = s.x(r, 0);
+        const auto v = s.value(r, se);
+        const auto peak = se.peak.empty() ? v : s.value(r, se, se.peak);
+        if (x && v && peak) pts.emplace_back(*x, num(*x) + "," + num(*v) + "," + num(*peak));
+      }
+      if (pts.empty()) continue;
+      std::stable_sort(pts.begin(), pts.end(),
+                       [](const auto& a, const auto& b) { return a.first < b.first; });
+      std::vector<std::string> lines;
+      for (auto& p : pts) lines.push_back(std::move(p.second));
+      const std::string d = out.block(lines);
+      const std::string style = std::string(se.second ? " dt 2" : "") + " lt " + lt;
+      plot += std::string(plot.empty() ? "" : ", ") + d +
+              " using 1:2 with linespoints lw 2 pt 7 ps 0.6" + style + " title " +
+              gp_string(se.peak.empty() ? se.label : se.label + " RMS");
+      if (!se.peak.empty()) {
+        plot += ", " + d + " using 1:3 with lines lw 1.2 dt 3 lt " + lt + " title " +
+                gp_string(se.label + " max");
+      }
+    }
+    if (plot.empty()) continue;
+    const bool peaks = !m.series.front().peak.empty();
+    const std::string caption =
+        peaks ? m.name + " (solid, points) and " + m.id + "_max (dotted) of each point"
+              : m.name + " of each point";
+    out.charts.push_back(
+        {"sweep-" + m.id, m.name + " against " + s.params[0].path,
+         caption + " against " + s.params[0].path +
+             (m.series.size() > 1
+                  ? ", the " + m.series[1].label + " design dashed over the " + m.series[0].label
+                  : std::string()) +
+             "; points whose status is not ok are left out.",
+         "set title " + gp_string(m.id + ": " + m.what) + "\nset xlabel " +
+             gp_string(axis_label(s.params[0])) + "\nset ylabel " + gp_string(m.what) + "\n" +
+             axis(s, 0, "x") + "plot " + plot});
+  }
+}
+
+// the panels of one chart side by side in one SVG
+std::string side_by_side(const std::string& title, const std::vector<std::string>& panels) {
+  std::string c = "set multiplot layout 1," + std::to_string(panels.size()) + " title " +
+                  gp_string(title) + "\n";
+  for (const std::string& p : panels) c += p + "\n";
+  return c + "unset multiplot";
+}
+
+// the data line of the least value among `v` (value, data line) pairs
+std::string minimum_line(const std::vector<std::pair<double, std::string>>& v) {
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < v.size(); ++i)
+    if (v[i].first < v[best].first) best = i;
+  return v[best].second;
+}
+
+// two parameters on a grid: a heat map of each metric per design, one rectangle per point
+// spanning halfway to its neighbours
+void heat_maps(const Sweep& s, Charts& out) {
+  const Parameter& px = s.params[0];
+  const Parameter& py = s.params[1];
+  // the plotted range: every grid value's cell
+  double x_lo = std::numeric_limits<double>::infinity(), x_hi = -x_lo;
+  double y_lo = x_lo, y_hi = -x_lo;
+  for (const double v : px.values) {
+    const auto [lo, hi] = cell_edges(px, v);
+    x_lo = std::min(x_lo, lo);
+    x_hi = std::max(x_hi, hi);
+  }
+  for (const double v : py.values) {
+    const auto [lo, hi] = cell_edges(py, v);
+    y_lo = std::min(y_lo, lo);
+    y_hi = std::max(y_hi, hi);
+  }
+  const std::string ranges =
+      axis("x", x_lo, x_hi, px.log_scale) + axis("y", y_lo, y_hi, py.log_scale);
+  for (const Metric& m : s.metrics) {
+    std::vector<std::string> panels;
+    for (const Series& se : m.series) {
+      std::vector<std::string> cells, failed;
+      std::vector<std::pair<double, std::string>> values;
+      for (std::size_t r = 0; r < s.csv.rows.size(); ++r) {
+        const auto x = s.x(r, 0);
+        const auto y = s.x(r, 1);
+        if (!x || !y) continue;
+        const auto [xa, xb] = cell_edges(px, *x);
+        const auto [ya, yb] = cell_edges(py, *y);
+        const std::string cell =
+            num(*x) + "," + num(*y) + "," + num(xa) + "," + num(xb) + "," + num(ya) + "," + num(yb);
+        if (const auto v = s.value(r, se)) {
+          cells.push_back(cell + "," + num(*v));
+          values.emplace_back(*v, num(*x) + "," + num(*y));
+        } else {
+          failed.push_back(cell);
+        }
+      }
+      if (cells.empty() && failed.empty()) continue;
+      std::string p = "set title " + gp_string(se.label) + "\nset xlabel " +
+                      gp_string(axis_label(px)) + "\nset ylabel " + gp_string(axis_label(py)) +
+                      "\n" + ranges + "unset key\nunset grid\nplot ";
+      std::string items;
+      if (!cells.empty()) {
+        items += out.block(cells) +
+                 " using 1:2:3:4:5:6:7 with boxxyerror fs solid 1.0 noborder lc palette notitle";
+      }
+      if (!failed.empty()) {
+        items += std::string(items.empty() ? "" : ", ") + out.block(failed) +
+                 " using 1:2:3:4:5:6 with boxxyerror fs solid 1.0 noborder lc rgb '#c8c8c8' "
+                 "notitle";
+      }
+      if (!values.empty()) {
+        items += ", " + out.block({minimum_line(values)}) +
+                 " using 1:2 with points pt 6 ps 2 lw 2 lc rgb '#e00000' notitle";
+      }
+      panels.push_back(p + items);
+    }
+    if (panels.empty()) continue;
+    out.charts.push_back(
+        {"sweep-" + m.id, m.name + " over " + px.path + " and " + py.path,
+         m.name + " (" + m.what +
+             ") at each grid point, one rectangle per point reaching "
+             "halfway to its neighbours" +
+             panels_text(m) +
+             ". Grey: failed points; blank: points not run; red circle: the least value.",
+         kPalette + side_by_side(m.name + ": " + m.what, panels), true});
+  }
+}
+
+// two parameters drawn at random: each point coloured by the metric
+void scatter_maps(const Sweep& s, Charts& out) {
+  const Parameter& px = s.params[0];
+  const Parameter& py = s.params[1];
+  for (const Metric& m : s.metrics) {
+    std::vector<std::string> panels;
+    for (const Series& se : m.series) {
+      std::vector<std::string> pts, failed;
+      std::vector<std::pair<double, std::string>> values;
+      for (std::size_t r = 0; r < s.csv.rows.size(); ++r) {
+        const auto x = s.x(r, 0);
+        const auto y = s.x(r, 1);
+        if (!x || !y) continue;
+        if (const auto v = s.value(r, se)) {
+          pts.push_back(num(*x) + "," + num(*y) + "," + num(*v));
+          values.emplace_back(*v, num(*x) + "," + num(*y));
+        } else {
+          failed.push_back(num(*x) + "," + num(*y));
+        }
+      }
+      if (pts.empty() && failed.empty()) continue;
+      std::string p = "set title " + gp_string(se.label) + "\nset xlabel " +
+                      gp_string(axis_label(px)) + "\nset ylabel " + gp_string(axis_label(py)) +
+                      "\n" + axis(s, 0, "x") + axis(s, 1, "y") + "unset key\nplot ";
+      std::string items;
+      if (!pts.empty()) {
+        items += out.block(pts) + " using 1:2:3 with points pt 7 ps 1.1 lc palette notitle";
+      }
+      if (!failed.empty()) {
+        items += std::string(items.empty() ? "" : ", ") + out.block(failed) +
+                 " using 1:2 with points pt 2 ps 1.1 lw 2 lc rgb '#808080' notitle";
+      }
+      if (!values.empty()) {
+        items += ", " + out.block({minimum_line(values)}) +
+                 " using 1:2 with points pt 6 ps 2.2 lw 2 lc rgb '#e00000' notitle";
+      }
+      panels.push_back(p + items);
+    }
+    if (panels.empty()) continue;
+    out.charts.push_back({"sweep-" + m.id, m.name + " over " + px.path + " and " + py.path,
+                          m.name + " (" + m.what + ") at each point of the " +
+                              (s.design == "lhs" ? "Latin-hypercube" : "random") +
+                              " design, by colour" + panels_text(m) +
+                              ". Grey crosses: failed points; red circle: the least value.",
+                          kPalette + side_by_side(m.name + ": " + m.what, panels), true});
+  }
+}
+
+// more than two parameters: each metric against each parameter, a small chart each
+void metric_by_parameter(const Sweep& s, Charts& out) {
+  const std::size_t n = s.params.size();
+  const std::size_t cols = std::min<std::size_t>(n, 3);
+  const std::size_t rows = (n + cols - 1) / cols;
+  for (const Metric& m : s.metrics) {
+    std::vector<std::string> blocks, labels;
+    std::vector<bool> second;
+    for (const Series& se : m.series) {
+      std::vector<std::string> lines;
+      for (std::size_t r = 0; r < s.csv.rows.size(); ++r) {
+        const auto v = s.value(r, se);
+        if (!v) continue;
+        std::string line;
+        bool ok = true;
+        for (std::size_t j = 0; j < n && ok; ++j) {
+          const auto x = s.x(r, j);
+          ok = x.has_value();
+          if (ok) line += num(*x) + ",";
+        }
+        if (ok) lines.push_back(line + num(*v));
+      }
+      if (lines.empty()) continue;
+      blocks.push_back(out.block(lines));
+      labels.push_back(se.label);
+      second.push_back(se.second);
+    }
+    if (blocks.empty()) continue;
+    std::string c = "set multiplot layout " + std::to_string(rows) + "," + std::to_string(cols) +
+                    " title " + gp_string(m.name + ": " + m.what) + "\n";
+    for (std::size_t j = 0; j < n; ++j) {
+      c += "unset logscale\nset xtics autofreq\n" + axis(s, j, "x") + "set xlabel " +
+           gp_string(axis_label(s.params[j])) + "\nset ylabel " +
+           gp_string(j % cols == 0 ? m.name : std::string()) + "\n" +
+           (j == 0 && blocks.size() > 1 ? "set key inside top left box opaque samplen 1\n"
+                                        : "unset key\n") +
+           "plot ";
+      for (std::size_t b = 0; b < blocks.size(); ++b) {
+        c += std::string(b ? ", " : "") + blocks[b] + " using " + std::to_string(j + 1) + ":" +
+             std::to_string(n + 1) + " with points pt " + (second[b] ? "6 lt 2" : "7 lt 1") +
+             " ps 0.6 title " + gp_string(labels[b]);
+      }
+      c += "\n";
+    }
+    c += "unset multiplot";
+    out.charts.push_back(
+        {"sweep-" + m.id, m.name + " against each parameter",
+         m.name + " (" + m.what + ") of each point against each parameter in turn" +
+             (m.series.size() > 1 ? ", the " + m.series[0].label + " design filled, the " +
+                                        m.series[1].label + " one open"
+                                  : std::string()) +
+             "; points whose status is not ok are left out.",
+         c, rows > 1});
+  }
+}
+
+Charts sweep_charts(const Sweep& s) {
+  Charts out;
+  if (s.params.size() == 1) {
+    one_parameter(s, out);
+  } else if (s.params.size() == 2 && s.design == "grid" && !s.params[0].values.empty() &&
+             !s.params[1].values.empty()) {
+    heat_maps(s, out);
+  } else if (s.params.size() == 2) {
+    scatter_maps(s, out);
+  } else {
+    metric_by_parameter(s, out);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string sweep_report_html(const Study& study, const fs::path& dir, const std::string& gnuplot) {
+  const Sweep s = load_sweep(study, dir);
+  const std::string name = s.info.str("study").empty() ? study.name : s.info.str("study");
+  const std::string source = s.info.str("source");
+
+  std::string h =
+      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+      "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+      "<title>" +
+      esc(name) + " &mdash; balance-design sweep report</title>\n<style>" + kStyle +
+      "</style>\n</head>\n<body>\n";
+  h += "<h1>" + esc(name) +
+       " (sweep)</h1>\n<p>balance-design report of the sweep of the study <code>" +
+       esc(source.empty() ? std::string("(built in code)") : source) +
+       "</code>: the study run at every point of the design below. Every number below is read "
+       "from <a href=\"sweep.csv\">sweep.csv</a> and <a href=\"sweep.json\">sweep.json</a> in "
+       "this folder (the linkage's inputs from the study file); hover over a number to see it "
+       "as written there.</p>\n";
+  h += status_section(s, dir);
+  h += design_section(s);
+  h += best_section(s);
+  h += failed_section(s);
+
+  h += "<h2>Charts</h2>\n";
+  const Charts charts = sweep_charts(s);
+  if (gnuplot.empty()) {
+    h += "<p class=\"notice\">The charts need gnuplot, which was not found on this machine "
+         "(install it, e.g. <code>apt-get install gnuplot-nox</code>, then rebuild this page with "
+         "<code>balance-design report DIR</code>). The tables and sweep.csv hold every "
+         "number.</p>\n";
+  } else if (charts.charts.empty()) {
+    h += "<p>No point has finished with status ok yet: nothing to chart.</p>\n";
+  } else {
+    const std::vector<std::string> svgs = draw(gnuplot, charts.datablocks, charts.charts);
+    for (std::size_t i = 0; i < charts.charts.size(); ++i) {
+      const Chart& c = charts.charts[i];
+      h += "<h3>" + esc(c.heading) + "</h3>\n<figure class=\"chart\" id=\"chart-" + c.id + "\">\n" +
+           svgs[i] + "\n<figcaption>" + esc(c.caption) + "</figcaption>\n</figure>\n";
+    }
+  }
+  h += points_section(s);
+  h += study_section(study, s);
+
+  return h + data_files_html(dir, {"sweep.csv", "sweep.json"});
+}
+
+fs::path write_sweep_report(const Study& study, const fs::path& dir) {
+  const std::string html = sweep_report_html(study, dir, find_gnuplot());
+  const fs::path target = dir / "report.html";
+  write_text_file(html, target);  // whole or not at all (runner.hpp)
+  return target;
+}
+
+}  // namespace bd::studies

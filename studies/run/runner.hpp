@@ -1,0 +1,171 @@
+#pragma once
+/// Running a study: simulate its scene, then write timeseries.csv and summary.json
+/// (DESIGN.md "Outputs (v1 contract)"); for a study with a balance section also the balanced
+/// design's balanced-timeseries.csv, balanced.yaml and comparison.csv; for a study with an
+/// optimize section the optimum's optimized-timeseries.csv, optimized.yaml, comparison.csv and,
+/// with a Pareto front, pareto.csv.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/metrics.hpp"
+#include "core/fourbar/simulate.hpp"
+#include "optimize/optimize.hpp"
+#include "studies/study/study.hpp"
+
+namespace bd::studies {
+
+/// The header line of timeseries.csv (without the newline).
+inline constexpr const char* kTimeseriesHeader =
+    "t,theta1,theta2,theta3,omega1,omega2,omega3,alpha1,alpha2,alpha3,RA0x,RA0y,RA3x,RA3y,Fshx,"
+    "Fshy,Msh,tau";
+
+/// The header line of comparison.csv (without the newline).
+inline constexpr const char* kComparisonHeader = "metric,before,after,ratio";
+
+/// The balanced design's run in a balance study (same scene, method chosen for it alike).
+struct BalancedRun {
+  MethodChoice method;               // formulation used for the balanced design, and why
+  core::Trajectory trajectory;       // its samples and status
+  core::Metrics metrics;             // over its samples
+  std::filesystem::path timeseries;  // out_dir/balanced-timeseries.csv
+  std::filesystem::path study_file;  // out_dir/balanced.yaml
+  std::filesystem::path comparison;  // out_dir/comparison.csv
+};
+
+/// The optimisation in an optimize study, and the optimum's run (same scene, method chosen for it
+/// alike).
+struct OptimizedRun {
+  optimize::OptimizeResult result;            // what optimize() returned (termination kNotRun,
+                                              // with a message, when it was not run)
+  std::vector<std::string> variable_names;    // of result.x, in order (optimize::Nlp's names)
+  int design_variables{};                     // the first ones of result.x: the design's own
+                                              // (the rest are bound variables of peak metrics)
+  std::vector<optimize::ParetoPoint> pareto;  // with optimize.pareto, point by point
+  MethodChoice method;                        // formulation used for the optimum, and why
+  core::Trajectory trajectory;                // the optimum simulated (none when not found)
+  core::Metrics metrics;                      // over its samples
+  std::filesystem::path timeseries;           // out_dir/optimized-timeseries.csv (when found)
+  std::filesystem::path study_file;           // out_dir/optimized.yaml (when found)
+  std::filesystem::path comparison;           // out_dir/comparison.csv (when found)
+  std::filesystem::path pareto_file;          // out_dir/pareto.csv (with a front, when found)
+  /// True when the optimiser returned a design (converged, or the budget ran out at a feasible
+  /// point): the optimum was simulated and its files written.
+  bool found() const { return result.ok(); }
+  /// True when the optimiser ran and found no design (infeasible, or it failed): exit code 4.
+  bool failed() const {
+    return result.termination == optimize::Termination::kInfeasible ||
+           result.termination == optimize::Termination::kFailed;
+  }
+};
+
+/// What a run did and where its files are.
+struct RunResult {
+  MethodChoice method;                  // formulation used, and why (the original design)
+  core::Trajectory trajectory;          // every sample computed, and the simulation's status
+  core::Metrics metrics;                // over the samples computed
+  std::filesystem::path timeseries;     // out_dir/timeseries.csv
+  std::filesystem::path summary;        // out_dir/summary.json
+  std::optional<BalancedRun> balanced;  // set when the study has a balance section
+  std::optional<OptimizedRun> optimized;  // set when the study has an optimize section
+  /// True when every simulation ran to the end (the original's, the balanced design's, the
+  /// optimum's) and an optimize study found its optimum.
+  bool ok() const {
+    return trajectory.ok() && (!balanced || balanced->trajectory.ok()) &&
+           (!optimized || (optimized->found() && optimized->trajectory.ok()));
+  }
+  /// True when a simulation stopped early (the original's, the balanced design's or the
+  /// optimum's): exit code 3.
+  bool stopped_early() const {
+    return !trajectory.ok() || (balanced && !balanced->trajectory.ok()) ||
+           (optimized && optimized->found() && !optimized->trajectory.ok());
+  }
+};
+
+/// One row of comparison.csv: a metric of the original design (before) and of the balanced or
+/// optimised one (after), and after/before (empty when before is 0).
+struct ComparisonRow {
+  std::string metric;  // "Fsh_rms", ..., "added_mass", "added_inertia"
+  double before{}, after{};
+  std::optional<double> ratio;
+};
+/// The rows of comparison.csv, in order: Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max,
+/// RA0_rms, RA0_max, RA3_rms, RA3_max, added_mass, added_inertia.
+/// In an optimize study added_mass and added_inertia are those of studies::added_mass() and
+/// added_inertia() (negative when the optimum takes mass away).
+/// Precondition: study.balance and result.balanced are set, or result.optimized has found its
+/// optimum.
+std::vector<ComparisonRow> comparison(const Study& study, const RunResult& result);
+
+/// What run_study() computes, without writing anything: simulates the study's scene, and with a
+/// balance section the balanced design, with an optimize section solves the design problem and
+/// simulates the optimum (each as run_study() describes). The result's file paths stay empty.
+/// Pure: the same study gives the same result, bit for bit, and the call is safe from several
+/// threads at once (run_sweep() computes its points so). Ipopt solves are serialised by a
+/// mutex: Debian 12's Ipopt 3.11.9 calls MUMPS, which is not thread-safe, and has no lock of its
+/// own (Ipopt takes one around MUMPS from 3.14 on).
+/// @throws bd::InputError as run_study().
+RunResult compute_study(const Study& study);
+
+/// Writes the files of a computed run into out_dir as run_study() does (creating out_dir when
+/// needed, summary.json last, then report.html), and sets the result's file paths.
+/// @throws std::runtime_error if an output file cannot be written (the message names it).
+void write_run(const Study& study, RunResult& result, const std::filesystem::path& out_dir);
+
+/// Writes `text` to `file` under a temporary name in its directory renamed into place, so a
+/// reader sees the whole file or none.
+/// @throws std::runtime_error if the file cannot be written (the message names it).
+void write_text_file(const std::string& text, const std::filesystem::path& file);
+
+/// Simulates the study's scene (core::simulate_free or core::simulate_driven) and writes
+/// `timeseries.csv` and `summary.json` into out_dir, creating out_dir when needed (and only after
+/// the simulation, so an invalid study creates nothing). Each file is written to a temporary
+/// file in out_dir and renamed into place, so no half-written output is ever left. When the
+/// simulation stops early, every sample computed so far is written and summary.json records the
+/// status and message; the result's ok() is then false.
+/// A study with a balance section also simulates its balanced design (balanced_study(), its own
+/// choose_method()) in the same scene and writes `balanced-timeseries.csv`, `balanced.yaml`
+/// (study_yaml() of the balanced design) and `comparison.csv`; summary.json gets `balance`,
+/// `balanced_run`, `balanced_metrics` and `reduction`.
+/// A study with an optimize section solves its design_problem() with optimize() (not when the
+/// original's simulation stopped early), simulates the optimum (optimized_study(), its own
+/// choose_method()) and writes `optimized-timeseries.csv`, `optimized.yaml` and `comparison.csv`;
+/// with optimize.pareto also pareto_front() as `pareto.csv`. summary.json gets `optimize`,
+/// `optimized_run`, `optimized_metrics` and `reduction`. When the optimiser finds no design
+/// (infeasible or failed) only the original's files are written, summary.json says why, and the
+/// result's optimized->failed() is true. summary.json is always written last.
+/// It is compute_study() followed by write_run().
+/// @throws bd::InputError if the scene or options are invalid (core's checks), or if an optimize
+///         study's problem is (the optimize layer's checks; load_study() has made them already).
+/// @throws std::runtime_error if an output file cannot be written (the message names it).
+RunResult run_study(const Study& study, const std::filesystem::path& out_dir);
+
+/// Writes the samples as timeseries.csv content (header, one row per sample, "%.17g").
+/// @throws std::runtime_error if the file cannot be written.
+void write_timeseries(const core::Trajectory& trajectory, const std::filesystem::path& file);
+
+/// The summary.json text of a run (UTF-8, ends in a newline).
+std::string summary_json(const Study& study, const RunResult& result);
+
+/// The comparison.csv text of a balance or optimize study's run: kComparisonHeader, then one row
+/// per comparison() entry, numbers "%.17g", ratio empty when before is 0.
+std::string comparison_csv(const Study& study, const RunResult& result);
+
+/// The balanced.yaml text of a balance study: study_yaml(balanced_study(study)) with a header
+/// comment saying where it came from.
+std::string balanced_yaml(const Study& study);
+
+/// The optimized.yaml text of an optimize study whose optimum was found:
+/// study_yaml(optimized_study(study, design)) with a header comment saying how it was found.
+std::string optimized_yaml(const Study& study, const OptimizedRun& run);
+
+/// The pareto.csv text: header `epsilon,<first>,<second>,termination,verification_error` and the
+/// design variables' names, then one row per point ("%.17g"; numbers empty for a point where no
+/// design was found). Precondition: study.optimize->pareto is set.
+std::string pareto_csv(const Study& study, const OptimizedRun& run);
+
+/// `text` as a JSON string literal, quotes included, with every character that needs it escaped.
+std::string json_string(const std::string& text);
+
+}  // namespace bd::studies

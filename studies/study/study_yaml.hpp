@@ -1,0 +1,17 @@
+#pragma once
+/// Writing a study back as a study file (the inverse of parse_study, without a balance section).
+#include <string>
+
+#include "studies/study/study.hpp"
+
+namespace bd::studies {
+
+/// A complete, runnable study file for `study`: name, linkage (each link as {length, mass, e, f,
+/// inertia}, and counter_rotations when the model has any), every load, the scene with all its
+/// keys, method and tolerance. Numbers are printed with "%.17g", so parse_study() of the text
+/// gives back the same model, scene and options bit for bit. A balance or optimize section is
+/// never written.
+/// `header` (may be empty) is written first as `# ` comment lines, one per line of it.
+std::string study_yaml(const Study& study, const std::string& header);
+
+}  // namespace bd::studies
