@@ -16,12 +16,11 @@
 #include <variant>
 #include <vector>
 
+#include "cli/sweep_display.hpp"
 #include "core/metrics.hpp"
-#include "studies/study/load_study.hpp"
 #include "studies/report/report.hpp"
-#include "studies/run/runner.hpp"
-#include "studies/sweep/sweep.hpp"
-#include "studies/bench/work_precision.hpp"
+#include "studies/studies.hpp"
+#include "studies/study/load_study.hpp"
 
 #ifndef BD_VERSION
 #define BD_VERSION "unknown"
@@ -216,6 +215,12 @@ void print_comparison(const st::Study& study, const st::RunResult& r) {
   }
 }
 
+// warnings of a run (the report page not written), one line each on stderr
+void print_warnings(const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings)
+    std::fprintf(stderr, "balance-design: warning: %s\n", w.c_str());
+}
+
 // the balanced design: what was added, and before / after / ratio of the main metrics
 void print_balance(const st::Study& study, const st::RunResult& r) {
   const bd::balance::BalancedDesign& b = *study.balance;
@@ -235,8 +240,8 @@ void print_balance(const st::Study& study, const st::RunResult& r) {
     if (!cws[i]->has_value()) continue;
     const bd::balance::Counterweight& c = **cws[i];
     std::printf("  %-7s  counterweight (%s) %.6g kg at [%.6g, %.6g] m from %s (%.6g m)", sides[i],
-                bd::balance::to_string(specs[i]->shape), c.mass, c.position.x(), c.position.y(), pivots[i],
-                c.distance);
+                bd::balance::to_string(specs[i]->shape), c.mass, c.position.x(), c.position.y(),
+                pivots[i], c.distance);
     if (c.radius > 0) std::printf(", radius %.6g m", c.radius);
     std::printf("\n");
   }
@@ -375,10 +380,8 @@ int run_sweep_study(const st::Study& study, const RunArgs& args, const fs::path&
   st::SweepOptions options;
   options.resume = args.resume;
   options.threads = args.threads;
-  options.progress = args.progress == "bar"     ? st::SweepProgress::kBar
-                     : args.progress == "lines" ? st::SweepProgress::kLines
-                     : args.progress == "none"  ? st::SweepProgress::kNone
-                                                : st::SweepProgress::kAuto;
+  bd::cli::SweepDisplay display(bd::cli::SweepDisplay::mode_named(args.progress));
+  options.progress = [&display](const st::SweepProgress& p) { display.show(p); };
   options.stop = &g_stop_sweep;
   catch_stop_signals();
   const auto start = std::chrono::steady_clock::now();
@@ -392,6 +395,7 @@ int run_sweep_study(const st::Study& study, const RunArgs& args, const fs::path&
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
+  print_warnings(r.warnings);
   std::fflush(stderr);
   std::string resumed;
   if (r.resumed > 0) resumed = " (" + std::to_string(r.resumed) + " resumed)";
@@ -436,6 +440,7 @@ int run(const RunArgs& args) {
     return kExitBadInput;
   }
 
+  print_warnings(result.warnings);
   std::fflush(stderr);
   print_summary(study, result);
   std::fflush(stdout);
@@ -525,6 +530,7 @@ int bench(const BenchArgs& args) {
     std::fprintf(stderr, "%s: %s\n", args.study.c_str(), e.what());
     return kExitBadInput;
   }
+  print_warnings(result.run.warnings);
   std::fflush(stderr);
   print_summary(study, result.run);
   const std::size_t rows =

@@ -18,8 +18,8 @@
 
 #include "core/input_error.hpp"
 #include "core/metrics.hpp"
-#include "studies/report/report.hpp"
-#include "studies/report/report_support.hpp"
+#include "core/number_text.hpp"
+#include "studies/run/files.hpp"
 
 namespace bd::studies {
 
@@ -28,27 +28,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// "%.17g" of a value, empty for NaN (as the data files write it)
-std::string csv_number(double x) {
-  if (std::isnan(x)) return "";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
-}
-
-std::string short_number(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
-}
-
-// a CSV field, quoted (RFC 4180)
-std::string quoted(const std::string& text) {
-  std::string q = "\"";
-  for (char c : text) q += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
-  return q + "\"";
-}
 
 // CPU time of this process [s]: what the measured code costs, whatever else the machine runs
 double cpu_seconds() {
@@ -162,10 +141,10 @@ BenchOptions BenchOptions::quick() {
 std::string BenchOptions::validate() const {
   if (tolerances.empty()) return "tolerances must not be empty";
   for (double t : tolerances) {
-    if (!(t > 0 && t < 1)) return "every tolerance must be > 0 and < 1, got " + short_number(t);
+    if (!(t > 0 && t < 1)) return "every tolerance must be > 0 and < 1, got " + text::digits(t, 3);
   }
   if (!(reference_tolerance > 0 && reference_tolerance < 1)) {
-    return "reference_tolerance must be > 0 and < 1, got " + short_number(reference_tolerance);
+    return "reference_tolerance must be > 0 and < 1, got " + text::digits(reference_tolerance, 3);
   }
   if (samples.empty()) return "samples must not be empty";
   for (int n : samples) {
@@ -176,10 +155,10 @@ std::string BenchOptions::validate() const {
   }
   if (repeats < 1) return "repeats must be >= 1, got " + std::to_string(repeats);
   if (!(min_time >= 0) || !std::isfinite(min_time)) {
-    return "min_time must be >= 0 s, got " + short_number(min_time);
+    return "min_time must be >= 0 s, got " + text::digits(min_time, 3);
   }
   if (!(long_run >= 0) || !std::isfinite(long_run)) {
-    return "long_run must be >= 0 s, got " + short_number(long_run);
+    return "long_run must be >= 0 s, got " + text::digits(long_run, 3);
   }
   return {};
 }
@@ -248,17 +227,17 @@ std::vector<WorkPrecisionRow> work_precision(const Study& study, const BenchOpti
                      : row.final_error > 0       ? std::min(16.0, -std::log10(row.final_error))
                                                  : 16.0;
         row.max_error = max_error(trajectory, reference.trajectory);
-        summary += " " + short_number(tolerance) + ": " +
-                   (trajectory.ok() ? short_number(1e3 * row.cpu_time) + " ms " +
-                                          short_number(row.digits) + " digits"
+        summary += " " + text::digits(tolerance, 3) + ": " +
+                   (trajectory.ok() ? text::digits(1e3 * row.cpu_time, 3) + " ms " +
+                                          text::digits(row.digits, 3) + " digits"
                                     : std::string(core::to_string(trajectory.status))) +
                    ";";
         rows.push_back(std::move(row));
       }
       if (options.progress) {
         options.progress(std::string("bench: ") + core::to_string(f) + " / " +
-                         core::to_string(integrator) + " (" + short_number(cpu_seconds() - start) +
-                         " s):" + summary);
+                         core::to_string(integrator) + " (" +
+                         text::digits(cpu_seconds() - start, 3) + " s):" + summary);
       }
     }
   }
@@ -323,15 +302,15 @@ std::vector<DrivenConvergenceRow> driven_convergence(const Study& study,
       row.Fsh_rms_error = relative(row.Fsh_rms, ref.Fsh_rms, ok);
       row.Msh_rms_error = relative(row.Msh_rms, ref.Msh_rms, ok);
       if (samples == 360 || samples == options.samples.back()) {
-        summary += " " + std::to_string(samples) + ": " + short_number(1e6 * row.cpu_time) +
-                   " us, errors " + short_number(row.Fsh_rms_error) + ", " +
-                   short_number(row.Msh_rms_error) + ";";
+        summary += " " + std::to_string(samples) + ": " + text::digits(1e6 * row.cpu_time, 3) +
+                   " us, errors " + text::digits(row.Fsh_rms_error, 3) + ", " +
+                   text::digits(row.Msh_rms_error, 3) + ";";
       }
       rows.push_back(std::move(row));
     }
     if (options.progress) {
       options.progress(std::string("bench: ") + core::to_string(f) + " (" +
-                       short_number(cpu_seconds() - start) + " s):" + summary);
+                       text::digits(cpu_seconds() - start, 3) + " s):" + summary);
     }
   }
   return rows;
@@ -347,7 +326,7 @@ std::string work_precision_csv(const std::vector<WorkPrecisionRow>& rows) {
          std::to_string(r.repeats) + "," + std::to_string(r.steps) + "," +
          std::to_string(r.rhs_evaluations) + "," + std::to_string(r.samples) + "," +
          csv_number(r.final_error) + "," + csv_number(r.digits) + "," + csv_number(r.max_error) +
-         "," + quoted(r.message) + "\n";
+         "," + csv_line_field(r.message) + "\n";
   }
   return s;
 }
@@ -360,22 +339,15 @@ std::string driven_convergence_csv(const std::vector<DrivenConvergenceRow>& rows
          "," + core::to_string(r.status) + "," + csv_number(r.cpu_time) + "," +
          std::to_string(r.repeats) + "," + csv_number(r.Fsh_rms) + "," + csv_number(r.Msh_rms) +
          "," + csv_number(r.Fsh_rms_error) + "," + csv_number(r.Msh_rms_error) + "," +
-         quoted(r.message) + "\n";
+         csv_line_field(r.message) + "\n";
   }
   return s;
 }
 
-BenchResult run_bench(const Study& study, const fs::path& out_dir, const BenchOptions& options) {
+BenchResult write_bench(const Study& study, const fs::path& out_dir, const BenchOptions& options) {
   check(options);
-  const bool free = std::holds_alternative<core::FreeScene>(study.scene);
-  // no stale measurements in the report that run_study() writes
-  for (const char* name : {"work-precision.csv", "driven-convergence.csv"}) {
-    std::error_code ec;
-    fs::remove(out_dir / name, ec);
-  }
   BenchResult result;
-  result.run = run_study(study, out_dir);
-  if (free) {
+  if (std::holds_alternative<core::FreeScene>(study.scene)) {
     result.free_rows = work_precision(study, options);
     result.csv = out_dir / "work-precision.csv";
     write_text_file(work_precision_csv(result.free_rows), result.csv);
@@ -384,301 +356,14 @@ BenchResult run_bench(const Study& study, const fs::path& out_dir, const BenchOp
     result.csv = out_dir / "driven-convergence.csv";
     write_text_file(driven_convergence_csv(result.driven_rows), result.csv);
   }
-  try {
-    result.report = write_report(study, out_dir);
-  } catch (const std::exception& e) {
-    std::error_code ec;
-    fs::remove(out_dir / "report.html", ec);  // never a page without the measurements
-    std::fprintf(stderr, "balance-design: warning: report.html not written: %s\n", e.what());
-  }
   return result;
 }
 
-// ---------------------------------------------------------------------------------------------
-// the report section
-
-namespace {
-
-using report_support::Chart;
-using report_support::Csv;
-using report_support::esc;
-using report_support::fmt;
-using report_support::gp_string;
-
-// the column index of `name` in a CSV header
-std::size_t column(const Csv& csv, const char* name, const fs::path& file) {
-  const auto it = std::find(csv.header.begin(), csv.header.end(), name);
-  if (it == csv.header.end()) {
-    throw std::runtime_error(file.string() + ": no column " + name);
+void remove_bench_files(const fs::path& out_dir) {
+  for (const char* name : {"work-precision.csv", "driven-convergence.csv"}) {
+    std::error_code ec;
+    fs::remove(out_dir / name, ec);
   }
-  return static_cast<std::size_t>(it - csv.header.begin());
-}
-
-double number_at(const std::vector<std::string>& row, std::size_t i) {
-  if (i >= row.size() || row[i].empty()) return kNaN;
-  char* end = nullptr;
-  const double v = std::strtod(row[i].c_str(), &end);
-  return end == row[i].c_str() ? kNaN : v;
-}
-
-const char* const kChartNotice =
-    "<p class=\"notice\">The charts need gnuplot, which was not found on this machine; the table "
-    "and the data file hold every number.</p>\n";
-
-std::string figure(const Chart& chart, const std::string& svg) {
-  return "<h3>" + esc(chart.heading) + "</h3>\n<figure class=\"chart\" id=\"chart-" + chart.id +
-         "\">\n" + svg + "\n<figcaption>" + esc(chart.caption) + "</figcaption>\n</figure>\n";
-}
-
-// the line colour and point type of an integrator, the same in every chart
-std::string line_style(const std::string& integrator) {
-  static const char* const colours[] = {"#9400d3", "#009e73", "#56b4e9", "#e69f00", "#c8b400",
-                                        "#0072b2", "#e51e10", "#000000", "#a0522d"};
-  std::size_t i = 0;
-  for (core::Integrator k : core::kIntegrators) {
-    if (integrator == core::to_string(k)) break;
-    ++i;
-  }
-  return " lc rgb '" + std::string(colours[i % 9]) + "' pt " + std::to_string(i + 1);
-}
-
-std::string free_section(const fs::path& file, const std::string& gnuplot) {
-  const Csv csv = report_support::read_csv(file);
-  const std::size_t c_f = column(csv, "formulation", file), c_i = column(csv, "integrator", file),
-                    c_tol = column(csv, "tolerance", file), c_st = column(csv, "status", file),
-                    c_t = column(csv, "cpu_time", file), c_e = column(csv, "final_error", file),
-                    c_d = column(csv, "digits", file), c_m = column(csv, "max_error", file),
-                    c_steps = column(csv, "steps", file),
-                    c_rf = column(csv, "reference_formulation", file),
-                    c_ri = column(csv, "reference_integrator", file),
-                    c_rt = column(csv, "reference_tolerance", file);
-
-  // methods in file order, each with its rows
-  std::vector<std::pair<std::string, std::string>> methods;
-  std::map<std::pair<std::string, std::string>, std::vector<const std::vector<std::string>*>> of;
-  for (const auto& row : csv.rows) {
-    if (row.size() < csv.header.size()) continue;
-    const auto key = std::pair{row[c_f], row[c_i]};
-    if (of.find(key) == of.end()) methods.push_back(key);
-    of[key].push_back(&row);
-  }
-  std::vector<std::string> formulations;
-  for (const auto& m : methods) {
-    if (std::find(formulations.begin(), formulations.end(), m.first) == formulations.end()) {
-      formulations.push_back(m.first);
-    }
-  }
-
-  std::string h =
-      "<p>From <a href=\"work-precision.csv\">work-precision.csv</a> (<code>balance-design "
-      "bench</code>): every formulation with every integrator it supports, at each tolerance "
-      "(absolute tolerance 1e-2 of it), the median CPU time of one run of the study's free "
-      "scene against its error. The error is that of &theta;1..&theta;3 against a reference "
-      "computed by a different formulation";
-  if (!csv.rows.empty() && csv.rows.front().size() > c_rt) {
-    const auto& r = csv.rows.front();
-    h += " (" + esc(r[c_ri]) + " at tolerance " + esc(fmt(number_at(r, c_rt), "%.0e")) +
-         "; the reference of " + esc(r[c_f]) + " is " + esc(r[c_rf]) + ")";
-  }
-  h += ": the largest relative error at the final time (its -log10 is the number of correct "
-       "digits) and the largest error over all samples.</p>\n";
-
-  // the charts: one per formulation, a line per integrator
-  std::string datablocks;
-  std::vector<Chart> charts;
-  for (std::size_t fi = 0; fi < formulations.size(); ++fi) {
-    std::string plot;
-    int lines = 0;
-    for (std::size_t mi = 0; mi < methods.size(); ++mi) {
-      if (methods[mi].first != formulations[fi]) continue;
-      const std::string block = "$wp_" + std::to_string(mi);
-      std::string data;
-      for (const auto* row : of[methods[mi]]) {
-        const double e = number_at(*row, c_e), t = number_at(*row, c_t);
-        if ((*row)[c_st] != "completed" || !(e > 0) || !(t > 0)) continue;
-        data += fmt(e, "%.6g") + "," + fmt(1e3 * t, "%.6g") + "\n";
-      }
-      if (data.empty()) continue;
-      datablocks += block + " << EOD\n" + data + "EOD\n";
-      ++lines;
-      plot += std::string(lines > 1 ? ", " : "") + block + " using 1:2 with linespoints lw 2" +
-              line_style(methods[mi].second) + " title " + gp_string(methods[mi].second);
-    }
-    if (lines == 0) continue;
-    charts.push_back(
-        {"work-precision-" + formulations[fi], "Work-precision: " + formulations[fi],
-         "CPU time of one run against the largest relative error of theta1..theta3 at the "
-         "final time, one line per integrator, one point per tolerance (more accurate to the "
-         "right); runs that stopped early are left out. From work-precision.csv.",
-         "set logscale xy\nset format x '1e%L'\nset xrange [*:*] reverse\n"
-         "set xlabel 'relative error at the final time'\nset ylabel 'CPU time per run [ms]'\n"
-         "plot " +
-             plot});
-  }
-
-  // the compact table: per method, the run at tolerance 1e-10 and the cheapest run with
-  // 10 correct digits
-  h += "<table><tr><th>formulation</th><th>integrator</th><th>at tolerance 1e-10: CPU time "
-       "[ms]</th><th>digits</th><th>max error [rad]</th><th>steps</th><th>cheapest run with "
-       "&ge; 10 digits: tolerance</th><th>CPU time [ms]</th><th>failed runs</th></tr>";
-  for (const auto& m : methods) {
-    const std::vector<std::string>* at = nullptr;
-    const std::vector<std::string>* best = nullptr;
-    int failed = 0;
-    for (const auto* row : of[m]) {
-      if ((*row)[c_st] != "completed") ++failed;
-      if (std::abs(number_at(*row, c_tol) / 1e-10 - 1) < 1e-6) at = row;
-      if ((*row)[c_st] == "completed" && number_at(*row, c_d) >= 10 &&
-          (best == nullptr || number_at(*row, c_t) < number_at(*best, c_t))) {
-        best = row;
-      }
-    }
-    const auto cell = [](double v, const char* f) {
-      return std::isnan(v) ? std::string("<td class=\"n\">&ndash;</td>")
-                           : "<td class=\"n\">" + esc(fmt(v, f)) + "</td>";
-    };
-    h += "<tr><td>" + esc(m.first) + "</td><td>" + esc(m.second) + "</td>";
-    if (at != nullptr && (*at)[c_st] == "completed") {
-      h += cell(1e3 * number_at(*at, c_t), "%.3g") + cell(number_at(*at, c_d), "%.1f") +
-           cell(number_at(*at, c_m), "%.2g") + cell(number_at(*at, c_steps), "%.0f");
-    } else {
-      h += "<td colspan=\"4\">" + esc(at != nullptr ? (*at)[c_st] : std::string("not run")) +
-           "</td>";
-    }
-    if (best != nullptr) {
-      h += cell(number_at(*best, c_tol), "%.0e") + cell(1e3 * number_at(*best, c_t), "%.3g");
-    } else {
-      h += "<td colspan=\"2\">none</td>";
-    }
-    h += "<td class=\"n\">" + std::to_string(failed) + "</td></tr>";
-  }
-  h += "</table>\n";
-
-  if (gnuplot.empty()) return h + kChartNotice;
-  const std::vector<std::string> svgs = report_support::draw(gnuplot, datablocks, charts);
-  for (std::size_t i = 0; i < charts.size(); ++i) h += figure(charts[i], svgs[i]);
-  return h;
-}
-
-std::string driven_section(const fs::path& file, const std::string& gnuplot) {
-  const Csv csv = report_support::read_csv(file);
-  const std::size_t c_f = column(csv, "formulation", file), c_n = column(csv, "samples", file),
-                    c_st = column(csv, "status", file), c_t = column(csv, "cpu_time", file),
-                    c_ef = column(csv, "Fsh_rms_error", file),
-                    c_em = column(csv, "Msh_rms_error", file),
-                    c_rf = column(csv, "reference_formulation", file),
-                    c_rn = column(csv, "reference_samples", file);
-  std::vector<std::string> formulations;
-  std::map<std::string, std::vector<const std::vector<std::string>*>> of;
-  for (const auto& row : csv.rows) {
-    if (row.size() < csv.header.size()) continue;
-    if (of.find(row[c_f]) == of.end()) formulations.push_back(row[c_f]);
-    of[row[c_f]].push_back(&row);
-  }
-
-  std::string h =
-      "<p>From <a href=\"driven-convergence.csv\">driven-convergence.csv</a> "
-      "(<code>balance-design bench</code>): one revolution of the study's driven scene per "
-      "formulation and number of samples per revolution, its median CPU time, and the relative "
-      "error of its RMS shaking force and moment against a revolution of ";
-  if (!csv.rows.empty()) {
-    h += esc(csv.rows.front()[c_rn]) + " samples computed by a different formulation (that of " +
-         esc(csv.rows.front()[c_f]) + " is " + esc(csv.rows.front()[c_rf]) + ")";
-  }
-  h += ". Evenly spaced samples of a periodic motion make the RMS a trapezoidal rule of a "
-       "smooth periodic function, which converges faster than any power of the samples "
-       "(spectrally) down to round-off.</p>\n";
-
-  std::string datablocks, errors, times;
-  int lines = 0;
-  for (std::size_t fi = 0; fi < formulations.size(); ++fi) {
-    std::string ef, em, t;
-    for (const auto* row : of[formulations[fi]]) {
-      if ((*row)[c_st] != "completed") continue;
-      const double n = number_at(*row, c_n);
-      const double e1 = number_at(*row, c_ef), e2 = number_at(*row, c_em);
-      const double ct = number_at(*row, c_t);
-      if (e1 > 0) ef += fmt(n, "%.0f") + "," + fmt(e1, "%.6g") + "\n";
-      if (e2 > 0) em += fmt(n, "%.0f") + "," + fmt(e2, "%.6g") + "\n";
-      if (ct > 0) t += fmt(n, "%.0f") + "," + fmt(1e6 * ct, "%.6g") + "\n";
-    }
-    const std::string id = std::to_string(fi);
-    const std::string name = formulations[fi];
-    const auto add = [&](const std::string& block, const std::string& data, std::string& plot,
-                         const std::string& title, int dash) {
-      if (data.empty()) return;
-      datablocks += block + " << EOD\n" + data + "EOD\n";
-      plot += std::string(plot.empty() ? "" : ", ") + block +
-              " using 1:2 with linespoints lw 2 lc " + std::to_string(fi + 1) + " dt " +
-              std::to_string(dash) + " pt " + std::to_string(fi + 5) + " title " + gp_string(title);
-      ++lines;
-    };
-    add("$dc_f" + id, ef, errors, name + ": Fsh_rms", 1);
-    add("$dc_m" + id, em, errors, name + ": Msh_rms", 2);
-    add("$dc_t" + id, t, times, name, 1);
-  }
-  std::vector<Chart> charts;
-  if (!errors.empty()) {
-    charts.push_back({"driven-convergence-error", "RMS error against samples per revolution",
-                      "Relative error of the RMS shaking force and moment of one revolution "
-                      "against the reference, per formulation; errors of exactly 0 are left "
-                      "out. From driven-convergence.csv.",
-                      "set logscale xy\nset format y '1e%L'\nset xlabel 'samples per "
-                      "revolution'\nset ylabel 'relative error of the RMS'\nplot " +
-                          errors});
-  }
-  if (!times.empty()) {
-    charts.push_back({"driven-convergence-time", "CPU time against samples per revolution",
-                      "Median CPU time of one revolution (core::simulate_driven and "
-                      "core::metrics), per formulation. From driven-convergence.csv.",
-                      "set logscale xy\nset xlabel 'samples per revolution'\nset ylabel 'CPU "
-                      "time per revolution [us]'\nplot " +
-                          times});
-  }
-
-  h += "<table><tr><th>formulation</th><th>samples for both errors &lt; 1e-12</th><th>CPU time "
-       "[&micro;s]</th><th>at 360 samples: CPU time [&micro;s]</th><th>Fsh_rms error</th>"
-       "<th>Msh_rms error</th></tr>";
-  for (const std::string& f : formulations) {
-    const std::vector<std::string>* enough = nullptr;
-    const std::vector<std::string>* at = nullptr;
-    for (const auto* row : of[f]) {
-      const double e1 = number_at(*row, c_ef), e2 = number_at(*row, c_em);
-      const bool small = (std::isnan(e1) || e1 < 1e-12) && (std::isnan(e2) || e2 < 1e-12) &&
-                         !(std::isnan(e1) && std::isnan(e2));
-      if ((*row)[c_st] == "completed" && small && enough == nullptr) enough = row;
-      if ((*row)[c_n] == "360") at = row;
-    }
-    const auto cell = [](const std::string& v) { return report_support::num_cell(v); };
-    h += "<tr><td>" + esc(f) + "</td>";
-    h += enough != nullptr ? cell((*enough)[c_n]) + "<td class=\"n\">" +
-                                 esc(fmt(1e6 * number_at(*enough, c_t), "%.3g")) + "</td>"
-                           : std::string("<td colspan=\"2\">none</td>");
-    h += at != nullptr ? "<td class=\"n\">" + esc(fmt(1e6 * number_at(*at, c_t), "%.3g")) +
-                             "</td>" + cell((*at)[c_ef]) + cell((*at)[c_em])
-                       : std::string("<td colspan=\"3\">not measured</td>");
-    h += "</tr>";
-  }
-  h += "</table>\n";
-
-  if (gnuplot.empty()) return h + kChartNotice;
-  const std::vector<std::string> svgs = report_support::draw(gnuplot, datablocks, charts);
-  for (std::size_t i = 0; i < charts.size(); ++i) h += figure(charts[i], svgs[i]);
-  return h;
-}
-
-}  // namespace
-
-std::string work_precision_section(const fs::path& dir, const std::string& gnuplot) {
-  std::string h;
-  std::error_code ec;
-  if (fs::is_regular_file(dir / "work-precision.csv", ec)) {
-    h += free_section(dir / "work-precision.csv", gnuplot);
-  }
-  if (fs::is_regular_file(dir / "driven-convergence.csv", ec)) {
-    h += driven_section(dir / "driven-convergence.csv", gnuplot);
-  }
-  return h.empty() ? h : "<h2 id=\"speed-against-accuracy\">Speed against accuracy</h2>\n" + h;
 }
 
 }  // namespace bd::studies

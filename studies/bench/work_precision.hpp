@@ -9,8 +9,8 @@
 /// a different formulation: driven-convergence.csv. Periodic sampling is the trapezoidal rule
 /// of a smooth periodic function, so the RMS converges faster than any power of the samples.
 ///
-/// The report's section "Speed against accuracy" (work_precision_section(), called by
-/// report_html()) charts either file found in the run's folder.
+/// The report's section "Speed against accuracy" (work_precision_section() in
+/// studies/report/report.hpp) charts either file found in the run's folder.
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -119,31 +119,25 @@ std::vector<DrivenConvergenceRow> driven_convergence(const Study& study,
 std::string work_precision_csv(const std::vector<WorkPrecisionRow>& rows);
 std::string driven_convergence_csv(const std::vector<DrivenConvergenceRow>& rows);
 
-/// What run_bench() did and where its files are.
+/// What a bench measured and where its file is.
 struct BenchResult {
-  RunResult run;                                  // the study run as `run` does it
+  RunResult run;                                  // the study run (run_bench() fills it)
   std::vector<WorkPrecisionRow> free_rows;        // free scenes
   std::vector<DrivenConvergenceRow> driven_rows;  // driven scenes
   std::filesystem::path csv;                      // work-precision.csv or driven-convergence.csv
   std::filesystem::path report;                   // report.html (empty when it was not written)
 };
 
-/// `balance-design bench`: removes the folder's earlier work-precision.csv and
-/// driven-convergence.csv, runs the study as run_study() does (so the folder is complete), then
-/// measures (work_precision() or driven_convergence()), writes the CSV under a temporary name
-/// renamed into place, and rewrites report.html (write_report()), now with its section "Speed
-/// against accuracy". A report that cannot be written is one warning line on stderr.
-/// @throws bd::InputError as run_study() and for invalid options.
-/// @throws std::runtime_error if a file cannot be written.
-BenchResult run_bench(const Study& study, const std::filesystem::path& out_dir,
-                      const BenchOptions& options);
+/// Measures the study's scene (work_precision() or driven_convergence()) and writes
+/// work-precision.csv or driven-convergence.csv into out_dir, under a temporary name renamed
+/// into place. (run_bench() in studies/studies.hpp runs the study first and writes the page.)
+/// @throws bd::InputError for invalid options.
+/// @throws std::runtime_error if the file cannot be written.
+BenchResult write_bench(const Study& study, const std::filesystem::path& out_dir,
+                        const BenchOptions& options);
 
-/// The report's "Speed against accuracy" section (HTML, starting with an <h2>) built from
-/// dir/work-precision.csv or dir/driven-convergence.csv: log-log charts drawn by `gnuplot`
-/// (free: CPU time against the final-time error, one chart per formulation with a line per
-/// integrator; driven: RMS error and CPU time against samples per revolution) and a compact
-/// table. Without gnuplot, the table and a notice. Empty when neither file exists.
-/// @throws std::runtime_error if a file cannot be read or gnuplot fails.
-std::string work_precision_section(const std::filesystem::path& dir, const std::string& gnuplot);
+/// Removes out_dir's work-precision.csv and driven-convergence.csv, so a page never shows the
+/// measurements of an earlier bench.
+void remove_bench_files(const std::filesystem::path& out_dir);
 
 }  // namespace bd::studies

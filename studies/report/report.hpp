@@ -34,4 +34,24 @@ std::string linkage_tables_html(const Study& study);
 /// @throws std::runtime_error as report_html(), or if the file cannot be written.
 std::filesystem::path write_report(const Study& study, const std::filesystem::path& dir);
 
+/// The sweep's report.html text, built from out_dir's sweep.csv and sweep.json: the study's
+/// inputs and design, the counts and failed points, and charts of every metric against the
+/// parameter (one parameter), heat maps (two parameters on a grid) or coloured scatter plots
+/// (two parameters, random or LHS), and each metric against each parameter (more than two).
+/// Without gnuplot (empty `gnuplot`) the page has the tables and says the charts need it.
+/// @throws std::runtime_error if a file cannot be read or gnuplot fails.
+std::string sweep_report_html(const Study& study, const std::filesystem::path& dir,
+                              const std::string& gnuplot);
+/// Writes dir/report.html (sweep_report_html() with find_gnuplot()) under a temporary name
+/// renamed into place, and returns its path.
+std::filesystem::path write_sweep_report(const Study& study, const std::filesystem::path& dir);
+
+/// The report's "Speed against accuracy" section (HTML, starting with an <h2>) built from
+/// dir/work-precision.csv or dir/driven-convergence.csv: log-log charts drawn by `gnuplot`
+/// (free: CPU time against the final-time error, one chart per formulation with a line per
+/// integrator; driven: RMS error and CPU time against samples per revolution) and a compact
+/// table. Without gnuplot, the table and a notice. Empty when neither file exists.
+/// @throws std::runtime_error if a file cannot be read or gnuplot fails.
+std::string work_precision_section(const std::filesystem::path& dir, const std::string& gnuplot);
+
 }  // namespace bd::studies

@@ -12,6 +12,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "studies/run/files.hpp"
+
 namespace bd::studies::report_support {
 
 namespace fs = std::filesystem;
@@ -19,163 +21,29 @@ namespace fs = std::filesystem;
 // ---------------------------------------------------------------------------------------------
 // reading the run's files back
 
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read " + p.string());
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-namespace {
-
-class JsonParser {
- public:
-  JsonParser(const std::string& text, std::string name) : s_(text), name_(std::move(name)) {}
-  Json parse() {
-    Json v = value();
-    space();
-    if (i_ != s_.size()) fail("trailing characters");
-    return v;
-  }
-
- private:
-  [[noreturn]] void fail(const char* what) const {
-    throw std::runtime_error(name_ + ": not valid JSON (" + what + " at byte " +
-                             std::to_string(i_) + ")");
-  }
-  void space() {
-    while (i_ < s_.size() && std::strchr(" \t\r\n", s_[i_]) != nullptr) ++i_;
-  }
-  bool eat(char c) {
-    space();
-    if (i_ < s_.size() && s_[i_] == c) {
-      ++i_;
-      return true;
-    }
-    return false;
-  }
-  std::string string_body() {
-    if (!eat('"')) fail("expected a string");
-    std::string out;
-    while (i_ < s_.size() && s_[i_] != '"') {
-      char c = s_[i_++];
-      if (c == '\\') {
-        if (i_ >= s_.size()) fail("bad escape");
-        const char e = s_[i_++];
-        switch (e) {
-          case 'n':
-            out += '\n';
-            break;
-          case 't':
-            out += '\t';
-            break;
-          case 'r':
-            out += '\r';
-            break;
-          case 'b':
-            out += '\b';
-            break;
-          case 'f':
-            out += '\f';
-            break;
-          case 'u': {
-            if (i_ + 4 > s_.size()) fail("bad escape");
-            const unsigned code = static_cast<unsigned>(std::stoul(s_.substr(i_, 4), nullptr, 16));
-            i_ += 4;
-            if (code < 0x80) {
-              out += static_cast<char>(code);
-            } else {
-              out += '?';  // summary.json escapes control characters only
-            }
-            break;
-          }
-          default:
-            out += e;
-        }
-      } else {
-        out += c;
-      }
-    }
-    if (i_ >= s_.size()) fail("unterminated string");
-    ++i_;
-    return out;
-  }
-  Json value() {
-    space();
-    if (i_ >= s_.size()) fail("unexpected end");
-    Json v;
-    const char c = s_[i_];
-    if (c == '{') {
-      ++i_;
-      v.kind = Json::Kind::kObject;
-      if (eat('}')) return v;
-      do {
-        std::string key = string_body();
-        if (!eat(':')) fail("expected ':'");
-        v.fields.emplace_back(std::move(key), value());
-      } while (eat(','));
-      if (!eat('}')) fail("expected '}'");
-    } else if (c == '[') {
-      ++i_;
-      v.kind = Json::Kind::kArray;
-      if (eat(']')) return v;
-      do v.items.push_back(value());
-      while (eat(','));
-      if (!eat(']')) fail("expected ']'");
-    } else if (c == '"') {
-      v.kind = Json::Kind::kString;
-      v.text = string_body();
-    } else if (s_.compare(i_, 4, "null") == 0) {
-      i_ += 4;
-    } else if (s_.compare(i_, 4, "true") == 0 || s_.compare(i_, 5, "false") == 0) {
-      v.kind = Json::Kind::kBool;
-      v.text = s_[i_] == 't' ? "true" : "false";
-      i_ += v.text.size();
-    } else {
-      const std::size_t start = i_;
-      while (i_ < s_.size() && std::strchr("+-0123456789.eE", s_[i_]) != nullptr) ++i_;
-      if (i_ == start) fail("unexpected character");
-      v.kind = Json::Kind::kNumber;
-      v.text = s_.substr(start, i_ - start);
-    }
-    return v;
-  }
-
-  const std::string& s_;
-  std::string name_;
-  std::size_t i_ = 0;
-};
-
-}  // namespace
-
 Json parse_json(const std::string& text, const std::string& name) {
-  return JsonParser(text, name).parse();
+  try {
+    return Json::parse(text);
+  } catch (const Json::exception& e) {
+    throw std::runtime_error(name + ": not valid JSON (" + e.what() + ")");
+  }
 }
 
-std::vector<std::string> csv_fields(const std::string& line) {
-  std::vector<std::string> out(1);
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        out.back() += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        out.back() += c;
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      out.emplace_back();
-    } else if (c != '\r') {
-      out.back() += c;
-    }
-  }
-  return out;
+const Json* member(const Json& j, const std::string& key) {
+  if (!j.is_object()) return nullptr;
+  const auto it = j.find(key);
+  return it == j.end() ? nullptr : &*it;
+}
+
+std::string text(const Json& v) {
+  if (v.is_string()) return v.get<std::string>();
+  if (v.is_null()) return "";
+  return v.dump();
+}
+
+std::string text(const Json& j, const std::string& key) {
+  const Json* v = member(j, key);
+  return v ? text(*v) : std::string();
 }
 
 Csv read_csv(const fs::path& p) {
@@ -242,14 +110,14 @@ std::string num_cell(const std::string& written) {
 // an object as a two-column table, an array of objects as a table with a column per key
 std::string json_table(const Json& v) {
   std::string h = "<table>";
-  if (v.kind == Json::Kind::kObject) {
-    for (const auto& [k, x] : v.fields) {
+  if (v.is_object()) {
+    for (const auto& [k, x] : v.items()) {
       h += "<tr><th>" + esc(k) + "</th>" + json_cell(x) + "</tr>";
     }
   } else {
     std::vector<std::string> keys;
-    for (const Json& item : v.items) {
-      for (const auto& [k, x] : item.fields) {
+    for (const Json& item : v) {
+      for (const auto& [k, x] : item.items()) {
         bool seen = false;
         for (const std::string& s : keys) seen = seen || s == k;
         if (!seen) keys.push_back(k);
@@ -258,10 +126,10 @@ std::string json_table(const Json& v) {
     h += "<tr>";
     for (const std::string& k : keys) h += "<th>" + esc(k) + "</th>";
     h += "</tr>";
-    for (const Json& item : v.items) {
+    for (const Json& item : v) {
       h += "<tr>";
       for (const std::string& k : keys) {
-        const Json* x = item.get(k);
+        const Json* x = member(item, k);
         h += x ? json_cell(*x) : "<td></td>";
       }
       h += "</tr>";
@@ -271,32 +139,20 @@ std::string json_table(const Json& v) {
 }
 
 std::string json_cell(const Json& v) {
-  switch (v.kind) {
-    case Json::Kind::kNull:
-      return "<td>&ndash;</td>";
-    case Json::Kind::kNumber:
-      return num_cell(v.text);
-    case Json::Kind::kBool:
-    case Json::Kind::kString:
-      return "<td>" + esc(v.text) + "</td>";
-    case Json::Kind::kObject:
-      return "<td>" + json_table(v) + "</td>";
-    case Json::Kind::kArray: {
-      if (v.items.empty()) return "<td>none</td>";
-      bool objects = true;
-      for (const Json& x : v.items) objects = objects && x.kind == Json::Kind::kObject;
-      if (objects) return "<td>" + json_table(v) + "</td>";
-      std::string s;
-      for (const Json& x : v.items) {
-        if (x.kind == Json::Kind::kObject || x.kind == Json::Kind::kArray) continue;
-        s +=
-            (s.empty() ? "" : ", ") +
-            esc(x.kind == Json::Kind::kNumber ? fmt(std::strtod(x.text.c_str(), nullptr)) : x.text);
-      }
-      return "<td>" + s + "</td>";
-    }
+  if (v.is_null()) return "<td>&ndash;</td>";
+  if (v.is_number()) return num_cell(text(v));
+  if (v.is_boolean() || v.is_string()) return "<td>" + esc(text(v)) + "</td>";
+  if (v.is_object()) return "<td>" + json_table(v) + "</td>";
+  if (v.empty()) return "<td>none</td>";
+  bool objects = true;
+  for (const Json& x : v) objects = objects && x.is_object();
+  if (objects) return "<td>" + json_table(v) + "</td>";
+  std::string s;
+  for (const Json& x : v) {
+    if (x.is_structured()) continue;
+    s += (s.empty() ? "" : ", ") + esc(x.is_number() ? fmt(x.get<double>()) : text(x));
   }
-  return "<td></td>";
+  return "<td>" + s + "</td>";
 }
 
 std::string data_files_html(const fs::path& dir, const std::vector<std::string>& names) {

@@ -3,43 +3,31 @@
 /// work-precision runs): reading a run's data files back, HTML escaping and tables, and drawing
 /// charts with gnuplot into inline SVG. Internal to bd_studies.
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace bd::studies::report_support {
 
-/// The whole file at `p`. @throws std::runtime_error naming the file if it cannot be read.
-std::string read_file(const std::filesystem::path& p);
-
-/// A JSON value as summary.json writes it; numbers keep their text exactly as written.
-struct Json {
-  enum class Kind { kNull, kBool, kNumber, kString, kArray, kObject } kind = Kind::kNull;
-  std::string text;                                  // number as written, string, "true"/"false"
-  std::vector<Json> items;                           // array
-  std::vector<std::pair<std::string, Json>> fields;  // object, in file order
-
-  const Json* get(const std::string& key) const {
-    for (const auto& [k, v] : fields)
-      if (k == key) return &v;
-    return nullptr;
-  }
-  std::string str(const std::string& key) const {
-    const Json* v = get(key);
-    return v ? v->text : std::string();
-  }
-};
+/// A JSON document as summary.json and sweep.json hold it: objects keep their file order.
+using Json = nlohmann::ordered_json;
 /// Parses JSON text; `name` names it in errors. @throws std::runtime_error on malformed text.
 Json parse_json(const std::string& text, const std::string& name);
+/// The member `key` of an object, or null when `j` is no object or has no such member.
+const Json* member(const Json& j, const std::string& key);
+/// A value as text: a string's characters, a number's exact text (the shortest that reads back
+/// as the same double), "true"/"false", "" for null.
+std::string text(const Json& v);
+/// text() of member `key`, "" when there is none.
+std::string text(const Json& j, const std::string& key);
 
 /// A CSV file: its header's fields and its rows' fields as written (quoted fields unquoted).
 struct Csv {
   std::vector<std::string> header;
   std::vector<std::vector<std::string>> rows;
 };
-/// The fields of one CSV line (RFC 4180 quoting; a trailing '\r' is dropped).
-std::vector<std::string> csv_fields(const std::string& line);
-/// @throws std::runtime_error if the file cannot be read.
+/// @throws std::runtime_error if the file cannot be read (read_file(), studies/run/files.hpp).
 Csv read_csv(const std::filesystem::path& p);
 /// The numbers of a CSV row (an empty field is NaN).
 std::vector<double> numbers(const std::vector<std::string>& row);

@@ -1,5 +1,3 @@
-#include "studies/report/report.hpp"
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -16,10 +14,11 @@
 #include "core/fourbar/kinematics.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/principal_vectors.hpp"
-#include "studies/study/load_study.hpp"
+#include "studies/bench/work_precision.hpp"
+#include "studies/report/report.hpp"
 #include "studies/report/report_support.hpp"
 #include "studies/run/runner.hpp"
-#include "studies/bench/work_precision.hpp"
+#include "studies/study/load_study.hpp"
 
 namespace bd::studies {
 
@@ -268,17 +267,17 @@ namespace {
 // the run facts of summary.json (or of its balanced_run / optimized_run) as a table
 std::string run_table(const Json& run, const std::string& what) {
   std::string h = "<table>";
-  if (const Json* method = run.get("method")) {
-    h += "<tr><th>method</th><td><b>" + esc(method->str("used")) + "</b> (requested " +
-         esc(method->str("requested")) + ")<br>" + esc(method->str("reason")) + "</td></tr>";
+  if (const Json* method = member(run, "method")) {
+    h += "<tr><th>method</th><td><b>" + esc(text(*method, "used")) + "</b> (requested " +
+         esc(text(*method, "requested")) + ")<br>" + esc(text(*method, "reason")) + "</td></tr>";
   }
-  const bool ok = run.str("ok") == "true";
+  const bool ok = text(run, "ok") == "true";
   h += "<tr><th>status</th><td class=\"" + std::string(ok ? "good" : "bad") + "\">" +
-       esc(run.str("status")) + "</td></tr>";
-  h += "<tr><th>message</th><td>" + esc(run.str("message")) + "</td></tr>";
-  h += "<tr><th>samples</th><td>" + esc(run.str("samples")) + "</td></tr>";
-  h += "<tr><th>integrator steps, dynamics evaluations</th><td>" + esc(run.str("steps")) + ", " +
-       esc(run.str("rhs_evaluations")) + "</td></tr>";
+       esc(text(run, "status")) + "</td></tr>";
+  h += "<tr><th>message</th><td>" + esc(text(run, "message")) + "</td></tr>";
+  h += "<tr><th>samples</th><td>" + esc(text(run, "samples")) + "</td></tr>";
+  h += "<tr><th>integrator steps, dynamics evaluations</th><td>" + esc(text(run, "steps")) + ", " +
+       esc(text(run, "rhs_evaluations")) + "</td></tr>";
   if (!ok) {
     h += "<tr><td colspan=\"2\" class=\"bad\">The " + what +
          " simulation stopped early: the charts and metrics cover the samples computed.</td></tr>";
@@ -311,11 +310,11 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
 
   // the second design, if any
   std::string second, second_label, second_file;
-  if (summary.get("balanced_run") && fs::exists(dir / "balanced-timeseries.csv")) {
+  if (member(summary, "balanced_run") && fs::exists(dir / "balanced-timeseries.csv")) {
     second = "balanced";
     second_label = "balanced";
     second_file = "balanced-timeseries.csv";
-  } else if (summary.get("optimized_run") && fs::exists(dir / "optimized-timeseries.csv")) {
+  } else if (member(summary, "optimized_run") && fs::exists(dir / "optimized-timeseries.csv")) {
     second = "optimized";
     second_label = "optimised";
     second_file = "optimized-timeseries.csv";
@@ -323,7 +322,7 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
   const bool has_comparison = !second.empty() && fs::exists(dir / "comparison.csv");
   const bool has_pareto = fs::exists(dir / "pareto.csv");
 
-  const std::string name = summary.str("study").empty() ? study.name : summary.str("study");
+  const std::string name = text(summary, "study").empty() ? study.name : text(summary, "study");
   std::string h =
       "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
       "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
@@ -331,38 +330,39 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
       esc(name) + " &mdash; balance-design report</title>\n<style>" + kStyle +
       "</style>\n</head>\n<body>\n";
   h += "<h1>" + esc(name) + "</h1>\n<p>balance-design report of the study <code>" +
-       esc(summary.str("source").empty() ? std::string("(built in code)") : summary.str("source")) +
+       esc(text(summary, "source").empty() ? std::string("(built in code)")
+                                           : text(summary, "source")) +
        "</code>. Every number below is read from the data files of this folder; hover over a "
        "number to see it as written there.</p>\n";
 
   // status first: whether the run can be trusted
-  const bool ok = summary.str("ok") == "true";
+  const bool ok = text(summary, "ok") == "true";
   h += "<h2>Simulation</h2>\n";
   if (!ok) {
-    h += "<p class=\"notice bad\">The simulation stopped early: " + esc(summary.str("message")) +
+    h += "<p class=\"notice bad\">The simulation stopped early: " + esc(text(summary, "message")) +
          "</p>\n";
   }
   h += run_table(summary, "original design's");
-  if (const Json* scene = summary.get("scene")) {
+  if (const Json* scene = member(summary, "scene")) {
     h += "<h3>Scene</h3>" + json_table(*scene);
-    h += "<p>Integrator relative tolerance " + esc(summary.str("tolerance")) + ".</p>\n";
+    h += "<p>Integrator relative tolerance " + esc(text(summary, "tolerance")) + ".</p>\n";
   }
 
   h += "<h2>Linkage</h2>\n" + linkage_tables_html(study);
 
   // metrics, side by side with the second design's when there is one
   h += "<h2>Metrics</h2>\n<table><tr><th>metric</th><th>original</th>";
-  const Json* metrics = summary.get("metrics");
-  const Json* second_metrics = second.empty() ? nullptr : summary.get(second + "_metrics");
-  const Json* reduction = summary.get("reduction");
+  const Json* metrics = member(summary, "metrics");
+  const Json* second_metrics = second.empty() ? nullptr : member(summary, second + "_metrics");
+  const Json* reduction = member(summary, "reduction");
   if (second_metrics) h += "<th>" + esc(second_label) + "</th><th>ratio</th>";
   h += "</tr>";
   if (metrics) {
-    for (const auto& [k, v] : metrics->fields) {
+    for (const auto& [k, v] : metrics->items()) {
       h += "<tr><th>" + esc(k) + "</th>" + json_cell(v);
       if (second_metrics) {
-        const Json* s = second_metrics->get(k);
-        const Json* r = reduction ? reduction->get(k) : nullptr;
+        const Json* s = member(*second_metrics, k);
+        const Json* r = reduction ? member(*reduction, k) : nullptr;
         h += (s ? json_cell(*s) : "<td></td>") + (r ? json_cell(*r) : "<td></td>");
       }
       h += "</tr>";
@@ -559,11 +559,11 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
     const char* section = second == "balanced" ? "balance" : "optimize";
     h += std::string("<h2>") + (second == "balanced" ? "Balanced design" : "Optimised design") +
          "</h2>\n";
-    if (const Json* s = summary.get(section)) h += json_table(*s);
-    if (const Json* run = summary.get(second + "_run")) {
+    if (const Json* s = member(summary, section)) h += json_table(*s);
+    if (const Json* run = member(summary, second + "_run")) {
       h += "<h3>Its simulation (same scene)</h3>" + run_table(*run, second_label + " design's");
     }
-  } else if (const Json* s = summary.get("optimize")) {
+  } else if (const Json* s = member(summary, "optimize")) {
     h +=
         "<h2>Optimisation</h2>\n<p class=\"notice bad\">No optimum was found.</p>" + json_table(*s);
   }

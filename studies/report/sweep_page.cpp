@@ -172,15 +172,15 @@ Sweep load_sweep(const Study& study, const fs::path& dir) {
   }
   Sweep s;
   s.info = parse_json(read_file(json_file), json_file.string());
-  s.design = s.info.str("design");
-  if (const Json* ps = s.info.get("parameters")) {
-    for (const Json& p : ps->items) {
+  s.design = text(s.info, "design");
+  if (const Json* ps = member(s.info, "parameters")) {
+    for (const Json& p : (*ps)) {
       Parameter q;
-      q.path = p.str("path");
-      q.log_scale = p.str("scale") == "log";
-      if (const Json* values = p.get("values")) {
-        for (const Json& v : values->items) {
-          if (const auto d = number(v.text)) q.values.push_back(*d);
+      q.path = text(p, "path");
+      q.log_scale = text(p, "scale") == "log";
+      if (const Json* values = member(p, "values")) {
+        for (const Json& v : (*values)) {
+          if (const auto d = number(text(v))) q.values.push_back(*d);
         }
       }
       s.params.push_back(std::move(q));
@@ -239,12 +239,12 @@ Sweep load_sweep(const Study& study, const fs::path& dir) {
 std::string td(const std::string& html) { return "<td>" + html + "</td>"; }
 
 std::string status_section(const Sweep& s, const fs::path& dir) {
-  const std::string status = s.info.str("status");
+  const std::string status = text(s.info, "status");
   const std::size_t rows = s.csv.rows.size();
   std::size_t failed = 0;
   for (std::size_t r = 0; r < rows; ++r) failed += s.status(r) != "ok";
-  const std::string points = s.info.str("points");
-  const std::string source = s.info.str("source");
+  const std::string points = text(s.info, "points");
+  const std::string source = text(s.info, "source");
   const std::string resume = "<code>balance-design run " +
                              esc(source.empty() ? std::string("STUDY.yaml") : source) + " --out " +
                              esc(dir.string()) + " --resume</code>";
@@ -278,24 +278,23 @@ std::string status_section(const Sweep& s, const fs::path& dir) {
                                                        {"failed", "failed (sweep.json)"},
                                                        {"elapsed_s", "elapsed [s]"}};
   for (const auto& [key, what] : facts) {
-    if (const Json* v = s.info.get(key))
+    if (const Json* v = member(s.info, key))
       h += std::string("<tr><th>") + what + "</th>" + json_cell(*v) + "</tr>";
   }
   return h + "</table>\n";
 }
 
 std::string values_text(const Json& values) {
-  const std::size_t n = values.items.size();
+  const std::size_t n = values.size();
   std::string t;
   for (std::size_t i = 0; i < n; ++i) {
     if (n > 12 && i == 6) {
       t += ", &hellip;";
       i = n - 3;
     }
-    const auto v = number(values.items[i].text);
-    t += (t.empty() ? "" : ", ") +
-         std::string("<span title=\"" + esc(values.items[i].text) + "\">") +
-         esc(v ? fmt(*v) : values.items[i].text) + "</span>";
+    const auto v = number(text(values[i]));
+    t += (t.empty() ? "" : ", ") + std::string("<span title=\"" + esc(text(values[i])) + "\">") +
+         esc(v ? fmt(*v) : text(values[i])) + "</span>";
   }
   if (n > 12) t += " (" + std::to_string(n) + " values)";
   return t;
@@ -305,26 +304,26 @@ std::string design_section(const Sweep& s) {
   const Json& j = s.info;
   std::string h = "<h2>Design</h2>\n<table>";
   h += "<tr><th>design</th><td>" + esc(s.design) + "</td></tr>";
-  if (s.design != "grid" && j.get("seed"))
-    h += "<tr><th>seed</th>" + json_cell(*j.get("seed")) + "</tr>";
-  if (const Json* v = j.get("points")) h += "<tr><th>points</th>" + json_cell(*v) + "</tr>";
-  if (const Json* v = j.get("threads")) h += "<tr><th>threads</th>" + json_cell(*v) + "</tr>";
-  if (const Json* v = j.get("fingerprint")) {
-    h += "<tr><th>study file fingerprint</th><td><code>" + esc(v->text) + "</code></td></tr>";
+  if (s.design != "grid" && member(j, "seed"))
+    h += "<tr><th>seed</th>" + json_cell(*member(j, "seed")) + "</tr>";
+  if (const Json* v = member(j, "points")) h += "<tr><th>points</th>" + json_cell(*v) + "</tr>";
+  if (const Json* v = member(j, "threads")) h += "<tr><th>threads</th>" + json_cell(*v) + "</tr>";
+  if (const Json* v = member(j, "fingerprint")) {
+    h += "<tr><th>study file fingerprint</th><td><code>" + esc(text(*v)) + "</code></td></tr>";
   }
   h += "</table>\n<table><tr><th>parameter (path in the study file)</th><th>scale</th>"
        "<th>from</th><th>to</th><th>values</th></tr>";
-  if (const Json* ps = j.get("parameters")) {
-    for (const Json& p : ps->items) {
-      const Json* from = p.get("from");
-      const Json* to = p.get("to");
-      const Json* values = p.get("values");
-      h += "<tr><td><code>" + esc(p.str("path")) + "</code></td><td>" + esc(p.str("scale")) +
+  if (const Json* ps = member(j, "parameters")) {
+    for (const Json& p : (*ps)) {
+      const Json* from = member(p, "from");
+      const Json* to = member(p, "to");
+      const Json* values = member(p, "values");
+      h += "<tr><td><code>" + esc(text(p, "path")) + "</code></td><td>" + esc(text(p, "scale")) +
            "</td>" + (from ? json_cell(*from) : "<td></td>") + (to ? json_cell(*to) : "<td></td>") +
            td(values ? values_text(*values)
                      : std::string(s.design == "lhs" ? "Latin hypercube draws"
                                                      : "uniform random draws") +
-                           (p.str("scale") == "log" ? " (uniform in log)" : "")) +
+                           (text(p, "scale") == "log" ? " (uniform in log)" : "")) +
            "</tr>";
     }
   }
@@ -834,8 +833,8 @@ Charts sweep_charts(const Sweep& s) {
 
 std::string sweep_report_html(const Study& study, const fs::path& dir, const std::string& gnuplot) {
   const Sweep s = load_sweep(study, dir);
-  const std::string name = s.info.str("study").empty() ? study.name : s.info.str("study");
-  const std::string source = s.info.str("source");
+  const std::string name = text(s.info, "study").empty() ? study.name : text(s.info, "study");
+  const std::string source = text(s.info, "source");
 
   std::string h =
       "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"

@@ -9,9 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "core/metrics.hpp"
 #include "core/fourbar/simulate.hpp"
+#include "core/metrics.hpp"
 #include "optimize/optimize.hpp"
+#include "studies/run/files.hpp"
 #include "studies/study/study.hpp"
 
 namespace bd::studies {
@@ -62,13 +63,14 @@ struct OptimizedRun {
 
 /// What a run did and where its files are.
 struct RunResult {
-  MethodChoice method;                  // formulation used, and why (the original design)
-  core::Trajectory trajectory;          // every sample computed, and the simulation's status
-  core::Metrics metrics;                // over the samples computed
-  std::filesystem::path timeseries;     // out_dir/timeseries.csv
-  std::filesystem::path summary;        // out_dir/summary.json
-  std::optional<BalancedRun> balanced;  // set when the study has a balance section
+  MethodChoice method;                    // formulation used, and why (the original design)
+  core::Trajectory trajectory;            // every sample computed, and the simulation's status
+  core::Metrics metrics;                  // over the samples computed
+  std::filesystem::path timeseries;       // out_dir/timeseries.csv
+  std::filesystem::path summary;          // out_dir/summary.json
+  std::optional<BalancedRun> balanced;    // set when the study has a balance section
   std::optional<OptimizedRun> optimized;  // set when the study has an optimize section
+  std::vector<std::string> warnings;      // what went wrong besides the run (the report page)
   /// True when every simulation ran to the end (the original's, the balanced design's, the
   /// optimum's) and an optimize study found its optimum.
   bool ok() const {
@@ -98,48 +100,31 @@ struct ComparisonRow {
 /// optimum.
 std::vector<ComparisonRow> comparison(const Study& study, const RunResult& result);
 
-/// What run_study() computes, without writing anything: simulates the study's scene, and with a
-/// balance section the balanced design, with an optimize section solves the design problem and
-/// simulates the optimum (each as run_study() describes). The result's file paths stay empty.
-/// Pure: the same study gives the same result, bit for bit, and the call is safe from several
-/// threads at once (run_sweep() computes its points so). Ipopt solves are serialised by a
-/// mutex: Debian 12's Ipopt 3.11.9 calls MUMPS, which is not thread-safe, and has no lock of its
-/// own (Ipopt takes one around MUMPS from 3.14 on).
+/// What run_study() (studies/studies.hpp) computes, without writing anything: simulates the study's
+/// scene, and with a balance section the balanced design, with an optimize section solves the
+/// design problem and simulates the optimum (each as run_study() describes). The result's file
+/// paths stay empty. Pure: the same study gives the same result, bit for bit, and the call is safe
+/// from several threads at once (run_sweep() computes its points so). Ipopt solves are serialised
+/// by a mutex: Debian 12's Ipopt 3.11.9 calls MUMPS, which is not thread-safe, and has no lock of
+/// its own (Ipopt takes one around MUMPS from 3.14 on).
 /// @throws bd::InputError as run_study().
 RunResult compute_study(const Study& study);
 
-/// Writes the files of a computed run into out_dir as run_study() does (creating out_dir when
-/// needed, summary.json last, then report.html), and sets the result's file paths.
+/// Writes the data files of a computed run into out_dir (creating out_dir when needed) and sets
+/// the result's file paths. `timeseries.csv` and `summary.json`; each file is written to a
+/// temporary file in out_dir and renamed into place, so no half-written output is ever left.
+/// When the simulation stopped early, every sample computed is written and summary.json records
+/// the status and message. A study with a balance section also writes the balanced design's
+/// `balanced-timeseries.csv`, `balanced.yaml` (study_yaml() of the balanced design) and
+/// `comparison.csv`; summary.json gets `balance`, `balanced_run`, `balanced_metrics` and
+/// `reduction`. A study with an optimize section whose optimum was found writes
+/// `optimized-timeseries.csv`, `optimized.yaml`, `comparison.csv` and, with optimize.pareto,
+/// `pareto.csv`; summary.json gets `optimize`, `optimized_run`, `optimized_metrics` and
+/// `reduction`. When the optimiser found no design only the original's files are written and
+/// summary.json says why. summary.json is always written last: its presence means the other
+/// files are complete.
 /// @throws std::runtime_error if an output file cannot be written (the message names it).
 void write_run(const Study& study, RunResult& result, const std::filesystem::path& out_dir);
-
-/// Writes `text` to `file` under a temporary name in its directory renamed into place, so a
-/// reader sees the whole file or none.
-/// @throws std::runtime_error if the file cannot be written (the message names it).
-void write_text_file(const std::string& text, const std::filesystem::path& file);
-
-/// Simulates the study's scene (core::simulate_free or core::simulate_driven) and writes
-/// `timeseries.csv` and `summary.json` into out_dir, creating out_dir when needed (and only after
-/// the simulation, so an invalid study creates nothing). Each file is written to a temporary
-/// file in out_dir and renamed into place, so no half-written output is ever left. When the
-/// simulation stops early, every sample computed so far is written and summary.json records the
-/// status and message; the result's ok() is then false.
-/// A study with a balance section also simulates its balanced design (balanced_study(), its own
-/// choose_method()) in the same scene and writes `balanced-timeseries.csv`, `balanced.yaml`
-/// (study_yaml() of the balanced design) and `comparison.csv`; summary.json gets `balance`,
-/// `balanced_run`, `balanced_metrics` and `reduction`.
-/// A study with an optimize section solves its design_problem() with optimize() (not when the
-/// original's simulation stopped early), simulates the optimum (optimized_study(), its own
-/// choose_method()) and writes `optimized-timeseries.csv`, `optimized.yaml` and `comparison.csv`;
-/// with optimize.pareto also pareto_front() as `pareto.csv`. summary.json gets `optimize`,
-/// `optimized_run`, `optimized_metrics` and `reduction`. When the optimiser finds no design
-/// (infeasible or failed) only the original's files are written, summary.json says why, and the
-/// result's optimized->failed() is true. summary.json is always written last.
-/// It is compute_study() followed by write_run().
-/// @throws bd::InputError if the scene or options are invalid (core's checks), or if an optimize
-///         study's problem is (the optimize layer's checks; load_study() has made them already).
-/// @throws std::runtime_error if an output file cannot be written (the message names it).
-RunResult run_study(const Study& study, const std::filesystem::path& out_dir);
 
 /// Writes the samples as timeseries.csv content (header, one row per sample, "%.17g").
 /// @throws std::runtime_error if the file cannot be written.
@@ -164,8 +149,5 @@ std::string optimized_yaml(const Study& study, const OptimizedRun& run);
 /// design variables' names, then one row per point ("%.17g"; numbers empty for a point where no
 /// design was found). Precondition: study.optimize->pareto is set.
 std::string pareto_csv(const Study& study, const OptimizedRun& run);
-
-/// `text` as a JSON string literal, quotes included, with every character that needs it escaped.
-std::string json_string(const std::string& text);
 
 }  // namespace bd::studies

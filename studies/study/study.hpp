@@ -5,11 +5,11 @@
 #include <string>
 #include <variant>
 
+#include "balance/synthesis.hpp"
 #include "core/fourbar/dynamics.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/simulate.hpp"
 #include "optimize/problem.hpp"
-#include "balance/synthesis.hpp"
 #include "studies/study/optimize_request.hpp"
 #include "studies/study/sweep_request.hpp"
 

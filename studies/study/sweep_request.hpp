@@ -27,7 +27,7 @@ struct SweepParameter {
   /// Grid: the values, in order (given as a list, or from `from` to `to` in `count` steps).
   /// Random and LHS: empty.
   std::vector<double> values;
-  double from{}, to{};    // the range (random, LHS; and grid when given by from/to/count)
+  double from{}, to{};     // the range (random, LHS; and grid when given by from/to/count)
   bool log_scale = false;  // from/to spaced (grid) or drawn (random, LHS) uniformly in log;
                            // then 0 < from < to
   int line{}, column{};    // where the parameter is given in the study file (1-based)
@@ -37,9 +37,9 @@ struct SweepParameter {
 struct SweepRequest {
   SweepDesign design = SweepDesign::kGrid;
   std::vector<SweepParameter> parameters;  // >= 1, paths distinct
-  int points{};             // random and LHS: how many (>= 1); grid: the product of the counts
-  std::uint64_t seed = 1;   // random and LHS: the same seed gives the same points everywhere
-  int threads = 0;          // parallel runs; 0: one per core
+  int points{};            // random and LHS: how many (>= 1); grid: the product of the counts
+  std::uint64_t seed = 1;  // random and LHS: the same seed gives the same points everywhere
+  int threads = 0;         // parallel runs; 0: one per core
   /// The study file's text as loaded: each point's study is this text with the parameters set
   /// (point_study()), so errors at a point name places in the user's file.
   std::string study_text;

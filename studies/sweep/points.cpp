@@ -1,7 +1,5 @@
 // The points of a sweep design and the study at each point. run_sweep() and the CSV columns are
 // in sweep_runner.cpp, the report in sweep_report.cpp.
-#include "studies/sweep/sweep.hpp"
-
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -13,6 +11,7 @@
 
 #include "studies/study/load_study.hpp"
 #include "studies/study/load_study_internal.hpp"
+#include "studies/sweep/sweep.hpp"
 
 namespace bd::studies {
 

@@ -4,6 +4,7 @@
 /// row per point to sweep.csv as it goes, so an interrupted sweep resumes where it stopped.
 #include <atomic>
 #include <filesystem>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -42,12 +43,13 @@ Study point_study(const Study& base, std::span<const double> values);
 /// (line breaks become spaces), empty when ok.
 std::vector<std::string> sweep_columns(const Study& study);
 
-/// How run_sweep() shows progress on stderr.
-enum class SweepProgress {
-  kAuto,   // a bar with rate and ETA redrawn in place when stderr is a terminal, else kLines
-  kBar,    // the bar
-  kLines,  // a plain line every 10 s and at the end
-  kNone,
+/// Where a sweep stands, for a progress display.
+struct SweepProgress {
+  int done{};          // rows in sweep.csv (resumed ones included)
+  int points{};        // in the design
+  int resumed{};       // rows kept from an earlier run
+  double elapsed_s{};  // since this run started [s]
+  bool finished{};     // the last call of the run
 };
 
 struct SweepOptions {
@@ -55,48 +57,37 @@ struct SweepOptions {
   /// after checking that they belong to this study and design, and run the missing points.
   bool resume = false;
   int threads = 0;  // > 0 overrides the request's
-  SweepProgress progress = SweepProgress::kAuto;
+  /// Called on the calling thread after every row appended to sweep.csv, and once more at the
+  /// end with `finished` set (a display draws from it; may be empty).
+  std::function<void(const SweepProgress&)> progress;
   /// When it becomes true (e.g. set by a SIGINT handler), no new point is started; the points
-  /// running finish and are written, and run_sweep() returns with interrupted set.
+  /// running finish and are written, and write_sweep() returns with interrupted set.
   const std::atomic<bool>* stop = nullptr;
 };
 
 struct SweepResult {
-  int points{};     // in the design
-  int done{};       // rows in sweep.csv at the end (resumed ones included)
-  int resumed{};    // rows kept from an earlier run
-  int failed{};     // rows whose status is not ok
+  int points{};   // in the design
+  int done{};     // rows in sweep.csv at the end (resumed ones included)
+  int resumed{};  // rows kept from an earlier run
+  int failed{};   // rows whose status is not ok
   bool interrupted = false;
-  std::filesystem::path csv;      // out_dir/sweep.csv
-  std::filesystem::path summary;  // out_dir/sweep.json
+  std::filesystem::path csv;          // out_dir/sweep.csv
+  std::filesystem::path summary;      // out_dir/sweep.json
+  std::vector<std::string> warnings;  // what went wrong besides the points (the report page)
   bool complete() const { return done == points; }
 };
 
 /// Runs `study` at every point of its sweep, `threads` at a time, and writes into out_dir:
 /// sweep.csv (header sweep_columns(), one row per point in point order, each row appended and
-/// flushed once it and every earlier point are done, numbers "%.17g"), sweep.json (the study,
-/// the design, every parameter and the counts; rewritten at the start and at the end), and
-/// report.html (write_sweep_report()). A point's failure is its row's status, never the
-/// sweep's.
+/// flushed once it and every earlier point are done, numbers "%.17g") and sweep.json (the study,
+/// the design, every parameter and the counts; rewritten at the start and at the end). A point's
+/// failure is its row's status, never the sweep's. (The page comes from write_sweep_report();
+/// run_sweep() in studies/studies.hpp does both.)
 /// @throws bd::InputError if out_dir holds a sweep that cannot be resumed (another study or
 ///         design, or rows that do not match the design), or holds an unfinished sweep and
 ///         options.resume is false (the message says to pass --resume).
 /// @throws std::runtime_error if a file cannot be written.
-/// Test hook: with BD_SWEEP_KILL_AFTER_ROWS=N in the environment the process kills itself
-/// (SIGKILL) right after sweep.csv holds N rows (tests of resuming an interrupted sweep).
-SweepResult run_sweep(const Study& study, const std::filesystem::path& out_dir,
-                      const SweepOptions& options = {});
-
-/// The sweep's report.html text, built from out_dir's sweep.csv and sweep.json: the study's
-/// inputs and design, the counts and failed points, and charts of every metric against the
-/// parameter (one parameter), heat maps (two parameters on a grid) or coloured scatter plots
-/// (two parameters, random or LHS), and each metric against each parameter (more than two).
-/// Without gnuplot (empty `gnuplot`) the page has the tables and says the charts need it.
-/// @throws std::runtime_error if a file cannot be read or gnuplot fails.
-std::string sweep_report_html(const Study& study, const std::filesystem::path& dir,
-                              const std::string& gnuplot);
-/// Writes dir/report.html (sweep_report_html() with find_gnuplot()) under a temporary name
-/// renamed into place, and returns its path.
-std::filesystem::path write_sweep_report(const Study& study, const std::filesystem::path& dir);
+SweepResult write_sweep(const Study& study, const std::filesystem::path& out_dir,
+                        const SweepOptions& options = {});
 
 }  // namespace bd::studies

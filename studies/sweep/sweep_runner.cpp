@@ -20,6 +20,7 @@
 #include <exception>
 #include <map>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -30,15 +31,14 @@
 
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
-#include "studies/report/report_support.hpp"
 #include "studies/run/runner.hpp"
 #include "studies/sweep/sweep.hpp"
 
 namespace bd::studies {
 
 namespace fs = std::filesystem;
-namespace rs = report_support;
 using Clock = std::chrono::steady_clock;
+using Json = nlohmann::ordered_json;
 
 namespace {
 
@@ -53,25 +53,6 @@ std::vector<double> metric_values(const core::Metrics& m) {
 
 // the statuses a row may have (sweep.hpp, sweep_columns())
 constexpr const char* kStatuses[] = {"ok", "stopped-early", "no-optimum", "bad-input", "error"};
-
-// a CSV field, quoted (RFC 4180) when it holds a comma, a quote or a line break
-std::string csv_field(const std::string& text) {
-  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
-  std::string q = "\"";
-  for (char c : text) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
-
-// a message as the last field of a row: on one line (so every row is one line of the file, which
-// resuming relies on), quoted unless empty
-std::string message_field(std::string message) {
-  if (message.empty()) return message;
-  std::replace(message.begin(), message.end(), '\n', ' ');
-  std::replace(message.begin(), message.end(), '\r', ' ');
-  std::string q = "\"";
-  for (char c : message) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
 
 std::string header_line(const Study& study) {
   std::string line;
@@ -171,7 +152,7 @@ PointRow point_row(const Study& base, int index, std::span<const double> values,
   }
   PointRow row;
   row.ok = status == "ok";
-  row.text = head + body + "," + status + "," + message_field(message) + "\n";
+  row.text = head + body + "," + status + "," + csv_line_field(message) + "\n";
   return row;
 }
 
@@ -184,31 +165,22 @@ std::pair<double, double> range_of(const SweepParameter& p, SweepDesign design) 
   return {*lo, *hi};
 }
 
-// the keys that say which sweep a folder holds (checked when resuming), without the braces
-std::string identity_json(const Study& study, int points) {
+// the keys that say which sweep a folder holds (checked when resuming)
+Json identity_json(const Study& study, int points) {
   const SweepRequest& req = *study.sweep;
-  std::string j;
-  j += "  \"fingerprint\": " + json_string(fingerprint(req.study_text)) + ",\n";
-  j += "  \"design\": " + json_string(to_string(req.design)) + ",\n";
-  j += "  \"seed\": " + std::to_string(req.seed) + ",\n";
-  j += "  \"points\": " + std::to_string(points) + ",\n";
-  j += "  \"parameters\": [\n";
-  for (std::size_t k = 0; k < req.parameters.size(); ++k) {
-    const SweepParameter& p = req.parameters[k];
+  Json parameters = Json::array();
+  for (const SweepParameter& p : req.parameters) {
     const auto [from, to] = range_of(p, req.design);
-    j += "    {\"path\": " + json_string(p.path) +
-         ", \"scale\": " + (p.log_scale ? "\"log\"" : "\"linear\"") +
-         ", \"from\": " + text::exact(from) + ", \"to\": " + text::exact(to);
-    if (req.design == SweepDesign::kGrid) {
-      j += ", \"values\": [";
-      for (std::size_t i = 0; i < p.values.size(); ++i)
-        j += (i ? ", " : "") + text::exact(p.values[i]);
-      j += "]";
-    }
-    j += std::string("}") + (k + 1 < req.parameters.size() ? ",\n" : "\n");
+    Json j = {
+        {"path", p.path}, {"scale", p.log_scale ? "log" : "linear"}, {"from", from}, {"to", to}};
+    if (req.design == SweepDesign::kGrid) j["values"] = p.values;
+    parameters.push_back(j);
   }
-  j += "  ],\n";
-  return j;
+  return {{"fingerprint", fingerprint(req.study_text)},
+          {"design", to_string(req.design)},
+          {"seed", req.seed},
+          {"points", points},
+          {"parameters", parameters}};
 }
 
 struct Counts {
@@ -218,66 +190,51 @@ struct Counts {
 };
 
 std::string sweep_json(const Study& study, int points, const Counts& c) {
-  char elapsed[32];
-  std::snprintf(elapsed, sizeof elapsed, "%.3f", c.elapsed_s);
-  std::string j = "{\n";
-  j += "  \"study\": " + json_string(study.name) + ",\n";
-  j += "  \"source\": " + json_string(study.source) + ",\n";
-  std::string id = identity_json(study, points);
-  // threads after points, as the docs list the keys
-  const std::size_t at = id.find("  \"parameters\"");
-  id.insert(at, "  \"threads\": " + std::to_string(c.threads) + ",\n");
-  j += id;
-  j += std::string("  \"status\": \"") + c.status + "\",\n";
-  j += "  \"done\": " + std::to_string(c.done) + ", \"resumed\": " + std::to_string(c.resumed) +
-       ", \"failed\": " + std::to_string(c.failed) + ",\n";
-  j += std::string("  \"elapsed_s\": ") + elapsed + "\n";
-  return j + "}\n";
+  const Json identity = identity_json(study, points);
+  Json j = {{"study", study.name}, {"source", study.source}};
+  for (const auto& [key, value] : identity.items()) {
+    if (key == "parameters") j["threads"] = c.threads;  // threads after points, as the docs list
+    j[key] = value;
+  }
+  j["status"] = c.status;
+  j["done"] = c.done;
+  j["resumed"] = c.resumed;
+  j["failed"] = c.failed;
+  j["elapsed_s"] = std::round(c.elapsed_s * 1000) / 1000;  // to the millisecond
+  return j.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
 // --- the folder's earlier sweep --------------------------------------------------------------
 
-// two JSON values alike (numbers compared as written)
-bool same_json(const rs::Json& a, const rs::Json& b) {
-  if (a.kind != b.kind || a.text != b.text || a.items.size() != b.items.size() ||
-      a.fields.size() != b.fields.size()) {
-    return false;
-  }
-  for (std::size_t i = 0; i < a.items.size(); ++i) {
-    if (!same_json(a.items[i], b.items[i])) return false;
-  }
-  for (std::size_t i = 0; i < a.fields.size(); ++i) {
-    if (a.fields[i].first != b.fields[i].first ||
-        !same_json(a.fields[i].second, b.fields[i].second))
-      return false;
-  }
-  return true;
-}
-
 std::string read_or_empty(const fs::path& p) {
   std::error_code ec;
   if (!fs::exists(p, ec)) return {};
-  return rs::read_file(p);
+  return read_file(p);
+}
+
+// a value as sweep.json shows it in a message ("nothing" when absent)
+std::string shown(const Json& j, const char* key) {
+  if (!j.contains(key)) return "nothing";
+  const Json& v = j[key];
+  return v.is_string() ? v.get<std::string>() : v.dump();
 }
 
 // what differs between the folder's sweep.json and this sweep, in words; empty when alike
-std::string identity_difference(const rs::Json& old, const Study& study, int points) {
-  const rs::Json now =
-      rs::parse_json("{\n" + identity_json(study, points) + "  \"end\": 0\n}\n", "sweep.json");
-  auto shown = [](const rs::Json* v) { return v ? v->text : std::string("nothing"); };
-  const rs::Json* f = old.get("fingerprint");
-  if (!f || f->text != now.str("fingerprint")) {
-    return "the study file differs (fingerprint " + now.str("fingerprint") + ", was " + shown(f) +
-           ")";
+// (numbers compare as the doubles they read back as: the writer's text is exact)
+std::string identity_difference(const Json& old, const Study& study, int points) {
+  const Json now = identity_json(study, points);
+  if (!old.contains("fingerprint") || old["fingerprint"] != now["fingerprint"]) {
+    return "the study file differs (fingerprint " + shown(now, "fingerprint") + ", was " +
+           shown(old, "fingerprint") + ")";
   }
   for (const char* key : {"design", "seed", "points"}) {
-    const rs::Json* v = old.get(key);
-    if (!v || v->text != now.str(key)) {
-      return std::string(key) + " " + now.str(key) + ", was " + shown(v);
+    if (!old.contains(key) || old[key] != now[key]) {
+      return std::string(key) + " " + shown(now, key) + ", was " + shown(old, key);
     }
   }
-  const rs::Json* p = old.get("parameters");
-  if (!p || !same_json(*p, *now.get("parameters"))) return "the parameters differ";
+  if (!old.contains("parameters") || old["parameters"] != now["parameters"]) {
+    return "the parameters differ";
+  }
   return {};
 }
 
@@ -308,7 +265,7 @@ CsvRows split_rows(const std::string& text) {
 // what is wrong with kept row i, in words; empty when it is the row of point i of this design
 std::string row_problem(const std::string& line, std::size_t i, std::size_t columns,
                         const std::vector<double>& values) {
-  const std::vector<std::string> f = rs::csv_fields(line);
+  const std::vector<std::string> f = csv_fields(line);
   if (f.size() != columns) {
     return "it has " + std::to_string(f.size()) + " fields, the header " + std::to_string(columns);
   }
@@ -377,123 +334,6 @@ class RowFile {
   int fd_ = -1;
 };
 
-// --- progress --------------------------------------------------------------------------------
-
-// "0:05", "12:34", "1:02:03"
-std::string clock_text(double seconds) {
-  const long s = std::lround(seconds);
-  char buf[32];
-  if (s >= 3600) {
-    std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
-  } else {
-    std::snprintf(buf, sizeof buf, "%ld:%02ld", s / 60, s % 60);
-  }
-  return buf;
-}
-
-// "5 s", "3 min 20 s", "2 h 5 min"
-std::string duration_text(double seconds) {
-  const long s = std::lround(seconds);
-  char buf[48];
-  if (s >= 3600) {
-    std::snprintf(buf, sizeof buf, "%ld h %ld min", s / 3600, s / 60 % 60);
-  } else if (s >= 60) {
-    std::snprintf(buf, sizeof buf, "%ld min %ld s", s / 60, s % 60);
-  } else {
-    std::snprintf(buf, sizeof buf, "%ld s", s);
-  }
-  return buf;
-}
-
-// the progress display on stderr: a bar redrawn in place at most ten times a second, or a plain
-// line every 10 s; both end with the final state. The rate is over the points run in this
-// session, the done count includes the resumed ones.
-class Progress {
- public:
-  Progress(SweepProgress mode, int points, int resumed)
-      : mode_(mode), points_(points), resumed_(resumed), start_(Clock::now()) {
-    if (mode_ == SweepProgress::kAuto) {
-      mode_ = ::isatty(STDERR_FILENO) ? SweepProgress::kBar : SweepProgress::kLines;
-    }
-    last_ = start_;
-  }
-
-  void update(int done) {
-    const Clock::time_point now = Clock::now();
-    if (mode_ == SweepProgress::kBar && now - last_ >= std::chrono::milliseconds(100)) {
-      draw_bar(done, now);
-      last_ = now;
-    } else if (mode_ == SweepProgress::kLines && now - last_ >= std::chrono::seconds(10)) {
-      print_line(done, now);
-      last_ = now;
-    }
-  }
-
-  void finish(int done) {
-    const Clock::time_point now = Clock::now();
-    if (mode_ == SweepProgress::kBar) {
-      draw_bar(done, now);
-      std::fputc('\n', stderr);
-      std::fflush(stderr);
-    } else if (mode_ == SweepProgress::kLines) {
-      print_line(done, now);
-    }
-  }
-
- private:
-  // points per second in this session, and the seconds left at that rate (< 0: unknown)
-  std::pair<double, double> rate_eta(int done, Clock::time_point now) const {
-    const double elapsed = std::chrono::duration<double>(now - start_).count();
-    const int run = done - resumed_;
-    if (run <= 0 || elapsed <= 0) return {0.0, done >= points_ ? 0.0 : -1.0};
-    const double rate = run / elapsed;
-    return {rate, (points_ - done) / rate};
-  }
-
-  double percent(int done) const { return points_ > 0 ? 100.0 * done / points_ : 100.0; }
-
-  void draw_bar(int done, Clock::time_point now) {
-    constexpr int kWidth = 20;
-    const auto [rate, eta] = rate_eta(done, now);
-    const int filled =
-        points_ > 0 ? static_cast<int>(kWidth * static_cast<long>(done) / points_) : kWidth;
-    char line[160];
-    std::snprintf(line, sizeof line, "  sweep [%s%s]  %d/%d  %.1f%%   %.1f points/s  ETA %s",
-                  std::string(static_cast<std::size_t>(filled), '#').c_str(),
-                  std::string(static_cast<std::size_t>(kWidth - filled), '.').c_str(), done,
-                  points_, percent(done), rate, eta < 0 ? "-:--" : clock_text(eta).c_str());
-    std::string text = line;
-    const std::size_t width = text.size();
-    if (width < drawn_) text.append(drawn_ - width, ' ');  // clear the longer line before
-    drawn_ = width;
-    std::fprintf(stderr, "\r%s", text.c_str());
-    std::fflush(stderr);
-  }
-
-  void print_line(int done, Clock::time_point now) const {
-    const auto [rate, eta] = rate_eta(done, now);
-    std::fprintf(stderr, "sweep: %d/%d points (%.1f %%), %.1f points/s, ETA %s\n", done, points_,
-                 percent(done), rate, eta < 0 ? "unknown" : duration_text(eta).c_str());
-    std::fflush(stderr);
-  }
-
-  SweepProgress mode_;
-  int points_, resumed_;
-  Clock::time_point start_, last_;
-  std::size_t drawn_ = 0;  // width of the bar line last drawn
-};
-
-// Test hook: with BD_SWEEP_KILL_AFTER_ROWS=N in the environment, the process kills itself
-// (SIGKILL) right after sweep.csv holds N rows, so tests can interrupt a sweep at a known
-// place. Unset or not a positive number: no effect.
-int kill_after_rows() {
-  const char* env = std::getenv("BD_SWEEP_KILL_AFTER_ROWS");
-  if (!env) return 0;
-  char* end = nullptr;
-  const long n = std::strtol(env, &end, 10);
-  return end != env && *end == '\0' && n > 0 && n < 1'000'000'000 ? static_cast<int>(n) : 0;
-}
-
 }  // namespace
 
 std::vector<std::string> sweep_columns(const Study& study) {
@@ -514,8 +354,9 @@ std::vector<std::string> sweep_columns(const Study& study) {
   return columns;
 }
 
-SweepResult run_sweep(const Study& study, const fs::path& out_dir, const SweepOptions& options) {
-  if (!study.sweep) throw InputError("run_sweep: study '" + study.name + "' has no sweep section");
+SweepResult write_sweep(const Study& study, const fs::path& out_dir, const SweepOptions& options) {
+  if (!study.sweep)
+    throw InputError("write_sweep: study '" + study.name + "' has no sweep section");
   const Clock::time_point start = Clock::now();
   const std::vector<std::vector<double>> points = sweep_points(*study.sweep);
   const int n = static_cast<int>(points.size());
@@ -532,22 +373,19 @@ SweepResult run_sweep(const Study& study, const fs::path& out_dir, const SweepOp
   const std::string old_csv = read_or_empty(result.csv);
   const std::string old_json = read_or_empty(result.summary);
   const CsvRows old = split_rows(old_csv);
-  std::optional<rs::Json> old_summary;
+  std::optional<Json> old_summary;
   if (!old_json.empty()) {
-    try {
-      old_summary = rs::parse_json(old_json, result.summary.string());
-    } catch (const std::runtime_error&) {
-      // unreadable: a sweep.csv beside it cannot be checked (below)
-    }
+    // unreadable: a sweep.csv beside it cannot be checked (below)
+    Json j = Json::parse(old_json, nullptr, false);
+    if (!j.is_discarded() && j.is_object()) old_summary = std::move(j);
   }
 
   int kept = 0, kept_failed = 0;
   if (!old_csv.empty() && !options.resume) {
     // a finished sweep is replaced; an unfinished one only on request
     int folder_points = n;
-    if (old_summary) {
-      if (const rs::Json* p = old_summary->get("points"))
-        folder_points = std::atoi(p->text.c_str());
+    if (old_summary && (*old_summary)["points"].is_number_integer()) {
+      folder_points = (*old_summary)["points"].get<int>();
     }
     if (static_cast<int>(old.rows.size()) < folder_points) {
       throw InputError(out_dir.string() + " holds an unfinished sweep (" +
@@ -572,7 +410,7 @@ SweepResult run_sweep(const Study& study, const fs::path& out_dir, const SweepOp
                          std::to_string(i) + " of this design (" + why +
                          "); remove the folder to start over");
       }
-      const std::vector<std::string> f = rs::csv_fields(old.rows[i]);
+      const std::vector<std::string> f = csv_fields(old.rows[i]);
       if (f[columns - 2] != "ok") ++kept_failed;
     }
     kept = static_cast<int>(old.rows.size());
@@ -615,14 +453,16 @@ SweepResult run_sweep(const Study& study, const fs::path& out_dir, const SweepOp
   std::mutex mutex;
   std::condition_variable changed;
   std::map<int, PointRow> finished;  // rows not written yet (a later point may finish first)
-  int completed = kept;              // points done, written or not
   int workers_done = 0;
   std::atomic<int> next_point{kept};
   std::atomic<bool> halt{false};  // the writer failed: the workers stop too
   auto stopping = [&] { return halt.load() || (options.stop != nullptr && options.stop->load()); };
 
-  Progress progress(options.progress, n, kept);
-  const int kill_after = kill_after_rows();
+  auto report_progress = [&](int done, bool last_call) {
+    if (!options.progress) return;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    options.progress(SweepProgress{done, n, kept, elapsed, last_call});
+  };
   int written = kept;
   RowFile csv(result.csv);
   {
@@ -637,7 +477,6 @@ SweepResult run_sweep(const Study& study, const fs::path& out_dir, const SweepOp
             {
               const std::lock_guard<std::mutex> lock(mutex);
               finished.emplace(i, std::move(row));
-              ++completed;
             }
             changed.notify_one();
           }
@@ -663,15 +502,13 @@ SweepResult run_sweep(const Study& study, const fs::path& out_dir, const SweepOp
         }
         const bool last = workers_done == threads;
         assert(!last || finished.empty());
-        const int done_now = completed;
         lock.unlock();
         int rows = written - static_cast<int>(batch.size());
         for (const PointRow& row : batch) {
           csv.append(row.text);
           if (!row.ok) ++counts.failed;
-          if (++rows == kill_after) std::raise(SIGKILL);
+          report_progress(++rows, false);
         }
-        progress.update(done_now);
         // every point started has finished once the workers are done, and points start in
         // order: nothing is left behind
         if (last) break;
@@ -688,21 +525,14 @@ SweepResult run_sweep(const Study& study, const fs::path& out_dir, const SweepOp
   counts.done = written;
   counts.status = written == n ? "complete" : "interrupted";
   counts.elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
-  progress.finish(written);
   write_text_file(sweep_json(study, n, counts), result.summary);
+  report_progress(written, true);
 
   result.done = written;
   result.resumed = kept;
   result.failed = counts.failed;
   result.interrupted = written < n;
 
-  // the report is read back from the files just written; it never fails the sweep
-  try {
-    write_sweep_report(study, out_dir);
-  } catch (const std::exception& e) {
-    fs::remove(out_dir / "report.html", ec);  // never a stale page of an earlier run
-    std::fprintf(stderr, "balance-design: warning: report.html not written: %s\n", e.what());
-  }
   return result;
 }
 

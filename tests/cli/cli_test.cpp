@@ -302,6 +302,21 @@ TEST_F(CliTest, RunWritesTheReportAndReportRebuildsIt) {
   EXPECT_NE(read(dir_ / "res" / "report.html").find("The charts need gnuplot"), std::string::npos);
 }
 
+TEST_F(CliTest, AReportThatCannotBeWrittenIsOneWarningLineAndTheRunSucceeds) {
+  const std::string cmd = "cd " + quote(dir_.string()) + " && BD_GNUPLOT=/bin/false " +
+                          quote(kExe) + " " + quote(kExamples + "/paper-fourbar-driven.yaml") +
+                          " --out res >out.txt 2>err.txt";
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  const std::string err = read(dir_ / "err.txt");
+  EXPECT_EQ(err.rfind("balance-design: warning: report.html not written: gnuplot failed", 0), 0u)
+      << err;
+  EXPECT_EQ(err.find('\n'), err.size() - 1) << "one line: " << err;
+  EXPECT_TRUE(fs::exists(dir_ / "res" / "summary.json"));
+  EXPECT_FALSE(fs::exists(dir_ / "res" / "report.html"));
+}
+
 TEST_F(CliTest, ReportNeedsTheFolderOfARun) {
   fs::create_directories(dir_ / "empty");
   EXPECT_EQ(run("report empty"), 2);

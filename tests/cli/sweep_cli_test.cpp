@@ -1,5 +1,5 @@
-// The balance-design executable running sweeps: killed midway (a real SIGKILL, and the test
-// hook BD_SWEEP_KILL_AFTER_ROWS) and resumed to the rows of an uninterrupted run, Ctrl-C
+// The balance-design executable running sweeps: killed midway (a real SIGKILL from outside, and
+// one the test sets off after a known row) and resumed to the rows of an uninterrupted run, Ctrl-C
 // (SIGINT) ending with exit code 5 and the rows kept, the progress output, validate and report
 // of a sweep study. Needs the executable built (target balance-design).
 #include <fcntl.h>
@@ -21,6 +21,8 @@
 #include <thread>
 #include <vector>
 
+#include "studies/studies.hpp"
+#include "studies/study/load_study.hpp"
 #include "tests/support/studies.hpp"
 #include "tests/support/text.hpp"
 
@@ -165,22 +167,39 @@ TEST_F(SweepCli, KilledSweepResumesToTheRowsOfAnUninterruptedRun) {
             std::string::npos);
 }
 
-TEST_F(SweepCli, KillHookStopsAfterNRowsAndResumeCompletesTheExample) {
-  const std::string example = quote(kExamples + "/paper-fourbar-sweep.yaml");
-  ASSERT_EQ(run(example + " --out full --progress none"), 0) << err_;
+TEST_F(SweepCli, ResumeCompletesASweepKilledAfterAKnownRow) {
+  const std::string example = kExamples + "/paper-fourbar-sweep.yaml";
+  ASSERT_EQ(run(quote(example) + " --out full --progress none"), 0) << err_;
   const std::string full = read(dir_ / "full" / "sweep.csv");
   ASSERT_EQ(rows(dir_ / "full" / "sweep.csv"), 441);
 
-  // the test hook: the process kills itself right after the 57th row
-  EXPECT_EQ(run(example + " --out part --progress none", "BD_SWEEP_KILL_AFTER_ROWS=57"),
-            128 + SIGKILL);
-  EXPECT_EQ(rows(dir_ / "part" / "sweep.csv"), 57);
-  EXPECT_EQ(
-      full.compare(0, read(dir_ / "part" / "sweep.csv").size(), read(dir_ / "part" / "sweep.csv")),
-      0);
-  ASSERT_EQ(run(example + " --out part --resume --progress none"), 0) << err_;
+  // a child process runs the sweep through the library and kills itself (SIGKILL: nothing runs
+  // after it) right after the 57th row is written: the test's own hook, at a known place
+  const fs::path part = dir_ / "part";
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    bd::studies::SweepOptions options;
+    options.threads = 2;
+    options.progress = [](const bd::studies::SweepProgress& p) {
+      if (p.done == 57) ::raise(SIGKILL);
+    };
+    try {
+      bd::studies::run_sweep(bd::studies::load_study(example), part, options);
+    } catch (...) {
+    }
+    std::_Exit(0);  // not reached when the hook fires
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << "status " << status;
+  EXPECT_EQ(rows(part / "sweep.csv"), 57);
+  EXPECT_EQ(full.compare(0, read(part / "sweep.csv").size(), read(part / "sweep.csv")), 0);
+
+  // the command line resumes it to the uninterrupted run's bytes
+  ASSERT_EQ(run(quote(example) + " --out part --resume --progress none"), 0) << err_;
   EXPECT_NE(out_.find("441 of 441 points (57 resumed)"), std::string::npos) << out_;
-  EXPECT_EQ(read(dir_ / "part" / "sweep.csv"), full);
+  EXPECT_EQ(read(part / "sweep.csv"), full);
 }
 
 TEST_F(SweepCli, InterruptExitsFiveAndKeepsTheRows) {

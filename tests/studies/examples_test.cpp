@@ -3,8 +3,9 @@
 
 #include <filesystem>
 
-#include "studies/study/load_study.hpp"
 #include "studies/run/runner.hpp"
+#include "studies/studies.hpp"
+#include "studies/study/load_study.hpp"
 #include "studies/sweep/sweep.hpp"
 
 namespace bd::studies {
@@ -15,8 +16,7 @@ namespace fs = std::filesystem;
 // each test writes under its own name: ctest runs the tests of this file in parallel
 RunResult run_example(const std::string& file) {
   const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path out =
-      fs::path(BD_BINARY_DIR) / "test-output" / "examples" / test->name() / file;
+  const fs::path out = fs::path(BD_BINARY_DIR) / "test-output" / "examples" / test->name() / file;
   fs::remove_all(out);
   return run_study(load_study(std::string(BD_SOURCE_DIR) + "/studies/examples/" + file), out);
 }
@@ -33,7 +33,6 @@ TEST(Examples, EveryExampleRunsToTheEnd) {
                            "EveryExampleRunsToTheEnd" / entry.path().filename();
       fs::remove_all(out);
       SweepOptions options;
-      options.progress = SweepProgress::kNone;
       const SweepResult s = run_sweep(study, out, options);
       EXPECT_TRUE(s.complete()) << entry.path();
       EXPECT_EQ(s.failed, 0) << entry.path() << ": see " << s.csv;

@@ -1,11 +1,10 @@
 // The optimize section's helpers: what an optimum added (mass, inertia about the pivots), metric
 // look-up by name, the problem and the study of an optimum built from a study.
-#include "studies/study/optimize_request.hpp"
-
 #include <gtest/gtest.h>
 
 #include "balance/counterweight.hpp"
 #include "core/fourbar/samples.hpp"
+#include "studies/study/optimize_request.hpp"
 #include "studies/study/study.hpp"
 
 namespace bd::studies {

@@ -17,16 +17,16 @@ Study study_of(const core::FourBar& model, Scene scene) {
 }
 
 TEST(ChooseMethod, FreeTurningCrankTakesTheCheapestExactFormulation) {
-  const MethodChoice c = choose_method(
-      study_of(core::samples::paper_fourbar(), core::FreeScene{1.0, 0.0, 5.0, 501}));
+  const MethodChoice c =
+      choose_method(study_of(core::samples::paper_fourbar(), core::FreeScene{1.0, 0.0, 5.0, 501}));
   EXPECT_EQ(c.formulation, core::Formulation::kMassMatrix);
   EXPECT_NE(c.reason.find("cheapest exact formulation"), std::string::npos) << c.reason;
   EXPECT_NE(c.reason.find("reduced equation in theta1"), std::string::npos) << c.reason;
 }
 
 TEST(ChooseMethod, DrivenSceneNeedsNoIntegrator) {
-  const MethodChoice c = choose_method(
-      study_of(core::samples::paper_fourbar(), core::DrivenScene{0.0, 6.28, 1, 360}));
+  const MethodChoice c =
+      choose_method(study_of(core::samples::paper_fourbar(), core::DrivenScene{0.0, 6.28, 1, 360}));
   EXPECT_EQ(c.formulation, core::Formulation::kMassMatrix);
   EXPECT_NE(c.reason.find("no integrator"), std::string::npos) << c.reason;
 }
@@ -70,8 +70,7 @@ TEST(ChooseMethod, OpenedLoopIntegratorFollowsTheTolerance) {
   s.tolerance = 1e-8;
   c = choose_method(s);
   EXPECT_EQ(c.integrator, core::Integrator::kErk5);
-  EXPECT_NE(c.reason.find("Dormand-Prince 5(4) Runge-Kutta pair"), std::string::npos)
-      << c.reason;
+  EXPECT_NE(c.reason.find("Dormand-Prince 5(4) Runge-Kutta pair"), std::string::npos) << c.reason;
   // a requested formulation gets the integrator auto would give it
   Study paper = study_of(core::samples::paper_fourbar(), core::FreeScene{1.0, 0.0, 5.0, 501});
   paper.formulation = core::Formulation::kOpenedLoop;

@@ -22,12 +22,13 @@
 #include <string>
 #include <vector>
 
+#include "balance/synthesis.hpp"
 #include "core/input_error.hpp"
 #include "core/metrics.hpp"
-#include "balance/synthesis.hpp"
-#include "studies/study/load_study.hpp"
 #include "studies/report/report.hpp"
 #include "studies/report/report_support.hpp"
+#include "studies/studies.hpp"
+#include "studies/study/load_study.hpp"
 #include "studies/sweep/sweep.hpp"
 #include "tests/support/text.hpp"
 
@@ -268,8 +269,8 @@ std::vector<std::vector<std::string>> csv_rows(const fs::path& file,
   std::vector<std::vector<std::string>> rows;
   std::string line;
   std::getline(in, line);
-  for (const std::string& f : report_support::csv_fields(line)) header->push_back(f);
-  while (std::getline(in, line)) rows.push_back(report_support::csv_fields(line));
+  for (const std::string& f : csv_fields(line)) header->push_back(f);
+  while (std::getline(in, line)) rows.push_back(csv_fields(line));
   return rows;
 }
 
@@ -507,7 +508,7 @@ TEST_F(SweepReportTest, OptimizeSweepKeepsTheOriginalOfAPointWithoutOptimum) {
   std::vector<std::string> lines;
   std::istringstream in(csv);
   for (std::string l; std::getline(in, l);) lines.push_back(l);
-  std::vector<std::string> fields = report_support::csv_fields(lines[1]);
+  std::vector<std::string> fields = csv_fields(lines[1]);
   const std::size_t n = fields.size();
   for (std::size_t c = 12; c < n - 2; ++c) fields[c].clear();  // optimized_*, added_*
   fields[n - 2] = "no-optimum";
@@ -608,7 +609,6 @@ TEST_F(SweepReportTest, PageOfARealSweepRun) {
   std::ofstream(file) << yaml;
   const Study study = load_study(file.string());
   SweepOptions options;
-  options.progress = SweepProgress::kNone;
   options.threads = 2;
   const fs::path out = dir_ / "out";
   const SweepResult r = run_sweep(study, out, options);

@@ -13,9 +13,10 @@
 #include <thread>
 #include <vector>
 
-#include "studies/study/load_study.hpp"
 #include "studies/report/report_support.hpp"
 #include "studies/run/runner.hpp"
+#include "studies/studies.hpp"
+#include "studies/study/load_study.hpp"
 #include "studies/sweep/sweep.hpp"
 #include "tests/support/studies.hpp"
 #include "tests/support/text.hpp"
@@ -73,7 +74,6 @@ std::string number(double v) {
 SweepOptions quiet(int threads = 0) {
   SweepOptions o;
   o.threads = threads;
-  o.progress = SweepProgress::kNone;
   return o;
 }
 
@@ -136,12 +136,12 @@ TEST_F(SweepRunner, EachRowIsThePointsStudyRunOnItsOwn) {
   const std::vector<std::string> rows = lines(read(r.csv));
   ASSERT_EQ(rows.size(), 10u);
   const std::vector<std::string> columns = sweep_columns(study);
-  EXPECT_EQ(rs::csv_fields(rows[0]), columns);
+  EXPECT_EQ(csv_fields(rows[0]), columns);
   const auto points = sweep_points(*study.sweep);
   ASSERT_EQ(points.size(), 9u);
   for (std::size_t i = 0; i < points.size(); ++i) {
     SCOPED_TRACE("point " + std::to_string(i));
-    const std::vector<std::string> f = rs::csv_fields(rows[i + 1]);
+    const std::vector<std::string> f = csv_fields(rows[i + 1]);
     ASSERT_EQ(f.size(), columns.size());
     // the same computation as a run of the point's study: the same numbers, bit for bit
     const Study at = point_study(study, points[i]);
@@ -163,39 +163,40 @@ TEST_F(SweepRunner, EachRowIsThePointsStudyRunOnItsOwn) {
     EXPECT_EQ(f[columns.size() - 1], "");
   }
   // the grid: first parameter slowest; the values as given
-  EXPECT_EQ(rs::csv_fields(rows[4])[1], "3");
-  EXPECT_EQ(rs::csv_fields(rows[4])[2], "0.5");
-  EXPECT_EQ(rs::csv_fields(rows[9])[2], "2.5");
+  EXPECT_EQ(csv_fields(rows[4])[1], "3");
+  EXPECT_EQ(csv_fields(rows[4])[2], "0.5");
+  EXPECT_EQ(csv_fields(rows[9])[2], "2.5");
 
   // run_study() of a point writes what compute_study() computes
   const Study at = point_study(study, points[4]);
   const RunResult written = run_study(at, dir_ / "point-4");
-  EXPECT_EQ(number(written.metrics.Msh_rms), rs::csv_fields(rows[5])[5]);
+  EXPECT_EQ(number(written.metrics.Msh_rms), csv_fields(rows[5])[5]);
   EXPECT_TRUE(fs::exists(dir_ / "point-4" / "summary.json"));
 
   // sweep.json: the design and the counts
   const rs::Json j = rs::parse_json(read(r.summary), "sweep.json");
-  EXPECT_EQ(j.str("study"), "driven");
-  EXPECT_EQ(j.str("source"), "s.yaml");
-  EXPECT_EQ(j.str("fingerprint").size(), 16u);
-  EXPECT_EQ(j.str("design"), "grid");
-  EXPECT_EQ(j.str("points"), "9");
-  EXPECT_EQ(j.str("threads"), "2");
-  EXPECT_EQ(j.str("status"), "complete");
-  EXPECT_EQ(j.str("done"), "9");
-  EXPECT_EQ(j.str("resumed"), "0");
-  EXPECT_EQ(j.str("failed"), "0");
-  const rs::Json* params = j.get("parameters");
-  ASSERT_TRUE(params && params->items.size() == 2);
-  EXPECT_EQ(params->items[0].str("path"), "linkage.coupler.mass");
-  EXPECT_EQ(params->items[0].str("scale"), "linear");
-  EXPECT_EQ(params->items[0].str("from"), "1");
-  EXPECT_EQ(params->items[0].str("to"), "5");
-  ASSERT_EQ(params->items[0].get("values")->items.size(), 3u);
-  EXPECT_EQ(params->items[0].get("values")->items[1].text, "3");
+  EXPECT_EQ(rs::text(j, "study"), "driven");
+  EXPECT_EQ(rs::text(j, "source"), "s.yaml");
+  EXPECT_EQ(rs::text(j, "fingerprint").size(), 16u);
+  EXPECT_EQ(rs::text(j, "design"), "grid");
+  EXPECT_EQ(rs::text(j, "points"), "9");
+  EXPECT_EQ(rs::text(j, "threads"), "2");
+  EXPECT_EQ(rs::text(j, "status"), "complete");
+  EXPECT_EQ(rs::text(j, "done"), "9");
+  EXPECT_EQ(rs::text(j, "resumed"), "0");
+  EXPECT_EQ(rs::text(j, "failed"), "0");
+  const rs::Json* params = rs::member(j, "parameters");
+  ASSERT_TRUE(params && params->size() == 2);
+  const rs::Json& first = (*params)[0];
+  EXPECT_EQ(rs::text(first, "path"), "linkage.coupler.mass");
+  EXPECT_EQ(rs::text(first, "scale"), "linear");
+  EXPECT_EQ(first["from"].get<double>(), 1.0);
+  EXPECT_EQ(first["to"].get<double>(), 5.0);
+  ASSERT_EQ(first["values"].size(), 3u);
+  EXPECT_EQ(first["values"][1].get<double>(), 3.0);
   // a values list: from and to are its least and greatest
-  EXPECT_EQ(params->items[1].str("from"), "0.5");
-  EXPECT_EQ(params->items[1].str("to"), "2.5");
+  EXPECT_EQ((*params)[1]["from"].get<double>(), 0.5);
+  EXPECT_EQ((*params)[1]["to"].get<double>(), 2.5);
 }
 
 TEST_F(SweepRunner, OneThreadAndTwoThreadsWriteTheSameFile) {
@@ -259,7 +260,7 @@ TEST_F(SweepRunner, PointsThatCannotRunAreRowsAndTheSweepGoesOn) {
                             "stopped-early", "bad-input", "ok"};
   for (std::size_t i = 0; i < 6; ++i) {
     SCOPED_TRACE("point " + std::to_string(i));
-    const std::vector<std::string> f = rs::csv_fields(rows[i + 1]);
+    const std::vector<std::string> f = csv_fields(rows[i + 1]);
     ASSERT_EQ(f.size(), n);
     EXPECT_EQ(f[n - 2], expected[i]);
     if (f[n - 2] == "bad-input") {
@@ -278,13 +279,12 @@ TEST_F(SweepRunner, PointsThatCannotRunAreRowsAndTheSweepGoesOn) {
     }
   }
   // -1 kg: the mass's message; 0.1 m: the assembly's
-  EXPECT_NE(rs::csv_fields(rows[1]).back().find("linkage.coupler.mass must be > 0 kg, got -1"),
+  EXPECT_NE(csv_fields(rows[1]).back().find("linkage.coupler.mass must be > 0 kg, got -1"),
             std::string::npos)
       << rows[1];
-  EXPECT_NE(rs::csv_fields(rows[2]).back().find("cannot be assembled"), std::string::npos)
-      << rows[2];
+  EXPECT_NE(csv_fields(rows[2]).back().find("cannot be assembled"), std::string::npos) << rows[2];
   // stopped early: the simulation's message (time and crank angle), the metrics over the samples
-  const std::vector<std::string> stopped = rs::csv_fields(rows[4]);
+  const std::vector<std::string> stopped = csv_fields(rows[4]);
   const RunResult alone = compute_study(point_study(study, points[3]));
   ASSERT_FALSE(alone.trajectory.ok());
   EXPECT_EQ(stopped[n - 1], alone.trajectory.message);
@@ -292,7 +292,7 @@ TEST_F(SweepRunner, PointsThatCannotRunAreRowsAndTheSweepGoesOn) {
   // the message is quoted CSV text
   EXPECT_NE(rows[1].find(",bad-input,\"bad.yaml:7:"), std::string::npos) << rows[1];
   const rs::Json j = rs::parse_json(read(r.summary), "sweep.json");
-  EXPECT_EQ(j.str("failed"), "5");
+  EXPECT_EQ(rs::text(j, "failed"), "5");
 }
 
 TEST_F(SweepRunner, NoOptimumIsARowWithTheOptimisersMessage) {
@@ -315,7 +315,7 @@ TEST_F(SweepRunner, NoOptimumIsARowWithTheOptimisersMessage) {
   const std::size_t n = sweep_columns(study).size();
   const auto points = sweep_points(*study.sweep);
   for (std::size_t i = 0; i < 2; ++i) {
-    const std::vector<std::string> f = rs::csv_fields(rows[i + 1]);
+    const std::vector<std::string> f = csv_fields(rows[i + 1]);
     ASSERT_EQ(f.size(), n);
     EXPECT_EQ(f[n - 2], "no-optimum");
     const RunResult alone = compute_study(point_study(study, points[i]));
@@ -355,9 +355,9 @@ TEST_F(SweepRunner, ResumeCompletesACutShortFileToTheSameBytes) {
     EXPECT_TRUE(r.complete());
     EXPECT_EQ(read(part / "sweep.csv"), full) << part;
     const rs::Json j = rs::parse_json(read(part / "sweep.json"), "sweep.json");
-    EXPECT_EQ(j.str("status"), "complete");
-    EXPECT_EQ(j.str("resumed"), "10");
-    EXPECT_EQ(j.str("done"), "30");
+    EXPECT_EQ(rs::text(j, "status"), "complete");
+    EXPECT_EQ(rs::text(j, "resumed"), "10");
+    EXPECT_EQ(rs::text(j, "done"), "30");
   }
 
   // resuming a complete sweep runs nothing and keeps the file
@@ -482,8 +482,8 @@ TEST_F(SweepRunner, StopKeepsAPrefixAndResumeCompletesIt) {
   EXPECT_EQ(lines(stopped).size(), static_cast<std::size_t>(r.done) + 1);
   EXPECT_EQ(full.compare(0, stopped.size(), stopped), 0) << "not the beginning of the sweep";
   const rs::Json j = rs::parse_json(read(dir_ / "stopped" / "sweep.json"), "sweep.json");
-  EXPECT_EQ(j.str("status"), "interrupted");
-  EXPECT_EQ(j.str("done"), std::to_string(r.done));
+  EXPECT_EQ(rs::text(j, "status"), "interrupted");
+  EXPECT_EQ(rs::text(j, "done"), std::to_string(r.done));
 
   // without --resume the unfinished sweep is refused; with it, completed to the same bytes
   EXPECT_THROW(run_sweep(study, dir_ / "stopped", quiet(2)), InputError);

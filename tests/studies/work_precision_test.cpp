@@ -20,9 +20,10 @@
 #include <vector>
 
 #include "core/input_error.hpp"
-#include "studies/study/load_study.hpp"
 #include "studies/report/report.hpp"
 #include "studies/report/report_support.hpp"
+#include "studies/studies.hpp"
+#include "studies/study/load_study.hpp"
 #include "tests/support/text.hpp"
 
 namespace bd::studies {

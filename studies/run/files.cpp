@@ -1,0 +1,128 @@
+#include "studies/run/files.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <system_error>
+
+#include "core/number_text.hpp"
+
+namespace bd::studies {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+[[noreturn]] void fail(const char* what, const fs::path& p) {
+  throw std::runtime_error(std::string(what) + " " + p.string() + ": " + std::strerror(errno));
+}
+
+std::string quote(const std::string& text) {
+  std::string q = "\"";
+  for (char c : text) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+}  // namespace
+
+AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
+  static std::atomic<unsigned> counter{0};
+  // appended piece by piece: GCC 12 at -O3 warns falsely on `"." + std::string&&` (GCC bug
+  // 105329, -Wrestrict)
+  std::string name = ".";
+  name.append(target_.filename().string()).append(".").append(std::to_string(::getpid()));
+  name.append(".").append(std::to_string(counter++)).append(".tmp");
+  temp_ = target_.parent_path() / name;
+  file_ = std::fopen(temp_.c_str(), "wbx");
+  if (!file_) fail("cannot create", temp_);
+}
+
+AtomicFile::~AtomicFile() {
+  if (file_) std::fclose(file_);
+  if (!committed_) {
+    std::error_code ec;
+    fs::remove(temp_, ec);
+  }
+}
+
+void AtomicFile::commit() {
+  const bool write_error = std::fflush(file_) != 0 || std::ferror(file_) != 0;
+  const int saved = errno;
+  const bool close_error = std::fclose(file_) != 0;
+  file_ = nullptr;
+  if (write_error || close_error) {
+    errno = write_error ? saved : errno;
+    fail("cannot write", temp_);
+  }
+  std::error_code ec;
+  fs::rename(temp_, target_, ec);
+  if (ec) {
+    throw std::runtime_error("cannot rename " + temp_.string() + " to " + target_.string() + ": " +
+                             ec.message());
+  }
+  committed_ = true;
+}
+
+void write_text_file(const std::string& text, const fs::path& file) {
+  AtomicFile out(file);
+  if (std::fwrite(text.data(), 1, text.size(), out.get()) != text.size()) {
+    fail("cannot write", file);
+  }
+  out.commit();
+}
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + p.string());
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+  return quote(text);
+}
+
+std::string csv_line_field(std::string text) {
+  if (text.empty()) return text;
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  std::replace(text.begin(), text.end(), '\r', ' ');
+  return quote(text);
+}
+
+std::string csv_number(double v) { return std::isnan(v) ? std::string() : text::exact(v); }
+
+std::vector<std::string> csv_fields(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        out.back() += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        out.back() += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      out.emplace_back();
+    } else if (c != '\r') {
+      out.back() += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace bd::studies

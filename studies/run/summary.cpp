@@ -1,0 +1,231 @@
+// summary.json: what a run computed, as one JSON document written by nlohmann-json (keys in the
+// order below, numbers in their shortest exact text, a number that is not finite as null).
+#include <cassert>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <variant>
+
+#include "studies/run/runner.hpp"
+
+namespace bd::studies {
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+Json vec(const Vec2& v) { return Json::array({v.x(), v.y()}); }
+
+// the metrics in the table's order
+Json metrics_json(const core::Metrics& m) {
+  Json j = Json::object();
+  for (const core::MetricInfo& info : core::kMetricTable) j[info.name] = m.*info.field;
+  return j;
+}
+
+// after / before per metric; null where before is 0
+Json reduction_json(const core::Metrics& before, const core::Metrics& after) {
+  Json j = Json::object();
+  for (const core::MetricInfo& info : core::kMetricTable) {
+    const double b = before.*info.field;
+    j[info.name] = b != 0 ? Json(after.*info.field / b) : Json(nullptr);
+  }
+  return j;
+}
+
+Json method_json(const Study& study, const MethodChoice& method) {
+  return {{"requested", study.method_name()},
+          {"used", core::to_string(method.formulation)},
+          {"reason", method.reason}};
+}
+
+Json scene_json(const Scene& scene) {
+  if (const auto* free = std::get_if<core::FreeScene>(&scene)) {
+    return {{"type", "free"},
+            {"theta1", free->theta1},
+            {"omega1", free->omega1},
+            {"duration", free->duration},
+            {"samples", free->samples}};
+  }
+  const auto& driven = std::get<core::DrivenScene>(scene);
+  return {{"type", "driven"},
+          {"theta1", driven.theta1},
+          {"omega1", driven.omega1},
+          {"revolutions", driven.revolutions},
+          {"samples", driven.samples}};
+}
+
+// a trajectory's run facts (status, counts), added to `j`
+void add_run_fields(Json& j, const core::Trajectory& tr) {
+  j["samples"] = tr.samples.size();
+  j["status"] = core::to_string(tr.status);
+  j["ok"] = tr.ok();
+  j["message"] = tr.message;
+  j["steps"] = tr.steps;
+  j["rhs_evaluations"] = tr.rhs_evaluations;
+}
+
+Json counterweight_json(const char* link, balance::CounterweightShape shape,
+                        const balance::Counterweight& c) {
+  return {{"link", link},
+          {"shape", balance::to_string(shape)},
+          {"mass", c.mass},
+          {"position", vec(c.position)},
+          {"distance", c.distance},
+          {"radius", c.radius},
+          {"thickness", c.thickness},
+          {"inertia", c.inertia}};
+}
+
+// the balance section: what was asked, what was added, which conditions hold
+Json balance_json(const balance::BalancedDesign& b) {
+  Json j = {{"force", b.request.force ? "full" : "none"},
+            {"moment", b.request.moment ? "full" : "none"}};
+  Json cws = Json::array();
+  if (b.crank_counterweight) {
+    cws.push_back(
+        counterweight_json("crank", b.request.crank_counterweight.shape, *b.crank_counterweight));
+  }
+  if (b.rocker_counterweight) {
+    cws.push_back(counterweight_json("rocker", b.request.rocker_counterweight.shape,
+                                     *b.rocker_counterweight));
+  }
+  j["counterweights"] = cws;
+  Json discs = Json::array();
+  const std::pair<const char*, const core::CounterRotation*> rotations[] = {
+      {"crank", &b.model.counter_rotations.crank}, {"rocker", &b.model.counter_rotations.rocker}};
+  for (const auto& [link, disc] : rotations) {
+    if (disc->inertia > 0)
+      discs.push_back({{"link", link}, {"inertia", disc->inertia}, {"at", vec(disc->at)}});
+  }
+  j["counter_rotations"] = discs;
+  j["added_mass"] = b.added_mass;
+  j["added_inertia"] = b.added_inertia;
+  j["force_balanced"] = b.conditions.force_balanced();
+  j["moment_balanced"] = b.conditions.moment_balanced();
+  Json conditions = Json::array();
+  for (const auto* group : {&b.conditions.force, &b.conditions.moment}) {
+    for (const balance::Condition& c : *group) {
+      conditions.push_back({{"name", c.name},
+                            {"residual", c.residual},
+                            {"scale", c.scale},
+                            {"unit", c.unit},
+                            {"holds", c.holds}});
+    }
+  }
+  j["conditions"] = conditions;
+  return j;
+}
+
+// the optimum's counterweights, as the balance section writes them
+Json optimum_counterweights_json(const OptimizeRequest& request,
+                                 const std::vector<optimize::PlacedCounterweight>& cws) {
+  Json items = Json::array();
+  for (const optimize::PlacedCounterweight& p : cws) {
+    balance::CounterweightShape shape = balance::CounterweightShape::kPoint;
+    for (const optimize::CounterweightVariables& v : request.counterweights) {
+      if (v.link == p.link) shape = v.shape;
+    }
+    items.push_back(counterweight_json(core::link_name(p.link), shape, p.counterweight));
+  }
+  return items;
+}
+
+// the problem as the study states it: solver, terms, constraints
+Json problem_json(const OptimizeRequest& req, const MethodChoice& method) {
+  Json j = {{"algorithm", optimize::to_string(req.options.algorithm)},
+            {"formulation", core::to_string(method.formulation)}};
+  Json terms = Json::array();
+  for (const optimize::Term& t : req.objective) {
+    terms.push_back({{"metric", optimize::to_string(t.metric)}, {"weight", t.weight}});
+  }
+  j["terms"] = terms;
+  j["force_balance"] = req.force_balance;
+  Json limits = Json::array();
+  for (const optimize::Limit& l : req.limits) {
+    const bool kg = l.metric == optimize::Metric::kAddedMass;
+    limits.push_back({{"metric", optimize::to_string(l.metric)},
+                      {"value", l.value},
+                      {"unit", kg ? "kg" : "fraction of the original"}});
+  }
+  j["limits"] = limits;
+  return j;
+}
+
+// the optimize section: the problem, how the solver ended, the optimum
+Json optimize_json(const Study& study, const RunResult& result) {
+  const OptimizeRequest& req = *study.optimize;
+  const OptimizedRun& o = *result.optimized;
+  const optimize::OptimizeResult& r = o.result;
+  Json j = problem_json(req, result.method);
+  j["termination"] = optimize::to_string(r.termination);
+  j["message"] = r.message;
+  j["iterations"] = r.iterations;
+  j["evaluations"] = r.evaluations;
+  j["seconds"] = r.seconds;
+  const bool found = o.found();
+  j["objective"] = found ? Json(r.objective) : Json(nullptr);
+  j["constraint_violation"] = found ? Json(r.constraint_violation) : Json(nullptr);
+  Json variables = Json::array();
+  if (static_cast<std::size_t>(r.x.size()) == o.variable_names.size()) {
+    for (std::size_t k = 0; k < o.variable_names.size(); ++k) {
+      variables.push_back(
+          {{"name", o.variable_names[k]}, {"value", r.x[static_cast<Eigen::Index>(k)]}});
+    }
+  }
+  j["variables"] = variables;
+  j["counterweights"] = found ? optimum_counterweights_json(req, r.counterweights) : Json::array();
+  if (found) {
+    j["added_mass"] = added_mass(study.model, r.design);
+    j["added_inertia"] = added_inertia(study.model, r.design);
+    j["verified_with"] = core::to_string(r.verified_with);
+    j["verification_error"] = r.verification_error;
+  }
+  if (req.pareto) {
+    j["pareto"] = {{"first", optimize::to_string(req.pareto->first)},
+                   {"second", optimize::to_string(req.pareto->second)},
+                   {"points", o.pareto.size()}};
+  }
+  j["brief_report"] = r.brief_report();
+  return j;
+}
+
+// the keys of a second design's run (the balanced or the optimised one): `<what>_run`,
+// `<what>_metrics`, and `reduction` (second / original per metric)
+void add_second_run(Json& j, const Study& study, const std::string& what,
+                    const MethodChoice& method, const core::Trajectory& trajectory,
+                    const core::Metrics& original, const core::Metrics& second) {
+  Json run = {{"study", study.name + "-" + what}, {"method", method_json(study, method)}};
+  add_run_fields(run, trajectory);
+  j[what + "_run"] = run;
+  j[what + "_metrics"] = metrics_json(second);
+  j["reduction"] = reduction_json(original, second);
+}
+
+}  // namespace
+
+std::string summary_json(const Study& study, const RunResult& result) {
+  Json j = {{"format", "balance-design summary v1"},
+            {"study", study.name},
+            {"source", study.source},
+            {"method", method_json(study, result.method)},
+            {"scene", scene_json(study.scene)},
+            {"tolerance", study.tolerance}};
+  add_run_fields(j, result.trajectory);
+  j["metrics"] = metrics_json(result.metrics);
+  if (study.balance && result.balanced) {
+    const BalancedRun& b = *result.balanced;
+    j["balance"] = balance_json(*study.balance);
+    add_second_run(j, study, "balanced", b.method, b.trajectory, result.metrics, b.metrics);
+  }
+  if (study.optimize && result.optimized) {
+    const OptimizedRun& o = *result.optimized;
+    j["optimize"] = optimize_json(study, result);
+    if (o.found()) {
+      add_second_run(j, study, "optimized", o.method, o.trajectory, result.metrics, o.metrics);
+    }
+  }
+  // invalid UTF-8 in a message (a key copied from a study file) is replaced, never a failure
+  return j.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
+}
+
+}  // namespace bd::studies

@@ -1,0 +1,56 @@
+#include "studies/studies.hpp"
+
+#include <exception>
+#include <system_error>
+
+#include "studies/report/report.hpp"
+
+namespace bd::studies {
+
+namespace fs = std::filesystem;
+
+std::optional<std::string> try_write_report(const Study& study, const fs::path& dir) {
+  try {
+    if (study.sweep) {
+      write_sweep_report(study, dir);
+    } else {
+      write_report(study, dir);
+    }
+    return std::nullopt;
+  } catch (const std::exception& e) {
+    std::error_code ec;
+    fs::remove(dir / "report.html", ec);
+    return std::string("report.html not written: ") + e.what();
+  }
+}
+
+RunResult run_study(const Study& study, const fs::path& out_dir) {
+  // compute first: an invalid scene throws before anything is created on disk
+  RunResult result = compute_study(study);
+  write_run(study, result, out_dir);
+  Study page = study;
+  page.sweep.reset();  // a study page, also for a sweep's base study
+  if (auto warning = try_write_report(page, out_dir)) result.warnings.push_back(*warning);
+  return result;
+}
+
+SweepResult run_sweep(const Study& study, const fs::path& out_dir, const SweepOptions& options) {
+  SweepResult result = write_sweep(study, out_dir, options);
+  if (auto warning = try_write_report(study, out_dir)) result.warnings.push_back(*warning);
+  return result;
+}
+
+BenchResult run_bench(const Study& study, const fs::path& out_dir, const BenchOptions& options) {
+  remove_bench_files(out_dir);  // no stale measurements in the page run_study() writes
+  RunResult run = run_study(study, out_dir);
+  BenchResult result = write_bench(study, out_dir, options);
+  result.run = std::move(run);
+  if (auto warning = try_write_report(study, out_dir)) {
+    result.run.warnings.push_back(*warning);
+  } else {
+    result.report = out_dir / "report.html";
+  }
+  return result;
+}
+
+}  // namespace bd::studies
