@@ -1,6 +1,7 @@
 // Position closure by Newton's method on the scaled, full-pivoting-LU-factorized Jacobian.
 #include "tests/reference/planar/solve.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -14,6 +15,11 @@ Factorized::Factorized(const Model& model, const MatrixXd& J)
     if (model.inputs[k].angle) dr_[model.input_row(k)] = model.length;
   scaled_ = dr_.asDiagonal() * J * dc_.asDiagonal();
   lu_.compute(scaled_);
+}
+
+double Factorized::rcond() const {
+  const VectorXd pivots = lu_.matrixLU().diagonal().cwiseAbs();
+  return std::min(lu_.rcond(), pivots.minCoeff() / pivots.maxCoeff());
 }
 
 VectorXd Factorized::solve(const VectorXd& b) const {

@@ -8,7 +8,7 @@
 
 namespace bd::referee::detail {
 
-/// Below this reciprocal condition number (1-norm estimate) of the scaled Jacobian, a position
+/// Below this reciprocal condition number (Factorized::rcond) of the scaled Jacobian, a position
 /// is reported singular. The scaled Jacobian (angles and angle-input rows multiplied by the
 /// characteristic length) has rcond ~ 1e-2..1 for ordinary positions and ~ distance to the
 /// singularity / length near one, so 1e-9 flags only positions within ~1e-9 of a singular one.
@@ -20,7 +20,10 @@ inline constexpr double kSingularRcond = 1e-9;
 class Factorized {
  public:
   Factorized(const Model& model, const MatrixXd& J);
-  double rcond() const { return lu_.rcond(); }
+  /// Reciprocal condition indicator: the smaller of LU's 1-norm estimate and the ratio of the
+  /// smallest to the largest pivot (the estimate alone misses exactly singular matrices, whose
+  /// zero pivot the pseudo-solve skips).
+  double rcond() const;
   VectorXd solve(const VectorXd& b) const;             ///< x with J x = b
   VectorXd solve_transposed(const VectorXd& b) const;  ///< y with J^T y = b
 
