@@ -30,15 +30,13 @@ namespace bd::referee::detail {
 
 namespace {
 
-double angle_of(const VectorXd& q, int body) { return body == kGround ? 0.0 : q[3 * body + 2]; }
-double omega_of(const VectorXd& qd, int body) { return body == kGround ? 0.0 : qd[3 * body + 2]; }
-Vec2 line_dir(const VectorXd& q, const LineRow& l) {
-  return rotate(angle_of(q, l.line_body), l.u0);
-}
+Real angle_of(const VecX& q, int body) { return body == kGround ? 0.0 : q[3 * body + 2]; }
+Real omega_of(const VecX& qd, int body) { return body == kGround ? 0.0 : qd[3 * body + 2]; }
+V2 line_dir(const VecX& q, const LineRow& l) { return rotate(angle_of(q, l.line_body), l.u0); }
 
 // Adds sign * gradient of w . P(q) for a point p to row `row` of J (w held fixed).
-void add_point_gradient(MatrixXd& J, Index row, const VectorXd& q, const Attach& p, const Vec2& w,
-                        double sign) {
+void add_point_gradient(MatX& J, Index row, const VecX& q, const Attach& p, const V2& w,
+                        Real sign) {
   if (p.body == kGround) return;
   const Index c = 3 * p.body;
   J(row, c) += sign * w.x();
@@ -48,20 +46,20 @@ void add_point_gradient(MatrixXd& J, Index row, const VectorXd& q, const Attach&
 
 }  // namespace
 
-Vec2 arm(const VectorXd& q, const Attach& p) {
-  return p.body == kGround ? Vec2(0, 0) : rotate(q[3 * p.body + 2], p.s);
+V2 arm(const VecX& q, const Attach& p) {
+  return p.body == kGround ? V2(0, 0) : rotate(q[3 * p.body + 2], p.s);
 }
-Vec2 position(const VectorXd& q, const Attach& p) {
+V2 position(const VecX& q, const Attach& p) {
   if (p.body == kGround) return p.s;
-  return Vec2(q.segment<2>(3 * p.body)) + rotate(q[3 * p.body + 2], p.s);
+  return V2(q.segment<2>(3 * p.body)) + rotate(q[3 * p.body + 2], p.s);
 }
-Vec2 velocity(const VectorXd& q, const VectorXd& qd, const Attach& p) {
+V2 velocity(const VecX& q, const VecX& qd, const Attach& p) {
   if (p.body == kGround) return {0, 0};
-  return Vec2(qd.segment<2>(3 * p.body)) + qd[3 * p.body + 2] * perp(arm(q, p));
+  return V2(qd.segment<2>(3 * p.body)) + qd[3 * p.body + 2] * perp(arm(q, p));
 }
 
-VectorXd input_values(const Model& model, const VectorXd& q) {
-  VectorXd v(model.ndof());
+VecX input_values(const Model& model, const VecX& q) {
+  VecX v(model.ndof());
   for (Index k = 0; k < model.ndof(); ++k) {
     const InputRow& in = model.inputs[k];
     if (in.angle) {
@@ -74,8 +72,8 @@ VectorXd input_values(const Model& model, const VectorXd& q) {
   return v;
 }
 
-VectorXd residual(const Model& model, const VectorXd& q, const VectorXd& values) {
-  VectorXd c(model.n());
+VecX residual(const Model& model, const VecX& q, const VecX& values) {
+  VecX c(model.n());
   Index r = 0;
   for (const auto& [a, b] : model.pins) {
     c.segment<2>(r) = position(q, b) - position(q, a);
@@ -92,24 +90,24 @@ VectorXd residual(const Model& model, const VectorXd& q, const VectorXd& values)
   return c;
 }
 
-MatrixXd jacobian(const Model& model, const VectorXd& q) {
-  MatrixXd J = MatrixXd::Zero(model.n(), model.n());
+MatX jacobian(const Model& model, const VecX& q) {
+  MatX J = MatX::Zero(model.n(), model.n());
   Index r = 0;
   for (const auto& [a, b] : model.pins) {
     for (int axis = 0; axis < 2; ++axis, ++r) {
-      const Vec2 w = axis == 0 ? Vec2(1, 0) : Vec2(0, 1);
+      const V2 w = axis == 0 ? V2(1, 0) : V2(0, 1);
       add_point_gradient(J, r, q, b, w, 1);
       add_point_gradient(J, r, q, a, w, -1);
     }
   }
-  auto line_row = [&](const LineRow& l, const Vec2& w, double extra) {
+  auto line_row = [&](const LineRow& l, const V2& w, Real extra) {
     add_point_gradient(J, r, q, l.p, w, 1);
     add_point_gradient(J, r, q, l.from, w, -1);
     if (l.line_body != kGround) J(r, 3 * l.line_body + 2) += extra;
     ++r;
   };
   for (const auto& l : model.lines) {
-    const Vec2 u = line_dir(q, l), d = position(q, l.p) - position(q, l.from);
+    const V2 u = line_dir(q, l), d = position(q, l.p) - position(q, l.from);
     line_row(l, perp(u), -d.dot(u));
   }
   for (const auto& g : model.gears) {
@@ -124,7 +122,7 @@ MatrixXd jacobian(const Model& model, const VectorXd& q) {
       J(r++, 3 * in.body + 2) = 1;
     } else {
       const LineRow& l = model.lines[in.slider];
-      const Vec2 u = line_dir(q, l), d = position(q, l.p) - position(q, l.from);
+      const V2 u = line_dir(q, l), d = position(q, l.p) - position(q, l.from);
       line_row(l, u, d.dot(perp(u)));
     }
   }
@@ -134,30 +132,30 @@ MatrixXd jacobian(const Model& model, const VectorXd& q) {
 namespace {
 
 // gamma of a slider row (direction w = n, sign_u = +1) or a slide-input row (w = u).
-double line_gamma(const VectorXd& q, const VectorXd& qd, const LineRow& l, bool normal) {
-  const Vec2 u = line_dir(q, l), n = perp(u);
-  const Vec2 d = position(q, l.p) - position(q, l.from);
-  const Vec2 dd = velocity(q, qd, l.p) - velocity(q, qd, l.from);
-  const double wp = omega_of(qd, l.p.body), wl = omega_of(qd, l.line_body);
-  const Vec2 w = normal ? n : u;
-  const double base =
+Real line_gamma(const VecX& q, const VecX& qd, const LineRow& l, bool normal) {
+  const V2 u = line_dir(q, l), n = perp(u);
+  const V2 d = position(q, l.p) - position(q, l.from);
+  const V2 dd = velocity(q, qd, l.p) - velocity(q, qd, l.from);
+  const Real wp = omega_of(qd, l.p.body), wl = omega_of(qd, l.line_body);
+  const V2 w = normal ? n : u;
+  const Real base =
       wp * wp * arm(q, l.p).dot(w) - wl * wl * arm(q, l.from).dot(w) + wl * wl * d.dot(w);
   return normal ? base + 2 * wl * dd.dot(u) : base - 2 * wl * dd.dot(n);
 }
 
 }  // namespace
 
-VectorXd gamma(const Model& model, const VectorXd& q, const VectorXd& qd) {
-  VectorXd g = VectorXd::Zero(model.n());
+VecX gamma(const Model& model, const VecX& q, const VecX& qd) {
+  VecX g = VecX::Zero(model.n());
   Index r = 0;
   for (const auto& [a, b] : model.pins) {
-    const double wa = omega_of(qd, a.body), wb = omega_of(qd, b.body);
+    const Real wa = omega_of(qd, a.body), wb = omega_of(qd, b.body);
     g.segment<2>(r) = wb * wb * arm(q, b) - wa * wa * arm(q, a);
     r += 2;
   }
   for (const auto& l : model.lines) g[r++] = line_gamma(q, qd, l, true);
   for (const auto& gr : model.gears) {
-    const double wa = qd[3 * gr.a + 2], wb = qd[3 * gr.b + 2];
+    const Real wa = qd[3 * gr.a + 2], wb = qd[3 * gr.b + 2];
     g[r++] = wa * wa * gr.t.dot(arm(q, gr.pa)) - wb * wb * gr.t.dot(arm(q, gr.pb));
   }
   for (const auto& in : model.inputs) {

@@ -3,10 +3,9 @@
 // Driven scene at time t: the inputs are held at rate * (t - t0), so all n constraint rows
 // (mechanism and inputs) form a square system J. Positions by Newton (continued from the
 // previous sample), then
-//   J q'  = (0, ..., 0, rates)                    (the input rows' c_t = -rate)
-//   J q'' = gamma                                 (constant rates: no input acceleration)
-//   J^T lambda = M q'' - Q                        (Newton–Euler of every body, M q'' = Q + J^T
-//   lambda)
+//   J q'  = (0, ..., 0, rates)             (the input rows' c_t = -rate)
+//   J q'' = gamma                          (constant rates: no input acceleration)
+//   J^T lambda = M q'' - Q                 (Newton–Euler of every body: M q'' = Q + J^T lambda)
 // where the last ndof multipliers are the drive efforts.
 #include <iomanip>
 #include <sstream>
@@ -17,7 +16,8 @@
 namespace bd::referee {
 
 using detail::Index;
-using detail::VectorXd;
+using detail::Real;
+using detail::VecX;
 
 namespace {
 
@@ -27,8 +27,8 @@ std::string at_time(double t) {
   return os.str();
 }
 
-VectorXd to_vector(const std::vector<double>& v) {
-  return Eigen::Map<const VectorXd>(v.data(), static_cast<Index>(v.size()));
+VecX to_vector(const std::vector<double>& v) {
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Index>(v.size())).cast<Real>();
 }
 
 void check_size(const detail::Model& model, const std::vector<double>& v, const char* what) {
@@ -41,11 +41,11 @@ void check_size(const detail::Model& model, const std::vector<double>& v, const 
 std::vector<Pose> assemble(const Mechanism& mechanism, const std::vector<double>& input_values) {
   const detail::Model model = detail::compile(mechanism);
   check_size(model, input_values, "assemble");
-  VectorXd q = detail::described_q(model);
-  detail::continue_loop(model, VectorXd::Zero(model.ndof()), to_vector(input_values), q,
-                        "assemble");
+  VecX q = detail::described_q(model);
+  detail::continue_loop(model, VecX::Zero(model.ndof()), to_vector(input_values), q, "assemble");
   std::vector<Pose> poses;
-  for (int i = 0; i < model.nb; ++i) poses.push_back({q.segment<2>(3 * i), q[3 * i + 2]});
+  for (int i = 0; i < model.nb; ++i)
+    poses.push_back({detail::dbl(q.segment<2>(3 * i)), static_cast<double>(q[3 * i + 2])});
   return poses;
 }
 
@@ -53,25 +53,25 @@ std::vector<Sample> driven(const Mechanism& mechanism, const std::vector<double>
                            double t0, const std::vector<double>& times) {
   const detail::Model model = detail::compile(mechanism);
   check_size(model, input_rates, "driven");
-  const VectorXd rates = to_vector(input_rates);
-  const VectorXd mass = detail::mass_diagonal(model);
-  VectorXd q = detail::described_q(model);
-  VectorXd previous = VectorXd::Zero(model.ndof());
+  const VecX rates = to_vector(input_rates);
+  const VecX mass = detail::mass_diagonal(model);
+  VecX q = detail::described_q(model);
+  VecX previous = VecX::Zero(model.ndof());
   std::vector<Sample> out;
   for (std::size_t i = 0; i < times.size(); ++i) {
     if (i > 0 && times[i] < times[i - 1])
       throw std::domain_error("bd::referee: driven: sample times must ascend");
     detail::State s;
     s.t = times[i];
-    const VectorXd values = rates * (s.t - t0);
-    const auto f = detail::continue_loop(model, previous, values, q, "driven " + at_time(s.t));
+    const VecX values = rates * (Real(times[i]) - Real(t0));
+    const auto f = detail::continue_loop(model, previous, values, q, "driven " + at_time(times[i]));
     previous = values;
-    VectorXd rhs = VectorXd::Zero(model.n());
+    VecX rhs = VecX::Zero(model.n());
     rhs.tail(model.ndof()) = rates;
     s.q = q;
     s.qd = f.solve(rhs);
     s.qdd = f.solve(detail::gamma(model, s.q, s.qd));
-    const VectorXd Q = detail::applied_forces(model, mechanism, s.t, s.q, s.qd);
+    const VecX Q = detail::applied_forces(model, mechanism, s.t, s.q, s.qd);
     s.lambda = f.solve_transposed(mass.cwiseProduct(s.qdd) - Q);
     out.push_back(detail::make_sample(model, mechanism, s));
   }
@@ -82,11 +82,13 @@ PointMotion point_motion(const Mechanism& mechanism, const Sample& sample, int b
                          const Vec2& described_point) {
   if (body == kGround) return {described_point, {0, 0}, {0, 0}};
   const BodyState& b = sample.bodies.at(static_cast<std::size_t>(body));
-  const Vec2 rho = detail::rotate(b.angle, described_point - merged(mechanism.bodies[body]).com);
+  const Vec2 s = described_point - merged(mechanism.bodies[body]).com;
+  const double c = std::cos(b.angle), sn = std::sin(b.angle);
+  const Vec2 rho{c * s.x() - sn * s.y(), sn * s.x() + c * s.y()}, rho_perp{-rho.y(), rho.x()};
   PointMotion m;
   m.p = b.com + rho;
-  m.v = b.velocity + b.omega * detail::perp(rho);
-  m.a = b.acceleration + b.alpha * detail::perp(rho) - b.omega * b.omega * rho;
+  m.v = b.velocity + b.omega * rho_perp;
+  m.a = b.acceleration + b.alpha * rho_perp - b.omega * b.omega * rho;
   return m;
 }
 

@@ -13,14 +13,13 @@ namespace bd::referee::detail {
 
 namespace {
 
-Eigen::VectorXd midpoint_row(OdeSystem& sys, double t, const Eigen::VectorXd& y,
-                             const Eigen::VectorXd& f0, double H, int n) {
+VecX midpoint_row(OdeSystem& sys, Real t, const VecX& y, const VecX& f0, Real H, int n) {
   sys.restart();
-  const double h = H / n;
-  Eigen::VectorXd prev = y;
-  Eigen::VectorXd z = y + h * f0;
+  const Real h = H / n;
+  VecX prev = y;
+  VecX z = y + h * f0;
   for (int i = 1; i < n; ++i) {
-    Eigen::VectorXd next = prev + 2 * h * sys.rhs(t + i * h, z);
+    VecX next = prev + 2 * h * sys.rhs(t + i * h, z);
     prev = std::move(z);
     z = std::move(next);
   }
@@ -29,23 +28,26 @@ Eigen::VectorXd midpoint_row(OdeSystem& sys, double t, const Eigen::VectorXd& y,
 
 }  // namespace
 
-StepOutcome gbs_step(OdeSystem& sys, double t, const Eigen::VectorXd& y, const Eigen::VectorXd& f0,
-                     double H, const Eigen::VectorXd& scale, double tol) {
+StepOutcome gbs_step(OdeSystem& sys, Real t, const VecX& y, const VecX& f0, Real H,
+                     const VecX& scale, Real tol) {
   const Eigen::Index nc = scale.size();
-  std::vector<Eigen::VectorXd> T;  // T[k] = T(j, k+1) of the current row j
+  std::vector<VecX> T;  // T[k] = T(j, k+1) of the current row j
   StepOutcome out;
   for (int j = 1; j <= kMaxRow; ++j) {
-    std::vector<Eigen::VectorXd> row{midpoint_row(sys, t, y, f0, H, 2 * j)};
+    std::vector<VecX> row{midpoint_row(sys, t, y, f0, H, 2 * j)};
     for (int k = 1; k < j; ++k) {
-      const double ratio = static_cast<double>(j) / (j - k);  // n_j / n_(j-k)
+      const Real ratio = static_cast<Real>(j) / (j - k);  // n_j / n_(j-k)
       row.push_back(row[k - 1] + (row[k - 1] - T[k - 1]) / (ratio * ratio - 1));
     }
     T = std::move(row);
     if (j < 2) continue;
-    const Eigen::VectorXd diff = (T[j - 1] - T[j - 2]).head(nc);
+    const VecX diff = (T[j - 1] - T[j - 2]).head(nc);
+    const Real previous = out.error;
     out.error = (diff.cwiseAbs().array() / (tol * scale.array())).maxCoeff();
     out.row = j;
-    if (j >= kMinRow && out.error <= 1) {
+    // two consecutive rows within the tolerance: one estimate alone can be small by accident
+    // (a component's difference crossing zero) and let a poor step through
+    if (j >= kMinRow && out.error <= 1 && previous <= 1) {
       out.converged = true;
       break;
     }

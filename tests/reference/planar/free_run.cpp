@@ -17,11 +17,14 @@
 // The ODE y' = (a', a'', P_in, P_damp, P_app) is smooth as long as the inputs are valid
 // coordinates (J regular), and is integrated by GBS extrapolation (extrapolation.hpp) with the
 // step landing exactly on every sample time. Error control: per component of (a, a'), the local
-// error estimate <= tolerance * scale, scale = max(running max |y_i|, floor), floor = 1 rad or
-// the characteristic length for a, that divided by the duration for a'.
+// error estimate <= tolerance * scale, with scale = 1 rad (angle input) or the characteristic
+// length (slide input) for a -- fixed, since the mechanism's positions are what matter, not how
+// many turns a crank has made -- and for a' the running maximum of |a'| over the run, at least
+// the position scale divided by the duration. The whole ODE is solved in long double.
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -31,104 +34,118 @@
 namespace bd::referee {
 
 using detail::Index;
-using detail::MatrixXd;
-using detail::VectorXd;
+using detail::MatX;
+using detail::Real;
+using detail::VecX;
 
 namespace {
 
 thread_local FreeRunStats g_stats;
 
-std::string at_time(double t) {
+std::string at_time(Real t) {
   std::ostringstream os;
   os << std::setprecision(12) << "free run at t = " << t << " s";
   return os.str();
 }
 
+// Where the next Newton solve starts: the last solution in the same step (positions,
+// velocities, accelerations, time) and its factorized Jacobian, used for a second-order
+// predictor and for simplified Newton iterations.
+struct Guess {
+  Real t = 0;
+  VecX q, qd, qdd;
+  std::optional<detail::Factorized> f;
+};
+
 class FreeSystem final : public detail::OdeSystem {
  public:
-  FreeSystem(const detail::Model& model, const Mechanism& mech, VectorXd q0)
-      : model_(model),
-        mech_(mech),
-        mass_(detail::mass_diagonal(model)),
-        base_(std::move(q0)),
-        work_(base_) {}
+  FreeSystem(const detail::Model& model, const Mechanism& mech, VecX q0)
+      : model_(model), mech_(mech), mass_(detail::mass_diagonal(model)) {
+    base_.q = std::move(q0);
+    base_.qd = base_.qdd = VecX::Zero(base_.q.size());
+    work_ = base_;
+  }
 
   void restart() override { work_ = base_; }
-  VectorXd rhs(double t, const VectorXd& y) override {
-    return derivative(evaluate(t, y, work_, false));
-  }
+  VecX rhs(Real t, const VecX& y) override { return derivative(evaluate(t, y, work_, false)); }
 
-  /// The full state at (t, y), Newton starting from q (updated). The constraint multipliers
-  /// (not needed by the ODE) only when `multipliers`; otherwise lambda holds just the efforts.
-  detail::State evaluate(double t, const VectorXd& y, VectorXd& q, bool multipliers) const;
-  /// Evaluates at an accepted point and makes its positions the base of the next step.
-  detail::State accept(double t, const VectorXd& y) {
-    VectorXd q = base_;
-    detail::State s = evaluate(t, y, q, true);
-    base_ = q;
+  /// The full state at (t, y), Newton starting from the guess (updated to the solution). The
+  /// constraint multipliers (not needed by the ODE) only when `multipliers`; otherwise lambda
+  /// holds just the efforts.
+  detail::State evaluate(Real t, const VecX& y, Guess& guess, bool multipliers) const;
+  /// Evaluates at an accepted point and makes it the start of the next step.
+  detail::State accept(Real t, const VecX& y) {
+    Guess g = base_;
+    detail::State s = evaluate(t, y, g, true);
+    base_ = std::move(g);
     return s;
   }
-  VectorXd derivative(const detail::State& s) const;
+  VecX derivative(const detail::State& s) const;
 
  private:
-  VectorXd efforts(double t) const {
-    VectorXd tau = VectorXd::Zero(model_.ndof());
+  VecX efforts(Real t) const {
+    VecX tau = VecX::Zero(model_.ndof());
     for (std::size_t k = 0; k < mech_.input_efforts.size(); ++k)
-      tau[static_cast<Index>(k)] = mech_.input_efforts[k](t);
+      tau[static_cast<Index>(k)] = mech_.input_efforts[k](static_cast<double>(t));
     return tau;
   }
 
   const detail::Model& model_;
   const Mechanism& mech_;
-  VectorXd mass_, base_, work_;
+  VecX mass_;
+  Guess base_, work_;
 };
 
-detail::State FreeSystem::evaluate(double t, const VectorXd& y, VectorXd& q,
-                                   bool multipliers) const {
+detail::State FreeSystem::evaluate(Real t, const VecX& y, Guess& guess, bool multipliers) const {
   ++g_stats.evaluations;
   const Index n = model_.n(), nd = model_.ndof();
-  const auto f = detail::close_loop(model_, y.head(nd), q, at_time(t));
+  const Real dt = t - guess.t;
+  VecX q = guess.q + dt * guess.qd + (dt * dt / 2) * guess.qdd;
+  const auto f =
+      detail::close_loop(model_, y.head(nd), q, at_time(t), guess.f ? &*guess.f : nullptr);
   detail::State s;
   s.t = t;
   s.q = q;
-  VectorXd rhs = VectorXd::Zero(n);
+  VecX rhs = VecX::Zero(n);
   rhs.tail(nd) = y.segment(nd, nd);
   s.qd = f.solve(rhs);
-  MatrixXd N(n, nd);
-  for (Index k = 0; k < nd; ++k) N.col(k) = f.solve(VectorXd::Unit(n, model_.input_row(k)));
-  const VectorXd qdd0 = f.solve(detail::gamma(model_, s.q, s.qd));
-  const VectorXd Q = detail::applied_forces(model_, mech_, t, s.q, s.qd);
-  const VectorXd tau = efforts(t);
-  const MatrixXd reduced_mass = N.transpose() * mass_.asDiagonal() * N;
-  const Eigen::FullPivLU<MatrixXd> lu(reduced_mass);
+  MatX N(n, nd);
+  for (Index k = 0; k < nd; ++k) N.col(k) = f.solve(VecX::Unit(n, model_.input_row(k)));
+  const VecX qdd0 = f.solve(detail::gamma(model_, s.q, s.qd));
+  const VecX Q = detail::applied_forces(model_, mech_, t, s.q, s.qd);
+  const VecX tau = efforts(t);
+  const MatX reduced_mass = N.transpose() * mass_.asDiagonal() * N;
+  const Eigen::FullPivLU<MatX> lu(reduced_mass);
   if (!lu.isInvertible())
     throw std::domain_error("bd::referee: " + at_time(t) + ": the reduced mass is singular");
-  const VectorXd add = lu.solve(N.transpose() * (Q - mass_.cwiseProduct(qdd0)) + tau);
+  const VecX add = lu.solve(N.transpose() * (Q - mass_.cwiseProduct(qdd0)) + tau);
   s.qdd = qdd0 + N * add;
-  s.lambda = multipliers ? f.solve_transposed(mass_.cwiseProduct(s.qdd) - Q) : VectorXd::Zero(n);
+  s.lambda = multipliers ? f.solve_transposed(mass_.cwiseProduct(s.qdd) - Q) : VecX::Zero(n);
   s.lambda.tail(nd) = tau;  // equal to rounding; report the given efforts exactly
+  guess = Guess{t, s.q, s.qd, s.qdd, f};
   s.input_work = y[2 * nd];
   s.damper_work = y[2 * nd + 1];
   s.applied_work = y[2 * nd + 2];
   return s;
 }
 
-VectorXd FreeSystem::derivative(const detail::State& s) const {
+VecX FreeSystem::derivative(const detail::State& s) const {
   const Index nd = model_.ndof();
-  const MatrixXd J_in = detail::jacobian(model_, s.q).bottomRows(nd);
-  const VectorXd rates = J_in * s.qd;
-  VectorXd dy(2 * nd + 3);
+  const MatX J_in = detail::jacobian(model_, s.q).bottomRows(nd);
+  const VecX rates = J_in * s.qd;
+  VecX dy(2 * nd + 3);
   dy.head(nd) = rates;
   dy.segment(nd, nd) = J_in * s.qdd - detail::gamma(model_, s.q, s.qd).tail(nd);
   dy[2 * nd] = s.lambda.tail(nd).dot(rates);
-  double damp = 0, applied = 0;
+  Real damp = 0, applied = 0;
   for (std::size_t k = 0; k < mech_.springs.size(); ++k) {
     const auto st = detail::spring_state(model_, mech_, k, s.q, s.qd);
     damp += mech_.springs[k].damping * st.rate * st.rate;
   }
   for (std::size_t k = 0; k < mech_.forces.size(); ++k)
-    applied += mech_.forces[k].force(s.t).dot(detail::velocity(s.q, s.qd, model_.force_points[k]));
-  for (const auto& m : mech_.moments) applied += m.moment(s.t) * s.qd[3 * m.body + 2];
+    applied += detail::force_at(mech_.forces[k], s.t)
+                   .dot(detail::velocity(s.q, s.qd, model_.force_points[k]));
+  for (const auto& m : mech_.moments) applied += detail::moment_at(m, s.t) * s.qd[3 * m.body + 2];
   dy[2 * nd + 1] = damp;
   dy[2 * nd + 2] = applied;
   return dy;
@@ -137,10 +154,9 @@ VectorXd FreeSystem::derivative(const detail::State& s) const {
 // Steps the free system from sample time to sample time (see the top of this file).
 class Integrator {
  public:
-  Integrator(FreeSystem& sys, const detail::Model& model, const VectorXd& y0, double duration,
-             double tol)
+  Integrator(FreeSystem& sys, const detail::Model& model, const VecX& y0, Real duration, Real tol)
       : sys_(sys), nd_(model.ndof()), y_(y0), tol_(tol), duration_(duration) {
-    scale_ = VectorXd::Zero(2 * nd_);
+    scale_ = VecX::Zero(2 * nd_);
     for (Index k = 0; k < nd_; ++k) {
       scale_[k] = model.inputs[k].angle ? 1.0 : model.length;
       scale_[nd_ + k] = scale_[k] / duration;
@@ -151,26 +167,28 @@ class Integrator {
     H_ = std::min(duration / 100, branch_limit());
   }
   const detail::State& state() const { return state_; }
-  void advance_to(double target);
+  void advance_to(Real target);
 
  private:
   // The first midpoint substep (H / 2) turns no body by more than 0.25 rad.
-  double branch_limit() const {
-    double w = 0;
+  Real branch_limit() const {
+    Real w = 0;
     for (Index i = 2; i < state_.qd.size(); i += 3) w = std::max(w, std::abs(state_.qd[i]));
     return w > 0 ? 0.5 / w : duration_;
   }
-  void update_scale() { scale_ = scale_.cwiseMax(y_.head(2 * nd_).cwiseAbs()); }
-  bool try_step(double H, double t_new, detail::StepOutcome& o, std::string& why);
+  void update_scale() {
+    scale_.tail(nd_) = scale_.tail(nd_).cwiseMax(y_.segment(nd_, nd_).cwiseAbs());
+  }
+  bool try_step(Real H, Real t_new, detail::StepOutcome& o, std::string& why);
 
   FreeSystem& sys_;
   Index nd_;
-  VectorXd y_, f_, scale_;
-  double t_ = 0, H_ = 0, tol_, duration_;
+  VecX y_, f_, scale_;
+  Real t_ = 0, H_ = 0, tol_, duration_;
   detail::State state_;
 };
 
-bool Integrator::try_step(double H, double t_new, detail::StepOutcome& o, std::string& why) {
+bool Integrator::try_step(Real H, Real t_new, detail::StepOutcome& o, std::string& why) {
   try {
     o = detail::gbs_step(sys_, t_, y_, f_, H, scale_, tol_);
     if (!o.converged) {
@@ -187,18 +205,18 @@ bool Integrator::try_step(double H, double t_new, detail::StepOutcome& o, std::s
   return true;
 }
 
-void Integrator::advance_to(double target) {
+void Integrator::advance_to(Real target) {
   while (t_ < target) {
-    const double H = std::min({H_, target - t_, branch_limit()});
+    const Real H = std::min({H_, target - t_, branch_limit()});
     const bool last = H == target - t_;
-    const double t_new = last ? target : t_ + H;
+    const Real t_new = last ? target : t_ + H;
     detail::StepOutcome o;
     std::string why;
     if (!try_step(H, t_new, o, why)) {
       ++g_stats.rejected;
-      const double err_fac = 0.9 * std::pow(1 / o.error, 1.0 / (2 * detail::kMaxRow - 1));
-      H_ = H * (o.error == 0 || !std::isfinite(err_fac) ? 0.25 : std::clamp(err_fac, 0.1, 0.5));
-      if (!(H_ > 1e-13 * std::max(duration_, std::abs(t_))))
+      const Real err_fac = 0.9L * std::pow(1 / o.error, 1.0L / (2 * detail::kMaxRow - 1));
+      H_ = H * (o.error == 0 || !std::isfinite(err_fac) ? 0.25L : std::clamp(err_fac, 0.1L, 0.5L));
+      if (!(H_ > 1e-13L * std::max(duration_, std::abs(t_))))
         throw std::domain_error("bd::referee: " + at_time(t_) + ": step size underflow (" + why +
                                 ")");
       continue;
@@ -208,9 +226,9 @@ void Integrator::advance_to(double target) {
     y_ = o.y;
     f_ = sys_.derivative(state_);
     update_scale();
-    double fac = 0.9 * std::pow(1 / std::max(o.error, 1e-10), 1.0 / (2 * o.row - 1));
-    fac = std::clamp(fac, 0.2, 4.0);
-    if (o.row >= detail::kMaxRow - 1) fac = std::min(fac, 0.7);  // back to cheaper rows
+    Real fac = 0.9L * std::pow(1 / std::max(o.error, 1e-10L), 1.0L / (2 * o.row - 1));
+    fac = std::clamp(fac, 0.2L, 4.0L);
+    if (o.row >= detail::kMaxRow - 1) fac = std::min(fac, 0.7L);  // back to cheaper rows
     H_ = (H < H_ && fac >= 1) ? H_ : H * fac;
   }
 }
@@ -231,10 +249,10 @@ std::vector<Sample> free_run(const Mechanism& mechanism, const std::vector<doubl
     if (times[i] < 0 || times[i] > duration || (i > 0 && times[i] < times[i - 1]))
       throw std::domain_error("bd::referee: free_run: times must ascend within [0, duration]");
   g_stats = {};
-  VectorXd q0 = detail::described_q(model);
-  detail::close_loop(model, VectorXd::Zero(nd), q0, at_time(0));
-  VectorXd y0 = VectorXd::Zero(2 * nd + 3);
-  y0.segment(nd, nd) = Eigen::Map<const VectorXd>(initial_rates.data(), nd);
+  VecX q0 = detail::described_q(model);
+  detail::close_loop(model, VecX::Zero(nd), q0, at_time(0));
+  VecX y0 = VecX::Zero(2 * nd + 3);
+  y0.segment(nd, nd) = Eigen::Map<const Eigen::VectorXd>(initial_rates.data(), nd).cast<Real>();
   FreeSystem sys(model, mechanism, q0);
   Integrator integrator(sys, model, y0, duration, tolerance);
   std::vector<Sample> out;

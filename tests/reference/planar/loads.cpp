@@ -7,24 +7,24 @@
 
 namespace bd::referee::detail {
 
-VectorXd mass_diagonal(const Model& model) {
-  VectorXd m(model.n());
+VecX mass_diagonal(const Model& model) {
+  VecX m(model.n());
   for (int i = 0; i < model.nb; ++i)
     m.segment<3>(3 * i) << model.mass[i], model.mass[i], model.inertia[i];
   return m;
 }
 
-void add_point_force(VectorXd& Q, const VectorXd& q, const Attach& p, const Vec2& f) {
+void add_point_force(VecX& Q, const VecX& q, const Attach& p, const V2& f) {
   if (p.body == kGround) return;
   Q.segment<2>(3 * p.body) += f;
   Q[3 * p.body + 2] += cross(arm(q, p), f);
 }
 
-SpringState spring_state(const Model& model, const Mechanism& mech, std::size_t k,
-                         const VectorXd& q, const VectorXd& qd) {
+SpringState spring_state(const Model& model, const Mechanism& mech, std::size_t k, const VecX& q,
+                         const VecX& qd) {
   const SpringRow& row = model.springs[k];
   const Spring& s = mech.springs[k];
-  const Vec2 d = position(q, row.b) - position(q, row.a);
+  const V2 d = position(q, row.b) - position(q, row.a);
   SpringState st;
   st.length = d.norm();
   if (!(st.length > 1e-12 * model.length))
@@ -35,13 +35,13 @@ SpringState spring_state(const Model& model, const Mechanism& mech, std::size_t 
   return st;
 }
 
-VectorXd applied_forces(const Model& model, const Mechanism& mech, double t, const VectorXd& q,
-                        const VectorXd& qd) {
-  VectorXd Q = VectorXd::Zero(model.n());
-  for (int i = 0; i < model.nb; ++i) Q.segment<2>(3 * i) += model.mass[i] * mech.gravity;
+VecX applied_forces(const Model& model, const Mechanism& mech, Real t, const VecX& q,
+                    const VecX& qd) {
+  VecX Q = VecX::Zero(model.n());
+  for (int i = 0; i < model.nb; ++i) Q.segment<2>(3 * i) += model.mass[i] * ext(mech.gravity);
   for (std::size_t k = 0; k < mech.forces.size(); ++k)
-    add_point_force(Q, q, model.force_points[k], mech.forces[k].force(t));
-  for (const auto& m : mech.moments) Q[3 * m.body + 2] += m.moment(t);
+    add_point_force(Q, q, model.force_points[k], force_at(mech.forces[k], t));
+  for (const auto& m : mech.moments) Q[3 * m.body + 2] += moment_at(m, t);
   for (std::size_t k = 0; k < mech.springs.size(); ++k) {
     const SpringState st = spring_state(model, mech, k, q, qd);
     // tension pulls b towards a and a towards b

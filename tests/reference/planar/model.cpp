@@ -32,8 +32,8 @@ void check_body(const Model& model, int body, bool ground_ok, const std::string&
 }
 
 Attach attach(const Model& model, int body, const Vec2& point) {
-  if (body == kGround) return {kGround, point};
-  return {body, point - model.com0[body]};
+  if (body == kGround) return {kGround, ext(point)};
+  return {body, ext(point) - model.com0[body]};
 }
 
 // Characteristic length: the diagonal of the bounding box of all described points.
@@ -68,7 +68,7 @@ void compile_bodies(const Mechanism& mech, Model& model) {
     const MassProperties mp = merged(b);
     model.mass.push_back(mp.mass);
     model.inertia.push_back(mp.inertia);
-    model.com0.push_back(mp.com);
+    model.com0.push_back(ext(mp.com));
   }
 }
 
@@ -96,7 +96,7 @@ void compile_sliders(const Mechanism& mech, Model& model) {
     row.p = attach(model, s.point_body, s.point);
     row.from = attach(model, s.line_body, s.line_from);
     row.line_body = s.line_body;
-    row.u0 = dir.normalized();
+    row.u0 = ext(dir).normalized();
     model.lines.push_back(row);
     model.row_names.push_back(where);
   }
@@ -110,7 +110,7 @@ bool has_ground_pin(const Mechanism& mech, int body, const Vec2& at, double tol)
 }
 
 void compile_gears(const Mechanism& mech, Model& model) {
-  const double tol = 1e-9 * model.length;
+  const double tol = 1e-9 * static_cast<double>(model.length);
   for (const auto& g : mech.gears) {
     const std::string where = "gear '" + g.name + "'";
     check_body(model, g.a, false, where);
@@ -121,15 +121,15 @@ void compile_gears(const Mechanism& mech, Model& model) {
     GearRow row;
     row.a = g.a;
     row.b = g.b;
-    row.ra = (g.pitch_point - g.pivot_a).norm();
-    row.rb = (g.pitch_point - g.pivot_b).norm();
-    const double dist = (g.pivot_b - g.pivot_a).norm();
+    row.oa = ext(g.pivot_a);
+    row.ob = ext(g.pivot_b);
+    row.pitch = ext(g.pitch_point);
+    row.ra = (row.pitch - row.oa).norm();
+    row.rb = (row.pitch - row.ob).norm();
+    const Real dist = (row.ob - row.oa).norm();
     if (!(row.ra > tol && row.rb > tol) || std::abs(row.ra + row.rb - dist) > tol)
       fail(where + ": the pitch point must lie strictly between the pivots");
-    row.oa = g.pivot_a;
-    row.ob = g.pivot_b;
-    row.t = perp((g.pivot_b - g.pivot_a) / dist);
-    row.pitch = g.pitch_point;
+    row.t = perp(V2((row.ob - row.oa) / dist));
     row.pa = attach(model, g.a, g.pivot_a);
     row.pb = attach(model, g.b, g.pivot_b);
     model.gears.push_back(row);
@@ -151,7 +151,7 @@ void compile_inputs(const Mechanism& mech, Model& model) {
       row.angle = false;
       row.slider = s;
       const auto& sl = mech.sliders[s];
-      row.s0 = (sl.point - sl.line_from).dot(model.lines[s].u0);
+      row.s0 = (ext(sl.point) - ext(sl.line_from)).dot(model.lines[s].u0);
     }
     model.inputs.push_back(row);
     model.row_names.push_back(where);
@@ -183,7 +183,7 @@ void compile_loads(const Mechanism& mech, Model& model) {
 Model compile(const Mechanism& mech) {
   Model model;
   compile_bodies(mech, model);
-  model.length = characteristic_length(mech);
+  model.length = static_cast<Real>(characteristic_length(mech));
   compile_pins(mech, model);
   compile_sliders(mech, model);
   compile_gears(mech, model);
@@ -193,16 +193,16 @@ Model compile(const Mechanism& mech) {
   if (rows != model.n())
     fail("3 x bodies = " + std::to_string(model.n()) + " coordinates but 2 x pins + sliders + " +
          "gears + inputs = " + std::to_string(rows) + " constraints: one input per DOF needed");
-  const VectorXd c = residual(model, described_q(model), VectorXd::Zero(model.ndof()));
+  const VecX c = residual(model, described_q(model), VecX::Zero(model.ndof()));
   for (Index i = 0; i < model.m(); ++i)
     if (std::abs(c[i]) > 1e-8 * model.length)
       fail("the described configuration violates " + model.row_names[i] + " by " +
-           std::to_string(c[i]));
+           std::to_string(static_cast<double>(c[i])));
   return model;
 }
 
-VectorXd described_q(const Model& model) {
-  VectorXd q = VectorXd::Zero(model.n());
+VecX described_q(const Model& model) {
+  VecX q = VecX::Zero(model.n());
   for (int i = 0; i < model.nb; ++i) q.segment<2>(3 * i) = model.com0[i];
   return q;
 }

@@ -27,14 +27,25 @@
 
 namespace bd::referee::detail {
 
+// All internal arithmetic is in long double (64-bit mantissa on x86-64): the constraint
+// Jacobians have condition numbers of 1e2..1e3, so in double the velocities, accelerations and
+// forces would carry ~1e-14 relative noise; in long double they are exact to double precision
+// and the free-run integrator is no longer limited by noisy right-hand sides.
+using Real = long double;
 using Eigen::Index;
-using Eigen::MatrixXd;
-using Eigen::VectorXd;
+using VecX = Eigen::Matrix<Real, Eigen::Dynamic, 1>;
+using MatX = Eigen::Matrix<Real, Eigen::Dynamic, Eigen::Dynamic>;
+using V2 = Eigen::Matrix<Real, 2, 1>;
+inline V2 ext(const Vec2& v) { return v.cast<Real>(); }
+inline Vec2 dbl(const V2& v) { return v.cast<double>(); }
+// The user's load functions take and return double.
+inline V2 force_at(const PointForce& f, Real t) { return ext(f.force(static_cast<double>(t))); }
+inline Real moment_at(const BodyMoment& m, Real t) { return m.moment(static_cast<double>(t)); }
 
-inline Vec2 perp(const Vec2& v) { return {-v.y(), v.x()}; }
-inline double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
-inline Vec2 rotate(double phi, const Vec2& s) {
-  const double c = std::cos(phi), sn = std::sin(phi);
+inline V2 perp(const V2& v) { return {-v.y(), v.x()}; }
+inline Real cross(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); }
+inline V2 rotate(Real phi, const V2& s) {
+  const Real c = std::cos(phi), sn = std::sin(phi);
   return {c * s.x() - sn * s.y(), sn * s.x() + c * s.y()};
 }
 
@@ -42,25 +53,25 @@ inline Vec2 rotate(double phi, const Vec2& s) {
 /// orientation; for the ground, s is the fixed global point.
 struct Attach {
   int body = kGround;
-  Vec2 s{0, 0};
+  V2 s{0, 0};
 };
 
 struct LineRow {
   Attach p, from;  // the point on point_body; line_from on line_body
   int line_body = kGround;
-  Vec2 u0{1, 0};  // unit direction in the described orientation
+  V2 u0{1, 0};  // unit direction in the described orientation
 };
 struct GearRow {
   int a = 0, b = 0;
-  double ra = 0, rb = 0;
-  Attach pa, pb;                                  // the pivots as points of a and b
-  Vec2 oa{0, 0}, ob{0, 0}, t{0, 1}, pitch{0, 0};  // fixed pivots, t = perp(unit(ob - oa))
+  Real ra = 0, rb = 0;
+  Attach pa, pb;                                // the pivots as points of a and b
+  V2 oa{0, 0}, ob{0, 0}, t{0, 1}, pitch{0, 0};  // fixed pivots, t = perp(unit(ob - oa))
 };
 struct InputRow {
   bool angle = true;
   int body = 0;    // angle input
   int slider = 0;  // slide input
-  double s0 = 0;   // slide input: (P - A) . u in the described configuration
+  Real s0 = 0;     // slide input: (P - A) . u in the described configuration
 };
 struct SpringRow {
   Attach a, b;
@@ -68,8 +79,8 @@ struct SpringRow {
 
 struct Model {
   int nb = 0;
-  std::vector<double> mass, inertia;
-  std::vector<Vec2> com0;
+  std::vector<Real> mass, inertia;
+  std::vector<V2> com0;
   std::vector<std::pair<Attach, Attach>> pins;  // (a side, b side)
   std::vector<LineRow> lines;
   std::vector<GearRow> gears;
@@ -77,7 +88,7 @@ struct Model {
   std::vector<Attach> force_points;
   std::vector<SpringRow> springs;
   std::vector<std::string> row_names;  // for messages
-  double length = 1;                   // characteristic length of the mechanism [m]
+  Real length = 1;                     // characteristic length of the mechanism [m]
 
   Index n() const { return 3 * nb; }
   Index ndof() const { return static_cast<Index>(inputs.size()); }
@@ -92,39 +103,39 @@ struct Model {
 Model compile(const Mechanism& mechanism);
 
 /// q of the described configuration.
-VectorXd described_q(const Model& model);
+VecX described_q(const Model& model);
 
-Vec2 position(const VectorXd& q, const Attach& p);
-Vec2 velocity(const VectorXd& q, const VectorXd& qd, const Attach& p);
+V2 position(const VecX& q, const Attach& p);
+V2 velocity(const VecX& q, const VecX& qd, const Attach& p);
 /// R(phi) s of the point (its offset from the centre of mass, current orientation); 0 for ground.
-Vec2 arm(const VectorXd& q, const Attach& p);
+V2 arm(const VecX& q, const Attach& p);
 
 /// Residuals of all n rows with the inputs held at `values`.
-VectorXd residual(const Model& model, const VectorXd& q, const VectorXd& values);
+VecX residual(const Model& model, const VecX& q, const VecX& values);
 /// The n x n constraint Jacobian (all rows).
-MatrixXd jacobian(const Model& model, const VectorXd& q);
+MatX jacobian(const Model& model, const VecX& q);
 /// gamma = -(dJ/dt) q' for all rows.
-VectorXd gamma(const Model& model, const VectorXd& q, const VectorXd& qd);
+VecX gamma(const Model& model, const VecX& q, const VecX& qd);
 /// Current values of the input coordinates.
-VectorXd input_values(const Model& model, const VectorXd& q);
+VecX input_values(const Model& model, const VecX& q);
 
 /// Mass matrix diagonal (m, m, I per body).
-VectorXd mass_diagonal(const Model& model);
+VecX mass_diagonal(const Model& model);
 
 /// Spring state: length, rate of length, tension, unit vector from a to b.
 struct SpringState {
-  double length = 0, rate = 0, tension = 0;
-  Vec2 e{1, 0};
+  Real length = 0, rate = 0, tension = 0;
+  V2 e{1, 0};
 };
-SpringState spring_state(const Model& model, const Mechanism& mech, std::size_t k,
-                         const VectorXd& q, const VectorXd& qd);
+SpringState spring_state(const Model& model, const Mechanism& mech, std::size_t k, const VecX& q,
+                         const VecX& qd);
 
 /// Generalized applied forces at time t: gravity, point forces, moments, springs (not the
 /// input efforts).
-VectorXd applied_forces(const Model& model, const Mechanism& mech, double t, const VectorXd& q,
-                        const VectorXd& qd);
+VecX applied_forces(const Model& model, const Mechanism& mech, Real t, const VecX& q,
+                    const VecX& qd);
 
 /// Adds the generalized force of a force f acting at point p (of p.body) to Q.
-void add_point_force(VectorXd& Q, const VectorXd& q, const Attach& p, const Vec2& f);
+void add_point_force(VecX& Q, const VecX& q, const Attach& p, const V2& f);
 
 }  // namespace bd::referee::detail

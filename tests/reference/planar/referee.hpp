@@ -201,7 +201,7 @@ std::vector<Sample> driven(const Mechanism& mechanism, const std::vector<double>
 ///         valid coordinates) or when the integrator fails.
 std::vector<Sample> free_run(const Mechanism& mechanism, const std::vector<double>& initial_rates,
                              double duration, const std::vector<double>& times,
-                             double tolerance = 1e-13);
+                             double tolerance = 1e-15);
 
 /// Counters of the last free_run on this thread (for tests and reports).
 struct FreeRunStats {

@@ -12,45 +12,47 @@ namespace bd::referee::detail {
 /// is reported singular. The scaled Jacobian (angles and angle-input rows multiplied by the
 /// characteristic length) has rcond ~ 1e-2..1 for ordinary positions and ~ distance to the
 /// singularity / length near one, so 1e-9 flags only positions within ~1e-9 of a singular one.
-inline constexpr double kSingularRcond = 1e-9;
+inline constexpr Real kSingularRcond = 1e-9;
 
 /// The n x n constraint Jacobian J (all rows, inputs included) factorized by full-pivoting LU in
 /// scaled variables: J~ = Dr J Dc, Dc = 1/length on angle columns, Dr = length on angle-input
 /// rows, so that J~ is dimensionless.
 class Factorized {
  public:
-  Factorized(const Model& model, const MatrixXd& J);
+  Factorized(const Model& model, const MatX& J);
   /// Reciprocal condition indicator: the smaller of LU's 1-norm estimate and the ratio of the
   /// smallest to the largest pivot (the estimate alone misses exactly singular matrices, whose
   /// zero pivot the pseudo-solve skips).
-  double rcond() const;
-  VectorXd solve(const VectorXd& b) const;             ///< x with J x = b
-  VectorXd solve_transposed(const VectorXd& b) const;  ///< y with J^T y = b
+  Real rcond() const;
+  VecX solve(const VecX& b) const;             ///< x with J x = b
+  VecX solve_transposed(const VecX& b) const;  ///< y with J^T y = b
 
  private:
-  VectorXd dr_, dc_;
-  MatrixXd scaled_;
-  Eigen::FullPivLU<MatrixXd> lu_;
-  mutable std::optional<Eigen::FullPivLU<MatrixXd>> lu_transposed_;  // on first use
+  VecX dr_, dc_;
+  MatX scaled_;
+  Eigen::FullPivLU<MatX> lu_;
+  mutable std::optional<Eigen::FullPivLU<MatX>> lu_transposed_;  // on first use
 };
 
 /// Newton on residual(q, values) = 0 from q (updated in place) to machine precision; returns the
-/// Jacobian factorized at the solution. @throws std::domain_error (text `what` + reason) when
-/// Newton does not converge or the solution is singular.
-Factorized close_loop(const Model& model, const VectorXd& values, VectorXd& q,
-                      const std::string& what);
+/// Jacobian factorized at the solution. With `chord` (a factorization at a nearby solution) it
+/// first tries simplified Newton iterations with it, falling back to Newton. @throws
+/// std::domain_error (text `what` + reason) when Newton does not converge or the solution is
+/// singular.
+Factorized close_loop(const Model& model, const VecX& values, VecX& q, const std::string& what,
+                      const Factorized* chord = nullptr);
 
 /// close_loop continued from the input values `from` to `to` in steps of at most 0.1 rad /
 /// 0.05 length per input, so the branch of q is followed.
-Factorized continue_loop(const Model& model, const VectorXd& from, const VectorXd& to, VectorXd& q,
+Factorized continue_loop(const Model& model, const VecX& from, const VecX& to, VecX& q,
                          const std::string& what);
 
 /// Everything about one instant in maximal coordinates.
 struct State {
-  double t = 0;
-  VectorXd q, qd, qdd;
-  VectorXd lambda;  ///< n multipliers: m constraint forces, then the input efforts
-  double input_work = 0, damper_work = 0, applied_work = 0;
+  Real t = 0;
+  VecX q, qd, qdd;
+  VecX lambda;  ///< n multipliers: m constraint forces, then the input efforts
+  Real input_work = 0, damper_work = 0, applied_work = 0;
 };
 
 /// Builds the public Sample of a complete State.
