@@ -131,7 +131,7 @@ MatX jacobian(const Model& model, const VecX& q) {
 
 namespace {
 
-// gamma of a slider row (direction w = n, sign_u = +1) or a slide-input row (w = u).
+// gamma of a slider row (normal: direction n) or of a slide-input row (direction u).
 Real line_gamma(const VecX& q, const VecX& qd, const LineRow& l, bool normal) {
   const V2 u = line_dir(q, l), n = perp(u);
   const V2 d = position(q, l.p) - position(q, l.from);

@@ -3,9 +3,11 @@
 // The independent coordinates are the inputs a (one per degree of freedom). The integrated
 // state is y = (a, a', W_in, W_damp, W_app) (the last three: work quadratures). At every
 // evaluation the dependent coordinates are recovered exactly:
-//   positions      Newton on c(q) = 0 with the inputs held at a (machine precision), so there
-//                  is no constraint drift at all, and the branch is followed (Newton starts
-//                  from the previous evaluation in the same step);
+//   positions      Newton on c(q) = 0 with the inputs held at a, to the rounding level, so
+//                  there is no constraint drift at all; it starts from a second-order Taylor
+//                  prediction from the previous evaluation in the same step, with simplified
+//                  Newton iterations on that evaluation's factorized Jacobian (one LU per
+//                  evaluation), so the branch is followed;
 //   velocities     J q' = (0, a');
 //   accelerations  J q'' = gamma + (0, a''), i.e. q'' = q''_0 + N a'' with q''_0 = J^-1 gamma
 //                  and N = the input columns of J^-1 (J_m N = 0, J_in N = I);
@@ -21,6 +23,13 @@
 // length (slide input) for a -- fixed, since the mechanism's positions are what matter, not how
 // many turns a crank has made -- and for a' the running maximum of |a'| over the run, at least
 // the position scale divided by the duration. The whole ODE is solved in long double.
+//
+// Why this method: no drift and no stabilization parameters (the constraints hold to rounding
+// at every evaluation), a smooth low-dimensional ODE (2 ndof + 3), and an integrator whose order
+// rises to whatever the tolerance needs; the self-tests show the global error well below 1e-11
+// relative at the default tolerance (1e-15) with halving and tenfold tightening of it, energy
+// balances to ~1e-15 and agreement with closed forms and a fine RK4. Limitation: the inputs
+// must stay valid coordinates (a slide input through a dead centre fails, with the time).
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
@@ -86,7 +95,8 @@ class FreeSystem final : public detail::OdeSystem {
   VecX efforts(Real t) const {
     VecX tau = VecX::Zero(model_.ndof());
     for (std::size_t k = 0; k < mech_.input_efforts.size(); ++k)
-      tau[static_cast<Index>(k)] = mech_.input_efforts[k](static_cast<double>(t));
+      if (mech_.input_efforts[k])
+        tau[static_cast<Index>(k)] = mech_.input_efforts[k](static_cast<double>(t));
     return tau;
   }
 
@@ -217,8 +227,10 @@ void Integrator::advance_to(Real target) {
       const Real err_fac = 0.9L * std::pow(1 / o.error, 1.0L / (2 * detail::kMaxRow - 1));
       H_ = H * (o.error == 0 || !std::isfinite(err_fac) ? 0.25L : std::clamp(err_fac, 0.1L, 0.5L));
       if (!(H_ > 1e-13L * std::max(duration_, std::abs(t_))))
-        throw std::domain_error("bd::referee: " + at_time(t_) + ": step size underflow (" + why +
-                                ")");
+        throw std::domain_error("bd::referee: " + at_time(t_) +
+                                ": step size underflow, the inputs may have stopped being valid "
+                                "coordinates (last failure: " +
+                                why + ")");
       continue;
     }
     ++g_stats.steps;

@@ -16,6 +16,23 @@
 ///  * Degrees of freedom: exactly one Input per degree of freedom. The referee requires
 ///    3 * bodies == 2 * pins + sliders + gears + inputs and a full-rank constraint Jacobian
 ///    (redundant constraints, e.g. a parallelogram with an extra link, are not supported).
+///  * Errors (invalid descriptions, singular positions, failed closure) throw std::domain_error.
+///
+/// Describing a mechanism (notes for glue code):
+///  * A link with k joints (binary, ternary, ...) is ONE Body (mass, inertia about its centre
+///    of mass, centre of mass) plus one Pin per joint to the neighbouring body or kGround, at the
+///    joint's described position. The ground is never a Body.
+///  * A mass concentrated at a joint (a slider block, a piston, a node mass) goes into
+///    point_masses of ONE of the bodies meeting there. The motion does not depend on which, but
+///    the reported force of that pin does: it excludes the inertia and weight of the point mass
+///    on the side it was attached to.
+///  * A piston / slider block on a guide: the rod gets the block's mass as a point mass at the
+///    wrist pin and a PointOnLine{rod, kGround, wrist pin, guide}. (A block as a separate Body
+///    would be free to turn about the wrist pin: a point-on-line joint does not stop rotation.)
+///  * A slider driven by a force: SlideInput{slider} as the input, the force (along the line,
+///    towards line_to positive) in input_efforts. A crank driven by a motor: AngleInput{crank}
+///    and the torque in input_efforts. Driven scenes prescribe the inputs instead.
+///  * Gears (e.g. counter-rotating discs): each geared body also needs its Pin to the ground.
 #include <Eigen/Dense>
 #include <functional>
 #include <string>
@@ -117,7 +134,8 @@ struct Mechanism {
   Vec2 gravity{0, 0};  ///< [m/s^2], acts on every mass
   std::vector<Input> inputs;
   /// Free runs only: the effort (torque [N m] or force [N], conventions of AngleInput /
-  /// SlideInput) of each input as a function of time; empty = no efforts. Ignored by driven().
+  /// SlideInput) of each input as a function of time; empty vector or empty function = no
+  /// effort. Ignored by driven().
   std::vector<std::function<double(double t)>> input_efforts;
 };
 
@@ -194,9 +212,13 @@ std::vector<Sample> driven(const Mechanism& mechanism, const std::vector<double>
 
 /// Free scene (forward dynamics) from the described configuration at t = 0 with the given input
 /// rates (all body velocities follow from the constraints), under all loads and input_efforts,
-/// over [0, duration]. `times` ascending within [0, duration]. The local error of each step is
-/// below `tolerance` relative to the scale of each input coordinate and rate (see free.cpp);
-/// the self-tests show a global error around 1e-12 relative at the default.
+/// over [0, duration]. `times` ascending within [0, duration]; the integrator steps exactly onto
+/// each (many samples cost steps). Method (free_run.cpp): coordinate partitioning on the inputs
+/// (dependent coordinates by Newton at every evaluation: no drift), Gragg–Bulirsch–Stoer
+/// extrapolation, all in long double. `tolerance` bounds each step's local error estimate
+/// relative to 1 rad / the mechanism size for input positions and to the largest |rate| so far
+/// for input rates. At the default the self-tests find samples within ~1e-12 (worst 1.2e-12,
+/// typically 1e-14) of runs at half and a tenth of it: the claim is 1e-11 relative.
 /// @throws std::domain_error naming the time at a singular position (the inputs stop being
 ///         valid coordinates) or when the integrator fails.
 std::vector<Sample> free_run(const Mechanism& mechanism, const std::vector<double>& initial_rates,

@@ -237,6 +237,26 @@ TEST(PlanarReferee, GearPairDriven) {
     EXPECT_NEAR(s.bodies[1].omega, -s.bodies[0].omega, 1e-13);
 }
 
+// A counter-rotating disc (as in shaking-moment balancing) on a frame shaft at C, geared to the
+// crank with ratio -1 (pitch point midway between A0 and C): the gear's mesh force, the shaft and
+// crank bearing forces satisfy every body's Newton–Euler equations, and the disc turns at -omega.
+TEST(PlanarReferee, DrivenFourBarWithCounterRotatingDisc) {
+  const FourBar fb;
+  Mechanism m = loaded_four_bar(fb);
+  const Vec2 C{-0.06, -0.08};
+  m.bodies.push_back(Body{"disc", 0.7, 4e-4, C, {}});
+  m.pins.push_back({"disc shaft", kGround, 3, C});
+  m.gears.push_back({"disc mesh", 0, 3, {0, 0}, C, 0.5 * C});
+  const double w = 15.0;
+  const auto samples = driven(m, {w}, 0.0, linspace(0, 2 * std::acos(-1.0) / w, 121));
+  check_driven_balances(m, samples);
+  for (const Sample& s : samples) {
+    EXPECT_NEAR(s.bodies[3].omega, -w, 1e-12 * w);
+    EXPECT_NEAR(s.bodies[3].angle, -w * s.t, 1e-12);
+    EXPECT_NEAR(s.gear_forces[0].force.dot(C), 0, 1e-12 * s.gear_forces[0].force.norm());
+  }
+}
+
 TEST(PlanarReferee, SixBarRevolutionIsFast) {
   SixBar sb;
   Mechanism m = sb.build();
