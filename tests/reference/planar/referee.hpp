@@ -160,7 +160,9 @@ struct PointMotion {
 struct Sample {
   double t = 0;  ///< [s]
   std::vector<BodyState> bodies;
-  std::vector<Vec2> pin_forces;     ///< force of body a ON body b at the pin [N]
+  /// Force of body a ON body b at the pin [N]. The force ON the frame of a ground pin is
+  /// -pin_forces[k] when a == kGround and +pin_forces[k] when b == kGround.
+  std::vector<Vec2> pin_forces;
   std::vector<Vec2> slider_forces;  ///< normal force of line_body ON point_body, at the point [N]
   std::vector<Vec2> slider_points;  ///< current position of each slider's point [m]
   std::vector<GearForce> gear_forces;
@@ -175,7 +177,7 @@ struct Sample {
   /// ground sliders, springs anchored to the frame, reactions of slide drives on a frame guide.
   Vec2 shaking_force{0, 0};  ///< [N]
   /// The moments about the origin of those forces at their points, plus -torque of every angle
-  /// drive (its stator reacts on the frame) [N m].
+  /// drive (its stator reacts on the frame) [N m]. About a point P: shaking_moment - P x F.
   double shaking_moment = 0;
   Vec2 inertial_force{0, 0};    ///< -sum m_i a_i [N]
   double inertial_moment = 0;   ///< -dH/dt about the origin = -sum(r_i x m_i a_i + I_i alpha_i)
