@@ -1,0 +1,512 @@
+#include "core/planar/dynamics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/number_text.hpp"
+#include "core/planar/system.hpp"
+
+namespace bd::core::planar {
+
+using detail::GradientEntry;
+using detail::NodeVectors;
+using detail::System;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// Newton stops when a step moves no coordinate by more than this fraction of the length scale:
+// the position is then exact to round-off (the previous step was ~1e-8 of the scale or less)
+constexpr double kNewtonStep = 1e-14;
+constexpr int kNewtonIterations = 40;
+// A factorisation whose reciprocal condition estimate is below this is a singular position:
+// velocities and forces there would lose more than half of their digits.
+constexpr double kSingularRcond = 1e-8;
+
+std::string inputs_text(const Model& model, const std::vector<double>& inputs) {
+  std::string s;
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    const Input& in = model.linkage().inputs[k];
+    s += (k ? ", " : "") + in.name + " = " + text::digits(inputs[k], 10) +
+         (in.kind == Input::Kind::kAngle ? " rad" : " m");
+  }
+  return s;
+}
+
+// the name of row `row`, for messages
+std::string row_name(const System& s, int row) {
+  const System::RowRef& ref = s.row_ref[static_cast<std::size_t>(row)];
+  const Linkage& l = s.linkage;
+  switch (ref.kind) {
+    case System::RowRef::Kind::kElement:
+      return "the length of link " + l.links[static_cast<std::size_t>(ref.index)].name;
+    case System::RowRef::Kind::kRigid: {
+      const System::RigidRows& r = s.rigid[static_cast<std::size_t>(ref.index)];
+      return "node " + l.nodes[static_cast<std::size_t>(r.node)].name + " on link " +
+             l.links[static_cast<std::size_t>(r.link)].name;
+    }
+    case System::RowRef::Kind::kSlider:
+      return "slider " + l.sliders[static_cast<std::size_t>(ref.index)].name;
+    case System::RowRef::Kind::kInput:
+      return "input " + l.inputs[static_cast<std::size_t>(ref.index)].name;
+  }
+  return "?";
+}
+
+void resize(Instant& in, const Model& m) {
+  const Linkage& l = m.linkage();
+  in.x.assign(l.nodes.size(), Vec2(0, 0));
+  in.v.assign(l.nodes.size(), Vec2(0, 0));
+  in.a.assign(l.nodes.size(), Vec2(0, 0));
+  for (std::size_t i = 0; i < l.nodes.size(); ++i) in.x[i] = l.nodes[i].position;
+  in.input.assign(l.inputs.size(), 0.0);
+  in.input_rate.assign(l.inputs.size(), 0.0);
+  in.input_acceleration.assign(l.inputs.size(), 0.0);
+  in.effort.assign(l.inputs.size(), 0.0);
+  in.angle.assign(l.links.size(), 0.0);
+  in.omega.assign(l.links.size(), 0.0);
+  in.alpha.assign(l.links.size(), 0.0);
+  for (std::size_t k = 0; k < l.links.size(); ++k) {
+    const Vec2 d = l.nodes[static_cast<std::size_t>(l.links[k].nodes[1])].position -
+                   l.nodes[static_cast<std::size_t>(l.links[k].nodes[0])].position;
+    in.angle[k] = std::atan2(d.y(), d.x());
+  }
+  in.slide.assign(l.sliders.size(), 0.0);
+  in.slide_rate.assign(l.sliders.size(), 0.0);
+  in.slide_acceleration.assign(l.sliders.size(), 0.0);
+  in.ground_reaction.assign(m.ground_nodes().size(), Vec2(0, 0));
+  in.guide_reaction.assign(m.frame_guides().size(), Vec2(0, 0));
+  in.joint_force.assign(m.joints().size(), Vec2(0, 0));
+}
+
+bool finite(const VectorXd& v) { return v.allFinite(); }
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// model
+
+Model::Model(const Linkage& linkage) : system_(std::make_unique<System>(make_linkage(linkage))) {
+  const Linkage& l = system_->linkage;
+  for (std::size_t i = 0; i < l.nodes.size(); ++i) {
+    if (l.nodes[i].ground) ground_nodes_.push_back(static_cast<int>(i));
+  }
+  for (std::size_t k = 0; k < l.sliders.size(); ++k) {
+    if (l.sliders[k].link < 0) frame_guides_.push_back(static_cast<int>(k));
+  }
+  for (std::size_t i = 0; i < l.nodes.size(); ++i) {
+    if (l.nodes[i].ground) continue;
+    std::vector<int> links;
+    for (std::size_t k = 0; k < l.links.size(); ++k) {
+      const auto& n = l.links[k].nodes;
+      if (std::find(n.begin(), n.end(), static_cast<int>(i)) != n.end()) {
+        links.push_back(static_cast<int>(k));
+      }
+    }
+    const int node = static_cast<int>(i);
+    const bool carries = std::any_of(l.sliders.begin(), l.sliders.end(),
+                                     [&](const Slider& s) { return s.node == node; }) ||
+                         std::any_of(l.point_masses.begin(), l.point_masses.end(),
+                                     [&](const PointMass& p) { return p.node == node; });
+    if (links.size() == 2) {
+      joints_.push_back({l.nodes[i].name, node, links[1]});
+    } else if (links.size() > 2) {
+      for (std::size_t j = 1; j < links.size(); ++j) {
+        joints_.push_back({l.nodes[i].name + "_" + l.links[static_cast<std::size_t>(links[j])].name,
+                           node, links[j]});
+      }
+    } else if (links.size() == 1 && carries) {
+      joints_.push_back({l.nodes[i].name, node, links[0]});
+    }
+  }
+  for (const System::ElementRow& e : system_->elements)
+    length_scale_ = std::max(length_scale_, e.length);
+}
+
+Model::~Model() = default;
+Model::Model(const Model& other)
+    : system_(std::make_unique<System>(*other.system_)),
+      ground_nodes_(other.ground_nodes_),
+      frame_guides_(other.frame_guides_),
+      joints_(other.joints_),
+      length_scale_(other.length_scale_) {}
+Model& Model::operator=(const Model& other) {
+  if (this != &other) *this = Model(other);
+  return *this;
+}
+
+const Linkage& Model::linkage() const { return system_->linkage; }
+int Model::coordinates() const { return system_->n; }
+int Model::inputs() const { return static_cast<int>(system_->inputs.size()); }
+
+Workspace::Workspace(const Model& model) {
+  const System& s = model.system();
+  resize(instant, model);
+  q.setZero(s.n);
+  qd.setZero(s.n);
+  qdd.setZero(s.n);
+  g.setZero(s.rows);
+  gamma.setZero(s.rows);
+  F.setZero(s.n);
+  rhs.setZero(s.n);
+  lambda.setZero(s.rows);
+  G.setZero(s.rows, s.n);
+  T.setZero(s.n, model.inputs());
+  MT.setZero(s.n, model.inputs());
+  reduced.setZero(model.inputs(), model.inputs());
+  lu = Eigen::PartialPivLU<MatrixXd>(std::max(s.n, 1));
+  trial = instant.x;
+}
+
+std::vector<double> drawn_inputs(const Model& model) {
+  const System& s = model.system();
+  NodeVectors x;
+  for (const Node& n : s.linkage.nodes) x.push_back(n.position);
+  std::vector<double> z;
+  for (const System::InputRow& in : s.inputs) {
+    if (in.angle) {
+      const Vec2 d = x[static_cast<std::size_t>(in.q)] - x[static_cast<std::size_t>(in.p)];
+      z.push_back(std::atan2(d.y(), d.x()));
+    } else {
+      z.push_back(detail::slide_position(s, s.sliders[static_cast<std::size_t>(in.slider)], x));
+    }
+  }
+  return z;
+}
+
+int mobility(const Model& model) {
+  const System& s = model.system();
+  NodeVectors x;
+  for (const Node& n : s.linkage.nodes) x.push_back(n.position);
+  MatrixXd G;
+  detail::constraint_jacobian(s, x, s.structural_rows, G);
+  if (s.n == 0) return 0;
+  Eigen::FullPivLU<MatrixXd> lu(G);
+  lu.setThreshold(1e-10);
+  return s.n - static_cast<int>(lu.rank());
+}
+
+// ---------------------------------------------------------------------------------------------
+// positions
+
+Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
+                                           const std::vector<Vec2>& guess,
+                                           const std::vector<double>& inputs) {
+  const System& s = model.system();
+  Instant& in = ws.instant;
+  if (s.rows != s.n) {
+    return Unexpected<PlanarError>(
+        PlanarError{PlanarError::Kind::kMobility, std::to_string(s.inputs.size()) + " inputs for " +
+                                                      std::to_string(s.n - s.structural_rows) +
+                                                      " free coordinates left by the constraints"});
+  }
+  in.x = guess;
+  ws.q = detail::q_from_nodes(s, in.x);
+  const double step_limit = kNewtonStep * model.length_scale();
+  for (int it = 0; it < kNewtonIterations; ++it) {
+    detail::constraint_values(s, in.x, inputs, ws.g);
+    detail::constraint_jacobian(s, in.x, s.rows, ws.G);
+    if (!finite(ws.g) || !ws.G.allFinite()) {
+      return Unexpected<PlanarError>(PlanarError{
+          PlanarError::Kind::kNonFinite, "non-finite constraint at " + inputs_text(model, inputs)});
+    }
+    ws.lu.compute(ws.G);
+    if (s.n > 0 && !(ws.lu.rcond() >= kSingularRcond)) {
+      // a singular Jacobian at a closed position is a singular position; away from closure it
+      // means Newton cannot go on
+      Eigen::Index worst = 0;
+      const double residual = s.rows > 0 ? ws.g.cwiseAbs().maxCoeff(&worst) : 0.0;
+      if (residual <= 1e-9 * model.length_scale()) {
+        return Unexpected<PlanarError>(
+            PlanarError{PlanarError::Kind::kSingular,
+                        "singular position at " + inputs_text(model, inputs) +
+                            " (the constraints and inputs lose rank: reciprocal condition " +
+                            text::digits(ws.lu.rcond(), 2) + ")"});
+      }
+      return Unexpected<PlanarError>(
+          PlanarError{PlanarError::Kind::kAssembly,
+                      "the linkage cannot be assembled at " + inputs_text(model, inputs) + ": " +
+                          row_name(s, static_cast<int>(worst)) + " does not close"});
+    }
+    const VectorXd step = ws.lu.solve(-ws.g);
+    ws.q += step;
+    detail::nodes_from_q(s, ws.q, in.x);
+    if (s.n == 0 || step.cwiseAbs().maxCoeff() <= step_limit) {
+      in.input = inputs;
+      return true;
+    }
+  }
+  detail::constraint_values(s, in.x, inputs, ws.g);
+  Eigen::Index worst = 0;
+  if (s.rows > 0) ws.g.cwiseAbs().maxCoeff(&worst);
+  return Unexpected<PlanarError>(PlanarError{
+      PlanarError::Kind::kAssembly, "the linkage cannot be assembled at " +
+                                        inputs_text(model, inputs) + ": " +
+                                        row_name(s, static_cast<int>(worst)) +
+                                        " does not close (Newton's method did not converge)"});
+}
+
+Expected<bool, PlanarError> assemble(const Model& model, Workspace& ws,
+                                     const std::vector<double>& inputs) {
+  const std::vector<double> from = drawn_inputs(model);
+  // steps of at most 0.05 rad, or 2 % of the length scale for a slide, so that Newton stays on
+  // the drawn branch
+  double steps = 1;
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    const bool angle = model.linkage().inputs[k].kind == Input::Kind::kAngle;
+    const double unit = angle ? 0.05 : 0.02 * model.length_scale();
+    steps = std::max(steps, std::ceil(std::abs(inputs[k] - from[k]) / unit));
+  }
+  std::vector<Vec2> guess;
+  for (const Node& n : model.linkage().nodes) guess.push_back(n.position);
+  std::vector<double> z(inputs.size());
+  for (int i = 1; i <= static_cast<int>(steps); ++i) {
+    for (std::size_t k = 0; k < inputs.size(); ++k) {
+      z[k] = from[k] + (inputs[k] - from[k]) * (i / steps);
+    }
+    if (auto ok = solve_position(model, ws, guess, z); !ok) return ok;
+    guess = ws.instant.x;
+  }
+  if (steps < 1) return solve_position(model, ws, guess, inputs);
+  return true;
+}
+
+std::vector<double> efforts_at(const Model& model, double t) {
+  std::vector<double> e;
+  for (const Input& in : model.linkage().inputs) e.push_back(in.effort(t));
+  return e;
+}
+
+// ---------------------------------------------------------------------------------------------
+// velocities, accelerations and forces
+
+namespace {
+
+// the node velocities for the inputs' rates, with the factorisation at the current position
+void velocities(const Model& model, Workspace& ws, const std::vector<double>& rates) {
+  const System& s = model.system();
+  ws.rhs.setZero(s.n);
+  for (const System::InputRow& in : s.inputs) {
+    const double r = rates[static_cast<std::size_t>(in.input)];
+    ws.rhs[in.row] = in.angle ? in.length * r : r;
+  }
+  ws.qd = ws.lu.solve(ws.rhs);
+  detail::node_rates_from(s, ws.qd, ws.instant.v);
+  ws.instant.input_rate = rates;
+}
+
+// the link angles, rates and accelerations and the sliders' positions and rates, from the nodes
+void link_kinematics(const Model& model, Instant& in) {
+  const System& s = model.system();
+  for (std::size_t k = 0; k < s.elements.size(); ++k) {
+    const System::ElementRow& e = s.elements[k];
+    const std::size_t p = static_cast<std::size_t>(e.p), q = static_cast<std::size_t>(e.q);
+    const Vec2 d = in.x[q] - in.x[p], dv = in.v[q] - in.v[p], da = in.a[q] - in.a[p];
+    const double n2 = d.squaredNorm();
+    const double a = std::atan2(d.y(), d.x());
+    in.angle[k] = a + 2 * kPi * std::round((in.angle[k] - a) / (2 * kPi));
+    in.omega[k] = cross(d, dv) / n2;
+    in.alpha[k] = cross(d, da) / n2 - 2 * d.dot(dv) * in.omega[k] / n2;
+  }
+  for (std::size_t k = 0; k < s.sliders.size(); ++k) {
+    const System::SliderRow& sl = s.sliders[k];
+    in.slide[k] = detail::slide_position(s, sl, in.x);
+    in.slide_rate[k] = detail::slide_rate(s, sl, in.x, in.v);
+    const std::size_t P = static_cast<std::size_t>(sl.node);
+    if (!sl.on_link) {
+      in.slide_acceleration[k] = sl.unit.dot(in.a[P]);
+    } else {
+      const std::size_t Q = static_cast<std::size_t>(sl.from_node),
+                        R = static_cast<std::size_t>(sl.to_node);
+      const Vec2 a = in.x[P] - in.x[Q], b = in.x[R] - in.x[Q];
+      const Vec2 ad = in.v[P] - in.v[Q], bd = in.v[R] - in.v[Q];
+      const Vec2 aa = in.a[P] - in.a[Q], ba = in.a[R] - in.a[Q];
+      in.slide_acceleration[k] = (aa.dot(b) + 2 * ad.dot(bd) + a.dot(ba)) / sl.length;
+    }
+  }
+}
+
+// every force output from the multipliers of the structural rows (ws.lambda) and the efforts
+void forces(const Model& model, Workspace& ws) {
+  const System& s = model.system();
+  const Linkage& l = s.linkage;
+  Instant& in = ws.instant;
+  const std::size_t nodes = l.nodes.size();
+
+  // per link and node: the force on the link from the joint there (f = inertia - load - the
+  // link's own constraint forces); stored densely, links x nodes
+  std::vector<Vec2> on_link(l.links.size() * nodes, Vec2(0, 0));
+  auto f = [&](int link, int node) -> Vec2& {
+    return on_link[static_cast<std::size_t>(link) * nodes + static_cast<std::size_t>(node)];
+  };
+  const Vec2& gravity = l.loads.gravity;
+  std::vector<Vec2> load(l.links.size(), Vec2(0, 0));
+  std::vector<double> moment(l.links.size(), 0.0);
+  for (std::size_t k = 0; k < l.links.size(); ++k) load[k] = l.links[k].mass * gravity;
+  for (const LinkLoad& ld : l.loads.link_loads) {
+    load[static_cast<std::size_t>(ld.link)] += ld.force;
+    moment[static_cast<std::size_t>(ld.link)] += ld.moment;
+  }
+  for (std::size_t k = 0; k < l.links.size(); ++k) {
+    const System::ElementRow& e = s.elements[k];
+    Vec4 acc;
+    acc << in.a[static_cast<std::size_t>(e.p)], in.a[static_cast<std::size_t>(e.q)];
+    const Vec4 inertia = s.element_M[k] * acc;
+    const Vec4 applied = element_nodal_forces(s.com_weights[k], load[k], moment[k],
+                                              in.x[static_cast<std::size_t>(e.p)],
+                                              in.x[static_cast<std::size_t>(e.q)]);
+    f(static_cast<int>(k), e.p) += inertia.segment<2>(0) - applied.segment<2>(0);
+    f(static_cast<int>(k), e.q) += inertia.segment<2>(2) - applied.segment<2>(2);
+  }
+  GradientEntry entries[3];
+  for (int row = 0; row < s.rows; ++row) {
+    const int count = detail::row_gradient(s, in.x, row, entries);
+    for (int j = 0; j < count; ++j) {
+      if (entries[j].link >= 0)
+        f(entries[j].link, entries[j].node) -= ws.lambda[row] * entries[j].grad;
+    }
+  }
+
+  // the frame: ground pins, guides, slide drives on frame guides, springs anchored to it
+  in.Fsh = Vec2(0, 0);
+  in.Msh = 0.0;
+  auto on_frame = [&](const Vec2& force, const Vec2& at) {
+    in.Fsh += force;
+    in.Msh += cross(at, force);
+  };
+  for (std::size_t i = 0; i < model.ground_nodes().size(); ++i) {
+    const int g = model.ground_nodes()[i];
+    Vec2 r(0, 0);
+    for (std::size_t k = 0; k < l.links.size(); ++k) r -= f(static_cast<int>(k), g);
+    in.ground_reaction[i] = r;
+    on_frame(r, in.x[static_cast<std::size_t>(g)]);
+  }
+  for (std::size_t i = 0; i < model.frame_guides().size(); ++i) {
+    const System::SliderRow& sl = s.sliders[static_cast<std::size_t>(model.frame_guides()[i])];
+    in.guide_reaction[i] = -ws.lambda[sl.row] * sl.normal;
+    on_frame(in.guide_reaction[i], in.x[static_cast<std::size_t>(sl.node)]);
+  }
+  for (const System::InputRow& ir : s.inputs) {
+    const double e = in.effort[static_cast<std::size_t>(ir.input)];
+    if (ir.angle) {
+      in.Msh -= e;  // the drive's stator reacts on the frame
+    } else {
+      const System::SliderRow& sl = s.sliders[static_cast<std::size_t>(ir.slider)];
+      if (!sl.on_link) on_frame(-e * sl.unit, in.x[static_cast<std::size_t>(sl.node)]);
+    }
+  }
+  for (std::size_t k = 0; k < l.springs.size(); ++k) {
+    const Spring& sp = l.springs[k];
+    const detail::SpringState st = detail::spring_state(s, static_cast<int>(k), in.x, in.v);
+    if (l.nodes[static_cast<std::size_t>(sp.a)].ground) {
+      on_frame(st.tension * st.unit, in.x[static_cast<std::size_t>(sp.a)]);
+    }
+    if (l.nodes[static_cast<std::size_t>(sp.b)].ground) {
+      on_frame(-st.tension * st.unit, in.x[static_cast<std::size_t>(sp.b)]);
+    }
+  }
+  for (std::size_t j = 0; j < model.joints().size(); ++j) {
+    in.joint_force[j] = f(model.joints()[j].link, model.joints()[j].node);
+  }
+
+  // the inertial part: -Σ m a and -dH/dt about the origin
+  in.Fsh_inertial = Vec2(0, 0);
+  in.Msh_inertial = 0.0;
+  for (std::size_t k = 0; k < l.links.size(); ++k) {
+    const System::ElementRow& e = s.elements[k];
+    const PointWeights& w = s.com_weights[k];
+    const std::size_t p = static_cast<std::size_t>(e.p), q = static_cast<std::size_t>(e.q);
+    const Vec2 c = w.at_p * in.x[p] + w.at_q * in.x[q];
+    const Vec2 ac = w.at_p * in.a[p] + w.at_q * in.a[q];
+    const double m = l.links[k].mass;
+    in.Fsh_inertial -= m * ac;
+    in.Msh_inertial -= cross(c, m * ac) + l.links[k].inertia * in.alpha[k];
+  }
+  for (const PointMass& pm : l.point_masses) {
+    const std::size_t n = static_cast<std::size_t>(pm.node);
+    in.Fsh_inertial -= pm.mass * in.a[n];
+    in.Msh_inertial -= cross(in.x[n], pm.mass * in.a[n]);
+  }
+}
+
+// after the accelerations q̈: the multipliers from Gᵀ λ = M q̈ - F (efforts of the inputs
+// excluded from F: they are the input rows' multipliers) and every output
+Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t) {
+  const System& s = model.system();
+  Instant& in = ws.instant;
+  in.t = t;
+  detail::node_rates_from(s, ws.qdd, in.a);
+  detail::applied_forces(s, in.x, in.v, nullptr, ws.F);
+  ws.rhs = s.M * ws.qdd - ws.F;
+  ws.lambda = ws.lu.transpose().solve(ws.rhs);
+  for (const System::InputRow& ir : s.inputs) {
+    in.effort[static_cast<std::size_t>(ir.input)] =
+        ir.angle ? ws.lambda[ir.row] * ir.length : ws.lambda[ir.row];
+  }
+  link_kinematics(model, in);
+  forces(model, ws);
+  if (!finite(ws.lambda) || !finite(ws.qdd)) {
+    return Unexpected<PlanarError>(PlanarError{
+        PlanarError::Kind::kNonFinite, "non-finite result at " + inputs_text(model, in.input)});
+  }
+  return true;
+}
+
+}  // namespace
+
+Expected<bool, PlanarError> inverse_dynamics(const Model& model, Workspace& ws, double t,
+                                             const std::vector<double>& rates,
+                                             const std::vector<double>& accelerations) {
+  const System& s = model.system();
+  velocities(model, ws, rates);
+  detail::constraint_bias(s, ws.instant.x, ws.instant.v, s.rows, ws.gamma);
+  ws.rhs = -ws.gamma;
+  for (const System::InputRow& in : s.inputs) {
+    const double z = accelerations[static_cast<std::size_t>(in.input)];
+    ws.rhs[in.row] += in.angle ? in.length * z : z;
+  }
+  ws.qdd = ws.lu.solve(ws.rhs);
+  ws.instant.input_acceleration = accelerations;
+  return finish(model, ws, t);
+}
+
+Expected<bool, PlanarError> forward_dynamics(const Model& model, Workspace& ws, double t,
+                                             const std::vector<double>& rates,
+                                             const std::vector<double>& efforts) {
+  const System& s = model.system();
+  const int dof = model.inputs();
+  velocities(model, ws, rates);
+  // q̇ = T ż: T's columns solve G T = E (E the input rows, scaled as the rows are)
+  ws.T.setZero(s.n, dof);
+  for (const System::InputRow& in : s.inputs) {
+    VectorXd e = VectorXd::Zero(s.n);
+    e[in.row] = in.angle ? in.length : 1.0;
+    ws.T.col(in.input) = ws.lu.solve(e);
+  }
+  // q̈ = T z̈ + c with G c = -γ
+  detail::constraint_bias(s, ws.instant.x, ws.instant.v, s.rows, ws.gamma);
+  const VectorXd c = ws.lu.solve(-ws.gamma);
+  detail::applied_forces(s, ws.instant.x, ws.instant.v, nullptr, ws.F);
+  ws.MT = s.M * ws.T;
+  ws.reduced = ws.T.transpose() * ws.MT;
+  VectorXd right = ws.T.transpose() * (ws.F - s.M * c);
+  for (int k = 0; k < dof; ++k) right[k] += efforts[static_cast<std::size_t>(k)];
+  Eigen::LDLT<MatrixXd> ldlt(ws.reduced);
+  if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-14)) {
+    return Unexpected<PlanarError>(PlanarError{PlanarError::Kind::kSingular,
+                                               "the reduced inertia of the inputs is singular at " +
+                                                   inputs_text(model, ws.instant.input)});
+  }
+  const VectorXd zdd = ldlt.solve(right);
+  ws.qdd = ws.T * zdd + c;
+  ws.instant.input_acceleration.assign(zdd.data(), zdd.data() + dof);
+  auto done = finish(model, ws, t);
+  // the efforts are given: the input rows' multipliers reproduce them to round-off
+  ws.instant.effort = efforts;
+  return done;
+}
+
+}  // namespace bd::core::planar

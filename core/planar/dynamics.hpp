@@ -1,0 +1,148 @@
+#pragma once
+/// Kinematics and dynamics of a planar linkage at one instant (core/planar/model.hpp), in node
+/// coordinates on truss elements (core/planar/system.hpp has the equations):
+/// - assembly: Newton's method on the constraints from a guess (the drawn positions choose the
+///   branch), the inputs held;
+/// - velocities and accelerations from the square system of the constraints and the inputs;
+/// - inverse dynamics (the inputs' accelerations given): M q̈ = F + Gᵀ λ solved for the
+///   multipliers, which are the axial forces, guide forces and the drives' efforts;
+/// - forward dynamics (the drives' efforts given), reduced to the inputs: with q̇ = T ż and
+///   q̈ = T z̈ + c from the same square system, (Tᵀ M T) z̈ = Tᵀ (F - M c) + efforts;
+/// - the outputs of an instant from those: link angles and rates, ground reactions, guide
+///   reactions, joint forces, the shaking force and moment and their inertial parts.
+/// Model and Workspace follow Pinocchio's Model/Data: the model is compiled once and read-only,
+/// the workspace holds every buffer, sized once, so an evaluation allocates nothing.
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/expected.hpp"
+#include "core/planar/model.hpp"
+
+namespace bd::core::planar {
+
+namespace detail {
+struct System;
+}
+
+/// A joint whose force is an output: the force on `link` at `node` from the joint there.
+struct JointForce {
+  std::string name;  // "A1" (two links at the node), "A1_rocker" (more than two)
+  int node{};
+  int link{};
+};
+
+/// A compiled linkage: its equations and the names of its outputs.
+class Model {
+ public:
+  /// Compiles a linkage checked by make_linkage().
+  /// @throws bd::InputError as make_linkage().
+  explicit Model(const Linkage& linkage);
+  ~Model();
+  Model(const Model&);
+  Model& operator=(const Model&);
+
+  const Linkage& linkage() const;
+  int coordinates() const;  // free node coordinates
+  int inputs() const;       // degrees of freedom asked for
+  /// The ground nodes, in node order (their reactions R<name> are outputs).
+  const std::vector<int>& ground_nodes() const { return ground_nodes_; }
+  /// The sliders on frame guides, in slider order (their reactions R<name> are outputs).
+  const std::vector<int>& frame_guides() const { return frame_guides_; }
+  /// The joints whose forces are outputs: every moving node in two or more links (the force on
+  /// each link but the first, from the joint), or in one link and carrying a slider or a point
+  /// mass (the force on that link).
+  const std::vector<JointForce>& joints() const { return joints_; }
+  /// A length scale of the linkage: its longest element [m].
+  double length_scale() const { return length_scale_; }
+  const detail::System& system() const { return *system_; }
+
+ private:
+  std::unique_ptr<detail::System> system_;
+  std::vector<int> ground_nodes_, frame_guides_;
+  std::vector<JointForce> joints_;
+  double length_scale_{};
+};
+
+/// Everything at one instant. Sized by Workspace for the model; vectors indexed like the model's
+/// nodes, links, sliders, inputs, ground_nodes(), frame_guides() and joints().
+struct Instant {
+  double t{};
+  std::vector<Vec2> x, v, a;  // node positions, velocities, accelerations [m, m/s, m/s^2]
+  std::vector<double> input, input_rate, input_acceleration;  // [rad or m] and rates
+  /// Drive efforts: torque on the link from the frame [N m] or force on the slider's node along
+  /// its guide [N]; computed in driven scenes, given in free ones.
+  std::vector<double> effort;
+  std::vector<double> angle, omega, alpha;                    // per link [rad, rad/s, rad/s^2]
+  std::vector<double> slide, slide_rate, slide_acceleration;  // per slider [m, m/s, m/s^2]
+  std::vector<Vec2> ground_reaction;  // per ground node: force of the mechanism ON the frame [N]
+  std::vector<Vec2> guide_reaction;   // per frame guide: force ON the frame at the node [N]
+  std::vector<Vec2> joint_force;      // per joint: force on the link at the node [N]
+  Vec2 Fsh{0, 0};           // shaking force: every force of the mechanism ON the frame [N]
+  double Msh{};             // shaking moment about the origin, drives' reactions included [N m]
+  Vec2 Fsh_inertial{0, 0};  // -Σ m a [N]
+  double Msh_inertial{};    // -dH/dt about the origin [N m]
+};
+
+/// Why an instant could not be evaluated.
+struct PlanarError {
+  enum class Kind {
+    kAssembly,   // Newton found no position closing every constraint
+    kSingular,   // the constraints and inputs are singular (a dead centre, a limit position)
+    kMobility,   // the inputs do not match the degrees of freedom
+    kNonFinite,  // a value that is not finite appeared
+  };
+  Kind kind = Kind::kAssembly;
+  std::string detail;  // one line, naming the constraint or the condition
+};
+
+/// The buffers of evaluations on one model.
+class Workspace {
+ public:
+  explicit Workspace(const Model& model);
+  Instant instant;  // the last instant evaluated
+  // scratch
+  Eigen::VectorXd q, qd, qdd, g, gamma, F, rhs, lambda;
+  Eigen::MatrixXd G, T, MT, reduced;
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu;
+  std::vector<Vec2> trial;
+};
+
+/// Solves the positions with the inputs at `inputs` by Newton's method from `guess` (node
+/// positions; the drawn ones, or the last instant's, choose the branch), and factorises the
+/// constraints' Jacobian there. Sets ws.instant.x and .input.
+Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
+                                           const std::vector<Vec2>& guess,
+                                           const std::vector<double>& inputs);
+
+/// Assembles the linkage at `inputs`, stepping them from the drawn configuration's values in
+/// small increments so that Newton follows the drawn branch. On success ws.instant.x is set.
+Expected<bool, PlanarError> assemble(const Model& model, Workspace& ws,
+                                     const std::vector<double>& inputs);
+
+/// The inputs' values in the drawn configuration.
+std::vector<double> drawn_inputs(const Model& model);
+
+/// The degrees of freedom of the drawn configuration: coordinates minus the rank of the
+/// constraints' Jacobian (the structural rows).
+int mobility(const Model& model);
+
+/// After solve_position(): velocities and accelerations for the inputs' rates and
+/// accelerations, and every output for the given efforts (driven: `efforts` empty, computed).
+/// Inverse dynamics.
+Expected<bool, PlanarError> inverse_dynamics(const Model& model, Workspace& ws, double t,
+                                             const std::vector<double>& rates,
+                                             const std::vector<double>& accelerations);
+
+/// After solve_position(): the inputs' accelerations under the given efforts (forward
+/// dynamics, reduced to the inputs), then every output. Sets ws.instant.
+Expected<bool, PlanarError> forward_dynamics(const Model& model, Workspace& ws, double t,
+                                             const std::vector<double>& rates,
+                                             const std::vector<double>& efforts);
+
+/// The efforts of the model's inputs at time t (their TimeFunctions).
+std::vector<double> efforts_at(const Model& model, double t);
+
+}  // namespace bd::core::planar

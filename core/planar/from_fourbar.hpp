@@ -1,0 +1,17 @@
+#pragma once
+/// The four-bar as a planar linkage (method `truss`, and the cross-checks of the general engine
+/// against the dedicated four-bar formulations): nodes A0 (ground, origin), A1, A2, A3 (ground,
+/// (l4, 0)); links crank A0->A1, coupler A1->A2, rocker A2->A3 with the four-bar's mass data
+/// (the rocker's centre of mass measured from A2, as in the four-bar); the links' loads at their
+/// centres of mass; the crank's angle as the input.
+#include "core/fourbar/model.hpp"
+#include "core/planar/model.hpp"
+
+namespace bd::core::planar {
+
+/// The linkage drawn at crank angle theta1 on the four-bar's branch.
+/// @throws bd::InputError if the loop cannot close at theta1, or the four-bar has counter-rotating
+///         inertias (the general engine models them from the balancing layer's gears).
+Linkage linkage_of(const FourBar& fourbar, double theta1);
+
+}  // namespace bd::core::planar

@@ -1,0 +1,363 @@
+#include "core/planar/system.hpp"
+
+#include <cmath>
+
+namespace bd::core::planar::detail {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// adds `grad` to row `row` at node `node`'s coordinates (nothing for a ground node)
+void add_gradient(const System& s, MatrixXd& G, int row, int node, const Vec2& grad) {
+  const int c = s.coord[static_cast<std::size_t>(node)];
+  if (c < 0) return;
+  G(row, c) += grad.x();
+  G(row, c + 1) += grad.y();
+}
+
+void add_force(const System& s, VectorXd& F, int node, const Vec2& force) {
+  const int c = s.coord[static_cast<std::size_t>(node)];
+  if (c < 0) return;
+  F[c] += force.x();
+  F[c + 1] += force.y();
+}
+
+const Vec2& at(const NodeVectors& x, int node) { return x[static_cast<std::size_t>(node)]; }
+
+// the angle of d continued to within π of `near`
+double continued_angle(const Vec2& d, double near) {
+  const double a = std::atan2(d.y(), d.x());
+  return a + 2 * kPi * std::round((near - a) / (2 * kPi));
+}
+
+}  // namespace
+
+System::System(const Linkage& l) : linkage(l) {
+  coord.assign(l.nodes.size(), -1);
+  for (std::size_t i = 0; i < l.nodes.size(); ++i) {
+    if (!l.nodes[i].ground) {
+      coord[i] = n;
+      n += 2;
+    }
+  }
+  // element rows, one per link
+  int row = static_cast<int>(l.links.size());
+  std::vector<int> pending_rigid;  // rigid entries in row order, after the element rows
+  for (std::size_t k = 0; k < l.links.size(); ++k) {
+    const Link& link = l.links[k];
+    const int p = link.nodes[0], q = link.nodes[1];
+    const Vec2 d = l.nodes[static_cast<std::size_t>(q)].position -
+                   l.nodes[static_cast<std::size_t>(p)].position;
+    elements.push_back({p, q, d.norm(), d.squaredNorm()});
+    row_ref.push_back({RowRef::Kind::kElement, static_cast<int>(k)});
+    ElementMass em{d.norm(), link.mass, link.e, link.f, link.inertia};
+    element_mass.push_back(em);
+    element_M.push_back(element_mass_matrix(em));
+    com_weights.push_back(point_weights(link.e / em.length, link.f / em.length));
+    for (std::size_t j = 2; j < link.nodes.size(); ++j) {
+      const int r = link.nodes[j];
+      const Vec2 c = link_coordinates(l.nodes[static_cast<std::size_t>(p)].position,
+                                      l.nodes[static_cast<std::size_t>(q)].position,
+                                      l.nodes[static_cast<std::size_t>(r)].position);
+      const int index = static_cast<int>(rigid.size());
+      rigid.push_back({row, static_cast<int>(k), r, p, q, point_weights(c.x(), c.y())});
+      row += 2;
+      pending_rigid.push_back(index);
+    }
+  }
+  for (int index : pending_rigid) {
+    row_ref.push_back({RowRef::Kind::kRigid, index});
+    row_ref.push_back({RowRef::Kind::kRigid, index});
+  }
+  for (std::size_t k = 0; k < l.sliders.size(); ++k) {
+    const Slider& sl = l.sliders[k];
+    row_ref.push_back({RowRef::Kind::kSlider, static_cast<int>(k)});
+    SliderRow r;
+    r.row = row++;
+    r.slider = static_cast<int>(k);
+    r.node = sl.node;
+    r.on_link = sl.link >= 0;
+    if (r.on_link) {
+      r.from_node = sl.from_node;
+      r.to_node = sl.to_node;
+      r.length = (l.nodes[static_cast<std::size_t>(sl.to_node)].position -
+                  l.nodes[static_cast<std::size_t>(sl.from_node)].position)
+                     .norm();
+    } else {
+      r.from = sl.from;
+      r.unit = (sl.to - sl.from).normalized();
+      r.normal = perp(r.unit);
+    }
+    sliders.push_back(r);
+  }
+  structural_rows = row;
+  for (std::size_t k = 0; k < l.inputs.size(); ++k) {
+    const Input& in = l.inputs[k];
+    row_ref.push_back({RowRef::Kind::kInput, static_cast<int>(k)});
+    InputRow r;
+    r.row = row++;
+    r.input = static_cast<int>(k);
+    r.angle = in.kind == Input::Kind::kAngle;
+    if (r.angle) {
+      r.p = l.links[static_cast<std::size_t>(in.link)].nodes[0];
+      r.q = l.links[static_cast<std::size_t>(in.link)].nodes[1];
+      r.length = elements[static_cast<std::size_t>(in.link)].length;
+    } else {
+      r.slider = in.slider;
+    }
+    inputs.push_back(r);
+  }
+  rows = row;
+
+  // the constant mass matrix: the elements' blocks at their moving nodes, point masses
+  M = MatrixXd::Zero(n, n);
+  for (std::size_t k = 0; k < l.links.size(); ++k) {
+    const int nodes[2] = {elements[k].p, elements[k].q};
+    for (int a = 0; a < 2; ++a) {
+      const int ca = coord[static_cast<std::size_t>(nodes[a])];
+      if (ca < 0) continue;
+      for (int b = 0; b < 2; ++b) {
+        const int cb = coord[static_cast<std::size_t>(nodes[b])];
+        if (cb < 0) continue;
+        M.block<2, 2>(ca, cb) += element_M[k].block<2, 2>(2 * a, 2 * b);
+      }
+    }
+  }
+  node_mass.assign(l.nodes.size(), 0.0);
+  for (const PointMass& pm : l.point_masses) {
+    node_mass[static_cast<std::size_t>(pm.node)] += pm.mass;
+    const int c = coord[static_cast<std::size_t>(pm.node)];
+    M(c, c) += pm.mass;
+    M(c + 1, c + 1) += pm.mass;
+  }
+}
+
+void nodes_from_q(const System& s, const VectorXd& q, NodeVectors& x) {
+  x.resize(s.coord.size());
+  for (std::size_t i = 0; i < s.coord.size(); ++i) {
+    const int c = s.coord[i];
+    x[i] = c < 0 ? s.linkage.nodes[i].position : Vec2(q[c], q[c + 1]);
+  }
+}
+
+void node_rates_from(const System& s, const VectorXd& qd, NodeVectors& v) {
+  v.resize(s.coord.size());
+  for (std::size_t i = 0; i < s.coord.size(); ++i) {
+    const int c = s.coord[i];
+    v[i] = c < 0 ? Vec2(0, 0) : Vec2(qd[c], qd[c + 1]);
+  }
+}
+
+VectorXd q_from_nodes(const System& s, const NodeVectors& x) {
+  VectorXd q(s.n);
+  for (std::size_t i = 0; i < s.coord.size(); ++i) {
+    const int c = s.coord[i];
+    if (c >= 0) q.segment<2>(c) = x[i];
+  }
+  return q;
+}
+
+double input_angle(const System&, const System::InputRow& in, const NodeVectors& x, double near) {
+  return continued_angle(at(x, in.q) - at(x, in.p), near);
+}
+
+double slide_position(const System&, const System::SliderRow& sl, const NodeVectors& x) {
+  if (!sl.on_link) return sl.unit.dot(at(x, sl.node) - sl.from);
+  const Vec2 a = at(x, sl.node) - at(x, sl.from_node), b = at(x, sl.to_node) - at(x, sl.from_node);
+  return a.dot(b) / sl.length;
+}
+
+double slide_rate(const System&, const System::SliderRow& sl, const NodeVectors& x,
+                  const NodeVectors& v) {
+  if (!sl.on_link) return sl.unit.dot(at(v, sl.node));
+  const Vec2 a = at(x, sl.node) - at(x, sl.from_node), b = at(x, sl.to_node) - at(x, sl.from_node);
+  const Vec2 ad = at(v, sl.node) - at(v, sl.from_node),
+             bd = at(v, sl.to_node) - at(v, sl.from_node);
+  return (ad.dot(b) + a.dot(bd)) / sl.length;
+}
+
+void constraint_values(const System& s, const NodeVectors& x, const std::vector<double>& inputs,
+                       VectorXd& g) {
+  g.resize(s.rows);
+  for (std::size_t k = 0; k < s.elements.size(); ++k) {
+    const System::ElementRow& e = s.elements[k];
+    g[static_cast<Eigen::Index>(k)] =
+        ((at(x, e.q) - at(x, e.p)).squaredNorm() - e.length_sq) / (2 * e.length);
+  }
+  for (const System::RigidRows& r : s.rigid) {
+    g.segment<2>(r.row) = at(x, r.node) - r.weights.at_p * at(x, r.p) - r.weights.at_q * at(x, r.q);
+  }
+  for (const System::SliderRow& sl : s.sliders) {
+    if (!sl.on_link) {
+      g[sl.row] = sl.normal.dot(at(x, sl.node) - sl.from);
+    } else {
+      const Vec2 a = at(x, sl.node) - at(x, sl.from_node),
+                 b = at(x, sl.to_node) - at(x, sl.from_node);
+      g[sl.row] = cross(a, b) / sl.length;
+    }
+  }
+  for (const System::InputRow& in : s.inputs) {
+    const double target = inputs[static_cast<std::size_t>(in.input)];
+    g[in.row] = in.angle
+                    ? in.length * (input_angle(s, in, x, target) - target)
+                    : slide_position(s, s.sliders[static_cast<std::size_t>(in.slider)], x) - target;
+  }
+}
+
+namespace {
+
+// the gradient of a slider's guide row, or of a slide input on it: the sliding node's entry on
+// the node, the guide nodes' entries on the guide's link
+int slider_gradient(const System::SliderRow& sl, const NodeVectors& x, bool along, int link,
+                    GradientEntry out[3]) {
+  if (!sl.on_link) {
+    out[0] = {sl.node, along ? sl.unit : sl.normal, -1};
+    return 1;
+  }
+  const Vec2 a = at(x, sl.node) - at(x, sl.from_node), b = at(x, sl.to_node) - at(x, sl.from_node);
+  if (along) {  // s = a·b / L
+    out[0] = {sl.node, b / sl.length, -1};
+    out[1] = {sl.to_node, a / sl.length, link};
+    out[2] = {sl.from_node, -(a + b) / sl.length, link};
+  } else {  // g = a × b / L
+    out[0] = {sl.node, -perp(b) / sl.length, -1};
+    out[1] = {sl.to_node, perp(a) / sl.length, link};
+    out[2] = {sl.from_node, (perp(b) - perp(a)) / sl.length, link};
+  }
+  return 3;
+}
+
+}  // namespace
+
+int row_gradient(const System& s, const NodeVectors& x, int row, GradientEntry out[3]) {
+  const System::RowRef& ref = s.row_ref[static_cast<std::size_t>(row)];
+  switch (ref.kind) {
+    case System::RowRef::Kind::kElement: {
+      const System::ElementRow& e = s.elements[static_cast<std::size_t>(ref.index)];
+      const Vec2 d = (at(x, e.q) - at(x, e.p)) / e.length;
+      out[0] = {e.q, d, ref.index};
+      out[1] = {e.p, -d, ref.index};
+      return 2;
+    }
+    case System::RowRef::Kind::kRigid: {
+      const System::RigidRows& r = s.rigid[static_cast<std::size_t>(ref.index)];
+      const int i = row - r.row;  // 0: x, 1: y
+      out[0] = {r.node, Vec2::Unit(i), r.link};
+      out[1] = {r.p, -r.weights.at_p.row(i).transpose(), r.link};
+      out[2] = {r.q, -r.weights.at_q.row(i).transpose(), r.link};
+      return 3;
+    }
+    case System::RowRef::Kind::kSlider: {
+      const System::SliderRow& sl = s.sliders[static_cast<std::size_t>(ref.index)];
+      return slider_gradient(sl, x, false,
+                             s.linkage.sliders[static_cast<std::size_t>(ref.index)].link, out);
+    }
+    case System::RowRef::Kind::kInput: {
+      const System::InputRow& in = s.inputs[static_cast<std::size_t>(ref.index)];
+      if (in.angle) {
+        const Vec2 d = at(x, in.q) - at(x, in.p);
+        const Vec2 grad = in.length * perp(d) / d.squaredNorm();
+        const int link = s.linkage.inputs[static_cast<std::size_t>(in.input)].link;
+        out[0] = {in.q, grad, link};
+        out[1] = {in.p, -grad, link};
+        return 2;
+      }
+      const System::SliderRow& sl = s.sliders[static_cast<std::size_t>(in.slider)];
+      return slider_gradient(sl, x, true,
+                             s.linkage.sliders[static_cast<std::size_t>(in.slider)].link, out);
+    }
+  }
+  return 0;
+}
+
+void constraint_jacobian(const System& s, const NodeVectors& x, int rows, MatrixXd& G) {
+  G.setZero(rows, s.n);
+  GradientEntry entries[3];
+  for (int row = 0; row < rows; ++row) {
+    const int count = row_gradient(s, x, row, entries);
+    for (int k = 0; k < count; ++k) add_gradient(s, G, row, entries[k].node, entries[k].grad);
+  }
+}
+
+void constraint_bias(const System& s, const NodeVectors& x, const NodeVectors& v, int rows,
+                     VectorXd& gamma) {
+  gamma.setZero(rows);  // the rigid rows and frame guides are linear: no curvature
+  for (std::size_t k = 0; k < s.elements.size(); ++k) {
+    const System::ElementRow& e = s.elements[k];
+    gamma[static_cast<Eigen::Index>(k)] = (at(v, e.q) - at(v, e.p)).squaredNorm() / e.length;
+  }
+  for (const System::SliderRow& sl : s.sliders) {
+    if (!sl.on_link) continue;
+    const Vec2 ad = at(v, sl.node) - at(v, sl.from_node),
+               bd = at(v, sl.to_node) - at(v, sl.from_node);
+    gamma[sl.row] = 2 * cross(ad, bd) / sl.length;
+  }
+  if (rows <= s.structural_rows) return;
+  for (const System::InputRow& in : s.inputs) {
+    if (in.angle) {
+      const Vec2 d = at(x, in.q) - at(x, in.p), dd = at(v, in.q) - at(v, in.p);
+      const double n2 = d.squaredNorm();
+      gamma[in.row] = -2 * in.length * d.dot(dd) * perp(d).dot(dd) / (n2 * n2);
+    } else {
+      const System::SliderRow& sl = s.sliders[static_cast<std::size_t>(in.slider)];
+      if (!sl.on_link) continue;
+      const Vec2 ad = at(v, sl.node) - at(v, sl.from_node),
+                 bd = at(v, sl.to_node) - at(v, sl.from_node);
+      gamma[in.row] = 2 * ad.dot(bd) / sl.length;
+    }
+  }
+}
+
+SpringState spring_state(const System& s, int k, const NodeVectors& x, const NodeVectors& v) {
+  const Spring& sp = s.linkage.springs[static_cast<std::size_t>(k)];
+  SpringState st;
+  const Vec2 d = at(x, sp.b) - at(x, sp.a);
+  st.length = d.norm();
+  st.unit = d / st.length;
+  st.rate = st.unit.dot(at(v, sp.b) - at(v, sp.a));
+  st.tension = sp.stiffness * (st.length - sp.free_length) + sp.damping * st.rate;
+  return st;
+}
+
+void applied_forces(const System& s, const NodeVectors& x, const NodeVectors& v,
+                    const std::vector<double>* efforts, VectorXd& F) {
+  F.setZero(s.n);
+  const Linkage& l = s.linkage;
+  const Vec2& g = l.loads.gravity;
+  // weights at the centres of mass, and the links' loads (eq. 46)
+  std::vector<Vec2> force(l.links.size(), Vec2(0, 0));
+  std::vector<double> moment(l.links.size(), 0.0);
+  for (std::size_t k = 0; k < l.links.size(); ++k) force[k] = l.links[k].mass * g;
+  for (const LinkLoad& ld : l.loads.link_loads) {
+    force[static_cast<std::size_t>(ld.link)] += ld.force;
+    moment[static_cast<std::size_t>(ld.link)] += ld.moment;
+  }
+  for (std::size_t k = 0; k < l.links.size(); ++k) {
+    if (force[k].isZero(0.0) && moment[k] == 0.0) continue;
+    const System::ElementRow& e = s.elements[k];
+    const Vec4 f =
+        element_nodal_forces(s.com_weights[k], force[k], moment[k], at(x, e.p), at(x, e.q));
+    add_force(s, F, e.p, f.segment<2>(0));
+    add_force(s, F, e.q, f.segment<2>(2));
+  }
+  for (const NodeForce& nf : l.loads.node_forces) add_force(s, F, nf.node, nf.force);
+  for (const PointMass& pm : l.point_masses) add_force(s, F, pm.node, pm.mass * g);
+  for (std::size_t k = 0; k < l.springs.size(); ++k) {
+    const SpringState st = spring_state(s, static_cast<int>(k), x, v);
+    add_force(s, F, l.springs[k].a, st.tension * st.unit);
+    add_force(s, F, l.springs[k].b, -st.tension * st.unit);
+  }
+  if (!efforts) return;
+  GradientEntry entries[3];
+  for (const System::InputRow& in : s.inputs) {
+    const double e = (*efforts)[static_cast<std::size_t>(in.input)];
+    if (e == 0.0) continue;
+    // the row's gradient is scaled by the element length for an angle (λ l is the torque)
+    const double scale = in.angle ? e / in.length : e;
+    const int count = row_gradient(s, x, in.row, entries);
+    for (int k = 0; k < count; ++k) add_force(s, F, entries[k].node, scale * entries[k].grad);
+  }
+}
+
+}  // namespace bd::core::planar::detail

@@ -1,0 +1,137 @@
+#pragma once
+/// The equations of a planar linkage in node coordinates (core/planar/model.hpp), compiled once:
+/// the free coordinates q (x, y of every moving node), the constraint rows g(q) = 0, the constant
+/// mass matrix M of the truss elements and point masses, and the applied forces F(q, q̇, t).
+///
+/// Constraint rows, in this order (structural rows first, then one row per input):
+/// - element length of each link, g = (|q - p|² - l²) / (2 l) (gradient of unit length, λ the
+///   element's axial force [N]);
+/// - each further node r of a link, r - A p - B q = 0 (two rows): the material point ξ + iη of
+///   the element p->q (eq. 41), exact for the rigid link because the element keeps its length;
+/// - each slider on a frame guide, n·(P - from) = 0 (n the guide's unit normal); on a link's
+///   guide through its nodes Q, R: (P - Q) × (R - Q) / |R - Q| = 0;
+/// - each input: an angle l (φ(q) - θ) = 0 (φ the link's first-to-second node direction, kept
+///   continuous, l its element length, so that the gradient has unit length and λ l is the
+///   drive's torque), or a slide s(q) - s = 0 (s the node's position along the guide, λ the
+///   drive's force).
+/// Every row is written g(q) = 0 with its gradient G = ∂g/∂q and its curvature term γ = Ġ q̇,
+/// so that q̈ satisfies G q̈ = -γ + (0, ..., z̈). The equations of motion with the multipliers λ
+/// are M q̈ = F + Gᵀ λ: λ of an element is its axial force over its length, λ of a rigid node the
+/// force the node exerts on the link, λ of a slider the normal force of its guide, λ of an input
+/// the drive's torque or force.
+///
+/// Internal to core/planar: the public interface is core/planar/dynamics.hpp and simulate.hpp.
+#include <Eigen/Core>
+#include <vector>
+
+#include "core/planar/model.hpp"
+#include "core/truss_element.hpp"
+
+namespace bd::core::planar::detail {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+/// Positions, velocities or accelerations of every node (ground nodes included, fixed there).
+using NodeVectors = std::vector<Vec2>;
+
+/// The compiled equations of one linkage.
+struct System {
+  Linkage linkage;
+  int n{};                 // free coordinates (2 per moving node)
+  int structural_rows{};   // rows of the constraints (not the inputs)
+  int rows{};              // structural rows + inputs
+  std::vector<int> coord;  // per node: index of its x in q, -1 for a ground node
+
+  struct ElementRow {  // one per link, row = link index
+    int p{}, q{};      // element nodes
+    double length{}, length_sq{};
+  };
+  struct RigidRows {  // two rows per further node of a link
+    int row{}, link{}, node{}, p{}, q{};
+    PointWeights weights;
+  };
+  struct SliderRow {
+    int row{}, slider{}, node{};
+    bool on_link{};                             // false: frame guide
+    Vec2 from{0, 0}, unit{0, 0}, normal{0, 0};  // frame guide
+    int from_node{-1}, to_node{-1};             // guide on a link
+    double length{};                            // |to_node - from_node|, constant
+  };
+  struct InputRow {
+    int row{}, input{};
+    bool angle{};
+    int p{}, q{};     // angle: the link's first two nodes
+    double length{};  // angle: the link's element length, the row's scale [m]
+    int slider{};     // slide: index into sliders (SliderRow)
+  };
+  /// What each row is: its kind and the index into elements, rigid, sliders or inputs (for a
+  /// rigid pair, both rows name the same entry).
+  struct RowRef {
+    enum class Kind { kElement, kRigid, kSlider, kInput } kind = Kind::kElement;
+    int index{};
+  };
+  std::vector<RowRef> row_ref;       // per row
+  std::vector<ElementRow> elements;  // per link
+  std::vector<RigidRows> rigid;
+  std::vector<SliderRow> sliders;  // per linkage slider
+  std::vector<InputRow> inputs;    // per input
+
+  std::vector<ElementMass> element_mass;  // per link
+  std::vector<Mat4> element_M;            // per link
+  std::vector<PointWeights> com_weights;  // per link: its centre of mass on the element
+  MatrixXd M;                             // n x n, constant
+  std::vector<double> node_mass;          // per node: point masses there [kg]
+
+  explicit System(const Linkage& linkage);
+};
+
+/// All coordinates of the nodes: ground nodes as drawn, moving ones from q.
+void nodes_from_q(const System& s, const VectorXd& q, NodeVectors& x);
+/// The velocities (or accelerations) of the nodes, ground nodes 0.
+void node_rates_from(const System& s, const VectorXd& qd, NodeVectors& v);
+/// q from the node positions (the moving nodes' coordinates).
+VectorXd q_from_nodes(const System& s, const NodeVectors& x);
+
+/// The angle of input row k from node positions, continued to within π of `near` [rad].
+double input_angle(const System& s, const System::InputRow& in, const NodeVectors& x, double near);
+/// The position of a slider's node along its guide [m].
+double slide_position(const System& s, const System::SliderRow& sl, const NodeVectors& x);
+/// A slider's velocity along its guide [m/s] (relative to the guide's link).
+double slide_rate(const System& s, const System::SliderRow& sl, const NodeVectors& x,
+                  const NodeVectors& v);
+
+/// One entry of a row's gradient: ∂g_row/∂(x, y of `node`), and the link the row's force acts
+/// on there (-1: on the node itself, e.g. a guide's force on its sliding node).
+struct GradientEntry {
+  int node{};
+  Vec2 grad{0, 0};
+  int link{-1};
+};
+/// The (at most three) nonzero entries of row `row`'s gradient at x, ground nodes included;
+/// returns how many.
+int row_gradient(const System& s, const NodeVectors& x, int row, GradientEntry out[3]);
+
+/// g(q) with the inputs at `inputs` (angles continued from them).
+void constraint_values(const System& s, const NodeVectors& x, const std::vector<double>& inputs,
+                       VectorXd& g);
+/// G = ∂g/∂q (rows x n); without the input rows when rows == structural_rows.
+void constraint_jacobian(const System& s, const NodeVectors& x, int rows, MatrixXd& G);
+/// γ = Ġ q̇ (rows), for the velocities v of the nodes.
+void constraint_bias(const System& s, const NodeVectors& x, const NodeVectors& v, int rows,
+                     VectorXd& gamma);
+
+/// The applied forces on q at time t: the links' loads and weights (eq. 46), the node forces
+/// and point-mass weights, the spring-dampers; with `efforts`, the inputs' drive efforts too.
+void applied_forces(const System& s, const NodeVectors& x, const NodeVectors& v,
+                    const std::vector<double>* efforts, VectorXd& F);
+
+/// The tension of spring k [N] (positive pulls its nodes together), its length and its unit
+/// vector from a to b.
+struct SpringState {
+  double tension{}, length{}, rate{};
+  Vec2 unit{0, 0};
+};
+SpringState spring_state(const System& s, int k, const NodeVectors& x, const NodeVectors& v);
+
+}  // namespace bd::core::planar::detail

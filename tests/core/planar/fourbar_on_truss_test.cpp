@@ -1,0 +1,107 @@
+// The four-bar on the general planar engine (truss elements in node coordinates) against the
+// dedicated closed-form four-bar: at random states of random crank-rockers on both branches,
+// inverse and forward dynamics give the same angles, rates, accelerations, support reactions,
+// shaking force and moment and drive torque to 1e-12 of each quantity's scale.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "core/fourbar/dynamics.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/samples.hpp"
+#include "core/planar/dynamics.hpp"
+#include "core/planar/from_fourbar.hpp"
+#include "tests/support/scales.hpp"
+
+namespace bd::core::planar {
+namespace {
+
+// Both routes are exact; they differ by the round-off of small solves (~1e-15 relative); the
+// margin covers the amplification of a poorly conditioned position (transmission angle near 0).
+constexpr double kTol = 1e-12;
+
+void expect_same(const DynamicsSample& d, const Instant& in, const FourBar& fb,
+                 const std::string& what) {
+  const double force = bd::testing::force_scale(d);
+  const double moment = bd::testing::moment_scale(fb, d);
+  const double rate = bd::testing::rate_scale(d), acc = bd::testing::acceleration_scale(d);
+  // link angles: the planar engine keeps them continuous; compare modulo 2π
+  auto angle_gap = [](double a, double b) { return std::remainder(a - b, 2 * M_PI); };
+  EXPECT_NEAR(angle_gap(in.angle[1], d.state.theta2), 0.0, kTol) << what;
+  EXPECT_NEAR(angle_gap(in.angle[2], d.state.theta3), 0.0, kTol) << what;
+  EXPECT_NEAR(in.omega[1], d.state.omega2, kTol * rate) << what;
+  EXPECT_NEAR(in.omega[2], d.state.omega3, kTol * rate) << what;
+  EXPECT_NEAR(in.alpha[0], d.state.alpha1, kTol * acc) << what;
+  EXPECT_NEAR(in.alpha[1], d.state.alpha2, kTol * acc) << what;
+  EXPECT_NEAR(in.alpha[2], d.state.alpha3, kTol * acc) << what;
+  EXPECT_LT((in.ground_reaction[0] - d.RA0).norm(), kTol * force) << what;
+  EXPECT_LT((in.ground_reaction[1] - d.RA3).norm(), kTol * force) << what;
+  EXPECT_LT((in.Fsh - d.Fsh).norm(), kTol * force) << what;
+  EXPECT_NEAR(in.Msh, d.Msh, kTol * moment) << what;
+  EXPECT_NEAR(in.effort[0], d.tau, kTol * moment) << what;
+}
+
+TEST(FourBarOnTruss, InverseDynamicsEqualsTheClosedFormOnRandomLinkagesBothBranches) {
+  std::mt19937_64 rng(20261125);
+  std::uniform_real_distribution<double> angle(-M_PI, M_PI), rate(-20, 20), acc(-200, 200);
+  int compared = 0;
+  for (int i = 0; i < 200; ++i) {
+    FourBar fb = samples::random_crank_rocker(rng);
+    if (i % 2) fb.branch = fb.branch == Branch::kPlus ? Branch::kMinus : Branch::kPlus;
+    const double theta1 = angle(rng), omega1 = rate(rng), alpha1 = acc(rng);
+    const auto d = inverse_dynamics(fb, theta1, omega1, alpha1);
+    if (!d) continue;  // a dead centre of the dedicated route
+    const Model model(linkage_of(fb, theta1));
+    Workspace ws(model);
+    std::vector<Vec2> guess = ws.instant.x;
+    ASSERT_TRUE(solve_position(model, ws, guess, {theta1}));
+    const auto r = inverse_dynamics(model, ws, 0.0, {omega1}, {alpha1});
+    ASSERT_TRUE(r) << r.error().detail;
+    expect_same(*d, ws.instant, fb, "linkage " + std::to_string(i));
+    ++compared;
+  }
+  EXPECT_GT(compared, 190);
+}
+
+TEST(FourBarOnTruss, ForwardDynamicsEqualsTheClosedFormOnRandomLinkages) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> angle(-M_PI, M_PI), rate(-20, 20);
+  int compared = 0;
+  for (int i = 0; i < 200; ++i) {
+    FourBar fb = samples::random_crank_rocker(rng);
+    if (i % 2) fb.branch = fb.branch == Branch::kPlus ? Branch::kMinus : Branch::kPlus;
+    const double theta1 = angle(rng), omega1 = rate(rng);
+    const auto d = forward_dynamics(fb, theta1, omega1);
+    if (!d) continue;
+    const Model model(linkage_of(fb, theta1));
+    Workspace ws(model);
+    ASSERT_TRUE(solve_position(model, ws, ws.instant.x, {theta1}));
+    const auto r = forward_dynamics(model, ws, 0.0, {omega1}, {0.0});
+    ASSERT_TRUE(r) << r.error().detail;
+    expect_same(*d, ws.instant, fb, "linkage " + std::to_string(i));
+    ++compared;
+  }
+  EXPECT_GT(compared, 190);
+}
+
+TEST(FourBarOnTruss, AssemblyFollowsTheDrawnBranchToAnyCrankAngle) {
+  const FourBar fb = samples::paper_fourbar();
+  for (Branch b : {Branch::kPlus, Branch::kMinus}) {
+    FourBar m = fb;
+    m.branch = b;
+    const Model model(linkage_of(m, 1.0));
+    Workspace ws(model);
+    for (double theta1 : {1.0, 2.5, -2.0, 4.0}) {
+      ASSERT_TRUE(assemble(model, ws, {theta1}));
+      const auto pose = solve_position(m, theta1);
+      ASSERT_TRUE(pose);
+      const Joints j = joint_positions(m, *pose);
+      EXPECT_LT((ws.instant.x[1] - j.A1).norm(), 1e-13);
+      EXPECT_LT((ws.instant.x[2] - j.A2).norm(), 1e-13);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace bd::core::planar
