@@ -446,8 +446,7 @@ Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t) 
     in.effort[static_cast<std::size_t>(ir.input)] =
         ir.angle ? ws.lambda[ir.row] * ir.length : ws.lambda[ir.row];
   }
-  link_kinematics(model, in);
-  forces(model, ws);
+  detail::finish_outputs(model, ws);
   if (!finite(ws.lambda) || !finite(ws.qdd)) {
     return Unexpected<PlanarError>(PlanarError{
         PlanarError::Kind::kNonFinite, "non-finite result at " + inputs_text(model, in.input)});
@@ -456,6 +455,11 @@ Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t) 
 }
 
 }  // namespace
+
+void detail::finish_outputs(const Model& model, Workspace& ws) {
+  link_kinematics(model, ws.instant);
+  forces(model, ws);
+}
 
 Expected<bool, PlanarError> inverse_dynamics(const Model& model, Workspace& ws, double t,
                                              const std::vector<double>& rates,

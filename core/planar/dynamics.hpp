@@ -142,6 +142,13 @@ Expected<bool, PlanarError> forward_dynamics(const Model& model, Workspace& ws, 
                                              const std::vector<double>& rates,
                                              const std::vector<double>& efforts);
 
+namespace detail {
+/// With ws.instant's positions, velocities, accelerations and efforts and ws.lambda (the
+/// multipliers of every row, the input rows' matching the efforts) set: the link angles and
+/// rates, the sliders' positions and every force output.
+void finish_outputs(const Model& model, Workspace& ws);
+}  // namespace detail
+
 /// The efforts of the model's inputs at time t (their TimeFunctions).
 std::vector<double> efforts_at(const Model& model, double t);
 

@@ -179,7 +179,7 @@ double slide_rate(const System&, const System::SliderRow& sl, const NodeVectors&
 
 void constraint_values(const System& s, const NodeVectors& x, const std::vector<double>& inputs,
                        VectorXd& g) {
-  g.resize(s.rows);
+  g.resize(inputs.empty() ? s.structural_rows : s.rows);
   for (std::size_t k = 0; k < s.elements.size(); ++k) {
     const System::ElementRow& e = s.elements[k];
     g[static_cast<Eigen::Index>(k)] =
@@ -197,6 +197,7 @@ void constraint_values(const System& s, const NodeVectors& x, const std::vector<
       g[sl.row] = cross(a, b) / sl.length;
     }
   }
+  if (inputs.empty()) return;
   for (const System::InputRow& in : s.inputs) {
     const double target = inputs[static_cast<std::size_t>(in.input)];
     g[in.row] = in.angle

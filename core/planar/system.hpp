@@ -112,7 +112,8 @@ struct GradientEntry {
 /// returns how many.
 int row_gradient(const System& s, const NodeVectors& x, int row, GradientEntry out[3]);
 
-/// g(q) with the inputs at `inputs` (angles continued from them).
+/// g(q) with the inputs at `inputs` (angles continued from them); the structural rows only when
+/// `inputs` is empty.
 void constraint_values(const System& s, const NodeVectors& x, const std::vector<double>& inputs,
                        VectorXd& g);
 /// G = ∂g/∂q (rows x n); without the input rows when rows == structural_rows.

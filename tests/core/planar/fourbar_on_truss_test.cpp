@@ -12,6 +12,7 @@
 #include "core/fourbar/samples.hpp"
 #include "core/planar/dynamics.hpp"
 #include "core/planar/from_fourbar.hpp"
+#include "core/planar/simulate.hpp"
 #include "tests/support/scales.hpp"
 
 namespace bd::core::planar {
@@ -101,6 +102,70 @@ TEST(FourBarOnTruss, AssemblyFollowsTheDrawnBranchToAnyCrankAngle) {
       EXPECT_LT((ws.instant.x[2] - j.A2).norm(), 1e-13);
     }
   }
+}
+
+}  // namespace
+}  // namespace bd::core::planar
+
+namespace bd::core::planar {
+namespace {
+
+// the largest difference between a column of the planar table and a four-bar quantity,
+// relative to the quantity's largest magnitude over the run
+double column_gap(const Trajectory& p, const char* column, const core::Trajectory& f,
+                  double (*get)(const DynamicsSample&)) {
+  const std::vector<double> col = p.table.column_values(column);
+  double scale = 0, gap = 0;
+  for (std::size_t i = 0; i < f.samples.size(); ++i) scale = std::max(scale, std::abs(get(f.samples[i])));
+  for (std::size_t i = 0; i < f.samples.size() && i < col.size(); ++i) {
+    gap = std::max(gap, std::abs(col[i] - get(f.samples[i])));
+  }
+  return gap / std::max(scale, 1e-300);
+}
+
+TEST(FourBarOnTruss, FreeMotionAgreesWithTheClosedFormToTheToleranceAskedFor) {
+  // the paper's loaded four-bar, 5 s from rest at theta1 = 1: both integrated at tolerance
+  // 1e-12 (relative; absolute 1e-14), so each is correct to about 1e-11 of the motion's scale
+  const FourBar fb = samples::paper_fourbar();
+  core::FreeScene fs{1.0, 0.0, 5.0, 501};
+  core::SimulateOptions fo;
+  fo.tolerance = 1e-12;
+  fo.absolute_tolerance = 1e-14;
+  const core::Trajectory f = core::simulate_free(fb, fs, fo);
+  ASSERT_TRUE(f.ok()) << f.message;
+  const Model model(linkage_of(fb, 1.0));
+  for (Route route : {Route::kReduced, Route::kDae}) {
+    SimulateOptions po;
+    po.route = route;
+    po.tolerance = 1e-12;
+    po.absolute_tolerance = 1e-14;
+    const Trajectory p = simulate_free(model, FreeScene{{1.0}, {0.0}, 5.0, 501}, po);
+    ASSERT_TRUE(p.ok()) << to_string(route) << ": " << p.message;
+    ASSERT_EQ(p.table.rows(), f.samples.size());
+    SCOPED_TRACE(to_string(route));
+    EXPECT_LT(column_gap(p, "theta_crank", f, [](const DynamicsSample& d) { return d.state.theta1; }), 1e-10);
+    EXPECT_LT(column_gap(p, "omega_crank", f, [](const DynamicsSample& d) { return d.state.omega1; }), 1e-10);
+    EXPECT_LT(column_gap(p, "alpha_rocker", f, [](const DynamicsSample& d) { return d.state.alpha3; }), 1e-10);
+    EXPECT_LT(column_gap(p, "RA0x", f, [](const DynamicsSample& d) { return d.RA0.x(); }), 1e-10);
+    EXPECT_LT(column_gap(p, "RA3y", f, [](const DynamicsSample& d) { return d.RA3.y(); }), 1e-10);
+    EXPECT_LT(column_gap(p, "Msh", f, [](const DynamicsSample& d) { return d.Msh; }), 1e-10);
+  }
+}
+
+TEST(FourBarOnTruss, DrivenRevolutionEqualsTheClosedForm) {
+  const FourBar fb = samples::paper_fourbar();
+  const core::Trajectory f = core::simulate_driven(fb, core::DrivenScene{0.3, 6.0, 2, 360});
+  ASSERT_TRUE(f.ok());
+  const Model model(linkage_of(fb, 0.3));
+  const Trajectory p = simulate_driven(model, DrivenScene{{0.3}, {6.0}, 2, 0, 360});
+  ASSERT_TRUE(p.ok()) << p.message;
+  ASSERT_EQ(p.table.rows(), f.samples.size());
+  const std::vector<double> t = p.table.column_values("t");
+  for (std::size_t i = 0; i < t.size(); ++i) EXPECT_NEAR(t[i], f.t[i], 1e-15 * f.t.back());
+  EXPECT_LT(column_gap(p, "tau", f, [](const DynamicsSample& d) { return d.tau; }), 1e-12);
+  EXPECT_LT(column_gap(p, "Fshx", f, [](const DynamicsSample& d) { return d.Fsh.x(); }), 1e-12);
+  EXPECT_LT(column_gap(p, "Msh", f, [](const DynamicsSample& d) { return d.Msh; }), 1e-12);
+  EXPECT_LT(column_gap(p, "RA3x", f, [](const DynamicsSample& d) { return d.RA3.x(); }), 1e-12);
 }
 
 }  // namespace

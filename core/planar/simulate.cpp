@@ -1,0 +1,584 @@
+#include "core/planar/simulate.hpp"
+
+#include <Eigen/LU>
+#include <cmath>
+
+#include "core/input_error.hpp"
+#include "core/integrators.hpp"
+#include "core/number_text.hpp"
+#include "core/planar/system.hpp"
+
+namespace bd::core::planar {
+
+using detail::NodeVectors;
+using detail::System;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+namespace {
+
+constexpr double kTwoPi = 6.28318530717958647692;
+constexpr long long kMaxSamples = 100'000'000;
+
+const char* unit_of(const Input& in) { return in.kind == Input::Kind::kAngle ? "rad" : "m"; }
+
+std::string state_text(const Model& model, double t, const std::vector<double>& z) {
+  std::string s = "t = " + text::digits(t, 10) + " s";
+  for (std::size_t k = 0; k < z.size(); ++k) {
+    const Input& in = model.linkage().inputs[k];
+    s += ", " + in.name + " = " + text::digits(z[k], 10) + " " + unit_of(in);
+  }
+  return s;
+}
+
+SimulationStatus status_of(const PlanarError& e) {
+  switch (e.kind) {
+    case PlanarError::Kind::kAssembly:
+      return SimulationStatus::kAssemblyFailed;
+    case PlanarError::Kind::kSingular:
+      return SimulationStatus::kSingular;
+    case PlanarError::Kind::kMobility:
+    case PlanarError::Kind::kNonFinite:
+      break;
+  }
+  return SimulationStatus::kIntegratorFailed;
+}
+
+void fail(Trajectory& out, const PlanarError& e, double t) {
+  out.status = status_of(e);
+  out.message = e.detail + " (t = " + text::digits(t, 10) + " s)";
+}
+
+// checks the scene's counts against the model and assembles the start; ws then holds it
+std::vector<double> start_of(const Model& model, Workspace& ws, const std::vector<double>& start,
+                             const char* scene) {
+  const int dof = model.inputs();
+  if (const int m = mobility(model); m != dof) {
+    throw InputError(FieldError{"linkage.inputs", -1,
+                                ": the linkage has " + std::to_string(m) +
+                                    " degree" + (m == 1 ? "" : "s") + " of freedom and " +
+                                    std::to_string(dof) + " input" + (dof == 1 ? "" : "s") +
+                                    "; give one input per degree of freedom"});
+  }
+  std::vector<double> z = start.empty() ? drawn_inputs(model) : start;
+  if (static_cast<int>(z.size()) != dof) {
+    throw InputError(FieldError{std::string(scene) + ".start", -1,
+                                "must give " + std::to_string(dof) + " values (one per input), got " +
+                                    std::to_string(z.size())});
+  }
+  for (double v : z) {
+    if (!std::isfinite(v)) throw InputError(FieldError{std::string(scene) + ".start", -1, "must be finite"});
+  }
+  if (auto ok = assemble(model, ws, z); !ok) {
+    throw InputError(FieldError{std::string(scene) + ".start", -1,
+                                ": " + ok.error().detail + " (the start of the scene)"});
+  }
+  return z;
+}
+
+void check_count(const std::vector<double>& v, int dof, const char* field, const char* meaning) {
+  if (static_cast<int>(v.size()) != dof) {
+    throw InputError(FieldError{field, -1,
+                                "must give " + std::to_string(dof) + " " + meaning +
+                                    " (one per input), got " + std::to_string(v.size())});
+  }
+  for (double x : v) {
+    if (!std::isfinite(x)) throw InputError(FieldError{field, -1, "must be finite"});
+  }
+}
+
+}  // namespace
+
+const char* to_string(Route r) { return r == Route::kDae ? "dae" : "reduced"; }
+
+// ---------------------------------------------------------------------------------------------
+// the table
+
+std::vector<std::string> columns(const Model& model) {
+  const Linkage& l = model.linkage();
+  std::vector<std::string> c = {"t"};
+  for (const Link& link : l.links) {
+    for (const char* p : {"theta_", "omega_", "alpha_"}) c.push_back(p + link.name);
+  }
+  for (const Slider& s : l.sliders) {
+    for (const char* p : {"s_", "v_", "a_"}) c.push_back(p + s.name);
+  }
+  for (const Node& n : l.nodes) {
+    if (n.ground) continue;
+    c.push_back("x_" + n.name);
+    c.push_back("y_" + n.name);
+  }
+  auto pair = [&](const std::string& name) {
+    c.push_back(name + "x");
+    c.push_back(name + "y");
+  };
+  for (int g : model.ground_nodes()) pair("R" + l.nodes[static_cast<std::size_t>(g)].name);
+  for (int s : model.frame_guides()) pair("R" + l.sliders[static_cast<std::size_t>(s)].name);
+  for (const JointForce& j : model.joints()) pair("F" + j.name);
+  c.insert(c.end(), {"Fshx", "Fshy", "Msh"});
+  if (l.inputs.size() == 1) {
+    c.push_back("tau");
+  } else {
+    for (const Input& in : l.inputs) c.push_back("tau_" + in.name);
+  }
+  c.insert(c.end(), {"Fshx_inertial", "Fshy_inertial", "Msh_inertial"});
+  return c;
+}
+
+void append_row(const Model& model, const Instant& in, Series& table) {
+  const Linkage& l = model.linkage();
+  std::vector<double>& v = table.values;
+  v.push_back(in.t);
+  for (std::size_t k = 0; k < l.links.size(); ++k) v.insert(v.end(), {in.angle[k], in.omega[k], in.alpha[k]});
+  for (std::size_t k = 0; k < l.sliders.size(); ++k) {
+    v.insert(v.end(), {in.slide[k], in.slide_rate[k], in.slide_acceleration[k]});
+  }
+  for (std::size_t i = 0; i < l.nodes.size(); ++i) {
+    if (!l.nodes[i].ground) v.insert(v.end(), {in.x[i].x(), in.x[i].y()});
+  }
+  for (const Vec2& r : in.ground_reaction) v.insert(v.end(), {r.x(), r.y()});
+  for (const Vec2& r : in.guide_reaction) v.insert(v.end(), {r.x(), r.y()});
+  for (const Vec2& f : in.joint_force) v.insert(v.end(), {f.x(), f.y()});
+  v.insert(v.end(), {in.Fsh.x(), in.Fsh.y(), in.Msh});
+  v.insert(v.end(), in.effort.begin(), in.effort.end());
+  v.insert(v.end(), {in.Fsh_inertial.x(), in.Fsh_inertial.y(), in.Msh_inertial});
+}
+
+// ---------------------------------------------------------------------------------------------
+// driven
+
+Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
+  const int dof = model.inputs();
+  check_count(scene.speeds, dof, "scene.speeds", "speeds");
+  if (scene.samples < 1) {
+    throw InputError(FieldError{"scene.samples", -1, "must be >= 1, got " + std::to_string(scene.samples)});
+  }
+  // the time span: turns of the first angle input, or the duration
+  double period = 0;
+  for (std::size_t k = 0; k < model.linkage().inputs.size(); ++k) {
+    if (model.linkage().inputs[k].kind == Input::Kind::kAngle && scene.speeds[k] != 0) {
+      period = kTwoPi / std::abs(scene.speeds[k]);
+      break;
+    }
+  }
+  const bool by_duration = scene.duration > 0;
+  if (!by_duration && !(period > 0)) {
+    throw InputError(FieldError{"scene.duration", -1,
+                                ": the scene needs a duration (no angle input turns, so there are "
+                                "no revolutions to count)"});
+  }
+  if (!by_duration && scene.revolutions < 1) {
+    throw InputError(FieldError{"scene.revolutions", -1, "must be >= 1"});
+  }
+  const long long rows = by_duration ? scene.samples
+                                     : static_cast<long long>(scene.samples) * scene.revolutions;
+  if (rows > kMaxSamples || (by_duration && rows < 2)) {
+    throw InputError(FieldError{"scene.samples", -1, "must be between 2 and 1e8 in all"});
+  }
+  Workspace ws(model);
+  const std::vector<double> start = start_of(model, ws, scene.start, "scene");
+
+  Trajectory out;
+  out.table.columns = columns(model);
+  out.table.values.reserve(static_cast<std::size_t>(rows) * out.table.width());
+  const std::vector<double> zero(static_cast<std::size_t>(dof), 0.0);
+  std::vector<double> z(static_cast<std::size_t>(dof));
+  std::vector<Vec2> guess = ws.instant.x;
+  double t_prev = 0;
+  for (long long i = 0; i < rows; ++i) {
+    const double t = by_duration ? scene.duration * static_cast<double>(i) / static_cast<double>(rows - 1)
+                                 : period * static_cast<double>(i) / scene.samples;
+    for (std::size_t k = 0; k < z.size(); ++k) z[k] = start[k] + scene.speeds[k] * t;
+    // the previous sample carried forward to second order: Newton then needs two or three steps
+    if (i > 0) {
+      const double h = t - t_prev;
+      for (std::size_t n = 0; n < guess.size(); ++n) {
+        guess[n] = ws.instant.x[n] + h * ws.instant.v[n] + 0.5 * h * h * ws.instant.a[n];
+      }
+    }
+    auto ok = solve_position(model, ws, guess, z);
+    if (ok) ok = inverse_dynamics(model, ws, t, scene.speeds, zero);
+    ++out.rhs_evaluations;
+    if (!ok) {
+      fail(out, ok.error(), t);
+      return out;
+    }
+    append_row(model, ws.instant, out.table);
+    t_prev = t;
+  }
+  out.status = SimulationStatus::kCompleted;
+  out.message = "completed";
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// free motion
+
+namespace {
+
+// what the integrator's callbacks share
+struct Motion {
+  const Model* model{};
+  Workspace* ws{};
+  Route route{};
+  double baumgarte{};
+  int dof{};
+  long evaluations{};
+  bool failed{};
+  PlanarError error;
+  double error_t{};
+  double root_sign = 1;  // the sign of the normalised determinant at the start
+  std::vector<Vec2> cache;  // positions of the last successful evaluation (Newton's guess)
+  // dae route scratch
+  MatrixXd kkt;
+  VectorXd kkt_rhs;
+  Eigen::PartialPivLU<MatrixXd> kkt_lu;
+};
+
+// the normalised determinant of the factorised constraints and inputs at ws
+double normalised_determinant(Workspace& ws) {
+  double d = ws.lu.determinant();
+  for (Eigen::Index r = 0; r < ws.G.rows(); ++r) d /= ws.G.row(r).norm();
+  return d;
+}
+
+// reduced route: y = (z, ż)
+Expected<bool, PlanarError> reduced_state(Motion& m, double t, const double* y) {
+  const int dof = m.dof;
+  const std::vector<double> z(y, y + dof), zd(y + dof, y + 2 * dof);
+  auto ok = solve_position(*m.model, *m.ws, m.cache, z);
+  if (ok) ok = forward_dynamics(*m.model, *m.ws, t, zd, efforts_at(*m.model, t));
+  if (ok) m.cache = m.ws->instant.x;
+  return ok;
+}
+
+int reduced_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* data) {
+  Motion& m = *static_cast<Motion*>(data);
+  ++m.evaluations;
+  const double* yv = N_VGetArrayPointer(y);
+  const auto ok = reduced_state(m, t, yv);
+  if (!ok) {
+    m.failed = true;
+    m.error = ok.error();
+    m.error_t = t;
+    return 1;  // recoverable: the integrator tries a smaller step
+  }
+  double* d = N_VGetArrayPointer(ydot);
+  for (int k = 0; k < m.dof; ++k) {
+    d[k] = yv[m.dof + k];
+    d[m.dof + k] = m.ws->instant.input_acceleration[static_cast<std::size_t>(k)];
+  }
+  return 0;
+}
+
+int reduced_root(sunrealtype, N_Vector y, sunrealtype* g, void* data) {
+  Motion& m = *static_cast<Motion*>(data);
+  const double* yv = N_VGetArrayPointer(y);
+  const std::vector<double> z(yv, yv + m.dof);
+  if (!solve_position(*m.model, *m.ws, m.cache, z)) {
+    g[0] = -1;  // beyond a limit: the root lies before
+    return 0;
+  }
+  g[0] = m.root_sign * normalised_determinant(*m.ws) - kLimitDeterminant;
+  return 0;
+}
+
+// dae route: y = (q, q̇); the accelerations and the structural multipliers from
+//   [M  -Gᵀ] [q̈]   [F                        ]
+//   [G   0 ] [λ ] = [-γ - 2α G q̇ - α² g(q)    ]
+Expected<bool, PlanarError> dae_accelerations(Motion& m, double t, const double* y, bool stabilise) {
+  const System& s = m.model->system();
+  Workspace& ws = *m.ws;
+  const int n = s.n, r = s.structural_rows;
+  ws.q = Eigen::Map<const VectorXd>(y, n);
+  ws.qd = Eigen::Map<const VectorXd>(y + n, n);
+  detail::nodes_from_q(s, ws.q, ws.instant.x);
+  detail::node_rates_from(s, ws.qd, ws.instant.v);
+  detail::constraint_jacobian(s, ws.instant.x, r, ws.G);
+  detail::constraint_bias(s, ws.instant.x, ws.instant.v, r, ws.gamma);
+  const std::vector<double> efforts = efforts_at(*m.model, t);
+  detail::applied_forces(s, ws.instant.x, ws.instant.v, &efforts, ws.F);
+  m.kkt.setZero(n + r, n + r);
+  m.kkt.topLeftCorner(n, n) = s.M;
+  m.kkt.topRightCorner(n, r) = -ws.G.transpose();
+  m.kkt.bottomLeftCorner(r, n) = ws.G;
+  m.kkt_rhs.resize(n + r);
+  m.kkt_rhs.head(n) = ws.F;
+  m.kkt_rhs.tail(r) = -ws.gamma;
+  if (stabilise && m.baumgarte > 0) {
+    std::vector<double> none;
+    detail::constraint_values(s, ws.instant.x, none, ws.g);
+    const double a = m.baumgarte;
+    m.kkt_rhs.tail(r) -= 2 * a * (ws.G * ws.qd) + a * a * ws.g.head(r);
+  }
+  m.kkt_lu.compute(m.kkt);
+  if (!(m.kkt_lu.rcond() > 1e-12)) {
+    return Unexpected<PlanarError>(PlanarError{
+        PlanarError::Kind::kSingular,
+        "the constraints lose rank (a lock-up or a branch point): the linkage cannot move on"});
+  }
+  const VectorXd sol = m.kkt_lu.solve(m.kkt_rhs);
+  ws.qdd = sol.head(n);
+  ws.lambda.setZero(s.rows);
+  ws.lambda.head(r) = sol.tail(r);
+  if (!ws.qdd.allFinite()) {
+    return Unexpected<PlanarError>(PlanarError{PlanarError::Kind::kNonFinite, "non-finite accelerations"});
+  }
+  return true;
+}
+
+int dae_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* data) {
+  Motion& m = *static_cast<Motion*>(data);
+  ++m.evaluations;
+  const auto ok = dae_accelerations(m, t, N_VGetArrayPointer(y), true);
+  if (!ok) {
+    m.failed = true;
+    m.error = ok.error();
+    m.error_t = t;
+    return 1;
+  }
+  const int n = m.model->system().n;
+  double* d = N_VGetArrayPointer(ydot);
+  const double* yv = N_VGetArrayPointer(y);
+  for (int k = 0; k < n; ++k) {
+    d[k] = yv[n + k];
+    d[n + k] = m.ws->qdd[k];
+  }
+  return 0;
+}
+
+// projects (q, q̇) onto g(q) = 0 and G q̇ = 0 (Newton with the least-norm step)
+void project(const Model& model, Workspace& ws, double* y) {
+  const System& s = model.system();
+  const int n = s.n, r = s.structural_rows;
+  Eigen::Map<VectorXd> q(y, n), qd(y + n, n);
+  const std::vector<double> none;
+  for (int it = 0; it < 4; ++it) {
+    detail::nodes_from_q(s, q, ws.instant.x);
+    detail::constraint_values(s, ws.instant.x, none, ws.g);
+    detail::constraint_jacobian(s, ws.instant.x, r, ws.G);
+    const MatrixXd GGt = ws.G * ws.G.transpose();
+    const VectorXd step = ws.G.transpose() * GGt.partialPivLu().solve(-ws.g.head(r));
+    q += step;
+    if (step.cwiseAbs().maxCoeff() <= 1e-15 * model.length_scale()) break;
+  }
+  detail::nodes_from_q(s, q, ws.instant.x);
+  detail::constraint_jacobian(s, ws.instant.x, r, ws.G);
+  const MatrixXd GGt = ws.G * ws.G.transpose();
+  qd -= ws.G.transpose() * GGt.partialPivLu().solve(ws.G * qd);
+}
+
+// the outputs at a dae state (projected): the inputs read off the nodes, forces from the
+// multipliers of the saddle-point system and the given efforts
+Expected<bool, PlanarError> dae_instant(Motion& m, double t, const double* y) {
+  auto ok = dae_accelerations(m, t, y, false);
+  if (!ok) return ok;
+  const Model& model = *m.model;
+  const System& s = model.system();
+  Workspace& ws = *m.ws;
+  Instant& in = ws.instant;
+  in.t = t;
+  detail::node_rates_from(s, ws.qdd, in.a);
+  const std::vector<double> efforts = efforts_at(model, t);
+  for (const System::InputRow& ir : s.inputs) {
+    const std::size_t k = static_cast<std::size_t>(ir.input);
+    in.effort[k] = efforts[k];
+    ws.lambda[ir.row] = ir.angle ? efforts[k] / ir.length : efforts[k];
+  }
+  detail::finish_outputs(model, ws);
+  // the inputs as the nodes give them
+  for (const System::InputRow& ir : s.inputs) {
+    const std::size_t k = static_cast<std::size_t>(ir.input);
+    const Input& input = model.linkage().inputs[k];
+    if (ir.angle) {
+      const std::size_t link = static_cast<std::size_t>(input.link);
+      in.input[k] = in.angle[link];
+      in.input_rate[k] = in.omega[link];
+      in.input_acceleration[k] = in.alpha[link];
+    } else {
+      const std::size_t sl = static_cast<std::size_t>(input.slider);
+      in.input[k] = in.slide[sl];
+      in.input_rate[k] = in.slide_rate[sl];
+      in.input_acceleration[k] = in.slide_acceleration[sl];
+    }
+  }
+  return true;
+}
+
+// the outcome of one advance, as the trajectory's status; false when the run stops
+bool advance_ok(Trajectory& out, const Motion& m, integrators::Integration& integration,
+                integrators::Integration::Outcome outcome, const SimulateOptions& options,
+                const std::string& where) {
+  using Outcome = integrators::Integration::Outcome;
+  if (outcome == Outcome::kReached) return true;
+  const std::string at = "t = " + text::digits(integration.t(), 10) + " s";
+  if (outcome == Outcome::kMaxSteps) {
+    out.status = SimulationStatus::kIntegratorFailed;
+    out.message = "integrator stopped at " + at + ": max_steps = " +
+                  std::to_string(options.max_steps) + " reached";
+  } else if (outcome == Outcome::kRoot) {
+    out.status = SimulationStatus::kSingular;
+    out.message = "limit position reached at " + where +
+                  ": the inputs stop being coordinates of the motion there (the dae route "
+                  "goes through it)";
+  } else if (m.failed) {
+    out.status = status_of(m.error);
+    out.message = m.error.detail + " (a step ahead of " + at + " reached it)";
+  } else {
+    out.status = SimulationStatus::kIntegratorFailed;
+    out.message = "integrator failed at " + at + ": " + integration.failure();
+  }
+  return false;
+}
+
+double output_time(const FreeScene& scene, std::size_t j) {
+  const std::size_t last = static_cast<std::size_t>(scene.samples - 1);
+  return j == last ? scene.duration
+                   : scene.duration * static_cast<double>(j) / static_cast<double>(last);
+}
+
+Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scene,
+                        const std::vector<double>& start, const std::vector<double>& rates,
+                        const SimulateOptions& options) {
+  const int dof = model.inputs();
+  Trajectory out;
+  out.table.columns = columns(model);
+  Motion m;
+  m.model = &model;
+  m.ws = &ws;
+  m.dof = dof;
+  m.cache = ws.instant.x;
+  std::vector<double> y0 = start;
+  y0.insert(y0.end(), rates.begin(), rates.end());
+  ++m.evaluations;
+  auto first = reduced_state(m, 0.0, y0.data());
+  if (first && std::abs(normalised_determinant(ws)) <= kLimitDeterminant) {
+    first = Unexpected<PlanarError>(PlanarError{PlanarError::Kind::kSingular,
+                                                "the start is a limit position of the inputs"});
+  }
+  if (!first) {
+    fail(out, first.error(), 0.0);
+    out.rhs_evaluations = m.evaluations;
+    return out;
+  }
+  m.root_sign = normalised_determinant(ws) > 0 ? 1.0 : -1.0;
+  append_row(model, ws.instant, out.table);
+
+  integrators::Problem problem;
+  problem.integrator = options.integrator;
+  problem.y0 = y0;
+  problem.absolute_tolerance.assign(y0.size(), options.absolute_tolerance);
+  problem.tolerance = options.tolerance;
+  problem.t_end = scene.duration;
+  problem.max_steps = options.max_steps;
+  problem.user_data = &m;
+  problem.rhs = reduced_rhs;
+  problem.root = reduced_root;
+  integrators::Integration integration(problem);
+  out.status = SimulationStatus::kCompleted;
+  out.message = "completed";
+  for (std::size_t j = 1; j < static_cast<std::size_t>(scene.samples); ++j) {
+    m.failed = false;
+    const auto outcome = integration.advance(output_time(scene, j));
+    const std::vector<double> z(integration.y(), integration.y() + dof);
+    if (!advance_ok(out, m, integration, outcome, options, state_text(model, integration.t(), z))) break;
+    ++m.evaluations;
+    const auto ok = reduced_state(m, integration.t(), integration.y());
+    if (!ok) {
+      fail(out, ok.error(), integration.t());
+      break;
+    }
+    append_row(model, ws.instant, out.table);
+  }
+  out.steps = integration.steps();
+  out.rhs_evaluations = m.evaluations;
+  return out;
+}
+
+Trajectory free_dae(const Model& model, Workspace& ws, const FreeScene& scene,
+                    const std::vector<double>& start, const std::vector<double>& rates,
+                    const SimulateOptions& options) {
+  const System& s = model.system();
+  Trajectory out;
+  out.table.columns = columns(model);
+  Motion m;
+  m.model = &model;
+  m.ws = &ws;
+  m.dof = model.inputs();
+  m.route = Route::kDae;
+  m.baumgarte = options.baumgarte;
+  // the start: positions assembled, velocities from the inputs' rates
+  if (auto ok = inverse_dynamics(model, ws, 0.0, rates, std::vector<double>(rates.size(), 0.0)); !ok) {
+    fail(out, ok.error(), 0.0);
+    return out;
+  }
+  (void)start;
+  std::vector<double> y0(static_cast<std::size_t>(2 * s.n));
+  const VectorXd q0 = detail::q_from_nodes(s, ws.instant.x), qd0 = ws.qd;
+  for (int k = 0; k < s.n; ++k) {
+    y0[static_cast<std::size_t>(k)] = q0[k];
+    y0[static_cast<std::size_t>(s.n + k)] = qd0[k];
+  }
+  ++m.evaluations;
+  if (auto ok = dae_instant(m, 0.0, y0.data()); !ok) {
+    fail(out, ok.error(), 0.0);
+    return out;
+  }
+  append_row(model, ws.instant, out.table);
+
+  integrators::Problem problem;
+  problem.integrator = options.integrator;
+  problem.y0 = y0;
+  problem.absolute_tolerance.assign(y0.size(), options.absolute_tolerance);
+  problem.tolerance = options.tolerance;
+  problem.t_end = scene.duration;
+  problem.max_steps = options.max_steps;
+  problem.user_data = &m;
+  problem.rhs = dae_rhs;
+  integrators::Integration integration(problem);
+  out.status = SimulationStatus::kCompleted;
+  out.message = "completed";
+  std::vector<double> y(y0.size());
+  for (std::size_t j = 1; j < static_cast<std::size_t>(scene.samples); ++j) {
+    m.failed = false;
+    const auto outcome = integration.advance(output_time(scene, j));
+    if (!advance_ok(out, m, integration, outcome, options, "t = " + text::digits(integration.t(), 10) + " s")) break;
+    y.assign(integration.y(), integration.y() + y0.size());
+    project(model, ws, y.data());
+    ++m.evaluations;
+    if (auto ok = dae_instant(m, integration.t(), y.data()); !ok) {
+      fail(out, ok.error(), integration.t());
+      break;
+    }
+    append_row(model, ws.instant, out.table);
+  }
+  out.steps = integration.steps();
+  out.rhs_evaluations = m.evaluations;
+  return out;
+}
+
+}  // namespace
+
+Trajectory simulate_free(const Model& model, const FreeScene& scene, const SimulateOptions& options) {
+  const int dof = model.inputs();
+  if (!(scene.duration > 0) || !std::isfinite(scene.duration)) {
+    throw InputError(FieldError{"scene.duration", -1, "must be > 0 s, got " + text::exact(scene.duration)});
+  }
+  if (scene.samples < 2 || scene.samples > kMaxSamples) {
+    throw InputError(FieldError{"scene.samples", -1, "must be between 2 and 1e8, got " + std::to_string(scene.samples)});
+  }
+  if (!(options.tolerance > 0 && options.tolerance < 1)) {
+    throw InputError(FieldError{"tolerance", -1, "must be > 0 and < 1, got " + text::exact(options.tolerance)});
+  }
+  if (options.integrator == Integrator::kIda) {
+    throw InputError(FieldError{"integrator", -1, ": ida is not available for planar linkages"});
+  }
+  const std::vector<double> rates = scene.rates.empty() ? std::vector<double>(static_cast<std::size_t>(dof), 0.0) : scene.rates;
+  check_count(rates, dof, "scene.rates", "rates");
+  Workspace ws(model);
+  const std::vector<double> start = start_of(model, ws, scene.start, "scene");
+  return options.route == Route::kDae ? free_dae(model, ws, scene, start, rates, options)
+                                      : free_reduced(model, ws, scene, start, rates, options);
+}
+
+}  // namespace bd::core::planar

@@ -1,0 +1,94 @@
+#pragma once
+/// Scenes of a planar linkage: driven inputs at constant speeds (inverse dynamics per sample, no
+/// integrator) and free motion under the loads and the drives' efforts (forward dynamics,
+/// integrated by SUNDIALS with error control, samples from the integrator's dense output).
+///
+/// Free motion has two routes:
+/// - reduced (the default): the ODE in the inputs z and their rates, the other coordinates
+///   solved by Newton at every evaluation (coordinate partitioning: the constraints hold to
+///   round-off, no drift). It stops where the inputs stop being coordinates (a limit position:
+///   the determinant of the constraints and inputs, normalised by its rows, reaches
+///   kLimitDeterminant, found by root finding);
+/// - dae: every node coordinate and its rate, the accelerations and multipliers from the
+///   constraints' saddle-point system with Baumgarte stabilisation, every output sample projected
+///   onto the constraints. It passes through limit positions, as the mechanism does; it stops
+///   only where the constraints themselves lose rank (a lock-up or bifurcation).
+#include <string>
+#include <vector>
+
+#include "core/fourbar/simulate.hpp"
+#include "core/planar/dynamics.hpp"
+#include "core/series.hpp"
+
+namespace bd::core::planar {
+
+/// Inputs driven at constant speeds from `start` (empty: the drawn values), over `revolutions`
+/// turns of the first angle input (`samples` per turn, evenly spaced in time, periodic end
+/// excluded), or, with duration > 0, over [0, duration] (`samples` in all, both ends included).
+struct DrivenScene {
+  std::vector<double> start;   // input values at t = 0 [rad or m]; empty: as drawn
+  std::vector<double> speeds;  // per input [rad/s or m/s]
+  int revolutions = 1;         // with duration == 0
+  double duration = 0;         // [s]; > 0 for a linkage without angle inputs
+  int samples = 360;
+};
+
+/// Free motion from `start` (empty: as drawn) with the inputs' rates `rates` (empty: at rest),
+/// `samples` instants evenly spaced over [0, duration], both ends included.
+struct FreeScene {
+  std::vector<double> start;
+  std::vector<double> rates;  // [rad/s or m/s]
+  double duration{};          // [s], > 0
+  int samples = 501;          // >= 2
+};
+
+enum class Route {
+  kReduced,  // the ODE in the inputs (coordinate partitioning)
+  kDae,      // every coordinate, saddle-point accelerations, Baumgarte, projected samples
+};
+/// "reduced", "dae".
+const char* to_string(Route r);
+
+struct SimulateOptions {
+  Route route = Route::kReduced;
+  Integrator integrator = Integrator::kCvodeAdams;  // any but kIda
+  double tolerance = 1e-10;                         // relative
+  double absolute_tolerance = 1e-12;                // on the coordinates and rates
+  long max_steps = 1000000;
+  double baumgarte = 10.0;  // the dae route's stabilisation rate α = β [1/s]
+};
+
+/// Where the reduced route stops: the determinant of the constraints and inputs divided by the
+/// product of its rows' lengths (1 for orthogonal rows, 0 at a singular position).
+inline constexpr double kLimitDeterminant = 1e-3;
+
+/// The samples, as a table (columns()), and why the run stopped. On failure every sample before
+/// the failure is kept.
+struct Trajectory {
+  Series table;
+  SimulationStatus status = SimulationStatus::kNotRun;
+  std::string message = "simulate was not called";
+  long steps{}, rhs_evaluations{};
+  bool ok() const { return status == SimulationStatus::kCompleted; }
+};
+
+/// The columns of a planar linkage's samples:
+///   t; per link theta_<link>, omega_<link>, alpha_<link> [rad, rad/s, rad/s^2]; per slider
+///   s_<slider>, v_<slider>, a_<slider> [m, m/s, m/s^2] (along its guide); per moving node
+///   x_<node>, y_<node> [m]; per ground node R<node>x, R<node>y and per frame guide
+///   R<slider>x, R<slider>y [N] (forces on the frame); per joint F<joint>x, F<joint>y [N] (on
+///   the joint's link); Fshx, Fshy [N], Msh [N m]; the drives' efforts: tau for a single input,
+///   else tau_<input> [N m or N]; Fshx_inertial, Fshy_inertial [N], Msh_inertial [N m].
+std::vector<std::string> columns(const Model& model);
+/// Appends `in` as a row of those columns.
+void append_row(const Model& model, const Instant& in, Series& table);
+
+/// @throws bd::InputError if the scene or options are invalid (speeds or rates of the wrong
+///         count, samples < 1, no angle input and no duration, ...), or the linkage cannot be
+///         assembled at the start or its inputs do not match its degrees of freedom (the message
+///         says which constraint does not close, or how many inputs the mobility needs).
+Trajectory simulate_driven(const Model& model, const DrivenScene& scene);
+Trajectory simulate_free(const Model& model, const FreeScene& scene,
+                         const SimulateOptions& options = {});
+
+}  // namespace bd::core::planar
