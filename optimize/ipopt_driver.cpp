@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <mutex>
 #include <string>
 
 #pragma GCC diagnostic push
@@ -240,18 +241,9 @@ std::string describe(Ipopt::ApplicationReturnStatus s) {
   return "unknown Ipopt status " + std::to_string(static_cast<int>(s));
 }
 
-}  // namespace
-
-DriverOutcome solve_with_ipopt(const Nlp& nlp, const VectorXd& x0, const OptimizeOptions& options) {
-  DriverOutcome out;
-  out.x = x0;
-  TrackedNlp tracked(nlp, options.constraint_tolerance);
-  Ipopt::SmartPtr<Tnlp> problem =
-      new Tnlp(tracked, x0.cwiseMax(nlp.lower()).cwiseMin(nlp.upper()), options.max_evaluations);
-  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
-
-  // options: silent, quasi-Newton Hessian, our tolerances and budget
-  Ipopt::OptionsList& o = *app->Options();
+// Ipopt's options: silent, quasi-Newton Hessian, our tolerances and budget; false if Ipopt
+// refused one
+bool set_options(Ipopt::OptionsList& o, const OptimizeOptions& options) {
   bool set = true;
   set &= o.SetStringValue("sb", "yes");  // no banner
   set &= o.SetIntegerValue("print_level", 0);
@@ -271,7 +263,24 @@ DriverOutcome solve_with_ipopt(const Nlp& nlp, const VectorXd& x0, const Optimiz
   // Ipopt relaxes every bound, the constraints' included, by 1e-8 by default: far more than
   // the feasibility we report, so the relaxation is kept below it
   set &= o.SetNumericValue("bound_relax_factor", 0.1 * options.constraint_tolerance);
-  if (!set) {
+  return set;
+}
+
+// Ipopt 3.11 (Debian 12) calls MUMPS, which is not thread-safe and has no lock of its own: one
+// Ipopt application at a time in this process, held from its creation to its destruction
+std::mutex ipopt_mutex;
+
+}  // namespace
+
+DriverOutcome solve_with_ipopt(const Nlp& nlp, const VectorXd& x0, const OptimizeOptions& options) {
+  const std::lock_guard<std::mutex> lock(ipopt_mutex);  // outlives the application below
+  DriverOutcome out;
+  out.x = x0;
+  TrackedNlp tracked(nlp, options.constraint_tolerance);
+  Ipopt::SmartPtr<Tnlp> problem =
+      new Tnlp(tracked, x0.cwiseMax(nlp.lower()).cwiseMin(nlp.upper()), options.max_evaluations);
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+  if (!set_options(*app->Options(), options)) {
     out.termination = Termination::kFailed;
     out.message = "Ipopt: an option was refused";
     return out;
