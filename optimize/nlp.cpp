@@ -166,8 +166,8 @@ struct Nlp::Impl {
 // set-up
 
 Nlp::Impl::Impl(const DesignProblem& p) : problem(p) {
-  if (const std::string e = problem.validate(); !e.empty()) {
-    throw InputError("invalid design problem: " + e);
+  if (const Problem e = problem.validate()) {
+    throw InputError("invalid design problem: " + e->text());
   }
   problem.original = core::make_fourbar(problem.original);
   driven = std::holds_alternative<core::DrivenScene>(problem.scene);
@@ -187,8 +187,10 @@ Nlp::Impl::Impl(const DesignProblem& p) : problem(p) {
              : core::simulate_free(problem.original, std::get<core::FreeScene>(problem.scene),
                                    options);
   if (!trajectory.ok()) {
-    throw InputError(std::string("the original design cannot be evaluated in the ") +
-                     (driven ? "driven" : "free") + " scene: " + trajectory.message);
+    throw InputError(FieldError{"", -1,
+                                std::string("the original design cannot be evaluated in the ") +
+                                    (driven ? "driven" : "free") +
+                                    " scene: " + trajectory.message});
   }
   original_metrics = core::metrics(trajectory);
   check_normalisers();
@@ -203,21 +205,22 @@ void Nlp::Impl::check_normalisers() const {
   const core::Metrics& o = original_metrics;
   const double force = std::max({o.RA0_max, o.RA3_max, o.Fsh_max});
   const double moment = std::max({o.tau_max, o.Msh_max, force * problem.original.frame_length});
-  auto check = [&](Metric m, const std::string& where) {
+  auto check = [&](Metric m, const char* list, std::size_t i) {
     if (m == Metric::kAddedMass) return;
     const double v = value(o, m), scale = is_moment(m) ? moment : force;
     if (!(v > 1e-10 * scale)) {
-      throw InputError(where + ": the original design's " + to_string(m) + " is " +
-                       text::digits(v, 6) + " " + metric_unit(m) +
-                       ", too small to normalise by (it is already minimal)");
+      throw InputError(FieldError{list, static_cast<int>(i),
+                                  std::string(": the original design's ") + to_string(m) +
+                                      " is " + text::digits(v, 6) + " " + metric_unit(m) +
+                                      ", too small to normalise by (it is already minimal)"});
     }
   };
   for (std::size_t i = 0; i < problem.objective.size(); ++i) {
     const Term& t = problem.objective[i];
-    if (t.weight > 0) check(t.metric, "objective[" + std::to_string(i) + "]");
+    if (t.weight > 0) check(t.metric, "objective", i);
   }
   for (std::size_t i = 0; i < problem.limits.size(); ++i) {
-    check(problem.limits[i].metric, "limits[" + std::to_string(i) + "]");
+    check(problem.limits[i].metric, "limits", i);
   }
 }
 

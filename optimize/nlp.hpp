@@ -74,11 +74,14 @@ class Nlp {
  public:
   /// Precomputes what the problem needs (the regressor for a driven scene, the original's
   /// metrics for the normalisation).
-  /// @throws bd::InputError if problem.validate() is not empty.
+  /// @throws bd::InputError if problem.validate() finds a problem ("invalid design problem: "
+  /// and its text).
   /// @throws bd::InputError also if the scene cannot be evaluated for the original (a driven
-  /// crank that cannot turn, a failed free simulation), or if the original's value of a metric
-  /// in the objective or a limit is zero (to 1e-10 of the original's reactions), so that it
-  /// cannot normalise.
+  /// crank that cannot turn, a failed free simulation; no field: the problem as a whole), or if
+  /// the original's value of a metric in the objective or a limit is zero (to 1e-10 of the
+  /// original's reactions), so that it cannot normalise: field "objective" or "limits", index
+  /// that of the term or limit, e.g. text() "objective[0]: the original design's Fsh_rms is 0 N,
+  /// too small to normalise by (it is already minimal)".
   explicit Nlp(const DesignProblem& problem);
   ~Nlp();
   Nlp(const Nlp&) = delete;

@@ -10,6 +10,7 @@
 
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
+#include "optimize/check_inputs.hpp"
 #include "optimize/ipopt_driver.hpp"
 #include "optimize/nlopt_driver.hpp"
 #include "optimize/nlp.hpp"
@@ -177,21 +178,46 @@ bool uses_gradients(Algorithm a) {
          a == Algorithm::kMlsl;
 }
 
-std::string OptimizeOptions::validate() const {
+Problem OptimizeOptions::validate() const {
   if (std::find(std::begin(kAlgorithms), std::end(kAlgorithms), algorithm) ==
       std::end(kAlgorithms)) {
-    return "algorithm must be one of slsqp, mma, ipopt, mlsl, isres, cobyla";
+    return FieldError{"algorithm", -1, "must be one of slsqp, mma, ipopt, mlsl, isres, cobyla"};
   }
   if (max_evaluations < 1) {
-    return "max_evaluations must be >= 1, got " + std::to_string(max_evaluations);
+    return FieldError{"max_evaluations", -1,
+                      "must be >= 1, got " + std::to_string(max_evaluations)};
   }
   if (!(std::isfinite(relative_tolerance) && relative_tolerance > 0 && relative_tolerance < 1)) {
-    return "relative_tolerance must be in (0, 1), got " + text::exact(relative_tolerance);
+    return FieldError{"relative_tolerance", -1,
+                      "must be in (0, 1), got " + text::exact(relative_tolerance)};
   }
   if (!(std::isfinite(constraint_tolerance) && constraint_tolerance > 0)) {
-    return "constraint_tolerance must be > 0, got " + text::exact(constraint_tolerance);
+    return FieldError{"constraint_tolerance", -1,
+                      "must be > 0, got " + text::exact(constraint_tolerance)};
   }
-  return "";
+  return std::nullopt;
+}
+
+Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options) {
+  const std::string name = std::string("'") + to_string(options.algorithm) + "'";
+  if (uses_gradients(options.algorithm) && std::holds_alternative<core::FreeScene>(problem.scene)) {
+    return FieldError{"algorithm", -1,
+                      name +
+                          " needs gradients, which a free scene does not provide; use cobyla "
+                          "or isres"};
+  }
+  if (options.algorithm == Algorithm::kMma && problem.force_balance) {
+    return FieldError{"algorithm", -1,
+                      name +
+                          " takes inequality constraints only, and force_balance adds "
+                          "equalities; use slsqp, ipopt, mlsl or cobyla"};
+  }
+  return std::nullopt;
+}
+
+void detail::check_inputs(const DesignProblem& problem, const OptimizeOptions& options) {
+  if (const Problem e = options.validate()) throw InputError("optimize options: " + e->text());
+  if (const Problem e = problem.validate()) throw InputError("design problem: " + e->text());
 }
 
 const char* to_string(Termination t) {
@@ -226,22 +252,9 @@ std::string OptimizeResult::brief_report() const {
 }
 
 OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& options) {
-  if (const std::string e = options.validate(); !e.empty()) {
-    throw InputError("optimize options: " + e);
-  }
-  if (const std::string e = problem.validate(); !e.empty()) {
-    throw InputError("design problem: " + e);
-  }
+  detail::check_inputs(problem, options);
   const Nlp nlp(problem);
-  if (uses_gradients(options.algorithm) && !nlp.has_gradients()) {
-    throw InputError(std::string("algorithm '") + to_string(options.algorithm) +
-                     "' needs gradients, which a free scene does not provide; use cobyla or isres");
-  }
-  if (options.algorithm == Algorithm::kMma && nlp.n_eq() > 0) {
-    throw InputError(
-        "algorithm 'mma' takes inequality constraints only, and force_balance adds equalities; "
-        "use slsqp, ipopt, mlsl or cobyla");
-  }
+  throw_if(check_algorithm(problem, options));
   const VectorXd x0 = nlp.start();
   if (options.check_gradients && nlp.has_gradients()) {
     // a wrong derivative would mislead every gradient method: stop before solving (Ceres)

@@ -14,6 +14,7 @@
 #include "core/metrics.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/simulate.hpp"
+#include "core/input_error.hpp"
 
 namespace bd::optimize {
 
@@ -126,9 +127,20 @@ struct DesignProblem {
   /// min(ε, ε²/(2r)) above r, so the objective is within ε · Σ weights above the exact sum
   /// (optimize/nlp.hpp has the bound on the optimum).
   double smoothing = kDefaultSmoothing;
-  /// Empty when valid, else the problem in words (no variables, bad bounds, no objective, ...),
-  /// e.g. "counterweights[1].link must be 1 (crank) or 3 (rocker), got 2".
-  std::string validate() const;
+  /// Empty when valid, else the first problem; text() says it in words, e.g.
+  /// "counterweights[1].link must be 1 (crank) or 3 (rocker), got 2". Its field:
+  /// - "original" (core's complaint about the design in the message), "scene.omega1" and the
+  ///   scene's other fields, "formulation", "tolerance", "objective_form", "smoothing";
+  /// - no field when there is no design variable; "objective" (no index) when the objective as
+  ///   a whole is wrong (no term, no positive weight);
+  /// - a list field with the element's index when the element is wrong as a whole: a second
+  ///   counterweight on a link ("counterweights", i), a link parameter twice or with bad bounds
+  ///   ("link_parameters", i: "(coupler.mass).lower must be > 0 kg, got 0"), a torque metric in
+  ///   a free scene ("objective" or "limits", i);
+  /// - the path of one field of an element, index -1: "counterweights[i].link" (.mass_max,
+  ///   .distance_max, .shape, .thickness, .density), "link_parameters[i].link" (.parameter),
+  ///   "objective[i].metric" (.weight), "limits[i].metric" (.value).
+  bd::Problem validate() const;
 };
 
 }  // namespace bd::optimize
