@@ -58,6 +58,9 @@
 ///
 /// Evaluations are const; free scenes keep the last simulation in a mutex-guarded cache, so the
 /// objective and the constraints at the same x simulate once.
+///
+/// Nlp holds the program of its problem's scene (optimize/nlp_program.hpp): driven_nlp.cpp
+/// evaluates by the regressor, free_nlp.cpp by simulation, nlp_program.cpp has what both share.
 #include <Eigen/Core>
 #include <memory>
 #include <string>
@@ -69,6 +72,10 @@
 #include "optimize/problem.hpp"
 
 namespace bd::optimize {
+
+namespace detail {
+class NlpProgram;
+}
 
 class Nlp {
  public:
@@ -135,8 +142,10 @@ class Nlp {
   double original(Metric m) const;
 
  private:
-  struct Impl;  // the regressor, the scaled problem data (the implementer may use plain members)
-  std::unique_ptr<Impl> impl_;
+  /// The program, once x has n() entries (else bd::InputError).
+  const detail::NlpProgram& at(const Eigen::VectorXd& x) const;
+
+  std::unique_ptr<detail::NlpProgram> program_;  // the driven or the free scene's
 };
 
 }  // namespace bd::optimize

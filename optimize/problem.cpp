@@ -29,33 +29,6 @@ FieldError at(const char* list, std::size_t i, std::string message) {
   return {list, static_cast<int>(i), std::move(message)};
 }
 
-const char* parameter_name(LinkParameterVariable::Parameter p) {
-  switch (p) {
-    case LinkParameterVariable::Parameter::kMass:
-      return "mass";
-    case LinkParameterVariable::Parameter::kE:
-      return "e";
-    case LinkParameterVariable::Parameter::kF:
-      return "f";
-    case LinkParameterVariable::Parameter::kInertia:
-      return "inertia";
-  }
-  return "?";
-}
-
-const char* parameter_unit(LinkParameterVariable::Parameter p) {
-  switch (p) {
-    case LinkParameterVariable::Parameter::kMass:
-      return "kg";
-    case LinkParameterVariable::Parameter::kE:
-    case LinkParameterVariable::Parameter::kF:
-      return "m";
-    case LinkParameterVariable::Parameter::kInertia:
-      return "kg m^2";
-  }
-  return "";
-}
-
 Problem check_scene(const core::FreeScene& s) {
   if (!(std::isfinite(s.duration) && s.duration > 0)) {
     return must_be("scene.duration", "> 0", "s", s.duration);
@@ -101,6 +74,33 @@ double value(const core::Metrics& metrics, Metric m) { return metrics.*info(m).f
 
 bool is_peak(Metric m) {
   return m != Metric::kAddedMass && info(m).statistic == core::Statistic::kMax;
+}
+
+const char* parameter_name(LinkParameterVariable::Parameter p) {
+  switch (p) {
+    case LinkParameterVariable::Parameter::kMass:
+      return "mass";
+    case LinkParameterVariable::Parameter::kE:
+      return "e";
+    case LinkParameterVariable::Parameter::kF:
+      return "f";
+    case LinkParameterVariable::Parameter::kInertia:
+      return "inertia";
+  }
+  return "?";
+}
+
+const char* parameter_unit(LinkParameterVariable::Parameter p) {
+  switch (p) {
+    case LinkParameterVariable::Parameter::kMass:
+      return "kg";
+    case LinkParameterVariable::Parameter::kE:
+    case LinkParameterVariable::Parameter::kF:
+      return "m";
+    case LinkParameterVariable::Parameter::kInertia:
+      return "kg m^2";
+  }
+  return "";
 }
 
 const char* to_string(ObjectiveForm f) {

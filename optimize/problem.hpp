@@ -109,6 +109,10 @@ struct LinkParameterVariable {
   enum class Parameter { kMass, kE, kF, kInertia } parameter = Parameter::kMass;
   double lower{}, upper{};  // [kg], [m], [m], [kg m^2]; mass lower > 0, inertia lower >= 0
 };
+/// "mass", "e", "f", "inertia".
+const char* parameter_name(LinkParameterVariable::Parameter p);
+/// "kg", "m", "m", "kg m^2".
+const char* parameter_unit(LinkParameterVariable::Parameter p);
 
 /// What to optimise, on which design, in which scene.
 struct DesignProblem {
