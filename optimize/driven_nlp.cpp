@@ -363,7 +363,7 @@ void DrivenNlp::bound_peaks() {
     // [-t_max, t_max]. With a lower bound at 0 (or δ), SLSQP's quadratic subproblems put t on
     // that bound at infeasible iterates, twice running at the same objective, and NLopt's
     // SLSQP then stops on ftol_rel (it tests f at every iterate once any feasible point was
-    // seen): measured on min Fsh_max, stopped after 12 evaluations at 0.35 x the original.
+    // seen), far from the optimum (docs/performance.md, "The objective's form").
     if (linear_) lower_(t) = -upper_(t);
   }
 }

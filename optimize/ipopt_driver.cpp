@@ -248,10 +248,9 @@ bool set_options(Ipopt::OptionsList& o, const OptimizeOptions& options) {
   set &= o.SetStringValue("sb", "yes");  // no banner
   set &= o.SetIntegerValue("print_level", 0);
   set &= o.SetStringValue("hessian_approximation", "limited-memory");
-  // the L-BFGS start sigma = y'y / s'y rather than s'y / s's: over the problems measured in
-  // docs/performance.md ("The objective's form") 7x (linear objective) and 13x (squared) fewer
-  // evaluations in all, most where the curvature varies most (a metric approaching 0 at the
-  // optimum), at most 2x more on one problem
+  // the L-BFGS start sigma = y'y / s'y rather than s'y / s's: far fewer evaluations where the
+  // curvature varies most (a metric approaching 0 at the optimum), a few more on some problems
+  // (docs/performance.md, "The objective's form")
   set &= o.SetStringValue("limited_memory_initialization", "scalar2");
   set &= o.SetNumericValue("tol", options.relative_tolerance);
   set &= o.SetNumericValue("constr_viol_tol", 0.1 * options.constraint_tolerance);

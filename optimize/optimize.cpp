@@ -251,6 +251,69 @@ std::string OptimizeResult::brief_report() const {
   return s;
 }
 
+namespace {
+
+// The result at x0 when the gradient check failed (`message`): not solved, not verified.
+OptimizeResult gradient_check_failed(const Nlp& nlp, const VectorXd& x0,
+                                     const OptimizeOptions& options, std::string message) {
+  OptimizeResult r;
+  r.algorithm = options.algorithm;
+  r.termination = Termination::kFailed;
+  r.message = std::move(message);
+  r.x = x0;
+  r.objective = nlp.objective(x0, nullptr);
+  r.constraint_violation = detail::constraint_violation(nlp, x0);
+  r.design = nlp.design(x0);
+  r.counterweights = nlp.counterweights(x0);
+  r.metrics = nlp.metrics(x0);
+  r.verification_error = std::numeric_limits<double>::quiet_NaN();  // not verified
+  return r;
+}
+
+// The feasibility of the point returned, whatever the solver said: r.constraint_violation, and
+// the termination and message when they disagree with it (`solver` is the solver's message).
+void check_feasibility(const Nlp& nlp, const OptimizeOptions& options, const std::string& solver,
+                       OptimizeResult& r) {
+  int worst = -1;
+  double worst_value = 0.0;
+  r.constraint_violation = detail::constraint_violation(nlp, r.x, &worst, &worst_value);
+  if (r.constraint_violation > options.constraint_tolerance) {
+    const std::string& name = nlp.constraint_names()[static_cast<size_t>(worst)];
+    const bool equality = worst < nlp.n_eq();
+    r.termination = Termination::kInfeasible;
+    r.message = "no feasible design found: the binding constraint is '" + name + "' at " +
+                text::digits(worst_value, 6) + (equality ? " (must be 0" : " (must be <= 0") +
+                ", tolerance " + text::digits(options.constraint_tolerance, 2) + ") [" + solver +
+                "]";
+  } else if (r.termination == Termination::kInfeasible) {
+    // the solver gave up on feasibility yet stopped at a feasible point: say so plainly
+    r.termination = Termination::kFailed;
+    r.message += " (the point returned is feasible)";
+  }
+}
+
+// The optimum re-simulated with another formulation, compared metric by metric.
+void verify(const DesignProblem& problem, OptimizeResult& r) {
+  core::SimulateOptions simulate;
+  simulate.formulation = other_than(problem.formulation);
+  simulate.tolerance = problem.tolerance;
+  r.verified_with = simulate.formulation;
+  const core::Trajectory trajectory =
+      std::holds_alternative<core::DrivenScene>(problem.scene)
+          ? core::simulate_driven(r.design, std::get<core::DrivenScene>(problem.scene), simulate)
+          : core::simulate_free(r.design, std::get<core::FreeScene>(problem.scene), simulate);
+  if (!trajectory.ok()) {
+    r.verification_error = std::numeric_limits<double>::infinity();
+    r.message += "; verification by " + std::string(core::to_string(simulate.formulation)) +
+                 " failed: " + trajectory.message;
+    return;
+  }
+  r.verified = core::metrics(trajectory);
+  r.verification_error = verification_error(r.metrics, r.verified, r.design.frame_length);
+}
+
+}  // namespace
+
 OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& options) {
   detail::check_inputs(problem, options);
   const Nlp nlp(problem);
@@ -259,18 +322,7 @@ OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& opt
   if (options.check_gradients && nlp.has_gradients()) {
     // a wrong derivative would mislead every gradient method: stop before solving (Ceres)
     if (std::string e = check_gradients(nlp, x0); !e.empty()) {
-      OptimizeResult r;
-      r.algorithm = options.algorithm;
-      r.termination = Termination::kFailed;
-      r.message = std::move(e);
-      r.x = x0;
-      r.objective = nlp.objective(x0, nullptr);
-      r.constraint_violation = detail::constraint_violation(nlp, x0);
-      r.design = nlp.design(x0);
-      r.counterweights = nlp.counterweights(x0);
-      r.metrics = nlp.metrics(x0);
-      r.verification_error = std::numeric_limits<double>::quiet_NaN();  // not verified
-      return r;
+      return gradient_check_failed(nlp, x0, options, std::move(e));
     }
   }
 
@@ -290,47 +342,13 @@ OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& opt
   r.evaluations = outcome.evaluations;
   r.seconds = std::chrono::duration<double>(stopped - started).count();
   r.objective = nlp.objective(r.x, nullptr);
+  check_feasibility(nlp, options, outcome.message, r);
 
-  // feasibility of the point returned, whatever the solver said
-  int worst = -1;
-  double worst_value = 0.0;
-  r.constraint_violation = detail::constraint_violation(nlp, r.x, &worst, &worst_value);
-  if (r.constraint_violation > options.constraint_tolerance) {
-    const std::string& name = nlp.constraint_names()[static_cast<size_t>(worst)];
-    const bool equality = worst < nlp.n_eq();
-    r.termination = Termination::kInfeasible;
-    r.message = "no feasible design found: the binding constraint is '" + name + "' at " +
-                text::digits(worst_value, 6) + (equality ? " (must be 0" : " (must be <= 0") +
-                ", tolerance " + text::digits(options.constraint_tolerance, 2) + ") [" +
-                outcome.message + "]";
-  } else if (r.termination == Termination::kInfeasible) {
-    // the solver gave up on feasibility yet stopped at a feasible point: say so plainly
-    r.termination = Termination::kFailed;
-    r.message += " (the point returned is feasible)";
-  }
-
-  // the optimum as a design, as the optimiser evaluated it
+  // the optimum as a design, as the optimiser evaluated it, then verified
   r.design = nlp.design(r.x);
   r.counterweights = nlp.counterweights(r.x);
   r.metrics = nlp.metrics(r.x);
-
-  // verification: re-simulated with another formulation, compared metric by metric
-  core::SimulateOptions simulate;
-  simulate.formulation = other_than(problem.formulation);
-  simulate.tolerance = problem.tolerance;
-  r.verified_with = simulate.formulation;
-  const core::Trajectory trajectory =
-      std::holds_alternative<core::DrivenScene>(problem.scene)
-          ? core::simulate_driven(r.design, std::get<core::DrivenScene>(problem.scene), simulate)
-          : core::simulate_free(r.design, std::get<core::FreeScene>(problem.scene), simulate);
-  if (!trajectory.ok()) {
-    r.verification_error = std::numeric_limits<double>::infinity();
-    r.message += "; verification by " + std::string(core::to_string(simulate.formulation)) +
-                 " failed: " + trajectory.message;
-    return r;
-  }
-  r.verified = core::metrics(trajectory);
-  r.verification_error = verification_error(r.metrics, r.verified, r.design.frame_length);
+  verify(problem, r);
   return r;
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 /// The optimisation problem: design variables on a four-bar, an objective and constraints built
-/// from the metrics of its simulated reactions (DESIGN.md "optimize"). Solver-agnostic: NLopt and
-/// Ipopt stay behind optimize() (optimize/optimize.hpp).
+/// from the metrics of its simulated reactions. Solver-agnostic: NLopt and Ipopt stay behind
+/// optimize() (optimize/optimize.hpp).
 #include <cstddef>
 #include <limits>
 #include <optional>
@@ -71,8 +71,8 @@ std::optional<ObjectiveForm> objective_form_named(const std::string& name);
 /// The default smoothing ε of the linear form's magnitudes (DesignProblem::smoothing), chosen
 /// from measurements (docs/performance.md, "The objective's form"): every gradient solver
 /// converges on optima where a metric vanishes, and the objective is within 1e-6 per unit of
-/// weight of the exact sum. At 1e-9 Ipopt runs out of budget on a vanishing peak, at 1e-12 on
-/// a vanishing RMS too.
+/// weight of the exact sum. With much smaller values Ipopt runs out of its budget where a metric
+/// vanishes.
 inline constexpr double kDefaultSmoothing = 1e-6;
 
 /// One term of the objective: weight · metric(design) / metric(original) for the reaction
