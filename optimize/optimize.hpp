@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "balance/counterweight.hpp"
-#include "core/input_error.hpp"
 #include "core/metrics.hpp"
 #include "optimize/problem.hpp"
 
