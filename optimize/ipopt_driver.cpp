@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <mutex>
 #include <string>
 
 #pragma GCC diagnostic push
@@ -240,26 +241,16 @@ std::string describe(Ipopt::ApplicationReturnStatus s) {
   return "unknown Ipopt status " + std::to_string(static_cast<int>(s));
 }
 
-}  // namespace
-
-DriverOutcome solve_with_ipopt(const Nlp& nlp, const VectorXd& x0, const OptimizeOptions& options) {
-  DriverOutcome out;
-  out.x = x0;
-  TrackedNlp tracked(nlp, options.constraint_tolerance);
-  Ipopt::SmartPtr<Tnlp> problem =
-      new Tnlp(tracked, x0.cwiseMax(nlp.lower()).cwiseMin(nlp.upper()), options.max_evaluations);
-  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
-
-  // options: silent, quasi-Newton Hessian, our tolerances and budget
-  Ipopt::OptionsList& o = *app->Options();
+// Ipopt's options: silent, quasi-Newton Hessian, our tolerances and budget; false if Ipopt
+// refused one
+bool set_options(Ipopt::OptionsList& o, const OptimizeOptions& options) {
   bool set = true;
   set &= o.SetStringValue("sb", "yes");  // no banner
   set &= o.SetIntegerValue("print_level", 0);
   set &= o.SetStringValue("hessian_approximation", "limited-memory");
-  // the L-BFGS start sigma = y'y / s'y rather than s'y / s's: over the problems measured in
-  // docs/performance.md ("The objective's form") 7x (linear objective) and 13x (squared) fewer
-  // evaluations in all, most where the curvature varies most (a metric approaching 0 at the
-  // optimum), at most 2x more on one problem
+  // the L-BFGS start sigma = y'y / s'y rather than s'y / s's: far fewer evaluations where the
+  // curvature varies most (a metric approaching 0 at the optimum), a few more on some problems
+  // (docs/performance.md, "The objective's form")
   set &= o.SetStringValue("limited_memory_initialization", "scalar2");
   set &= o.SetNumericValue("tol", options.relative_tolerance);
   set &= o.SetNumericValue("constr_viol_tol", 0.1 * options.constraint_tolerance);
@@ -271,7 +262,24 @@ DriverOutcome solve_with_ipopt(const Nlp& nlp, const VectorXd& x0, const Optimiz
   // Ipopt relaxes every bound, the constraints' included, by 1e-8 by default: far more than
   // the feasibility we report, so the relaxation is kept below it
   set &= o.SetNumericValue("bound_relax_factor", 0.1 * options.constraint_tolerance);
-  if (!set) {
+  return set;
+}
+
+// Ipopt 3.11 (Debian 12) calls MUMPS, which is not thread-safe and has no lock of its own: one
+// Ipopt application at a time in this process, held from its creation to its destruction
+std::mutex ipopt_mutex;
+
+}  // namespace
+
+DriverOutcome solve_with_ipopt(const Nlp& nlp, const VectorXd& x0, const OptimizeOptions& options) {
+  const std::lock_guard<std::mutex> lock(ipopt_mutex);  // outlives the application below
+  DriverOutcome out;
+  out.x = x0;
+  TrackedNlp tracked(nlp, options.constraint_tolerance);
+  Ipopt::SmartPtr<Tnlp> problem =
+      new Tnlp(tracked, x0.cwiseMax(nlp.lower()).cwiseMin(nlp.upper()), options.max_evaluations);
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+  if (!set_options(*app->Options(), options)) {
     out.termination = Termination::kFailed;
     out.message = "Ipopt: an option was refused";
     return out;

@@ -14,6 +14,8 @@ namespace bd::optimize::detail {
 /// the Lagrangian. tol = options.relative_tolerance, constr_viol_tol =
 /// 0.1 · options.constraint_tolerance, max_iter = options.max_evaluations, and the run is stopped
 /// once options.max_evaluations objective evaluations are spent. Nothing is printed.
+/// Thread-safe: solves from several threads run one at a time (Debian 12's Ipopt 3.11 calls
+/// MUMPS, which is not thread-safe).
 DriverOutcome solve_with_ipopt(const Nlp& nlp, const Eigen::VectorXd& x0,
                                const OptimizeOptions& options);
 

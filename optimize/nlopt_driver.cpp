@@ -295,10 +295,9 @@ Run run_nlopt(nlopt_algorithm algorithm, bool mma, TrackedNlp& tracked, const Ve
   check(nlopt_set_maxeval(ctx.opt, std::max(1, max_evaluations)));
   // MMA solves a dual subproblem per iteration, one multiplier per inequality, by default to
   // ftol_rel 1e-14 within as many steps as the outer budget (up to 100 000). With a peak term
-  // (one inequality per sample, nearly dependent) that dual never gets there, and a run on the
-  // 72-sample min Fsh_max took from 22 s to over 10 minutes for ~60 evaluations; capped at
-  // 1000 steps it takes 0.4 s, and the runs whose duals converge are unchanged (measured,
-  // docs/performance.md)
+  // (one inequality per sample, nearly dependent) that dual never gets there and a run takes
+  // orders of magnitude longer; capped at 1000 steps, the runs whose duals converge are
+  // unchanged (docs/performance.md, "MMA with a peak term")
   if (mma) check(nlopt_set_param(ctx.opt, "dual_maxeval", 1000));
   if (stop_on_tolerances) {
     check(nlopt_set_xtol_rel(ctx.opt, options.relative_tolerance));

@@ -72,8 +72,7 @@ double constraint_violation(const Nlp& nlp, const Eigen::VectorXd& x, int* worst
 ///   NLopt's SLSQP tests ftol_rel and xtol_rel at every iterate, feasible or not, once any
 ///   feasible point has been seen, and then returns the best feasible point it visited: when
 ///   the iterates approach the constraints from outside it can stop next to the optimum yet
-///   return a point far from it (measured: min Fsh_max with smoothing 1e-3 returned 0.35 x the
-///   original while its last iterate was at 1e-3 x, violating a constraint by 8e-9). So an
+///   return a point far from it (docs/performance.md, "The objective's form"). So an
 ///   SLSQP run that stops on a tolerance with a last iterate better than the point returned is
 ///   restarted from that iterate, up to three times within the budget (mlsl's runs too).
 /// - mma: LD_MMA takes inequalities only (optimize() refuses equalities: as pairs ±c <= δ they

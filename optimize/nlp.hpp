@@ -58,6 +58,9 @@
 ///
 /// Evaluations are const; free scenes keep the last simulation in a mutex-guarded cache, so the
 /// objective and the constraints at the same x simulate once.
+///
+/// Nlp holds the program of its problem's scene (optimize/nlp_program.hpp): driven_nlp.cpp
+/// evaluates by the regressor, free_nlp.cpp by simulation, nlp_program.cpp has what both share.
 #include <Eigen/Core>
 #include <memory>
 #include <string>
@@ -70,15 +73,22 @@
 
 namespace bd::optimize {
 
+namespace detail {
+class NlpProgram;
+}
+
 class Nlp {
  public:
   /// Precomputes what the problem needs (the regressor for a driven scene, the original's
   /// metrics for the normalisation).
-  /// @throws bd::InputError if problem.validate() is not empty.
+  /// @throws bd::InputError if problem.validate() finds a problem ("invalid design problem: "
+  /// and its text).
   /// @throws bd::InputError also if the scene cannot be evaluated for the original (a driven
-  /// crank that cannot turn, a failed free simulation), or if the original's value of a metric
-  /// in the objective or a limit is zero (to 1e-10 of the original's reactions), so that it
-  /// cannot normalise.
+  /// crank that cannot turn, a failed free simulation; no field: the problem as a whole), or if
+  /// the original's value of a metric in the objective or a limit is zero (to 1e-10 of the
+  /// original's reactions), so that it cannot normalise: field "objective" or "limits", index
+  /// that of the term or limit, e.g. text() "objective[0]: the original design's Fsh_rms is 0 N,
+  /// too small to normalise by (it is already minimal)".
   explicit Nlp(const DesignProblem& problem);
   ~Nlp();
   Nlp(const Nlp&) = delete;
@@ -132,8 +142,10 @@ class Nlp {
   double original(Metric m) const;
 
  private:
-  struct Impl;  // the regressor, the scaled problem data (the implementer may use plain members)
-  std::unique_ptr<Impl> impl_;
+  /// The program, once x has n() entries (else bd::InputError).
+  const detail::NlpProgram& at(const Eigen::VectorXd& x) const;
+
+  std::unique_ptr<detail::NlpProgram> program_;  // the driven or the free scene's
 };
 
 }  // namespace bd::optimize

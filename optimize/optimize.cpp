@@ -10,6 +10,7 @@
 
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
+#include "optimize/check_inputs.hpp"
 #include "optimize/ipopt_driver.hpp"
 #include "optimize/nlopt_driver.hpp"
 #include "optimize/nlp.hpp"
@@ -177,21 +178,46 @@ bool uses_gradients(Algorithm a) {
          a == Algorithm::kMlsl;
 }
 
-std::string OptimizeOptions::validate() const {
+Problem OptimizeOptions::validate() const {
   if (std::find(std::begin(kAlgorithms), std::end(kAlgorithms), algorithm) ==
       std::end(kAlgorithms)) {
-    return "algorithm must be one of slsqp, mma, ipopt, mlsl, isres, cobyla";
+    return FieldError{"algorithm", -1, "must be one of slsqp, mma, ipopt, mlsl, isres, cobyla"};
   }
   if (max_evaluations < 1) {
-    return "max_evaluations must be >= 1, got " + std::to_string(max_evaluations);
+    return FieldError{"max_evaluations", -1,
+                      "must be >= 1, got " + std::to_string(max_evaluations)};
   }
   if (!(std::isfinite(relative_tolerance) && relative_tolerance > 0 && relative_tolerance < 1)) {
-    return "relative_tolerance must be in (0, 1), got " + text::exact(relative_tolerance);
+    return FieldError{"relative_tolerance", -1,
+                      "must be in (0, 1), got " + text::exact(relative_tolerance)};
   }
   if (!(std::isfinite(constraint_tolerance) && constraint_tolerance > 0)) {
-    return "constraint_tolerance must be > 0, got " + text::exact(constraint_tolerance);
+    return FieldError{"constraint_tolerance", -1,
+                      "must be > 0, got " + text::exact(constraint_tolerance)};
   }
-  return "";
+  return std::nullopt;
+}
+
+Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options) {
+  const std::string name = std::string("'") + to_string(options.algorithm) + "'";
+  if (uses_gradients(options.algorithm) && std::holds_alternative<core::FreeScene>(problem.scene)) {
+    return FieldError{"algorithm", -1,
+                      name +
+                          " needs gradients, which a free scene does not provide; use cobyla "
+                          "or isres"};
+  }
+  if (options.algorithm == Algorithm::kMma && problem.force_balance) {
+    return FieldError{"algorithm", -1,
+                      name +
+                          " takes inequality constraints only, and force_balance adds "
+                          "equalities; use slsqp, ipopt, mlsl or cobyla"};
+  }
+  return std::nullopt;
+}
+
+void detail::check_inputs(const DesignProblem& problem, const OptimizeOptions& options) {
+  if (const Problem e = options.validate()) throw InputError("optimize options: " + e->text());
+  if (const Problem e = problem.validate()) throw InputError("design problem: " + e->text());
 }
 
 const char* to_string(Termination t) {
@@ -225,39 +251,78 @@ std::string OptimizeResult::brief_report() const {
   return s;
 }
 
+namespace {
+
+// The result at x0 when the gradient check failed (`message`): not solved, not verified.
+OptimizeResult gradient_check_failed(const Nlp& nlp, const VectorXd& x0,
+                                     const OptimizeOptions& options, std::string message) {
+  OptimizeResult r;
+  r.algorithm = options.algorithm;
+  r.termination = Termination::kFailed;
+  r.message = std::move(message);
+  r.x = x0;
+  r.objective = nlp.objective(x0, nullptr);
+  r.constraint_violation = detail::constraint_violation(nlp, x0);
+  r.design = nlp.design(x0);
+  r.counterweights = nlp.counterweights(x0);
+  r.metrics = nlp.metrics(x0);
+  r.verification_error = std::numeric_limits<double>::quiet_NaN();  // not verified
+  return r;
+}
+
+// The feasibility of the point returned, whatever the solver said: r.constraint_violation, and
+// the termination and message when they disagree with it (`solver` is the solver's message).
+void check_feasibility(const Nlp& nlp, const OptimizeOptions& options, const std::string& solver,
+                       OptimizeResult& r) {
+  int worst = -1;
+  double worst_value = 0.0;
+  r.constraint_violation = detail::constraint_violation(nlp, r.x, &worst, &worst_value);
+  if (r.constraint_violation > options.constraint_tolerance) {
+    const std::string& name = nlp.constraint_names()[static_cast<size_t>(worst)];
+    const bool equality = worst < nlp.n_eq();
+    r.termination = Termination::kInfeasible;
+    r.message = "no feasible design found: the binding constraint is '" + name + "' at " +
+                text::digits(worst_value, 6) + (equality ? " (must be 0" : " (must be <= 0") +
+                ", tolerance " + text::digits(options.constraint_tolerance, 2) + ") [" + solver +
+                "]";
+  } else if (r.termination == Termination::kInfeasible) {
+    // the solver gave up on feasibility yet stopped at a feasible point: say so plainly
+    r.termination = Termination::kFailed;
+    r.message += " (the point returned is feasible)";
+  }
+}
+
+// The optimum re-simulated with another formulation, compared metric by metric.
+void verify(const DesignProblem& problem, OptimizeResult& r) {
+  core::SimulateOptions simulate;
+  simulate.formulation = other_than(problem.formulation);
+  simulate.tolerance = problem.tolerance;
+  r.verified_with = simulate.formulation;
+  const core::Trajectory trajectory =
+      std::holds_alternative<core::DrivenScene>(problem.scene)
+          ? core::simulate_driven(r.design, std::get<core::DrivenScene>(problem.scene), simulate)
+          : core::simulate_free(r.design, std::get<core::FreeScene>(problem.scene), simulate);
+  if (!trajectory.ok()) {
+    r.verification_error = std::numeric_limits<double>::infinity();
+    r.message += "; verification by " + std::string(core::to_string(simulate.formulation)) +
+                 " failed: " + trajectory.message;
+    return;
+  }
+  r.verified = core::metrics(trajectory);
+  r.verification_error = verification_error(r.metrics, r.verified, r.design.frame_length);
+}
+
+}  // namespace
+
 OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& options) {
-  if (const std::string e = options.validate(); !e.empty()) {
-    throw InputError("optimize options: " + e);
-  }
-  if (const std::string e = problem.validate(); !e.empty()) {
-    throw InputError("design problem: " + e);
-  }
+  detail::check_inputs(problem, options);
   const Nlp nlp(problem);
-  if (uses_gradients(options.algorithm) && !nlp.has_gradients()) {
-    throw InputError(std::string("algorithm '") + to_string(options.algorithm) +
-                     "' needs gradients, which a free scene does not provide; use cobyla or isres");
-  }
-  if (options.algorithm == Algorithm::kMma && nlp.n_eq() > 0) {
-    throw InputError(
-        "algorithm 'mma' takes inequality constraints only, and force_balance adds equalities; "
-        "use slsqp, ipopt, mlsl or cobyla");
-  }
+  throw_if(check_algorithm(problem, options));
   const VectorXd x0 = nlp.start();
   if (options.check_gradients && nlp.has_gradients()) {
     // a wrong derivative would mislead every gradient method: stop before solving (Ceres)
     if (std::string e = check_gradients(nlp, x0); !e.empty()) {
-      OptimizeResult r;
-      r.algorithm = options.algorithm;
-      r.termination = Termination::kFailed;
-      r.message = std::move(e);
-      r.x = x0;
-      r.objective = nlp.objective(x0, nullptr);
-      r.constraint_violation = detail::constraint_violation(nlp, x0);
-      r.design = nlp.design(x0);
-      r.counterweights = nlp.counterweights(x0);
-      r.metrics = nlp.metrics(x0);
-      r.verification_error = std::numeric_limits<double>::quiet_NaN();  // not verified
-      return r;
+      return gradient_check_failed(nlp, x0, options, std::move(e));
     }
   }
 
@@ -277,47 +342,13 @@ OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& opt
   r.evaluations = outcome.evaluations;
   r.seconds = std::chrono::duration<double>(stopped - started).count();
   r.objective = nlp.objective(r.x, nullptr);
+  check_feasibility(nlp, options, outcome.message, r);
 
-  // feasibility of the point returned, whatever the solver said
-  int worst = -1;
-  double worst_value = 0.0;
-  r.constraint_violation = detail::constraint_violation(nlp, r.x, &worst, &worst_value);
-  if (r.constraint_violation > options.constraint_tolerance) {
-    const std::string& name = nlp.constraint_names()[static_cast<size_t>(worst)];
-    const bool equality = worst < nlp.n_eq();
-    r.termination = Termination::kInfeasible;
-    r.message = "no feasible design found: the binding constraint is '" + name + "' at " +
-                text::digits(worst_value, 6) + (equality ? " (must be 0" : " (must be <= 0") +
-                ", tolerance " + text::digits(options.constraint_tolerance, 2) + ") [" +
-                outcome.message + "]";
-  } else if (r.termination == Termination::kInfeasible) {
-    // the solver gave up on feasibility yet stopped at a feasible point: say so plainly
-    r.termination = Termination::kFailed;
-    r.message += " (the point returned is feasible)";
-  }
-
-  // the optimum as a design, as the optimiser evaluated it
+  // the optimum as a design, as the optimiser evaluated it, then verified
   r.design = nlp.design(r.x);
   r.counterweights = nlp.counterweights(r.x);
   r.metrics = nlp.metrics(r.x);
-
-  // verification: re-simulated with another formulation, compared metric by metric
-  core::SimulateOptions simulate;
-  simulate.formulation = other_than(problem.formulation);
-  simulate.tolerance = problem.tolerance;
-  r.verified_with = simulate.formulation;
-  const core::Trajectory trajectory =
-      std::holds_alternative<core::DrivenScene>(problem.scene)
-          ? core::simulate_driven(r.design, std::get<core::DrivenScene>(problem.scene), simulate)
-          : core::simulate_free(r.design, std::get<core::FreeScene>(problem.scene), simulate);
-  if (!trajectory.ok()) {
-    r.verification_error = std::numeric_limits<double>::infinity();
-    r.message += "; verification by " + std::string(core::to_string(simulate.formulation)) +
-                 " failed: " + trajectory.message;
-    return r;
-  }
-  r.verified = core::metrics(trajectory);
-  r.verification_error = verification_error(r.metrics, r.verified, r.design.frame_length);
+  verify(problem, r);
   return r;
 }
 

@@ -33,8 +33,18 @@ struct OptimizeOptions {
   double constraint_tolerance = 1e-9;  // feasibility of the reported optimum (scaled)
   bool check_gradients = false;        // compare analytic gradients with central differences first
   unsigned seed = 1;                   // global methods
-  std::string validate() const;
+  /// Empty when valid, else the first problem, its field one of "algorithm",
+  /// "max_evaluations", "relative_tolerance", "constraint_tolerance"; e.g. text()
+  /// "max_evaluations must be >= 1, got 0".
+  bd::Problem validate() const;
 };
+
+/// Whether options.algorithm can solve the problem at all, decided without solving anything:
+/// a gradient method (uses_gradients()) in a free scene, whose evaluations are simulations
+/// without derivatives, or mma with force_balance (equalities, which mma does not take), is a
+/// problem with field "algorithm", e.g. text() "algorithm 'slsqp' needs gradients, which a free
+/// scene does not provide; use cobyla or isres". optimize() refuses what this refuses.
+bd::Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options);
 
 enum class Termination {
   kNotRun,
@@ -75,7 +85,8 @@ struct OptimizeResult {
 
 /// Solves the problem from its natural start (every variable at its value in the original
 /// design, or mid-range where the original has none).
-/// @throws bd::InputError if the problem or the options are invalid.
+/// @throws bd::InputError if the problem or the options are invalid (validate()), if the problem
+/// cannot be set up (Nlp's constructor), or if check_algorithm() finds a problem.
 OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& options);
 
 /// The ε-constraint trade-off between two metrics: minimise `first` subject to

@@ -6,6 +6,7 @@
 
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
+#include "optimize/check_inputs.hpp"
 #include "optimize/nlp.hpp"
 #include "optimize/optimize.hpp"
 
@@ -40,12 +41,7 @@ std::vector<ParetoPoint> pareto_front(const DesignProblem& problem, Metric first
     throw InputError(std::string("pareto_front: the two metrics must differ, got ") +
                      to_string(first) + " twice");
   }
-  if (const std::string e = options.validate(); !e.empty()) {
-    throw InputError("optimize options: " + e);
-  }
-  if (const std::string e = problem.validate(); !e.empty()) {
-    throw InputError("design problem: " + e);
-  }
+  detail::check_inputs(problem, options);
   const Nlp nlp(problem);  // the original's metrics: the normalisers of the bounds
   if (second != Metric::kAddedMass && !(nlp.original(second) > 0)) {
     throw InputError(std::string("pareto_front: ") + to_string(second) +

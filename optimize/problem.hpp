@@ -1,7 +1,7 @@
 #pragma once
 /// The optimisation problem: design variables on a four-bar, an objective and constraints built
-/// from the metrics of its simulated reactions (DESIGN.md "optimize"). Solver-agnostic: NLopt and
-/// Ipopt stay behind optimize() (optimize/optimize.hpp).
+/// from the metrics of its simulated reactions. Solver-agnostic: NLopt and Ipopt stay behind
+/// optimize() (optimize/optimize.hpp).
 #include <cstddef>
 #include <limits>
 #include <optional>
@@ -14,6 +14,7 @@
 #include "core/metrics.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/simulate.hpp"
+#include "core/input_error.hpp"
 
 namespace bd::optimize {
 
@@ -70,8 +71,8 @@ std::optional<ObjectiveForm> objective_form_named(const std::string& name);
 /// The default smoothing ε of the linear form's magnitudes (DesignProblem::smoothing), chosen
 /// from measurements (docs/performance.md, "The objective's form"): every gradient solver
 /// converges on optima where a metric vanishes, and the objective is within 1e-6 per unit of
-/// weight of the exact sum. At 1e-9 Ipopt runs out of budget on a vanishing peak, at 1e-12 on
-/// a vanishing RMS too.
+/// weight of the exact sum. With much smaller values Ipopt runs out of its budget where a metric
+/// vanishes.
 inline constexpr double kDefaultSmoothing = 1e-6;
 
 /// One term of the objective: weight · metric(design) / metric(original) for the reaction
@@ -108,6 +109,10 @@ struct LinkParameterVariable {
   enum class Parameter { kMass, kE, kF, kInertia } parameter = Parameter::kMass;
   double lower{}, upper{};  // [kg], [m], [m], [kg m^2]; mass lower > 0, inertia lower >= 0
 };
+/// "mass", "e", "f", "inertia".
+const char* parameter_name(LinkParameterVariable::Parameter p);
+/// "kg", "m", "m", "kg m^2".
+const char* parameter_unit(LinkParameterVariable::Parameter p);
 
 /// What to optimise, on which design, in which scene.
 struct DesignProblem {
@@ -126,9 +131,20 @@ struct DesignProblem {
   /// min(ε, ε²/(2r)) above r, so the objective is within ε · Σ weights above the exact sum
   /// (optimize/nlp.hpp has the bound on the optimum).
   double smoothing = kDefaultSmoothing;
-  /// Empty when valid, else the problem in words (no variables, bad bounds, no objective, ...),
-  /// e.g. "counterweights[1].link must be 1 (crank) or 3 (rocker), got 2".
-  std::string validate() const;
+  /// Empty when valid, else the first problem; text() says it in words, e.g.
+  /// "counterweights[1].link must be 1 (crank) or 3 (rocker), got 2". Its field:
+  /// - "original" (core's complaint about the design in the message), "scene.omega1" and the
+  ///   scene's other fields, "formulation", "tolerance", "objective_form", "smoothing";
+  /// - no field when there is no design variable; "objective" (no index) when the objective as
+  ///   a whole is wrong (no term, no positive weight);
+  /// - a list field with the element's index when the element is wrong as a whole: a second
+  ///   counterweight on a link ("counterweights", i), a link parameter twice or with bad bounds
+  ///   ("link_parameters", i: "(coupler.mass).lower must be > 0 kg, got 0"), a torque metric in
+  ///   a free scene ("objective" or "limits", i);
+  /// - the path of one field of an element, index -1: "counterweights[i].link" (.mass_max,
+  ///   .distance_max, .shape, .thickness, .density), "link_parameters[i].link" (.parameter),
+  ///   "objective[i].metric" (.weight), "limits[i].metric" (.value).
+  bd::Problem validate() const;
 };
 
 }  // namespace bd::optimize

@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <mutex>
 #include <stdexcept>
 #include <system_error>
 #include <utility>
@@ -37,8 +36,6 @@ core::Trajectory simulate(const Study& study, const MethodChoice& method) {
   return core::simulate_driven(study.model, std::get<core::DrivenScene>(study.scene), options);
 }
 
-// held around every Ipopt solve (see optimize_study())
-std::mutex ipopt_mutex;
 
 // solves an optimize study's problem and simulates the optimum; not run when the original's
 // simulation stopped early (its metrics are the normalisers)
@@ -51,12 +48,7 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original) {
   }
   const OptimizeRequest& req = *study.optimize;
   const optimize::DesignProblem problem = design_problem(study);
-  // Ipopt 3.11 (Debian 12) calls MUMPS, which is not thread-safe, without a lock of its own:
-  // one Ipopt solve at a time in this process (compute_study() may run on several threads)
-  std::unique_lock<std::mutex> ipopt_lock(ipopt_mutex, std::defer_lock);
-  if (req.options.algorithm == optimize::Algorithm::kIpopt) ipopt_lock.lock();
   o.result = optimize::optimize(problem, req.options);
-  if (ipopt_lock.owns_lock()) ipopt_lock.unlock();
   {
     const optimize::Nlp nlp(problem);
     o.variable_names = nlp.variable_names();
@@ -70,7 +62,6 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original) {
   o.trajectory = simulate(best, o.method);
   o.metrics = core::metrics(o.trajectory);
   if (req.pareto) {
-    if (req.options.algorithm == optimize::Algorithm::kIpopt) ipopt_lock.lock();
     o.pareto = optimize::pareto_front(problem, req.pareto->first, req.pareto->second,
                                       req.pareto->points, req.options);
   }

@@ -638,15 +638,15 @@ class StudyParser {
     Study with = study;
     with.optimize = req;
     const optimize::DesignProblem problem = design_problem(with);
-    if (const std::string msg = problem.validate(); !msg.empty()) {
-      r_.fail(e.key_mark, "optimize: " + msg);
-    }
-    if (const std::string msg = req.options.validate(); !msg.empty()) {
+    if (const Problem p = problem.validate()) r_.fail(e.key_mark, "optimize: " + p->text());
+    if (const Problem p = req.options.validate()) {
       YAML::Mark where = e.key_mark;
-      if (msg.find("max_evaluations") != std::string::npos) where = evaluations_mark;
-      if (msg.find("tolerance") != std::string::npos) where = tolerance_mark;
-      if (msg.find("algorithm") != std::string::npos) where = algorithm_mark;
-      r_.fail(where, "optimize: " + msg);
+      if (p->field == "max_evaluations") where = evaluations_mark;
+      if (p->field == "relative_tolerance" || p->field == "constraint_tolerance") {
+        where = tolerance_mark;
+      }
+      if (p->field == "algorithm") where = algorithm_mark;
+      r_.fail(where, "optimize: " + p->text());
     }
     check_evaluation(problem, req, e.key_mark);
     check_algorithm(problem, req, algorithm_mark);
@@ -655,7 +655,7 @@ class StudyParser {
 
   // the optimize layer sets up the problem as it will solve it: the original simulated in the
   // scene (its metrics are the normalisers, which must not vanish); its complaint is reported at
-  // the objective term or constraint it names, else at the section
+  // the objective term or constraint whose field it names, else at the section
   void check_evaluation(const optimize::DesignProblem& problem, const OptimizeRequest& req,
                         const YAML::Mark& section) {
     struct Named {
@@ -676,19 +676,14 @@ class StudyParser {
       try {
         const optimize::Nlp nlp(p);
       } catch (const InputError& err) {
-        const std::string msg = err.what();
-        // "objective[i]: ..." or "limits[i]: ..."
-        for (const auto& [prefix, named] :
-             {std::pair{std::string("objective["), &t}, std::pair{std::string("limits["), &l}}) {
-          if (msg.rfind(prefix, 0) != 0) continue;
-          const std::size_t close = msg.find("]: ", prefix.size());
-          if (close == std::string::npos) continue;
-          const std::size_t i = std::stoul(msg.substr(prefix.size(), close - prefix.size()));
-          if (i < named->size()) {
-            r_.fail((*named)[i].mark, (*named)[i].path + ": " + msg.substr(close + 3));
-          }
+        if (const auto& f = err.field(); f && f->index >= 0) {
+          const std::vector<Named>* named = f->field == "objective" ? &t
+                                            : f->field == "limits"  ? &l
+                                                                    : nullptr;
+          const auto i = static_cast<std::size_t>(f->index);
+          if (named && i < named->size()) r_.fail((*named)[i].mark, f->joined((*named)[i].path));
         }
-        r_.fail(section, "optimize: " + msg);
+        r_.fail(section, "optimize: " + std::string(err.what()));
       }
     };
     set_up(problem, terms, limits);
@@ -703,24 +698,15 @@ class StudyParser {
   }
 
   // a gradient method in a free scene (whose every evaluation is a simulation, without
-  // derivatives) is reported at `algorithm` in optimize()'s own words: it refuses such a problem
-  // before solving anything, so a probe of one evaluation finds out what it says
+  // derivatives) is reported at `algorithm` in optimize()'s own words (optimize() refuses what
+  // check_algorithm() refuses). In a free scene that is its only complaint; in a driven scene
+  // (mma with force_balance) the run reports it, as before.
   void check_algorithm(const optimize::DesignProblem& problem, const OptimizeRequest& req,
                        const YAML::Mark& algorithm_mark) {
-    const optimize::Algorithm alg = req.options.algorithm;
-    if (!std::holds_alternative<core::FreeScene>(problem.scene) || !optimize::uses_gradients(alg)) {
-      return;
+    if (!std::holds_alternative<core::FreeScene>(problem.scene)) return;
+    if (const Problem p = optimize::check_algorithm(problem, req.options)) {
+      r_.fail(algorithm_mark, "optimize.algorithm: " + p->text());
     }
-    optimize::OptimizeOptions probe = req.options;
-    probe.max_evaluations = 1;
-    std::string msg = std::string("algorithm '") + optimize::to_string(alg) +
-                      "' needs gradients, which a free scene does not provide; use cobyla or isres";
-    try {
-      (void)optimize::optimize(problem, probe);
-    } catch (const InputError& err) {
-      msg = err.what();
-    }
-    r_.fail(algorithm_mark, "optimize.algorithm: " + msg);
   }
 
   // optimize.objective: {metric: weight, ...}

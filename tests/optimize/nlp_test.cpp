@@ -586,13 +586,25 @@ TEST(Nlp, ObjectiveNormaliserMustNotVanish) {
     EXPECT_NE(std::string(e.what()).find("objective[0]: the original design's Fsh_rms is"),
               std::string::npos)
         << e.what();
+    ASSERT_TRUE(e.field());
+    EXPECT_EQ(e.field()->field, "objective");
+    EXPECT_EQ(e.field()->index, 0);
   }
   p.objective = {{Metric::kTauRms, 1.0}};
   EXPECT_NO_THROW(Nlp{p});
   p.objective[0].weight = 0;
   p.objective.push_back({Metric::kRA0Max, 1.0});
   p.limits = {{Metric::kFshMax, 0.5}};
-  EXPECT_THROW(Nlp{p}, InputError);
+  try {
+    const Nlp nlp(p);
+    ADD_FAILURE() << "no exception";
+  } catch (const InputError& e) {
+    ASSERT_TRUE(e.field()) << e.what();
+    EXPECT_EQ(e.field()->field, "limits");
+    EXPECT_EQ(e.field()->index, 0);
+    EXPECT_EQ(std::string(e.what()).rfind("limits[0]: the original design's Fsh_max is", 0), 0u)
+        << e.what();
+  }
 }
 
 TEST(Nlp, InvalidProblemThrows) {

@@ -184,16 +184,25 @@ TEST(Optimize, AlgorithmNamesRoundTrip) {
 }
 
 TEST(Optimize, OptionsValidate) {
-  EXPECT_EQ(OptimizeOptions{}.validate(), "");
+  EXPECT_FALSE(OptimizeOptions{}.validate());
+  // the problem's text, and its field
+  auto problem = [](const OptimizeOptions& o) {
+    const Problem e = o.validate();
+    return e ? e->text() + " | " + e->field : std::string();
+  };
   OptimizeOptions o;
   o.max_evaluations = 0;
-  EXPECT_EQ(o.validate(), "max_evaluations must be >= 1, got 0");
+  EXPECT_EQ(problem(o), "max_evaluations must be >= 1, got 0 | max_evaluations");
   o = {};
   o.relative_tolerance = -1;
-  EXPECT_EQ(o.validate(), "relative_tolerance must be in (0, 1), got -1");
+  EXPECT_EQ(problem(o), "relative_tolerance must be in (0, 1), got -1 | relative_tolerance");
+  o = {};
+  o.algorithm = Algorithm{17};
+  EXPECT_EQ(problem(o),
+            "algorithm must be one of slsqp, mma, ipopt, mlsl, isres, cobyla | algorithm");
   o = {};
   o.constraint_tolerance = 0;
-  EXPECT_EQ(o.validate(), "constraint_tolerance must be > 0, got 0");
+  EXPECT_EQ(problem(o), "constraint_tolerance must be > 0, got 0 | constraint_tolerance");
   try {
     (void)optimize(counterweight_problem(), o);
     FAIL() << "invalid options accepted";
@@ -467,6 +476,10 @@ TEST(Optimize, ForceBalanceHoldsAtTheOptimumAndSolversAgree) {
 TEST(Optimize, MmaRefusesEqualities) {
   DesignProblem p = counterweight_problem();
   p.force_balance = true;
+  const Problem refused = check_algorithm(p, options_for(Algorithm::kMma));
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->field, "algorithm");
+  EXPECT_FALSE(check_algorithm(p, options_for(Algorithm::kSlsqp)));
   try {
     (void)optimize(p, options_for(Algorithm::kMma));
     FAIL() << "mma accepted equality constraints";
@@ -522,6 +535,13 @@ TEST(Optimize, GradientMethodOnAFreeSceneIsRefused) {
   for (Algorithm a : {Algorithm::kSlsqp, Algorithm::kIpopt}) {
     OptimizeOptions o;
     o.algorithm = a;
+    // said without solving anything, in optimize()'s words
+    const Problem refused = check_algorithm(free_problem(), o);
+    ASSERT_TRUE(refused);
+    EXPECT_EQ(refused->field, "algorithm");
+    EXPECT_EQ(refused->text(),
+              std::string("algorithm '") + to_string(a) +
+                  "' needs gradients, which a free scene does not provide; use cobyla or isres");
     try {
       (void)optimize(free_problem(), o);
       FAIL() << "a gradient method on a free scene was accepted";
@@ -537,7 +557,8 @@ TEST(Optimize, GradientMethodOnAFreeSceneIsRefused) {
 // reporting
 
 TEST(Optimize, BriefReportIsOneLineWithTheEssentials) {
-  const OptimizeResult r = optimize(counterweight_problem(1.0, 10.0), options_for(Algorithm::kSlsqp));
+  const OptimizeResult r =
+      optimize(counterweight_problem(1.0, 10.0), options_for(Algorithm::kSlsqp));
   const std::string line = r.brief_report();
   EXPECT_EQ(line.find('\n'), std::string::npos);
   for (const char* part : {"slsqp", "converged", "iterations", "evaluations", " s,", "objective",

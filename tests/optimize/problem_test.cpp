@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "core/fourbar/samples.hpp"
 
@@ -35,7 +36,7 @@ TEST(Problem, ObjectiveFormNamesRoundTripAndTheDefaultIsLinear) {
   EXPECT_STREQ(to_string(ObjectiveForm::kLinear), "linear");
   EXPECT_STREQ(to_string(ObjectiveForm::kSquared), "squared");
   EXPECT_FALSE(objective_form_named("Linear"));
-  EXPECT_EQ(DesignProblem{}.objective_form, ObjectiveForm::kLinear);  // the weighted sum
+  EXPECT_EQ(DesignProblem{}.objective_form, ObjectiveForm::kLinear);  // the weighted sum
   EXPECT_EQ(DesignProblem{}.smoothing, kDefaultSmoothing);
 }
 
@@ -58,15 +59,26 @@ DesignProblem valid_problem() {
   return p;
 }
 
+// validate()'s problem after a change of the valid problem: its text, "" when there is none
 template <class Change>
 std::string message_after(Change change) {
   DesignProblem p = valid_problem();
   change(p);
-  return p.validate();
+  const Problem e = p.validate();
+  return e ? e->text() : "";
+}
+
+// the field and index of validate()'s problem after a change
+template <class Change>
+std::pair<std::string, int> field_after(Change change) {
+  DesignProblem p = valid_problem();
+  change(p);
+  const Problem e = p.validate();
+  return e ? std::pair{e->field, e->index} : std::pair{std::string("none"), -1};
 }
 
 TEST(Problem, ValidProblemsPass) {
-  EXPECT_EQ(valid_problem().validate(), "");
+  EXPECT_FALSE(valid_problem().validate());
   // link parameters alone, a free scene, an added-mass limit below zero (remove mass)
   EXPECT_EQ(message_after([](DesignProblem& p) {
               p.counterweights.clear();
@@ -171,6 +183,43 @@ TEST(Problem, ValidateNamesEachMistake) {
               p.scene = core::FreeScene{0.0, 1.0, 1.0, 11};
             }),
             "limits[0]: tau_max is 0 in a free scene (no drive torque)");
+}
+
+TEST(Problem, ValidateNamesTheFieldOfEachMistake) {
+  using Field = std::pair<std::string, int>;
+  EXPECT_EQ(field_after([](DesignProblem& p) { p.original.coupler.mass = -1.2; }),
+            Field("original", -1));
+  EXPECT_EQ(field_after([](DesignProblem& p) {
+              p.scene = core::DrivenScene{0.0, 0.0, 1, 36};
+            }),
+            Field("scene.omega1", -1));
+  EXPECT_EQ(field_after([](DesignProblem& p) {
+              p.counterweights.clear();
+              p.link_parameters.clear();
+            }),
+            Field("", -1));
+  // an element as a whole: the list and the index; one field of an element: its path
+  EXPECT_EQ(field_after([](DesignProblem& p) { p.counterweights[1].link = 1; }),
+            Field("counterweights", 1));
+  EXPECT_EQ(field_after([](DesignProblem& p) { p.counterweights[1].link = 2; }),
+            Field("counterweights[1].link", -1));
+  EXPECT_EQ(field_after([](DesignProblem& p) { p.link_parameters[0].lower = 0; }),
+            Field("link_parameters", 0));
+  EXPECT_EQ(field_after([](DesignProblem& p) { p.objective.clear(); }), Field("objective", -1));
+  EXPECT_EQ(field_after([](DesignProblem& p) { p.objective[1].weight = -1; }),
+            Field("objective[1].weight", -1));
+  EXPECT_EQ(field_after([](DesignProblem& p) {
+              p.scene = core::FreeScene{0.0, 1.0, 1.0, 11};
+              p.objective[1] = {Metric::kTauRms, 1.0};
+            }),
+            Field("objective", 1));
+  EXPECT_EQ(field_after([](DesignProblem& p) {
+              p.scene = core::FreeScene{0.0, 1.0, 1.0, 11};
+            }),
+            Field("limits", 0));
+  EXPECT_EQ(field_after([](DesignProblem& p) { p.limits[0].value = 0; }),
+            Field("limits[0].value", -1));
+  EXPECT_EQ(field_after([](DesignProblem& p) { p.smoothing = 0; }), Field("smoothing", -1));
 }
 
 }  // namespace

@@ -584,7 +584,7 @@ TEST(LoadStudy, OptimizeSectionReadsEveryKey) {
   EXPECT_EQ(p.formulation, choose_method(s).formulation);
   EXPECT_EQ(p.tolerance, s.tolerance);
   EXPECT_TRUE(p.force_balance);
-  EXPECT_EQ(p.validate(), "");
+  EXPECT_FALSE(p.validate());
 }
 
 TEST(LoadStudy, OptimizeDefaults) {

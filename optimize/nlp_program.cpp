@@ -1,0 +1,397 @@
+// What the driven and the free program share: set-up, variables, q(x), the design at x, the
+// force-balance equalities, the envelopes and the added-mass limits.
+#include "optimize/nlp_program.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <variant>
+
+#include "core/input_error.hpp"
+#include "core/number_text.hpp"
+
+namespace bd::optimize::detail {
+
+double& parameter(core::Link& link, LinkParameterVariable::Parameter p) {
+  switch (p) {
+    case LinkParameterVariable::Parameter::kMass:
+      return link.mass;
+    case LinkParameterVariable::Parameter::kE:
+      return link.e;
+    case LinkParameterVariable::Parameter::kF:
+      return link.f;
+    case LinkParameterVariable::Parameter::kInertia:
+      break;
+  }
+  return link.inertia;
+}
+
+// ---------------------------------------------------------------------------------------------
+// set-up
+
+NlpProgram::NlpProgram(const DesignProblem& p) : problem_(p) {
+  if (const Problem e = problem_.validate()) {
+    throw InputError("invalid design problem: " + e->text());
+  }
+  problem_.original = core::make_fourbar(problem_.original);
+  original_mass_ = core::total_mass(problem_.original);
+  linear_ = problem_.objective_form == ObjectiveForm::kLinear;
+  eps_ = problem_.smoothing;
+  for (const Term& t : problem_.objective) weight_[metric_index(t.metric)] += t.weight;
+
+  // the original's metrics, by core's own simulation (the normalisers)
+  const core::Trajectory trajectory = simulate(problem_.original);
+  if (!trajectory.ok()) {
+    const bool driven = std::holds_alternative<core::DrivenScene>(problem_.scene);
+    throw InputError(FieldError{"", -1,
+                                std::string("the original design cannot be evaluated in the ") +
+                                    (driven ? "driven" : "free") +
+                                    " scene: " + trajectory.message});
+  }
+  original_metrics_ = core::metrics(trajectory);
+  check_normalisers();
+  set_up_design_variables();
+}
+
+core::Trajectory NlpProgram::simulate(const core::FourBar& model) const {
+  core::SimulateOptions options;
+  options.formulation = problem_.formulation;
+  options.tolerance = problem_.tolerance;
+  if (const auto* driven = std::get_if<core::DrivenScene>(&problem_.scene)) {
+    return core::simulate_driven(model, *driven, options);
+  }
+  return core::simulate_free(model, std::get<core::FreeScene>(problem_.scene), options);
+}
+
+void NlpProgram::check_normalisers() const {
+  const core::Metrics& o = original_metrics_;
+  const double force = std::max({o.RA0_max, o.RA3_max, o.Fsh_max});
+  const double moment = std::max({o.tau_max, o.Msh_max, force * problem_.original.frame_length});
+  auto check = [&](Metric m, const char* list, std::size_t i) {
+    if (m == Metric::kAddedMass) return;
+    const double v = value(o, m), scale = is_moment(m) ? moment : force;
+    if (!(v > 1e-10 * scale)) {
+      throw InputError(FieldError{list, static_cast<int>(i),
+                                  std::string(": the original design's ") + to_string(m) + " is " +
+                                      text::digits(v, 6) + " " + metric_unit(m) +
+                                      ", too small to normalise by (it is already minimal)"});
+    }
+  };
+  for (std::size_t i = 0; i < problem_.objective.size(); ++i) {
+    const Term& t = problem_.objective[i];
+    if (t.weight > 0) check(t.metric, "objective", i);
+  }
+  for (std::size_t i = 0; i < problem_.limits.size(); ++i) {
+    check(problem_.limits[i].metric, "limits", i);
+  }
+}
+
+int NlpProgram::add_variable(double lower, double upper, std::string name) {
+  lower_.conservativeResize(n_ + 1);
+  upper_.conservativeResize(n_ + 1);
+  lower_(n_) = lower;
+  upper_(n_) = upper;
+  variable_names_.push_back(std::move(name));
+  return n_++;
+}
+
+void NlpProgram::set_up_design_variables() {
+  for (const CounterweightVariables& c : problem_.counterweights) {
+    const std::string name = std::string(core::link_name(c.link)) + " counterweight ";
+    const double d = c.distance_max;
+    cw_var_.push_back(add_variable(0.0, c.mass_max, name + "mass [kg]"));
+    const char* pivot = c.link == 1 ? "A0" : "A3";
+    add_variable(-d, d, name + "x from " + pivot + " in link axes [m]");
+    add_variable(-d, d, name + "y from " + pivot + " in link axes [m]");
+  }
+  for (const LinkParameterVariable& v : problem_.link_parameters) {
+    param_var_.push_back(add_variable(v.lower, v.upper,
+                                      std::string(core::link_name(v.link)) + " " +
+                                          parameter_name(v.parameter) + " [" +
+                                          parameter_unit(v.parameter) + "]"));
+  }
+}
+
+// force balance (eq. 57) in q, over the original total mass:
+// crank m1 s̄1/l1 + m2 (1 - s̄2/l2), rocker m2 s̄2/l2 + m3 (1 - s̄3/l3)
+void NlpProgram::set_up_force_balance() {
+  const double l1 = problem_.original.crank.length, l2 = problem_.original.coupler.length,
+               l3 = problem_.original.rocker.length;
+  const int b1 = link_base(1), b2 = link_base(2), b3 = link_base(3);
+  balance_(0, b1 + 1) = 1 / l1;
+  balance_(0, b2) = 1;
+  balance_(0, b2 + 1) = -1 / l2;
+  balance_(1, b1 + 2) = 1 / l1;
+  balance_(1, b2 + 2) = -1 / l2;
+  balance_(2, b2 + 1) = 1 / l2;
+  balance_(2, b3) = 1;
+  balance_(2, b3 + 1) = -1 / l3;
+  balance_(3, b2 + 2) = 1 / l2;
+  balance_(3, b3 + 2) = -1 / l3;
+  balance_ /= original_mass_;
+  n_eq_ = 4;
+  for (const char* side : {"crank", "rocker"}) {
+    for (const char* part : {"real", "imaginary"}) {
+      constraint_names_.push_back(std::string("force balance, ") + side + " side (" + part +
+                                  " part)");
+    }
+  }
+}
+
+void NlpProgram::set_up_constraints() {
+  if (problem_.force_balance) set_up_force_balance();
+  // envelopes
+  for (std::size_t c = 0; c < problem_.counterweights.size(); ++c) {
+    const CounterweightVariables& cw = problem_.counterweights[c];
+    add_block({Block::Kind::kEnvelope, static_cast<int>(c), Metric::kAddedMass, 0.0, -1, 1},
+              {std::string(core::link_name(cw.link)) + " counterweight within distance_max = " +
+               text::digits(cw.distance_max, 6) + " m of " + (cw.link == 1 ? "A0" : "A3")});
+  }
+  // limits
+  for (const Limit& l : problem_.limits) {
+    Block b{Block::Kind::kRmsLimit, -1, l.metric, l.value, -1, 1};
+    const std::string name = std::string(to_string(l.metric)) + " <= " + text::digits(l.value, 6) +
+                             (l.metric == Metric::kAddedMass ? " kg" : " x original");
+    if (l.metric == Metric::kAddedMass) {
+      b.kind = Block::Kind::kAddedMassLimit;
+      add_block(b, {name});
+    } else if (is_peak(l.metric)) {
+      b.kind = Block::Kind::kPeakLimit;
+      std::vector<std::string> names = peak_limit_names(name);
+      b.count = static_cast<int>(names.size());
+      add_block(b, std::move(names));
+    } else {
+      add_block(b, {name});
+    }
+  }
+}
+
+void NlpProgram::add_block(const Block& block, std::vector<std::string> names) {
+  blocks_.push_back(block);
+  for (std::string& name : names) constraint_names_.push_back(std::move(name));
+  n_ineq_ += block.count;
+}
+
+std::vector<std::string> NlpProgram::peak_limit_names(const std::string& name) const {
+  return {name};
+}
+
+void NlpProgram::start_extra_variables(Eigen::VectorXd&) const {}
+
+// ---------------------------------------------------------------------------------------------
+// the design at x
+
+// The link's own parameters at x as q(b..b+3) = (m, m e, m f, J) and, when asked for, their
+// rows of ∂q/∂x; returns the link with its variables set.
+core::Link NlpProgram::add_link(int k, const Eigen::VectorXd& x, Inertial& out,
+                                bool with_jacobian) const {
+  core::Link l = core::link(problem_.original, k);
+  int var[4] = {-1, -1, -1, -1};  // the variable of each parameter, in Parameter's order
+  for (std::size_t i = 0; i < problem_.link_parameters.size(); ++i) {
+    const LinkParameterVariable& v = problem_.link_parameters[i];
+    if (v.link != k) continue;
+    parameter(l, v.parameter) = x(param_var_[i]);
+    var[static_cast<int>(v.parameter)] = param_var_[i];
+  }
+  const int vm = var[0], ve = var[1], vf = var[2], vi = var[3];
+  const int b = link_base(k);
+  out.q(b) = l.mass;
+  out.q(b + 1) = l.mass * l.e;
+  out.q(b + 2) = l.mass * l.f;
+  out.q(b + 3) = l.inertia + l.mass * (l.e * l.e + l.f * l.f);
+  if (with_jacobian) {
+    auto dM = out.B.row(b), dMx = out.B.row(b + 1), dMy = out.B.row(b + 2), dJ = out.B.row(b + 3);
+    if (vm >= 0) {
+      dM(vm) += 1;
+      dMx(vm) += l.e;
+      dMy(vm) += l.f;
+      dJ(vm) += l.e * l.e + l.f * l.f;
+    }
+    if (ve >= 0) {
+      dMx(ve) += l.mass;
+      dJ(ve) += 2 * l.mass * l.e;
+    }
+    if (vf >= 0) {
+      dMy(vf) += l.mass;
+      dJ(vf) += 2 * l.mass * l.f;
+    }
+    if (vi >= 0) dJ(vi) += 1;
+  }
+  return l;
+}
+
+// The link's counterweight (if any) added to q(b..b+3): mass mc at r (link axes from the first
+// joint), own inertia Ic(mc).
+void NlpProgram::add_counterweight(int k, const core::Link& l, const Eigen::VectorXd& x,
+                                   Inertial& out, bool with_jacobian) const {
+  const int b = link_base(k);
+  for (std::size_t c = 0; c < problem_.counterweights.size(); ++c) {
+    const CounterweightVariables& cw = problem_.counterweights[c];
+    if (cw.link != k) continue;
+    const int j = cw_var_[c];
+    const double mc = x(j), rx = x(j + 1) + (k == 3 ? l.length : 0.0), ry = x(j + 2);
+    double Ic = 0, dIc = 0;
+    if (cw.shape == balance::CounterweightShape::kDisc) {
+      const double area_density = cw.density * std::numbers::pi * cw.thickness;  // m/r²
+      Ic = mc * mc / (2 * area_density);
+      dIc = mc / area_density;
+    }
+    out.q(b) += mc;
+    out.q(b + 1) += mc * rx;
+    out.q(b + 2) += mc * ry;
+    out.q(b + 3) += Ic + mc * (rx * rx + ry * ry);
+    if (with_jacobian) {
+      auto dM = out.B.row(b), dMx = out.B.row(b + 1), dMy = out.B.row(b + 2), dJ = out.B.row(b + 3);
+      dM(j) += 1;
+      dMx(j) += rx;
+      dMy(j) += ry;
+      dJ(j) += dIc + rx * rx + ry * ry;
+      dMx(j + 1) += mc;
+      dJ(j + 1) += 2 * mc * rx;
+      dMy(j + 2) += mc;
+      dJ(j + 2) += 2 * mc * ry;
+    }
+  }
+}
+
+Inertial NlpProgram::inertial(const Eigen::VectorXd& x, bool with_jacobian) const {
+  Inertial out;
+  if (with_jacobian) out.B = Eigen::MatrixXd::Zero(kQ, n_);
+  for (int k = 1; k <= 3; ++k) {
+    const core::Link l = add_link(k, x, out, with_jacobian);
+    add_counterweight(k, l, x, out, with_jacobian);
+    // the centre of mass, where the applied force acts
+    const int b = link_base(k), r = rho_base(k);
+    const double M = out.q(b);
+    out.q(r) = out.q(b + 1) / M;
+    out.q(r + 1) = out.q(b + 2) / M;
+    if (with_jacobian) {
+      out.B.row(r) = (out.B.row(b + 1) - out.q(r) * out.B.row(b)) / M;
+      out.B.row(r + 1) = (out.B.row(b + 2) - out.q(r + 1) * out.B.row(b)) / M;
+    }
+  }
+  out.q(kCrankDisc) = problem_.original.counter_rotations.crank.inertia;
+  out.q(kRockerDisc) = problem_.original.counter_rotations.rocker.inertia;
+  out.q(kOne) = 1.0;
+  return out;
+}
+
+std::vector<PlacedCounterweight> NlpProgram::counterweights(const Eigen::VectorXd& x) const {
+  std::vector<PlacedCounterweight> out;
+  for (std::size_t c = 0; c < problem_.counterweights.size(); ++c) {
+    const CounterweightVariables& cw = problem_.counterweights[c];
+    const int j = cw_var_[c];
+    balance::Counterweight w;
+    w.mass = x(j);
+    w.position = Vec2(x(j + 1), x(j + 2));
+    w.distance = w.position.norm();
+    if (cw.shape == balance::CounterweightShape::kDisc) {
+      w.radius = std::sqrt(w.mass / (cw.density * std::numbers::pi * cw.thickness));
+      w.thickness = cw.thickness;
+      w.inertia = 0.5 * w.mass * w.radius * w.radius;
+    }
+    out.push_back({cw.link, w});
+  }
+  return out;
+}
+
+core::FourBar NlpProgram::design(const Eigen::VectorXd& x) const {
+  core::FourBar m = problem_.original;
+  core::Link* links[3] = {&m.crank, &m.coupler, &m.rocker};
+  for (std::size_t i = 0; i < problem_.link_parameters.size(); ++i) {
+    const LinkParameterVariable& v = problem_.link_parameters[i];
+    parameter(*links[v.link - 1], v.parameter) = x(param_var_[i]);
+  }
+  for (const PlacedCounterweight& c : counterweights(x)) {
+    core::Link& l = *links[c.link - 1];
+    l = balance::merged(l, c.counterweight, c.link == 3);
+  }
+  return core::make_fourbar(m);
+}
+
+double NlpProgram::added_mass(const VecQ& q) const {
+  return q(link_base(1)) + q(link_base(2)) + q(link_base(3)) - original_mass_;
+}
+
+double NlpProgram::metric(const Eigen::VectorXd& x, Metric m) const {
+  if (m == Metric::kAddedMass) return added_mass(inertial(x, false).q);
+  return reaction_metric(x, m);
+}
+
+double NlpProgram::original(Metric m) const {
+  return m == Metric::kAddedMass ? original_mass_ : value(original_metrics_, m);
+}
+
+// ---------------------------------------------------------------------------------------------
+// the program
+
+void NlpProgram::require_gradients(bool asked, const char* function) const {
+  if (asked && !has_gradients()) {
+    throw std::logic_error(std::string("Nlp::") + function +
+                           ": no gradients in a free scene (has_gradients() is false)");
+  }
+}
+
+Eigen::VectorXd NlpProgram::start() const {
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n_);
+  for (std::size_t c = 0; c < problem_.counterweights.size(); ++c) {
+    const CounterweightVariables& cw = problem_.counterweights[c];
+    const int j = cw_var_[c];
+    x(j) = cw.mass_max / 2;
+    x(j + 1) = (cw.link == 1 ? -0.5 : 0.5) * cw.distance_max;
+  }
+  for (std::size_t i = 0; i < problem_.link_parameters.size(); ++i) {
+    const LinkParameterVariable& v = problem_.link_parameters[i];
+    core::Link l = core::link(problem_.original, v.link);
+    x(param_var_[i]) = std::clamp(parameter(l, v.parameter), v.lower, v.upper);
+  }
+  start_extra_variables(x);
+  return x;
+}
+
+bool NlpProgram::sized(int m, Eigen::VectorXd& c, Eigen::MatrixXd* jac,
+                       const char* function) const {
+  require_gradients(jac != nullptr, function);
+  c.resize(m);
+  if (jac) jac->setZero(m, n_);
+  return m > 0;
+}
+
+void NlpProgram::equalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
+                            Eigen::MatrixXd* jac) const {
+  if (!sized(n_eq_, c, jac, "equalities")) return;
+  const Inertial in = inertial(x, jac != nullptr);
+  c = balance_ * in.q;
+  if (jac) *jac = balance_ * in.B;
+}
+
+void NlpProgram::inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
+                              Eigen::MatrixXd* jac) const {
+  if (!sized(n_ineq_, c, jac, "inequalities")) return;
+  const Inertial in = inertial(x, jac != nullptr);
+  metric_inequalities(x, in, c, jac);
+  int row = 0;
+  for (const Block& b : blocks_) {
+    if (b.kind == Block::Kind::kEnvelope) {
+      // (x² + y²) / distance_max² - 1
+      const auto i = static_cast<std::size_t>(b.counterweight);
+      const int j = cw_var_[i];
+      const double d2 =
+          problem_.counterweights[i].distance_max * problem_.counterweights[i].distance_max;
+      c(row) = (x(j + 1) * x(j + 1) + x(j + 2) * x(j + 2)) / d2 - 1;
+      if (jac) {
+        (*jac)(row, j + 1) = 2 * x(j + 1) / d2;
+        (*jac)(row, j + 2) = 2 * x(j + 2) / d2;
+      }
+    } else if (b.kind == Block::Kind::kAddedMassLimit) {
+      c(row) = (added_mass(in.q) - b.value) / original_mass_;
+      if (jac) {
+        for (int k = 1; k <= 3; ++k) jac->row(row) += in.B.row(link_base(k)) / original_mass_;
+      }
+    }
+    row += b.count;
+  }
+}
+
+}  // namespace bd::optimize::detail
