@@ -17,8 +17,8 @@ struct FieldError {
   /// The element of a list field (objective term 2: field "objective", index 2); -1 for none.
   int index = -1;
   /// What is wrong, reading on from the field's name: "must be > 0 kg, got -1.2", or, after a
-  /// colon, ": the original design's value is 0". Starts with ':' or ',' to be joined without a
-  /// space.
+  /// colon, ": the original design's value is 0", or a sub-field of a list element,
+  /// ".mass must be >= 0 kg, got -1". Starts with ':', ',' or '.' to be joined without a space.
   std::string message;
 
   /// The field (with "[index]") and the message as one line, e.g.
@@ -31,7 +31,8 @@ struct FieldError {
   std::string joined(const std::string& name) const {
     if (name.empty()) return message.rfind(": ", 0) == 0 ? message.substr(2) : message;
     if (message.empty()) return name;
-    return name + (message[0] == ':' || message[0] == ',' ? "" : " ") + message;
+    return name + (message[0] == ':' || message[0] == ',' || message[0] == '.' ? "" : " ") +
+           message;
   }
 };
 
