@@ -16,7 +16,7 @@
 #include <variant>
 #include <vector>
 
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "studies/study/load_study.hpp"
 #include "studies/report/report.hpp"
 #include "studies/run/runner.hpp"

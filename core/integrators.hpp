@@ -1,9 +1,9 @@
 #pragma once
-/// The SUNDIALS integrators of free motion behind one door (core/simulate.hpp `Integrator`):
+/// The SUNDIALS integrators of free motion behind one door (core/simulation.hpp `Integrator`):
 /// CVODE (Adams-Moulton, BDF), ARKODE ERKStep (embedded explicit Runge-Kutta pairs) for an ODE
-/// y' = f(t, y), and IDA for a DAE F(t, y, y') = 0. Used by core/simulate.cpp (the reduced
-/// equation in theta1) and core/opened_loop_dae.cpp (the opened loop's ODE and DAE). Internal to
-/// core: SUNDIALS types appear in no public header.
+/// y' = f(t, y), and IDA for a DAE F(t, y, y') = 0. Used by core/fourbar/simulate.cpp (the
+/// four-bar's reduced equation in theta1) and core/fourbar/opened_loop_dae.cpp (its opened loop's
+/// ODE and DAE). Internal to core: SUNDIALS types appear in no public header.
 ///
 /// One Integration owns every SUNDIALS object of one run (context, vectors, matrix, solvers,
 /// integrator memory) and frees them in reverse order of creation; it captures the integrator's
@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "core/fourbar/simulate.hpp"
+#include "core/simulation.hpp"
 
 namespace bd::core::integrators {
 

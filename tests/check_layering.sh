@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Includes point one way only: core <- balance <- optimize <- studies <- cli; third-party
-# headers stay behind their one door (yaml-cpp in studies/, CLI11 in cli/, NLopt and Ipopt in
-# optimize/*.cpp).
+# Includes point one way only: core <- balance <- optimize <- studies <- cli. Within core, the
+# files at its root (what any linkage shares) are the floor below the four-bar's own files in
+# core/fourbar/ and never include them. Third-party headers stay behind their one door
+# (yaml-cpp in studies/, CLI11 in cli/, NLopt and Ipopt in optimize/*.cpp).
 cd "$(dirname "$0")/.." || exit 1
 fail=0
 forbid() {  # forbid DESCRIPTION REGEX PATH...
@@ -15,6 +16,8 @@ forbid() {  # forbid DESCRIPTION REGEX PATH...
   fi
 }
 forbid "core/ includes a higher layer" '(balance|optimize|studies|cli|tests)/' core
+forbid "core/'s shared root includes the four-bar (core/fourbar/)" 'core/fourbar/' \
+  $(ls core/*.hpp core/*.cpp 2>/dev/null)
 forbid "balance/ includes a higher layer" '(optimize|studies|cli|tests)/' balance
 forbid "optimize/ includes a higher layer" '(studies|cli|tests)/' optimize
 forbid "studies/ includes a higher layer" '(cli|tests)/' studies

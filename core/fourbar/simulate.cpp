@@ -226,30 +226,6 @@ std::string SimulateOptions::validate() const {
   return {};
 }
 
-const char* to_string(Integrator integrator) {
-  switch (integrator) {
-    case Integrator::kCvodeAdams:
-      return "cvode-adams";
-    case Integrator::kCvodeBdf:
-      return "cvode-bdf";
-    case Integrator::kErk2:
-      return "erk2";
-    case Integrator::kErk3:
-      return "erk3";
-    case Integrator::kErk4:
-      return "erk4";
-    case Integrator::kErk5:
-      return "erk5";
-    case Integrator::kErk6:
-      return "erk6";
-    case Integrator::kErk8:
-      return "erk8";
-    case Integrator::kIda:
-      return "ida";
-  }
-  return "?";
-}
-
 SimulationStatus status_of(DynamicsError::Kind kind) {
   switch (kind) {
     case DynamicsError::Kind::kAssembly:
@@ -276,22 +252,6 @@ void validate_scene(const FreeScene& scene) {
     throw InputError("scene.samples must be >= 2 (and <= 1e8), got " +
                      std::to_string(scene.samples));
   }
-}
-
-const char* to_string(SimulationStatus s) {
-  switch (s) {
-    case SimulationStatus::kNotRun:
-      return "not-run";
-    case SimulationStatus::kCompleted:
-      return "completed";
-    case SimulationStatus::kAssemblyFailed:
-      return "assembly-failed";
-    case SimulationStatus::kSingular:
-      return "singular";
-    case SimulationStatus::kIntegratorFailed:
-      return "integrator-failed";
-  }
-  return "?";
 }
 
 Trajectory simulate_free(const FourBar& model, const FreeScene& scene,

@@ -16,8 +16,8 @@
 #include <utility>
 #include <variant>
 
+#include "core/fourbar/metrics.hpp"
 #include "core/input_error.hpp"
-#include "core/metrics.hpp"
 #include "studies/report/report.hpp"
 #include "studies/report/report_support.hpp"
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "core/fourbar/simulate.hpp"
 #include "optimize/optimize.hpp"
 #include "studies/study/study.hpp"

@@ -31,7 +31,7 @@
 #include "core/fourbar/energy.hpp"
 #include "core/input_error.hpp"
 #include "core/fourbar/kinematics.hpp"
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/samples.hpp"
 #include "core/fourbar/simulate.hpp"

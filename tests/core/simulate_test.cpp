@@ -11,7 +11,7 @@
 #include "core/fourbar/energy.hpp"
 #include "core/input_error.hpp"
 #include "core/fourbar/kinematics.hpp"
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "core/fourbar/samples.hpp"
 
 namespace bd::core {

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "studies/study/load_study.hpp"
 #include "tests/support/csv.hpp"
 #include "tests/support/models.hpp"

@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "core/input_error.hpp"
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "balance/synthesis.hpp"
 #include "studies/study/load_study.hpp"
 #include "studies/report/report.hpp"
