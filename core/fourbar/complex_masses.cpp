@@ -157,7 +157,8 @@ std::optional<Failure> complex_masses_at(const FourBar& model, const ComplexMass
                                          DynamicsSample& out) {
   // the instant gives the rates and the dependent accelerations θ̈_k = Θ_k θ̈1 + γ_k
   const ComplexMassEquations eq = equations(model, c, instant.l1, instant.l3);
-  const double Theta2 = instant.tf.Theta2, Theta3 = instant.tf.Theta3;
+  const double dtheta2_dtheta1 = instant.tf.dtheta2_dtheta1,
+               dtheta3_dtheta1 = instant.tf.dtheta3_dtheta1;
   const double gamma2 = instant.bias.gamma2, gamma3 = instant.bias.gamma3;
   const double omega1_sq = instant.state.omega1 * instant.state.omega1,
                omega3_sq = instant.state.omega3 * instant.state.omega3;
@@ -165,11 +166,12 @@ std::optional<Failure> complex_masses_at(const FourBar& model, const ComplexMass
 
   // reduced equation: δθ = Θ δθ1 keeps the loop closed, so Σ_j Θ_j Q^c_j = 0 and
   // (Θᵀ M Θ) θ̈1 = Θᵀ (Q - M γ - C θ̇²) + τ   (τ enters Q1, Θ1 = 1), with M12 = M23 = 0
-  const double inertia =
-      c.M11 + 2.0 * M13 * Theta3 + I2 * Theta2 * Theta2 + c.M33 * Theta3 * Theta3;
+  const double inertia = c.M11 + 2.0 * M13 * dtheta3_dtheta1 +
+                         I2 * dtheta2_dtheta1 * dtheta2_dtheta1 +
+                         c.M33 * dtheta3_dtheta1 * dtheta3_dtheta1;
   const double rhs = (eq.Q(0) - M13 * gamma3 - eq.C13 * omega3_sq) +
-                     Theta2 * (eq.Q(1) - I2 * gamma2) +
-                     Theta3 * (eq.Q(2) - c.M33 * gamma3 + eq.C13 * omega1_sq);
+                     dtheta2_dtheta1 * (eq.Q(1) - I2 * gamma2) +
+                     dtheta3_dtheta1 * (eq.Q(2) - c.M33 * gamma3 + eq.C13 * omega1_sq);
   double alpha1 = 0.0, tau = 0.0;
   if (!input.torque_unknown) {
     alpha1 = rhs / inertia;

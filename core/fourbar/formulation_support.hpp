@@ -90,16 +90,16 @@ inline std::optional<Failure> close_instant(const FourBar& model, double theta1,
   c.inv_l2_x_l3 = 1.0 / l2_x_l3;
   // eq. 7 via cross products: l̄1 + l̄2 Θ2 + l̄3 Θ3 = 0 (eq. 5) crossed with l̄3 and with l̄2
   // (the operations of transfer_functions(), kinematics.hpp)
-  c.tf.Theta2 = cross(c.l3, c.l1) * c.inv_l2_x_l3;
-  c.tf.Theta3 = cross(c.l1, c.l2) * c.inv_l2_x_l3;
+  c.tf.dtheta2_dtheta1 = cross(c.l3, c.l1) * c.inv_l2_x_l3;
+  c.tf.dtheta3_dtheta1 = cross(c.l1, c.l2) * c.inv_l2_x_l3;
   c.state.theta1 = theta1;
   // the angles: two atan2, the longest chain of the instant, but only its outputs need them, so
   // they run alongside the rest
   c.state.theta2 = link_angle(c.l2);
   c.state.theta3 = link_angle(c.l3);
   c.state.omega1 = omega1;
-  c.state.omega2 = c.tf.Theta2 * omega1;
-  c.state.omega3 = c.tf.Theta3 * omega1;
+  c.state.omega2 = c.tf.dtheta2_dtheta1 * omega1;
+  c.state.omega3 = c.tf.dtheta3_dtheta1 * omega1;
   c.state.alpha1 = c.state.alpha2 = c.state.alpha3 = 0.0;
   // eq. 8: Σ l̄k α_k = -i b with b = Σ l̄k ω_k²; crossed with l̄3 and l̄2 (eqs. 9-10), as
   // acceleration_bias()
@@ -125,8 +125,8 @@ inline void set_state(const ClosedInstant& c, double alpha1, FourBarState& s) {
   s.omega2 = c.state.omega2;
   s.omega3 = c.state.omega3;
   s.alpha1 = alpha1;
-  s.alpha2 = c.tf.Theta2 * alpha1 + c.bias.gamma2;
-  s.alpha3 = c.tf.Theta3 * alpha1 + c.bias.gamma3;
+  s.alpha2 = c.tf.dtheta2_dtheta1 * alpha1 + c.bias.gamma2;
+  s.alpha3 = c.tf.dtheta3_dtheta1 * alpha1 + c.bias.gamma3;
 }
 
 /// Fills the reactions RA0, RA3 [N], Fsh = RA0 + RA3, tau [N m] and Msh = l4·RA3y - tau of `s`,

@@ -36,7 +36,7 @@ inline std::optional<Failure> mass_matrix_at(const FourBar& model, const MassMat
 
   // accelerations of the moving joints [A1, A2]: r̈ = J·alpha1 + c (eqs. 50-51), with
   // A1 = l̄1 and A2 = A3 - l̄3; A0 and A3 do not move
-  const mass_matrix_detail::JointPair J{il1, -instant.tf.Theta3 * il3};
+  const mass_matrix_detail::JointPair J{il1, -instant.tf.dtheta3_dtheta1 * il3};
   const mass_matrix_detail::JointPair bias{
       -(omega1 * omega1) * instant.l1, (omega3 * omega3) * instant.l3 - instant.bias.gamma3 * il3};
 

@@ -112,10 +112,10 @@ std::optional<Failure> solve(const OpenedLoopConstants& c, const FourBar& model,
   const double inv_det = 1.0 / cross(li, lj);
   // Σ i l̄ θ̈ = b2 with θ̈_k = 1, b2 = 0 (Θ) and with θ̈_k = 0 (g); i l̄ crossed with i l̄' is
   // l̄ × l̄', and x × i l̄ = x·l̄
-  double Theta[3], g[3];
-  Theta[k] = 1.0;
-  Theta[i] = -cross(lk, lj) * inv_det;
-  Theta[j] = -cross(li, lk) * inv_det;
+  double dtheta_dthetak[3], g[3];
+  dtheta_dthetak[k] = 1.0;
+  dtheta_dthetak[i] = -cross(lk, lj) * inv_det;
+  dtheta_dthetak[j] = -cross(li, lk) * inv_det;
   g[k] = 0.0;
   g[i] = dot(b2, lj) * inv_det;
   g[j] = -dot(b2, li) * inv_det;
@@ -128,11 +128,13 @@ std::optional<Failure> solve(const OpenedLoopConstants& c, const FourBar& model,
 
   double alpha[3];
   double tau = 0.0;
-  const double MTheta[3] = {M_times(Theta, 0), M_times(Theta, 1), M_times(Theta, 2)};
+  const double M_dtheta_dthetak[3] = {M_times(dtheta_dthetak, 0), M_times(dtheta_dthetak, 1),
+                                      M_times(dtheta_dthetak, 2)};
   const double alpha_k = !input.torque_unknown
-                             ? (dot3(Theta, b1) - dot3(MTheta, g)) / dot3(Theta, MTheta)
+                             ? (dot3(dtheta_dthetak, b1) - dot3(M_dtheta_dthetak, g)) /
+                                   dot3(dtheta_dthetak, M_dtheta_dthetak)
                              : input.alpha1;
-  for (int r = 0; r < 3; ++r) alpha[r] = Theta[r] * alpha_k + g[r];
+  for (int r = 0; r < 3; ++r) alpha[r] = dtheta_dthetak[r] * alpha_k + g[r];
   // rows i and j for R̄A3: i l̄_i · R̄ = q_i, i l̄_j · R̄ = q_j, so R̄ = (q_i l̄_j - q_j l̄_i)/det
   const double q[3] = {b1[0] - M_times(alpha, 0), b1[1] - M_times(alpha, 1),
                        b1[2] - M_times(alpha, 2)};
