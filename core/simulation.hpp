@@ -2,6 +2,7 @@
 /// What the simulation of any linkage shares, whatever its equations: the SUNDIALS integrator of
 /// free motion and the status a run ends with. The four-bar's scenes, options and trajectories
 /// (core/fourbar/simulate.hpp) build on these.
+#include "core/input_error.hpp"
 
 namespace bd::core {
 
@@ -31,6 +32,11 @@ inline constexpr Integrator kIntegrators[] = {
     Integrator::kCvodeAdams, Integrator::kCvodeBdf, Integrator::kErk2,
     Integrator::kErk3,       Integrator::kErk4,     Integrator::kErk5,
     Integrator::kErk6,       Integrator::kErk8,     Integrator::kIda};
+
+/// The checks every integration's options share: tolerance (relative) in (0, 1),
+/// absolute_tolerance > 0 and finite, max_steps >= 1. The problem's field is "tolerance",
+/// "absolute_tolerance" or "max_steps", e.g. "tolerance must be > 0 and < 1, got 0".
+Problem check_integration(double tolerance, double absolute_tolerance, long max_steps);
 
 /// How a run ended.
 enum class SimulationStatus {

@@ -12,11 +12,11 @@
 
 #include "core/fourbar/energy.hpp"
 #include "core/fourbar/formulation_support.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/opened_loop.hpp"
 #include "core/input_error.hpp"
 #include "core/integrators.hpp"
-#include "core/fourbar/kinematics.hpp"
 #include "core/number_text.hpp"
-#include "core/fourbar/opened_loop.hpp"
 
 namespace bd::core {
 
@@ -206,7 +206,7 @@ void fail(Trajectory& out, const DynamicsError& error, double t) {
 }
 
 void validate(const FreeScene& scene, const OpenedLoopDaeOptions& options) {
-  if (const std::string problem = options.validate(); !problem.empty()) throw InputError(problem);
+  throw_if(options.validate());
   validate_scene(scene);
 }
 
@@ -264,19 +264,17 @@ const char* to_string(DaeMethod m) {
   return "?";
 }
 
-std::string OpenedLoopDaeOptions::validate() const {
-  if (!(tolerance > 0.0 && tolerance < 1.0)) {
-    return "tolerance must be > 0 and < 1, got " + text::digits(tolerance, 10);
+Problem OpenedLoopDaeOptions::validate() const {
+  if (Problem problem = check_integration(tolerance, absolute_tolerance, max_steps)) {
+    return problem;
   }
-  if (!(absolute_tolerance > 0.0) || !std::isfinite(absolute_tolerance)) {
-    return "absolute_tolerance must be > 0, got " + text::digits(absolute_tolerance, 10);
-  }
-  if (max_steps < 1) return "max_steps must be >= 1, got " + std::to_string(max_steps);
   if (!(baumgarte_alpha >= 0.0) || !std::isfinite(baumgarte_alpha)) {
-    return "baumgarte_alpha must be >= 0 1/s, got " + text::digits(baumgarte_alpha, 10);
+    return FieldError{"baumgarte_alpha", -1,
+                      "must be >= 0 1/s, got " + text::digits(baumgarte_alpha, 10)};
   }
   if (!(baumgarte_beta >= 0.0) || !std::isfinite(baumgarte_beta)) {
-    return "baumgarte_beta must be >= 0 1/s, got " + text::digits(baumgarte_beta, 10);
+    return FieldError{"baumgarte_beta", -1,
+                      "must be >= 0 1/s, got " + text::digits(baumgarte_beta, 10)};
   }
   switch (method) {
     case DaeMethod::kAuto:
@@ -291,32 +289,37 @@ std::string OpenedLoopDaeOptions::validate() const {
     case DaeMethod::kIda:
       break;
     default:
-      return "method " + std::to_string(static_cast<int>(method)) + " is unknown";
+      return FieldError{"method", -1, std::to_string(static_cast<int>(method)) + " is unknown"};
   }
   switch (stabilisation) {
     case Stabilisation::kNone:
     case Stabilisation::kBaumgarte:
       if (method == DaeMethod::kIda) {
-        return std::string("method ida needs stabilisation ggl, got ") + to_string(stabilisation) +
-               ": IDA integrates the DAE in its stabilised index-2 form";
+        return FieldError{"method", -1,
+                          std::string("ida needs stabilisation ggl, got ") +
+                              to_string(stabilisation) +
+                              ": IDA integrates the DAE in its stabilised index-2 form"};
       }
       break;
     case Stabilisation::kProjection:
       if (method != DaeMethod::kAuto && method != DaeMethod::kBdf) {
-        return std::string("stabilisation projection needs method bdf (or auto), got ") +
-               to_string(method) + ": CVODE projects only with BDF";
+        return FieldError{"stabilisation", -1,
+                          std::string("projection needs method bdf (or auto), got ") +
+                              to_string(method) + ": CVODE projects only with BDF"};
       }
       break;
     case Stabilisation::kGgl:
       if (method != DaeMethod::kAuto && method != DaeMethod::kIda) {
-        return std::string("stabilisation ggl needs method ida (or auto), got ") +
-               to_string(method) + ": the GGL form is a DAE with algebraic equations";
+        return FieldError{"stabilisation", -1,
+                          std::string("ggl needs method ida (or auto), got ") + to_string(method) +
+                              ": the GGL form is a DAE with algebraic equations"};
       }
       break;
     default:
-      return "stabilisation " + std::to_string(static_cast<int>(stabilisation)) + " is unknown";
+      return FieldError{"stabilisation", -1,
+                        std::to_string(static_cast<int>(stabilisation)) + " is unknown"};
   }
-  return {};
+  return std::nullopt;
 }
 
 OpenedLoopDaeOptions opened_loop_dae_options(const SimulateOptions& options) {

@@ -18,6 +18,7 @@
 #include "core/fourbar/dynamics.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/simulate.hpp"
+#include "core/input_error.hpp"
 
 namespace bd::core {
 
@@ -73,8 +74,9 @@ struct OpenedLoopDaeOptions {
   /// the integration error (~tolerance), a force-balanced design would show a shaking force of
   /// that size; projected, it vanishes to round-off as on the exact motion.
   bool project_samples = false;
-  /// Empty when valid, else the problem in words.
-  std::string validate() const;
+  /// Empty when valid, else the first problem; its field is "tolerance", "absolute_tolerance",
+  /// "max_steps", "baumgarte_alpha", "baumgarte_beta", "method" or "stabilisation".
+  Problem validate() const;
 };
 
 /// A DAE run: the trajectory (samples with the state, all three accelerations and the reactions

@@ -10,16 +10,17 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "core/fourbar/counter_rotation.hpp"
 #include "core/fourbar/formulation_support.hpp"
-#include "core/input_error.hpp"
 #include "core/fourbar/instant_dynamics.hpp"
-#include "core/integrators.hpp"
 #include "core/fourbar/kinematics.hpp"
-#include "core/number_text.hpp"
 #include "core/fourbar/opened_loop.hpp"
 #include "core/fourbar/opened_loop_dae.hpp"
+#include "core/input_error.hpp"
+#include "core/integrators.hpp"
+#include "core/number_text.hpp"
 
 namespace bd::core {
 
@@ -158,49 +159,51 @@ int dead_centre_root(sunrealtype /*t*/, N_Vector y, sunrealtype* g, void* user_d
   return 0;
 }
 
+// rejects the input: `field` is wrong as `message` says
+[[noreturn]] void reject(std::string field, std::string message) {
+  throw InputError(FieldError{std::move(field), -1, std::move(message)});
+}
+
 void validate(const FreeScene& scene, const SimulateOptions& options) {
-  if (const std::string problem = options.validate(); !problem.empty()) throw InputError(problem);
+  throw_if(options.validate());
   validate_scene(scene);
 }
 
 void validate(const DrivenScene& scene, const SimulateOptions& options) {
-  if (const std::string problem = options.validate(); !problem.empty()) throw InputError(problem);
+  throw_if(options.validate());
   if (!std::isfinite(scene.theta1)) {
-    throw InputError("scene.theta1 must be finite, got " + text::digits(scene.theta1, 10));
+    reject("scene.theta1", "must be finite, got " + text::digits(scene.theta1, 10));
   }
   if (!(scene.omega1 != 0.0) || !std::isfinite(scene.omega1)) {
-    throw InputError("scene.omega1 must be finite and != 0 rad/s, got " +
-                     text::digits(scene.omega1, 10));
+    reject("scene.omega1", "must be finite and != 0 rad/s, got " + text::digits(scene.omega1, 10));
   }
   if (scene.revolutions < 1) {
-    throw InputError("scene.revolutions must be >= 1, got " + std::to_string(scene.revolutions));
+    reject("scene.revolutions", "must be >= 1, got " + std::to_string(scene.revolutions));
   }
   if (scene.samples < 1) {
-    throw InputError("scene.samples must be >= 1, got " + std::to_string(scene.samples));
+    reject("scene.samples", "must be >= 1, got " + std::to_string(scene.samples));
   }
   if (static_cast<long long>(scene.revolutions) * scene.samples > kMaxSamples) {
-    throw InputError("scene.revolutions * scene.samples must be <= 1e8, got " +
-                     std::to_string(static_cast<long long>(scene.revolutions) * scene.samples));
+    // two fields together: the scene as a whole
+    reject("", "scene.revolutions * scene.samples must be <= 1e8, got " +
+                   std::to_string(static_cast<long long>(scene.revolutions) * scene.samples));
   }
 }
 
 }  // namespace
 
-std::string SimulateOptions::validate() const {
-  if (!(tolerance > 0.0 && tolerance < 1.0)) {
-    return "tolerance must be > 0 and < 1, got " + text::digits(tolerance, 10);
+Problem SimulateOptions::validate() const {
+  if (Problem problem = check_integration(tolerance, absolute_tolerance, max_steps)) {
+    return problem;
   }
-  if (!(absolute_tolerance > 0.0) || !std::isfinite(absolute_tolerance)) {
-    return "absolute_tolerance must be > 0, got " + text::digits(absolute_tolerance, 10);
-  }
-  if (max_steps < 1) return "max_steps must be >= 1, got " + std::to_string(max_steps);
   switch (formulation) {
     case Formulation::kMassMatrix:
     case Formulation::kOpenedLoop:
     case Formulation::kComplexMasses:
       break;
     default:
-      return "formulation " + std::to_string(static_cast<int>(formulation)) + " is unknown";
+      return FieldError{"formulation", -1,
+                        std::to_string(static_cast<int>(formulation)) + " is unknown"};
   }
   switch (integrator) {
     case Integrator::kCvodeAdams:
@@ -214,16 +217,18 @@ std::string SimulateOptions::validate() const {
       break;
     case Integrator::kIda:
       if (formulation != Formulation::kOpenedLoop) {
-        return std::string("integrator ida needs formulation opened-loop, got ") +
-               to_string(formulation) +
-               ": IDA integrates the opened loop's DAE, while this formulation is an ODE in "
-               "theta1 (use cvode-adams, cvode-bdf or erk2 ... erk8)";
+        return FieldError{"integrator", -1,
+                          std::string("ida needs formulation opened-loop, got ") +
+                              to_string(formulation) +
+                              ": IDA integrates the opened loop's DAE, while this formulation "
+                              "is an ODE in theta1 (use cvode-adams, cvode-bdf or erk2 ... erk8)"};
       }
       break;
     default:
-      return "integrator " + std::to_string(static_cast<int>(integrator)) + " is unknown";
+      return FieldError{"integrator", -1,
+                        std::to_string(static_cast<int>(integrator)) + " is unknown"};
   }
-  return {};
+  return std::nullopt;
 }
 
 SimulationStatus status_of(DynamicsError::Kind kind) {
@@ -240,17 +245,16 @@ SimulationStatus status_of(DynamicsError::Kind kind) {
 
 void validate_scene(const FreeScene& scene) {
   if (!std::isfinite(scene.theta1)) {
-    throw InputError("scene.theta1 must be finite, got " + text::digits(scene.theta1, 10));
+    reject("scene.theta1", "must be finite, got " + text::digits(scene.theta1, 10));
   }
   if (!std::isfinite(scene.omega1)) {
-    throw InputError("scene.omega1 must be finite, got " + text::digits(scene.omega1, 10));
+    reject("scene.omega1", "must be finite, got " + text::digits(scene.omega1, 10));
   }
   if (!(scene.duration > 0.0) || !std::isfinite(scene.duration)) {
-    throw InputError("scene.duration must be > 0 s, got " + text::digits(scene.duration, 10));
+    reject("scene.duration", "must be > 0 s, got " + text::digits(scene.duration, 10));
   }
   if (scene.samples < 2 || scene.samples > kMaxSamples) {
-    throw InputError("scene.samples must be >= 2 (and <= 1e8), got " +
-                     std::to_string(scene.samples));
+    reject("scene.samples", "must be >= 2 (and <= 1e8), got " + std::to_string(scene.samples));
   }
 }
 

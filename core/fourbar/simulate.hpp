@@ -7,6 +7,7 @@
 
 #include "core/fourbar/dynamics.hpp"
 #include "core/fourbar/model.hpp"
+#include "core/input_error.hpp"
 #include "core/simulation.hpp"
 
 namespace bd::core {
@@ -36,8 +37,10 @@ struct SimulateOptions {
   double tolerance = 1e-10;                         // integrator relative tolerance (free scenes)
   double absolute_tolerance = 1e-12;                // on theta1 [rad] and omega1 [rad/s]
   long max_steps = 1000000;                         // integrator steps over the whole run
-  /// Empty when valid, else the problem in words (e.g. kIda with a reduced formulation).
-  std::string validate() const;
+  /// Empty when valid, else the first problem; its field is "tolerance",
+  /// "absolute_tolerance", "max_steps", "formulation" or "integrator" (e.g. "integrator ida
+  /// needs formulation opened-loop, got mass-matrix: ...").
+  Problem validate() const;
 };
 
 /// The status a run stops with when the dynamics fails with `kind`.
@@ -45,7 +48,8 @@ SimulationStatus status_of(DynamicsError::Kind kind);
 
 /// Checks a free scene (what both free-motion integrators need).
 /// @throws bd::InputError if theta1 or omega1 is not finite, duration is not > 0, or samples is
-///         outside [2, 1e8]; the message names the key, its unit and the value.
+///         outside [2, 1e8]; the message names the key, its unit and the value. Its field is
+///         "scene.theta1", "scene.omega1", "scene.duration" or "scene.samples".
 void validate_scene(const FreeScene& scene);
 
 /// The samples computed, in time order, and why the run stopped. On failure every sample
@@ -69,10 +73,13 @@ struct Trajectory {
 /// GGL form for IDA), every sample projected onto it; it passes through limit positions (the
 /// crank reverses, the branch flips), so a linkage whose crank cannot turn fully moves on
 /// physically.
-/// @throws bd::InputError if the scene or options are invalid (duration <= 0, samples < 2, ...).
+/// @throws bd::InputError if the scene or options are invalid (duration <= 0, samples < 2, ...),
+///         with the field of SimulateOptions::validate() or validate_scene().
 Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
                          const SimulateOptions& options = {});
-/// @throws bd::InputError if the scene or options are invalid (omega1 == 0, revolutions < 1, ...).
+/// @throws bd::InputError if the scene or options are invalid (omega1 == 0, revolutions < 1, ...),
+///         with the field of SimulateOptions::validate() or "scene.theta1", "scene.omega1",
+///         "scene.revolutions", "scene.samples"; none for revolutions * samples above 1e8.
 Trajectory simulate_driven(const FourBar& model, const DrivenScene& scene,
                            const SimulateOptions& options = {});
 

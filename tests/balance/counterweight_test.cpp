@@ -29,12 +29,12 @@
 #include "balance/conditions.hpp"
 #include "core/fourbar/dynamics.hpp"
 #include "core/fourbar/energy.hpp"
-#include "core/input_error.hpp"
 #include "core/fourbar/kinematics.hpp"
 #include "core/fourbar/metrics.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/samples.hpp"
 #include "core/fourbar/simulate.hpp"
+#include "core/input_error.hpp"
 
 namespace bd::balance {
 namespace {
@@ -391,8 +391,9 @@ TEST(ForceBalance, InvalidSpecsAreInputErrors) {
   // the spec's own validate() says the same without the side
   s = {};
   s.mass = 0.0;
-  EXPECT_EQ(s.validate(), "mass must be > 0 kg, got 0");
-  EXPECT_EQ(CounterweightSpec{}.validate(), "");
+  EXPECT_EQ(problem_text(s.validate()), "mass must be > 0 kg, got 0");
+  EXPECT_EQ(s.validate()->field, "mass");
+  EXPECT_EQ(problem_text(CounterweightSpec{}.validate()), "");
 }
 
 }  // namespace
