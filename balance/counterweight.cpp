@@ -1,11 +1,11 @@
 #include "balance/counterweight.hpp"
 
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <numbers>
 
 #include "balance/conditions.hpp"
-#include "core/fourbar/principal_vectors.hpp"
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
 
@@ -13,7 +13,9 @@ namespace bd::balance {
 
 namespace {
 
-using core::Complex;
+// Centre-of-mass offsets s̄ = e + i f and mass moments m s̄ in link axes, in the paper's complex
+// notation (eq. 57); what leaves this file (Counterweight::position) is a Vec2.
+using Complex = std::complex<double>;
 
 // nothing when v is finite and > 0, else "<field> must be > 0 <unit>, got <v>"
 Problem positive(const char* field, const char* unit, double v) {
@@ -39,7 +41,8 @@ Counterweight realise(const CounterweightSpec& spec, Complex moment, double link
     cw.distance = spec.distance ? *spec.distance : link_length;
     cw.mass = needed / cw.distance;
   }
-  cw.position = core::to_vec(cw.distance * direction);
+  const Complex position = cw.distance * direction;
+  cw.position = Vec2(position.real(), position.imag());
   if (disc) {
     cw.radius = spec.radius ? *spec.radius : std::sqrt(cw.mass / area_density);
     cw.thickness = spec.thickness;

@@ -42,9 +42,23 @@
 
 #include <cmath>
 
-#include "core/fourbar/formulation_support.hpp"
+#include "core/detail/complex_vector.hpp"
+#include "core/fourbar/detail/formulation_support.hpp"
 
 namespace bd::core {
+
+// the kernels' types and steps (core/detail/, core/fourbar/detail/)
+using detail::ClosedInstant;
+using detail::Complex;
+using detail::complex_mass_constants;
+using detail::ComplexMassConstants;
+using detail::CrankInput;
+using detail::evaluated;
+using detail::Failure;
+using detail::to_complex;
+using detail::to_vec;
+using detail::Xy;
+using detail::xy;
 
 namespace {
 
@@ -119,6 +133,8 @@ Expected<DynamicsSample, DynamicsError> one_instant(const FourBar& model, double
 
 }  // namespace
 
+namespace detail {
+
 ComplexMassConstants complex_mass_constants(const FourBar& model) {
   const Link &L1 = model.crank, &L2 = model.coupler, &L3 = model.rocker;
   const double m2 = L2.mass;
@@ -151,6 +167,10 @@ ComplexMassConstants complex_mass_constants(const FourBar& model) {
   c.total_mass = total_mass(model);
   return c;
 }
+
+}  // namespace detail
+
+namespace detail {
 
 std::optional<Failure> complex_masses_at(const FourBar& model, const ComplexMassConstants& c,
                                          const ClosedInstant& instant, CrankInput input,
@@ -225,6 +245,8 @@ std::optional<Failure> complex_masses_at(const FourBar& model, const ComplexMass
   return complete_sample(model, Fsh - RA3, RA3, tau, out);
 }
 
+}  // namespace detail
+
 ComplexMassEquations complex_mass_equations(const FourBar& model, const Pose& pose) {
   const LinkVectors l = link_vectors(model, pose);
   return equations(model, complex_mass_constants(model), xy(l.l1), xy(l.l3));
@@ -269,9 +291,9 @@ RotationAboutCentreOfMass rotation_about_centre_of_mass(const FourBar& model, co
   // eq. 40 = eq. 33 minus m_k r̄_S = -m_k (ā14 + ā41 + ā34) (eq. 32); for link 3 with
   // ā41 - l̄4 = ā43. The coupler mass at A1 is m̄2p = m2a - i m2c in all three lines.
   RotationAboutCentreOfMass c;
-  c.c1 = m1 * (a34 + a41) - (e2.mq + m3) * a14 - e2.mp * a12p;
-  c.c2 = (a34 + a41 + a12p) * e2.mp + (a14 + a43 + a32p) * e2.mq;
-  c.c3 = m3 * (a14 + a43) - (m1 + e2.mp) * a34 - e2.mq * a32p;
+  c.c1 = to_vec(m1 * (a34 + a41) - (e2.mq + m3) * a14 - e2.mp * a12p);
+  c.c2 = to_vec((a34 + a41 + a12p) * e2.mp + (a14 + a43 + a32p) * e2.mq);
+  c.c3 = to_vec(m3 * (a14 + a43) - (m1 + e2.mp) * a34 - e2.mq * a32p);
   return c;
 }
 

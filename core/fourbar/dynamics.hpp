@@ -3,7 +3,6 @@
 /// accelerations, the support reactions, the shaking force and moment, and the drive torque.
 #include <string>
 
-#include "core/fourbar/dynamics_constants.hpp"
 #include "core/expected.hpp"
 #include "core/fourbar/kinematics.hpp"
 #include "core/fourbar/model.hpp"
@@ -23,6 +22,14 @@ struct DynamicsSample {
   double Msh{};
   double tau{};  // drive torque on the crank from the frame [N m] (0 in free motion)
 };
+
+/// |sin(theta3 - theta2)| below this counts as a singular (dead-centre) position, and the dynamics
+/// returns kSingular instead of a number. Near a dead centre theta1 is an ill-conditioned input:
+/// the closed loop's angles move like sqrt(theta1 - limit), and every formulation's relative
+/// error is measured to grow like 7.8·eps/sin² (docs/failure-domains.md). At this threshold that
+/// bound is 1.7e-9, so every value returned is good to better than 2e-9; within 0.06° of a dead
+/// centre the tool says "singular" rather than return a number it cannot vouch for.
+inline constexpr double kSingularSin = 1e-3;
 
 /// Why the dynamics could not be evaluated at an instant.
 struct DynamicsError {
@@ -62,21 +69,6 @@ Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model, d
 /// theta1 [rad], omega1 [rad/s], with everything else.
 Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model, double theta1,
                                                          double omega1, double alpha1,
-                                                         Formulation f = Formulation::kMassMatrix);
-
-/// The same two with the model's constants computed once by dynamics_constants(model): what a
-/// loop over many instants of one model calls (a simulation's right-hand side, a sweep). The
-/// results are those of the calls above bit for bit, at 10-30 % less cost (docs/performance.md).
-/// `constants` must come from this `model`. Models with counter-rotations take the one-instant
-/// route.
-Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model,
-                                                         const DynamicsConstants& constants,
-                                                         double theta1, double omega1,
-                                                         Formulation f = Formulation::kMassMatrix);
-Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model,
-                                                         const DynamicsConstants& constants,
-                                                         double theta1, double omega1,
-                                                         double alpha1,
                                                          Formulation f = Formulation::kMassMatrix);
 
 }  // namespace bd::core

@@ -7,9 +7,15 @@
 #include <cstdio>
 #include <limits>
 
-#include "core/fourbar/loop_closure.hpp"
+#include "core/fourbar/detail/loop_closure.hpp"
 
 namespace bd::core {
+
+// the kernels' types and steps (core/detail/, core/fourbar/detail/)
+using detail::close_loop;
+using detail::LoopXy;
+using detail::to_vec2;
+using detail::xy;
 
 namespace {
 

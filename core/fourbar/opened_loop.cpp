@@ -4,10 +4,20 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/fourbar/formulation_support.hpp"
+#include "core/fourbar/detail/formulation_support.hpp"
 #include "core/fourbar/principal_vectors.hpp"
 
 namespace bd::core {
+
+// the kernels' types and steps (core/detail/, core/fourbar/detail/)
+using detail::ClosedInstant;
+using detail::CrankInput;
+using detail::evaluated;
+using detail::Failure;
+using detail::opened_loop_constants;
+using detail::OpenedLoopConstants;
+using detail::Xy;
+using detail::xy;
 
 namespace {
 
@@ -181,6 +191,8 @@ Expected<DynamicsSample, DynamicsError> one_instant(const FourBar& model, double
 
 }  // namespace
 
+namespace detail {
+
 OpenedLoopConstants opened_loop_constants(const FourBar& model) {
   const Link &L1 = model.crank, &L2 = model.coupler, &L3 = model.rocker;
   const double m1 = L1.mass, m2 = L2.mass, m3 = L3.mass, mt = m1 + m2 + m3;
@@ -219,6 +231,8 @@ OpenedLoopConstants opened_loop_constants(const FourBar& model) {
   return c;
 }
 
+}  // namespace detail
+
 OpenedLoopTerms opened_loop_terms(const FourBar& model, const Pose& pose) {
   const LinkVectors v = link_vectors(model, pose);
   const Terms t = terms(opened_loop_constants(model), model, {{xy(v.l1), xy(v.l2), xy(v.l3)}});
@@ -237,11 +251,15 @@ OpenedLoopTerms opened_loop_terms(const FourBar& model, const Pose& pose) {
   return out;
 }
 
+namespace detail {
+
 std::optional<Failure> opened_loop_at(const FourBar& model, const OpenedLoopConstants& c,
                                       const ClosedInstant& instant, CrankInput input,
                                       DynamicsSample& out) {
   return solve(c, model, instant.state, links_of(model, instant.state), input, Xy{}, out);
 }
+
+}  // namespace detail
 
 Expected<DynamicsSample, DynamicsError> forward_dynamics_opened_loop(const FourBar& model,
                                                                      double theta1, double omega1) {

@@ -10,8 +10,8 @@
 #include <optional>
 #include <string>
 
+#include "core/fourbar/detail/formulation_support.hpp"
 #include "core/fourbar/energy.hpp"
-#include "core/fourbar/formulation_support.hpp"
 #include "core/fourbar/kinematics.hpp"
 #include "core/fourbar/opened_loop.hpp"
 #include "core/input_error.hpp"
@@ -19,6 +19,9 @@
 #include "core/number_text.hpp"
 
 namespace bd::core {
+
+// the kernels' types and steps (core/detail/, core/fourbar/detail/)
+using detail::nonsingular_pose;
 
 namespace {
 

@@ -13,8 +13,8 @@
 #include <utility>
 
 #include "core/fourbar/counter_rotation.hpp"
-#include "core/fourbar/formulation_support.hpp"
-#include "core/fourbar/instant_dynamics.hpp"
+#include "core/fourbar/detail/formulation_support.hpp"
+#include "core/fourbar/detail/instant_dynamics.hpp"
 #include "core/fourbar/kinematics.hpp"
 #include "core/fourbar/opened_loop.hpp"
 #include "core/fourbar/opened_loop_dae.hpp"
@@ -23,6 +23,16 @@
 #include "core/number_text.hpp"
 
 namespace bd::core {
+
+// the kernels' types and steps (core/detail/, core/fourbar/detail/)
+using detail::close_instant;
+using detail::ClosedInstant;
+using detail::CrankInput;
+using detail::CrankSweep;
+using detail::dynamics_at;
+using detail::dynamics_constants;
+using detail::DynamicsConstants;
+using detail::Failure;
 
 namespace {
 
