@@ -94,6 +94,13 @@ class Integration {
 
  private:
   enum class Package { kCvode, kArkode, kIda };
+  // the constructor's steps for each package, after the context, y_ and atol_
+  void set_up_cvode(const Problem& p);
+  void set_up_arkode(const Problem& p);
+  void set_up_ida(const Problem& p);
+  // the dense matrix and linear solver of BDF and IDA's Newton iterations
+  void set_up_dense_solver(const Problem& p);
+
   Package package_;
   bool stop_at_outputs_;
   long max_steps_;

@@ -14,6 +14,7 @@
 
 #include "core/fourbar/counter_rotation.hpp"
 #include "core/fourbar/detail/formulation_support.hpp"
+#include "core/fourbar/detail/free_motion.hpp"
 #include "core/fourbar/detail/instant_dynamics.hpp"
 #include "core/fourbar/kinematics.hpp"
 #include "core/fourbar/opened_loop.hpp"
@@ -33,6 +34,8 @@ using detail::dynamics_at;
 using detail::dynamics_constants;
 using detail::DynamicsConstants;
 using detail::Failure;
+using detail::integrator_stopped;
+using detail::output_time;
 
 namespace {
 
@@ -268,33 +271,118 @@ void validate_scene(const FreeScene& scene) {
   }
 }
 
+namespace {
+
+// Formulation::kOpenedLoop: the opened loop's own form, the DAE in theta1..theta3, kept on the
+// loop closure as the integrator allows (opened_loop_dae_options); it has no singularity at a
+// crank limit position and passes through it.
+Trajectory simulate_free_opened_loop(const FourBar& model, const FreeScene& scene,
+                                     const SimulateOptions& options) {
+  const OpenedLoopDaeOptions dae = opened_loop_dae_options(options);
+  if (!has_counter_rotations(model)) {
+    return simulate_opened_loop_dae(model, scene, dae).trajectory;
+  }
+  // discs: the motion from the equations with I_k + J_k, then each sample's reactions from the
+  // bare linkage loaded by the mesh forces at the sample's own state (core/counter_rotation.hpp)
+  Trajectory out = simulate_opened_loop_dae(with_disc_inertia(model), scene, dae).trajectory;
+  for (std::size_t i = 0; i < out.samples.size(); ++i) {
+    const FourBarState& s = out.samples[i].state;
+    const MeshForces f = mesh_forces(model, s);
+    const auto bare = forward_dynamics_opened_loop(with_mesh_loads(model, s, f), s);
+    if (!bare) {  // cannot happen where the DAE itself evaluated; keep what came before
+      fail(out, bare.error(), out.t[i], s.theta1);
+      out.t.resize(i);
+      out.samples.resize(i);
+      break;
+    }
+    out.samples[i] = with_shaft_reactions(model, *bare, f);
+  }
+  return out;
+}
+
+// The integration of the reduced equation y = (theta1, omega1) from the scene's start.
+//
+// Method: options.integrator (docs/performance.md compares them). The crank equation is a
+// smooth, non-stiff ODE of two states (its Jacobian has the eigenvalues of a slow oscillator,
+// |lambda| ~ |omega1| + sqrt|d alpha1/d theta1|), solved at tight tolerances (1e-10): the
+// default, variable-order Adams-Moulton (orders 1-12) with a fixed-point corrector, reaches
+// them with few steps and no Jacobian; BDF (orders <= 5, Newton) and the explicit
+// Runge-Kutta pairs are there to be compared. Every one of them locates a dead centre by
+// root finding on |sin(theta3 - theta2)|, registered only where the coupler and rocker can
+// align: in a crank-rocker or double crank |A1A3| stays strictly between |l2 - l3| and
+// l2 + l3 at every crank angle, and there the root checks would only cost (an ERK pair's
+// Hermite dense output evaluates the dynamics for each check).
+integrators::Problem reduced_problem(const FourBar& model, const FreeScene& scene,
+                                     const SimulateOptions& options, FreeMotion& motion) {
+  integrators::Problem problem;
+  problem.integrator = options.integrator;
+  problem.y0 = {scene.theta1, scene.omega1};
+  problem.absolute_tolerance = {options.absolute_tolerance,   // theta1 [rad]
+                                options.absolute_tolerance};  // omega1 [rad/s]
+  problem.tolerance = options.tolerance;
+  problem.t_end = scene.duration;
+  problem.max_steps = options.max_steps;
+  problem.user_data = &motion;
+  problem.rhs = free_rhs;
+  const GrashofClass grashof = classify_grashof(model);
+  if (grashof != GrashofClass::kCrankRocker && grashof != GrashofClass::kDoubleCrank) {
+    problem.root = dead_centre_root;
+  }
+  return problem;
+}
+
+// True, with the trajectory's status and message set, when the integration stopped before
+// t_out: out of steps, failed, or at a limit position found by the root function; false when it
+// reached t_out (the state there is the next sample's).
+bool stopped_short(integrators::Integration::Outcome outcome,
+                   const integrators::Integration& integration, const FreeMotion& motion,
+                   const SimulateOptions& options, Trajectory& out) {
+  using Outcome = integrators::Integration::Outcome;
+  const double t_reached = integration.t();
+  const double theta1 = integration.y()[0];
+  switch (outcome) {
+    case Outcome::kReached:
+      return false;
+    case Outcome::kMaxSteps:
+      integrator_stopped(out, integration, outcome, options.max_steps);
+      return true;
+    case Outcome::kFailed:
+      if (motion.rhs_failed && motion.error.kind != DynamicsError::Kind::kNonFinite) {
+        // a trial step went into a dead centre or beyond it, where the loop cannot close, and
+        // the integrator could not step around it (ERKStep cannot retry): in free motion from
+        // an assembled start that is the crank reaching a limit position
+        out.status = SimulationStatus::kSingular;
+        out.message = "limit position reached after t = " + text::digits(t_reached, 10) +
+                      " s, theta1 = " + text::digits(theta1, 10) +
+                      " rad: the crank reaches a limit position within the integrator's next "
+                      "step (a trial step found: " +
+                      motion.error.what() + ")";
+      } else if (motion.rhs_failed) {
+        // the dynamics failed ahead of the last step and the integrator could not step around it
+        fail(out, motion.error, motion.error_t, motion.error_theta1);
+        out.message += "; integration stopped at t = " + text::digits(t_reached, 10) + " s";
+      } else {
+        integrator_stopped(out, integration, outcome, options.max_steps);
+      }
+      return true;
+    case Outcome::kRoot: {
+      // the crank reached a limit position before t_out: stop there
+      const auto pose = solve_position(*motion.model, theta1);
+      const double sin_mu = pose ? std::sin(pose->theta3 - pose->theta2) : 0.0;
+      fail(out, dead_centre_error(theta1, sin_mu), t_reached, theta1);
+      return true;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
                          const SimulateOptions& options) {
   validate(scene, options);
   if (options.formulation == Formulation::kOpenedLoop) {
-    // the opened loop's own form: the DAE in theta1..theta3, kept on the loop closure as the
-    // integrator allows (opened_loop_dae_options); it has no singularity at a crank limit
-    // position and passes through it
-    const OpenedLoopDaeOptions dae = opened_loop_dae_options(options);
-    if (!has_counter_rotations(model)) {
-      return simulate_opened_loop_dae(model, scene, dae).trajectory;
-    }
-    // discs: the motion from the equations with I_k + J_k, then each sample's reactions from the
-    // bare linkage loaded by the mesh forces at the sample's own state (core/counter_rotation.hpp)
-    Trajectory out = simulate_opened_loop_dae(with_disc_inertia(model), scene, dae).trajectory;
-    for (std::size_t i = 0; i < out.samples.size(); ++i) {
-      const FourBarState& s = out.samples[i].state;
-      const MeshForces f = mesh_forces(model, s);
-      const auto bare = forward_dynamics_opened_loop(with_mesh_loads(model, s, f), s);
-      if (!bare) {  // cannot happen where the DAE itself evaluated; keep what came before
-        fail(out, bare.error(), out.t[i], s.theta1);
-        out.t.resize(i);
-        out.samples.resize(i);
-        break;
-      }
-      out.samples[i] = with_shaft_reactions(model, *bare, f);
-    }
-    return out;
+    return simulate_free_opened_loop(model, scene, options);
   }
   const auto samples = static_cast<std::size_t>(scene.samples);
   Trajectory out;
@@ -316,80 +404,17 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
   out.t.push_back(0.0);
   out.samples.push_back(*first);
 
-  // Method: options.integrator (docs/performance.md compares them). The crank equation is a
-  // smooth, non-stiff ODE of two states (its Jacobian has the eigenvalues of a slow oscillator,
-  // |lambda| ~ |omega1| + sqrt|d alpha1/d theta1|), solved at tight tolerances (1e-10): the
-  // default, variable-order Adams-Moulton (orders 1-12) with a fixed-point corrector, reaches
-  // them with few steps and no Jacobian; BDF (orders <= 5, Newton) and the explicit
-  // Runge-Kutta pairs are there to be compared. Every one of them locates a dead centre by
-  // root finding on |sin(theta3 - theta2)|, registered only where the coupler and rocker can
-  // align: in a crank-rocker or double crank |A1A3| stays strictly between |l2 - l3| and
-  // l2 + l3 at every crank angle, and there the root checks would only cost (an ERK pair's
-  // Hermite dense output evaluates the dynamics for each check).
-  integrators::Problem problem;
-  problem.integrator = options.integrator;
-  problem.y0 = {scene.theta1, scene.omega1};
-  problem.absolute_tolerance = {options.absolute_tolerance,   // theta1 [rad]
-                                options.absolute_tolerance};  // omega1 [rad/s]
-  problem.tolerance = options.tolerance;
-  problem.t_end = scene.duration;
-  problem.max_steps = options.max_steps;
-  problem.user_data = &motion;
-  problem.rhs = free_rhs;
-  const GrashofClass grashof = classify_grashof(model);
-  if (grashof != GrashofClass::kCrankRocker && grashof != GrashofClass::kDoubleCrank) {
-    problem.root = dead_centre_root;
-  }
-  integrators::Integration integration(problem);
-
   // each output by the integrator's dense output, then the dynamics at that state
+  integrators::Integration integration(reduced_problem(model, scene, options, motion));
   out.status = SimulationStatus::kCompleted;
   out.message = "completed";
-  const double last = static_cast<double>(samples - 1);
   for (std::size_t j = 1; j < samples; ++j) {
-    const double t_out =
-        j + 1 == samples ? scene.duration : scene.duration * static_cast<double>(j) / last;
     motion.rhs_failed = false;
-    const auto outcome = integration.advance(t_out);
+    const auto outcome = integration.advance(output_time(scene, j));
+    if (stopped_short(outcome, integration, motion, options, out)) break;
+
     const double t_reached = integration.t();
     const double theta1 = integration.y()[0], omega1 = integration.y()[1];
-    if (outcome == integrators::Integration::Outcome::kMaxSteps) {
-      out.status = SimulationStatus::kIntegratorFailed;
-      out.message = "integrator stopped at t = " + text::digits(t_reached, 10) +
-                    " s, theta1 = " + text::digits(theta1, 10) +
-                    " rad: max_steps = " + std::to_string(options.max_steps) + " reached";
-      break;
-    }
-    if (outcome == integrators::Integration::Outcome::kFailed) {
-      if (motion.rhs_failed && motion.error.kind != DynamicsError::Kind::kNonFinite) {
-        // a trial step went into a dead centre or beyond it, where the loop cannot close, and
-        // the integrator could not step around it (ERKStep cannot retry): in free motion from
-        // an assembled start that is the crank reaching a limit position
-        out.status = SimulationStatus::kSingular;
-        out.message = "limit position reached after t = " + text::digits(t_reached, 10) +
-                      " s, theta1 = " + text::digits(theta1, 10) +
-                      " rad: the crank reaches a limit position within the integrator's next "
-                      "step (a trial step found: " +
-                      motion.error.what() + ")";
-      } else if (motion.rhs_failed) {
-        // the dynamics failed ahead of the last step and the integrator could not step around it
-        fail(out, motion.error, motion.error_t, motion.error_theta1);
-        out.message += "; integration stopped at t = " + text::digits(t_reached, 10) + " s";
-      } else {
-        out.status = SimulationStatus::kIntegratorFailed;
-        out.message = "integrator failed at t = " + text::digits(t_reached, 10) +
-                      " s, theta1 = " + text::digits(theta1, 10) + " rad: " + integration.failure();
-      }
-      break;
-    }
-    if (outcome == integrators::Integration::Outcome::kRoot) {
-      // the crank reached a limit position before t_out: stop there
-      const auto pose = solve_position(model, theta1);
-      const double sin_mu = pose ? std::sin(pose->theta3 - pose->theta2) : 0.0;
-      fail(out, dead_centre_error(theta1, sin_mu), t_reached, theta1);
-      break;
-    }
-
     ++motion.evaluations;
     auto sample = forward_dynamics(model, theta1, omega1, options.formulation);
     if (!sample || at_dead_centre(*sample, kDeadCentreSin, motion.error)) {
