@@ -70,9 +70,9 @@ ARKODE_ERKTableID erk_table(Integrator integrator) {
 // The table of an ERK integrator. SUNDIALS before 6.6 takes every table whose last node c_s is 1
 // for "first same as last" (FSAL) and reuses its last stage's f as f(y_{n+1}) (llnl/sundials
 // issue #311, fixed in 6.6.0). For the tables where that is false (Heun-Euler 2(1), Verner 6(5),
-// Fehlberg 8(7)) the next step then starts from a wrong slope: Verner 6(5) converges at order 3
-// (measured with fixed steps on a pendulum: errors 9.0e-6, 1.2e-6, 1.5e-7 for h = 0.1, 0.05,
-// 0.025 s; the same table in a plain Runge-Kutta loop gives order 6). Such a table gets one more
+// Fehlberg 8(7)) the next step then starts from a wrong slope: with fixed steps Verner 6(5)
+// converges at order 3, while the same table in a plain Runge-Kutta loop gives order 6
+// (tests/core/integrators_test.cpp checks every pair's order). Such a table gets one more
 // stage, y_{n+1} itself (row b, node 1, weight 0), which makes it FSAL in truth: the same method
 // at the same cost (s right-hand sides per step, f(y_{n+1}) computed once).
 ARKodeButcherTable erk_butcher_table(Integrator integrator) {

@@ -81,8 +81,8 @@ class Integration {
   /// True for the ERK pairs of order 6 and 8, whose steps always end at the output instants:
   /// ARKODE's Hermite interpolant has degree at most 5 and needs the right-hand side at interior
   /// points; between the long steps of these methods it is far less accurate than the steps
-  /// (paper example at tolerance 1e-10: 1.2e-6 rad (order 8) and 1.2e-8 rad (order 6) at the
-  /// samples against 1e-10 rad at the step ends), and costs four right-hand sides per output.
+  /// (by orders of magnitude on the paper example, docs/performance.md), and costs four
+  /// right-hand sides per output.
   bool stops_at_outputs() const { return stop_at_outputs_; }
 
   double t() const { return t_; }  // time reached [s]

@@ -11,9 +11,9 @@
 /// A Vec2 built from two scalars (Vec2(x, y), perp(v), a complex product) is stored as two
 /// 8-byte halves, and a 16-byte load of it right after cannot be forwarded from the store
 /// buffer: the load waits until the stores have left it, which serialises the pipeline. In the
-/// loop closure alone this made one solve 3.4 times slower (30 ns against 8.7 ns, measured on
-/// |l̄23|² = l̄23.squaredNorm()). Xy keeps the components in registers and costs nothing to
-/// convert: read a Vec2's x() and y(), write a Vec2 from two doubles.
+/// loop closure alone this made one solve several times slower (docs/performance.md). Xy keeps the
+/// components in registers and costs nothing to convert: read a Vec2's x() and y(), write a Vec2
+/// from two doubles.
 ///
 /// Operations are written out in the same order as types.hpp's cross() and Eigen's dot(), so a
 /// formula gives the same bits with either type.

@@ -1,7 +1,7 @@
 // The closed loop with complex equivalent masses (paper §4.1).
 //
 // Notation. Planar vectors are complex numbers; ⟨x̄, ȳ⟩ = Re(x̄* ȳ) (§2.1), so ⟨i x̄, ȳ⟩ = x̄ × ȳ.
-// In the per-instant code they are Xy (core/xy.hpp): x̄ ȳ is cmul(x, y), x̄* ȳ cmul_conj.
+// In the per-instant code they are Xy (core/detail/xy.hpp): x̄ ȳ is cmul(x, y), x̄* ȳ cmul_conj.
 // Link k has the complex masses m̄kp = m_k (1 - s̄k/lk) at its first joint and m̄kq = m_k s̄k/lk at
 // its second (eq. 29); for the coupler m̄2p = m2a - i m2c at A1 and m̄2q = m2b + i m2c at A2.
 // With A0 = 0 and A2 = A3 - l̄3 the mass centres, times their masses, are (eq. 33)
@@ -79,8 +79,8 @@ Complex com_offset(const Link& l) { return {l.e, l.f}; }
 // the coupler's complex masses per unit mass on their lever arms, p = m̄2p l̄1/m2 =
 // (1 - s̄2/l2) l̄1 at A1 and q = m̄2q l̄3/m2 = (s̄2/l2) l̄3 at A2 (c.w2 = s̄2/l2), eqs. 37-39 print
 // |m̄2p|²/m2, <m̄2p l̄1, m̄2q l̄3>/m2, ...; written with these unit-mass weights they are the same
-// numbers without the division, which loses accuracy when m2 is subnormal (measured: 25 % at
-// m2 = 4.9e-324 kg). The pose enters only through ζ13 = conj(l̄1) l̄3 = (l̄1·l̄3, l̄1 × l̄3):
+// numbers without the division, which loses accuracy when m2 is subnormal
+// (docs/failure-domains.md). The pose enters only through ζ13 = conj(l̄1) l̄3 = (l̄1·l̄3, l̄1 × l̄3):
 // m2 conj(p) q = kappa ζ13 with the constant kappa = m2 conj(1 - s̄2/l2) s̄2/l2.
 ComplexMassEquations equations(const FourBar& model, const ComplexMassConstants& c, const Xy& l1,
                                const Xy& l3) {
@@ -220,7 +220,7 @@ std::optional<Failure> complex_masses_at(const FourBar& model, const ComplexMass
   // (b) rotation about S: eq. 40 gives each centre of mass's lever c̄_k about S times m_k; the
   // virtual work uses c̄_k/m_k = r̄_k - r̄_S (the rigid-rotation identity the corrected eq. 40
   // satisfies, tested). Taken directly, it divides by no mass; c̄_k/m_k would lose
-  // ~eps·m_tot/m_k at a small m_k (measured: 56 % at m1 = 1e-16 kg). It gives R_A3y.
+  // ~eps·m_tot/m_k at a small m_k (docs/failure-domains.md). It gives R_A3y.
   const Xy rS = -(cmul(c.a14, instant.l1) + c.a41 + cmul(c.a34, instant.l3));
   double W_S = tau + model.loads.crank.moment - model.crank.inertia * s.alpha1 +
                model.loads.coupler.moment - I2 * s.alpha2 + model.loads.rocker.moment -

@@ -10,7 +10,9 @@
 
 namespace bd::core {
 
-/// Everything the dynamics gives at one instant (DESIGN.md conventions).
+/// Everything the dynamics gives at one instant, in the paper's conventions: SI units, angles in
+/// radians from the frame line A0→A3, and every reaction the force of the mechanism ON the
+/// ground.
 struct DynamicsSample {
   FourBarState state;  // angles [rad], rates [rad/s], accelerations [rad/s^2]
   Vec2 RA0{0, 0};      // force of the mechanism ON the ground at A0 [N]
@@ -26,9 +28,9 @@ struct DynamicsSample {
 /// |sin(theta3 - theta2)| below this counts as a singular (dead-centre) position, and the dynamics
 /// returns kSingular instead of a number. Near a dead centre theta1 is an ill-conditioned input:
 /// the closed loop's angles move like sqrt(theta1 - limit), and every formulation's relative
-/// error is measured to grow like 7.8·eps/sin² (docs/failure-domains.md). At this threshold that
-/// bound is 1.7e-9, so every value returned is good to better than 2e-9; within 0.06° of a dead
-/// centre the tool says "singular" rather than return a number it cannot vouch for.
+/// error grows like eps/sin² (docs/failure-domains.md measures the factor and derives this
+/// threshold from it), so every value returned is good to better than 2e-9; within 0.06° of a
+/// dead centre the tool says "singular" rather than return a number it cannot vouch for.
 inline constexpr double kSingularSin = 1e-3;
 
 /// Why the dynamics could not be evaluated at an instant.
@@ -45,7 +47,8 @@ struct DynamicsError {
   std::string what() const;
 };
 
-/// The formulations of the equations of motion (DESIGN.md "Formulations").
+/// The formulations of the equations of motion: three exact routes to the same dynamics, which
+/// agree to round-off with each other and with the Newton–Euler referee of the tests.
 enum class Formulation {
   kMassMatrix,     // constant equivalent mass matrix / truss element (paper §4.2)
   kOpenedLoop,     // opened kinematic loop with principal vectors, 5x5 solve (paper §3)
@@ -59,7 +62,7 @@ inline constexpr Formulation kFormulations[] = {Formulation::kMassMatrix, Formul
 
 /// Forward dynamics (free motion, tau = 0): the crank acceleration and everything else for crank
 /// angle theta1 [rad] and rate omega1 [rad/s] under the model's loads, with the model's
-/// counter-rotations (core/counter_rotation.hpp). The formulations' own entry points
+/// counter-rotations (core/fourbar/counter_rotation.hpp). The formulations' own entry points
 /// (forward_dynamics_mass_matrix, ...) model the bare linkage and ignore counter-rotations.
 Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model, double theta1,
                                                          double omega1,

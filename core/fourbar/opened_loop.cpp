@@ -207,10 +207,10 @@ OpenedLoopConstants opened_loop_constants(const FourBar& model) {
   // eq. 25 with F̄k = applied force + m_k ḡ. The paper prints the moments in principal vectors
   // divided by a mass ((m2+m3)/m1 <i ā12, F̄1>, (m1+m2)/m2 <i ā21, F̄2> + m3/m2 <i ā23, F̄2>,
   // m_tot/m3 <i ā32, F̄3>); those quotients are differences of O(m_tot) terms that are O(m_k),
-  // so at a small mass they lose ~eps·m_tot/m_k (measured: 8e-7 at m2 = 1e-8 kg,
-  // docs/failure-domains.md). Here the same moments, m_k r̄_k - m_k r̄_joint = m_k s̄_k l̄_k/l_k
-  // divided through exactly: <i s̄_k l̄_k/l_k, F̄k> = l̄_k × conj(s̄_k/l_k) F̄k, which divide by no
-  // mass; the forces on the links beyond act at the second joint, l̄_k × F̄.
+  // so at a small mass they lose ~eps·m_tot/m_k (docs/failure-domains.md). Here the same moments,
+  // m_k r̄_k - m_k r̄_joint = m_k s̄_k l̄_k/l_k divided through exactly: <i s̄_k l̄_k/l_k, F̄k> = l̄_k ×
+  // conj(s̄_k/l_k) F̄k, which divide by no mass; the forces on the links beyond act at the second
+  // joint, l̄_k × F̄.
   const Xy F1 = xy(model.loads.crank.force + m1 * model.loads.gravity);
   const Xy F2 = xy(model.loads.coupler.force + m2 * model.loads.gravity);
   const Xy F3 = xy(model.loads.rocker.force + m3 * model.loads.gravity);

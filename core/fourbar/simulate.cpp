@@ -283,7 +283,8 @@ Trajectory simulate_free_opened_loop(const FourBar& model, const FreeScene& scen
     return simulate_opened_loop_dae(model, scene, dae).trajectory;
   }
   // discs: the motion from the equations with I_k + J_k, then each sample's reactions from the
-  // bare linkage loaded by the mesh forces at the sample's own state (core/counter_rotation.hpp)
+  // bare linkage loaded by the mesh forces at the sample's own state
+  // (core/fourbar/counter_rotation.hpp)
   Trajectory out = simulate_opened_loop_dae(with_disc_inertia(model), scene, dae).trajectory;
   for (std::size_t i = 0; i < out.samples.size(); ++i) {
     const FourBarState& s = out.samples[i].state;
@@ -459,7 +460,8 @@ Trajectory simulate_driven(const FourBar& model, const DrivenScene& scene,
   out.message = "completed";
   // The model's constants once; the crank vector turned from sample to sample (CrankSweep); each
   // sample computed in its place in the trajectory by the inline kernels of
-  // core/instant_dynamics.hpp (a model with counter-rotations takes the one-instant route).
+  // core/fourbar/detail/instant_dynamics.hpp (a model with counter-rotations takes the one-instant
+  // route).
   const DynamicsConstants constants = dynamics_constants(model);
   CrankSweep crank(model.crank.length);
   // samples at most kMaxUnwrapStep apart in theta1 (the usual case) need no intermediate

@@ -68,7 +68,7 @@ struct Trajectory {
 /// by options.integrator (any but kIda); it stops (kSingular) where the crank reaches a limit
 /// position, located by root finding (or, for an ERK pair, where a trial step goes beyond it).
 /// With kOpenedLoop the opened loop's DAE in theta1..theta3 is integrated, kept on the loop
-/// closure by the means the integrator allows (core/opened_loop_dae.hpp,
+/// closure by the means the integrator allows (core/fourbar/opened_loop_dae.hpp,
 /// opened_loop_dae_options(): Baumgarte for Adams and the ERK pairs, projection for BDF, the
 /// GGL form for IDA), every sample projected onto it; it passes through limit positions (the
 /// crank reverses, the branch flips), so a linkage whose crank cannot turn fully moves on

@@ -187,7 +187,7 @@ TEST(ComplexMasses, MassMatrixIsSymmetricWithThePaperStructure) {
 }
 
 // ½ θ̇ᵀ M θ̇ with θ̇ = (ω1, ω2, ω3) on a closed state is the kinetic energy computed link by link
-// from the mass-centre velocities (core/energy.hpp), which shares no code with eq. 37.
+// from the mass-centre velocities (core/fourbar/energy.hpp), which shares no code with eq. 37.
 TEST(ComplexMasses, MassMatrixGivesTheKineticEnergy) {
   std::mt19937_64 rng(32);
   for (int i = 0; i < 200; ++i) {

@@ -88,7 +88,7 @@ TEST(DynamicsConstants, OverloadsWithConstantsGiveTheOneInstantResultsBitForBit)
 
 TEST(DynamicsConstants, MassMatrixBlocksAreTheAssembledMatrix) {
   // d1, d2 and w1..w3 are the blocks of eq. 48's M and eq. 53's Mr: M = [d1 1, W2; W2ᵀ, d2 1]
-  // with W v = w ⊗ v, and Mr = [W1, 0; 0, W3ᵀ] (core/dynamics_constants.hpp)
+  // with W v = w ⊗ v, and Mr = [W1, 0; 0, W3ᵀ] (core/fourbar/detail/dynamics_constants.hpp)
   std::mt19937_64 rng(32);
   for (int i = 0; i < 10; ++i) {
     const FourBar model = samples::random_crank_rocker(rng);

@@ -7,7 +7,7 @@
 //   d = 1e-1 .. 1e-15 rad; the shared position stage (eps / d, d ~ sin² mu) dominates. We
 //   assert 50 eps / sin² mu, a margin of 6 over the worst measured.
 // - away from singular positions the formulations agree with the reference to ~1e-13
-//   relative; 1e-10 is the project's agreement tolerance (STYLE.md).
+//   relative; 1e-10 is the tolerance to which the project's formulations must agree.
 // - near a limit the product answers only above |sin mu| = 1e-3 (kSingularSin), where the
 //   bound is < 1.2e-8; below it every formulation says kSingular.
 // - vanishing masses: no formulation divides by a link mass (the principal-vector quotients

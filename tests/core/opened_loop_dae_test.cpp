@@ -1,7 +1,7 @@
-// The opened-loop DAE integrated over time (core/opened_loop_dae.hpp): drift of the loop closure
-// over 100 s without stabilisation, with Baumgarte and with projection; energy drift; agreement
-// with the reduced-equation simulation; and a non-Grashof triple rocker integrated straight
-// through its limit positions, where the reduced equation is singular.
+// The opened-loop DAE integrated over time (core/fourbar/opened_loop_dae.hpp): drift of the loop
+// closure over 100 s without stabilisation, with Baumgarte and with projection; energy drift;
+// agreement with the reduced-equation simulation; and a non-Grashof triple rocker integrated
+// straight through its limit positions, where the reduced equation is singular.
 //
 // The bounds below are the measured values (written next to each, for tolerance 1e-10, absolute
 // 1e-12, the default options) with a margin of about ten: enough for another compiler or libm,

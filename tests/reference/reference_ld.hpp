@@ -22,7 +22,8 @@ struct RefPose {
   T sin_mu{};  // sin(theta3 - theta2) [-]
 };
 
-/// Everything at one instant (DESIGN.md conventions: reactions are forces ON the ground).
+/// Everything at one instant (core::DynamicsSample's conventions: reactions are forces ON the
+/// ground).
 template <class T>
 struct RefSample {
   RefPose<T> pose;

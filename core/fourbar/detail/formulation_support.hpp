@@ -11,8 +11,7 @@
 /// shows directly.
 /// - The per-instant stages are inline, so a loop over instants compiles an evaluation as one
 ///   piece; calls across translation units that passed the instant's kinematics through memory
-///   cost ~20 % (forward evaluation 129 ns against 106 ns once the rates and the acceleration
-///   bias were inline).
+///   cost a good share of an evaluation.
 /// - They compute in plain doubles (Xy, core/detail/xy.hpp says why not Vec2), fill their results
 ///   field by field into the caller's objects, and report failure as a small value (Failure):
 ///   results passed as whole structs are written as doubles and copied by the compiler in
