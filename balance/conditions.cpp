@@ -10,10 +10,10 @@ namespace bd::balance {
 
 namespace {
 
-using core::Complex;
-
 // s̄_k / l_k
-Complex relative_com(const core::Link& l) { return Complex(l.e, l.f) / l.length; }
+ComplexCoefficient relative_com(const core::Link& l) {
+  return ComplexCoefficient(l.e, l.f) / l.length;
+}
 
 Condition make_condition(std::string name, std::string meaning, double residual, double scale,
                          std::string unit, double relative_tolerance) {
@@ -46,8 +46,8 @@ ForceBalanceScales force_balance_scales(const core::FourBar& model) {
   // the larger of the masses involved and the sum of the terms' magnitudes, which bounds the
   // round-off of the sum
   const double m1 = model.crank.mass, m2 = model.coupler.mass, m3 = model.rocker.mass;
-  const Complex s1 = relative_com(model.crank), s2 = relative_com(model.coupler),
-                s3 = relative_com(model.rocker);
+  const ComplexCoefficient s1 = relative_com(model.crank), s2 = relative_com(model.coupler),
+                           s3 = relative_com(model.rocker);
   return {std::max(m1 + m2, std::abs(m1 * s1) + std::abs(m2 * (1.0 - s2))),
           std::max(m2 + m3, std::abs(m2 * s2) + std::abs(m3 * (1.0 - s3)))};
 }

@@ -6,14 +6,15 @@
 
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/principal_vectors.hpp"
+#include "core/types.hpp"
 
 namespace bd::balance {
 
 /// Eq. 57 as complex residuals [kg]; both zero iff the frame principal vectors ā14 = ā34 = 0, so
 /// the centre of mass S stays still and the shaking force vanishes for every motion.
 struct ForceBalanceResiduals {
-  core::Complex crank;   // m1 s̄1/l1 + m2 (1 - s̄2/l2): equivalent mass left at A1 [kg]
-  core::Complex rocker;  // m2 s̄2/l2 + m3 (1 - s̄3/l3): equivalent mass left at A2 [kg]
+  ComplexMass crank;   // m1 s̄1/l1 + m2 (1 - s̄2/l2): equivalent mass left at A1 [kg]
+  ComplexMass rocker;  // m2 s̄2/l2 + m3 (1 - s̄3/l3): equivalent mass left at A2 [kg]
 };
 ForceBalanceResiduals force_balance_residuals(const core::FourBar& model);
 /// What each residual of eq. 57 is measured against [kg]: the larger of the two masses involved

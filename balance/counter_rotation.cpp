@@ -28,7 +28,8 @@ MomentBalancedDesign moment_balance(const core::FourBar& force_balanced, Vec2 cr
   const BalanceReport report = check_balance(checked, kInputTolerance);
   for (const Condition& c : report.force) {
     if (!c.holds) {
-      throw InputError("moment_balance needs a force-balanced design: " + describe(c));
+      throw InputError(
+          FieldError{"", -1, "moment_balance needs a force-balanced design: " + describe(c)});
     }
   }
   const core::Link& coupler = checked.coupler;
@@ -37,7 +38,8 @@ MomentBalancedDesign moment_balance(const core::FourBar& force_balanced, Vec2 cr
     const std::string values = fmt::sprintf(
         "; got f2 = %.17g m, I2 = %.17g kg m^2, m2 e2 (l2 - e2) = %.17g kg m^2", coupler.f,
         coupler.inertia, coupler.mass * coupler.e * (coupler.length - coupler.e));
-    throw InputError("moment_balance needs a Berkof coupler: " + describe(c) + values);
+    throw InputError(
+        FieldError{"", -1, "moment_balance needs a Berkof coupler: " + describe(c) + values});
   }
 
   // a Berkof coupler has 0 <= e2 <= l2, so both reduced inertias are >= 0

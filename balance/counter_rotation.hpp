@@ -22,7 +22,8 @@ struct MomentBalancedDesign {
 ///         coupler (f2 = 0 and I2 = m2 e2 (l2 - e2), i.e. dynamically two point masses at A1 and
 ///         A2), checked to a relative 1e-9 (force_balance's output meets them to 1e-12); or a
 ///         shaft sits on its link's pivot (crank_at = A0, rocker_at = A3) where J > 0. The
-///         message gives the values and what they must be.
+///         message gives the values and what they must be; its field is empty (the design as a
+///         whole) except for make_fourbar's own ("counter_rotations.crank" for a shaft on A0).
 /// Any counter-rotations of the input are replaced.
 MomentBalancedDesign moment_balance(const core::FourBar& force_balanced, Vec2 crank_at,
                                     Vec2 rocker_at);

@@ -1,24 +1,26 @@
 #include "balance/counterweight.hpp"
 
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <numbers>
 
 #include "balance/conditions.hpp"
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
-#include "core/fourbar/principal_vectors.hpp"
 
 namespace bd::balance {
 
 namespace {
 
-using core::Complex;
+// Centre-of-mass offsets s̄ = e + i f and mass moments m s̄ in link axes, in the paper's complex
+// notation (eq. 57); what leaves this file (Counterweight::position) is a Vec2.
+using Complex = std::complex<double>;
 
-// "" when v is finite and > 0, else "<what> must be > 0 <unit>, got <v>"
-std::string positive(const char* what, const char* unit, double v) {
-  if (std::isfinite(v) && v > 0) return "";
-  return std::string(what) + " must be > 0 " + unit + ", got " + text::exact(v);
+// nothing when v is finite and > 0, else "<field> must be > 0 <unit>, got <v>"
+Problem positive(const char* field, const char* unit, double v) {
+  if (std::isfinite(v) && v > 0) return std::nullopt;
+  return FieldError{field, -1, std::string("must be > 0 ") + unit + ", got " + text::exact(v)};
 }
 
 // A counterweight of mass mc at `position` (link axes, from its pivot) whose mass moment is
@@ -39,7 +41,8 @@ Counterweight realise(const CounterweightSpec& spec, Complex moment, double link
     cw.distance = spec.distance ? *spec.distance : link_length;
     cw.mass = needed / cw.distance;
   }
-  cw.position = core::to_vec(cw.distance * direction);
+  const Complex position = cw.distance * direction;
+  cw.position = Vec2(position.real(), position.imag());
   if (disc) {
     cw.radius = spec.radius ? *spec.radius : std::sqrt(cw.mass / area_density);
     cw.thickness = spec.thickness;
@@ -50,7 +53,7 @@ Counterweight realise(const CounterweightSpec& spec, Complex moment, double link
 
 }  // namespace
 
-std::string CounterweightSpec::validate() const {
+Problem CounterweightSpec::validate() const {
   const int given = (mass ? 1 : 0) + (distance ? 1 : 0) + (radius ? 1 : 0);
   if (given > 1) {
     std::string what;
@@ -58,28 +61,30 @@ std::string CounterweightSpec::validate() const {
     if (mass) add("mass = " + text::exact(*mass) + " kg");
     if (distance) add("distance = " + text::exact(*distance) + " m");
     if (radius) add("radius = " + text::exact(*radius) + " m");
-    return "give at most one of mass, distance and radius (the others are solved), got " + what;
+    return FieldError{
+        "", -1,
+        "give at most one of mass, distance and radius (the others are solved), got " + what};
   }
   if (shape != CounterweightShape::kPoint && shape != CounterweightShape::kDisc) {
-    return "shape must be point or disc";
+    return FieldError{"shape", -1, "must be point or disc"};
   }
   if (radius && shape != CounterweightShape::kDisc) {
-    return "radius is given for a point counterweight; radius needs shape disc";
+    return FieldError{"radius", -1, "is given for a point counterweight; radius needs shape disc"};
   }
   if (mass) {
-    if (std::string e = positive("mass", "kg", *mass); !e.empty()) return e;
+    if (Problem p = positive("mass", "kg", *mass)) return p;
   }
   if (distance) {
-    if (std::string e = positive("distance", "m", *distance); !e.empty()) return e;
+    if (Problem p = positive("distance", "m", *distance)) return p;
   }
   if (radius) {
-    if (std::string e = positive("radius", "m", *radius); !e.empty()) return e;
+    if (Problem p = positive("radius", "m", *radius)) return p;
   }
   if (shape == CounterweightShape::kDisc) {
-    if (std::string e = positive("thickness", "m", thickness); !e.empty()) return e;
-    if (std::string e = positive("density", "kg/m^3", density); !e.empty()) return e;
+    if (Problem p = positive("thickness", "m", thickness)) return p;
+    if (Problem p = positive("density", "kg/m^3", density)) return p;
   }
-  return "";
+  return std::nullopt;
 }
 
 core::Link merged(const core::Link& link, const Counterweight& counterweight,
@@ -102,11 +107,12 @@ core::Link merged(const core::Link& link, const Counterweight& counterweight,
 
 ForceBalancedDesign force_balance(const core::FourBar& model, const CounterweightSpec& crank,
                                   const CounterweightSpec& rocker) {
-  if (const std::string e = crank.validate(); !e.empty()) {
-    throw InputError("crank counterweight: " + e);
+  // the field names the spec, its message the spec's own field
+  if (const Problem p = crank.validate()) {
+    throw InputError(FieldError{"crank counterweight", -1, ": " + p->text()});
   }
-  if (const std::string e = rocker.validate(); !e.empty()) {
-    throw InputError("rocker counterweight: " + e);
+  if (const Problem p = rocker.validate()) {
+    throw InputError(FieldError{"rocker counterweight", -1, ": " + p->text()});
   }
   const core::FourBar checked = core::make_fourbar(model);
   const core::Link &l1 = checked.crank, &l2 = checked.coupler, &l3 = checked.rocker;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/fourbar/model.hpp"
+#include "core/input_error.hpp"
 #include "core/types.hpp"
 
 namespace bd::balance {
@@ -24,8 +25,10 @@ struct CounterweightSpec {
                                    // and density; the distance is solved
   double thickness = 0.02;         // disc thickness [m] > 0
   double density = 7850.0;         // disc density [kg/m^3] > 0 (steel)
-  /// Empty when valid, else the problem in words.
-  std::string validate() const;
+  /// Empty when valid, else the first problem: its field is "mass", "distance", "radius",
+  /// "shape", "thickness" or "density", or empty when more than one of mass, distance and
+  /// radius is given (e.g. "mass must be > 0 kg, got 0").
+  Problem validate() const;
 };
 
 /// A realised counterweight.
@@ -53,7 +56,8 @@ struct ForceBalancedDesign {
 /// The counterweight's centre lies on the line through the pivot along the missing mass moment:
 /// crank m1 s̄1 + mc p = -m2 (1 - s̄2/l2) l1; rocker m3 (s̄3 - l3) + mc q = m2 s̄2 l3/l2.
 /// @throws bd::InputError if a spec is invalid ("crank counterweight: mass must be > 0 kg, got
-///         -1") or the model fails make_fourbar.
+///         -1": the field is "crank counterweight" or "rocker counterweight", the message the
+///         spec's own problem) or the model fails make_fourbar (with its field).
 ForceBalancedDesign force_balance(const core::FourBar& model, const CounterweightSpec& crank,
                                   const CounterweightSpec& rocker);
 

@@ -4,6 +4,7 @@
 // per iteration, so every call is a new instant and nothing is hoisted out of the loop.
 #include <benchmark/benchmark.h>
 
+#include "core/fourbar/detail/dynamics_constants.hpp"
 #include "core/fourbar/dynamics.hpp"
 #include "core/fourbar/kinematics.hpp"
 #include "core/fourbar/samples.hpp"
@@ -28,11 +29,11 @@ BENCHMARK(BM_PositionSolve);
 // One evaluation by each formulation, forward (arg 0: crank acceleration, reactions, shaking
 // force and moment at theta1 = 1 rad + ..., omega1 = 2 rad/s, tau = 0) and inverse (arg 1: the
 // drive torque for alpha1 = 0.5 rad/s^2 and all the rest), as a loop over instants calls it:
-// with the model's constants computed once (core::dynamics_constants). This is the figure the
-// issue's target "one forward-dynamics evaluation < 100 ns" is about.
+// with the model's constants computed once (core::detail::dynamics_constants). This is the figure
+// the project's target "one forward-dynamics evaluation < 100 ns" (docs/performance.md) is about.
 void BM_Formulation(benchmark::State& state, Formulation f) {
   const FourBar model = samples::paper_fourbar();
-  const DynamicsConstants constants = dynamics_constants(model);
+  const detail::DynamicsConstants constants = detail::dynamics_constants(model);
   const bool inverse = state.range(0) == 1;
   double theta1 = 1.0;
   for (auto _ : state) {

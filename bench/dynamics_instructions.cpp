@@ -8,7 +8,7 @@
 //                             complex-masses) through the one-instant calls, which compute the
 //                             model's constants each time
 //   F:forward:constants, F:inverse:constants
-//                             the same with core::DynamicsConstants computed once, as a
+//                             the same with core::detail::DynamicsConstants computed once, as a
 //                             simulation or a sweep calls them
 //   driven                    N driven revolutions of 360 samples (as BM_DrivenRevolution)
 // The instants: the paper's four-bar, theta1 from 1 rad in steps of 1e-3 rad, omega1 2 rad/s,
@@ -17,6 +17,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "core/fourbar/detail/dynamics_constants.hpp"
 #include "core/fourbar/dynamics.hpp"
 #include "core/fourbar/kinematics.hpp"
 #include "core/fourbar/samples.hpp"
@@ -58,7 +59,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "dynamics_instructions: unknown KIND %s\n", kind.c_str());
       return 2;
     }
-    const DynamicsConstants constants = dynamics_constants(model);
+    const detail::DynamicsConstants constants = detail::dynamics_constants(model);
     double theta1 = 1.0;
     for (int i = 0; i < n; ++i) {
       const auto s = with_constants

@@ -214,8 +214,8 @@ struct Conditioning {
 
 Conditioning conditioning(const FourBar& m, const RefSample<ld>& r, bool inverse) {
   const std::array<ld, 3> th{r.pose.theta1, r.pose.theta2, r.pose.theta3};
-  const std::array<ld, 3> Th{1, r.Theta2, r.Theta3}, om{r.omega1, r.omega2, r.omega3},
-      al{r.alpha1, r.alpha2, r.alpha3};
+  const std::array<ld, 3> Th{1, r.dtheta2_dtheta1, r.dtheta3_dtheta1},
+      om{r.omega1, r.omega2, r.omega3}, al{r.alpha1, r.alpha2, r.alpha3};
   std::array<V2<ld>, 3> lv;
   for (int k = 0; k < 3; ++k) lv[k] = ld(link(m, k + 1).length) * dir(th[k]);
   Conditioning c;
@@ -272,14 +272,14 @@ Conditioning conditioning(const FourBar& m, const RefSample<ld>& r, bool inverse
       F.segment<4>(2 * (k - 1)) +=
           link_nodal_forces(l, q.force + l.mass * m.loads.gravity, q.moment, p, qq);
     }
-    const V2<ld> J1 = rot(lv[0]), J2 = J1 + r.Theta2 * rot(lv[1]);
+    const V2<ld> J1 = rot(lv[0]), J2 = J1 + r.dtheta2_dtheta1 * rot(lv[1]);
     Eigen::Matrix<ld, 4, 1> J, acc;
     J << J1.x(), J1.y(), J2.x(), J2.y();
     // r̈ at the state's alpha1 (inverse) or at alpha1 = 0 (forward numerator)
     const ld a1 = inverse ? r.alpha1 : 0;
     const V2<ld> bA1 = a1 * rot(lv[0]) - om[0] * om[0] * lv[0];
     const V2<ld> bA2 =
-        bA1 + (r.Theta2 * a1 + r.gamma2) * rot(lv[1]) - om[1] * om[1] * lv[1];
+        bA1 + (r.dtheta2_dtheta1 * a1 + r.gamma2) * rot(lv[1]) - om[1] * om[1] * lv[1];
     acc << bA1.x(), bA1.y(), bA2.x(), bA2.y();
     const Eigen::Matrix<ld, 4, 1> res = M.cast<ld>() * acc - F.segment<4>(2).cast<ld>();
     ld sum = 0, sum_abs = 0;
@@ -294,7 +294,8 @@ Conditioning conditioning(const FourBar& m, const RefSample<ld>& r, bool inverse
   // theta_j (link j about its first joint, the distal links translated): Σ Θj Ej = tau
   {
     const ld a1 = inverse ? r.alpha1 : 0;
-    const std::array<ld, 3> alk{a1, r.Theta2 * a1 + r.gamma2, r.Theta3 * a1 + r.gamma3};
+    const std::array<ld, 3> alk{a1, r.dtheta2_dtheta1 * a1 + r.gamma2,
+                                r.dtheta3_dtheta1 * a1 + r.gamma3};
     std::array<V2<ld>, 4> p, ap;
     p[0] = V2<ld>::Zero();
     ap[0] = V2<ld>::Zero();
@@ -389,7 +390,7 @@ struct Case {
   const char* name;
   bool inverse;
   // crank rate [rad/s] and acceleration [rad/s^2] from the reference pose's Θ3
-  std::function<double(ld Theta3)> omega1;
+  std::function<double(ld dtheta3_dtheta1)> omega1;
   double alpha1;
 };
 
@@ -436,7 +437,7 @@ void singular_study(const std::vector<Method>& ms, const std::filesystem::path& 
         const auto pose = reference::ref_position<ld>(L.model, ld(t1));
         if (!pose || d_true <= 0) continue;
         // Θ3 of the pose: a throw-away forward solve at rest
-        const ld T3 = reference::ref_forward<ld>(L.model, *pose, 0).Theta3;
+        const ld T3 = reference::ref_forward<ld>(L.model, *pose, 0).dtheta3_dtheta1;
         const double w1 = c.omega1(T3), a1 = c.alpha1;
         const RefSample<ld> ref = c.inverse ? reference::ref_inverse<ld>(L.model, *pose, w1, a1)
                                             : reference::ref_forward<ld>(L.model, *pose, w1);

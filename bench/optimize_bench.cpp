@@ -10,7 +10,7 @@
 
 #include <numbers>
 
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "core/fourbar/samples.hpp"
 #include "core/fourbar/simulate.hpp"
 #include "optimize/nlp.hpp"

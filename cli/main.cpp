@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "cli/sweep_display.hpp"
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "studies/report/report.hpp"
 #include "studies/studies.hpp"
 #include "studies/study/load_study.hpp"

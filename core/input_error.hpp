@@ -39,6 +39,11 @@ struct FieldError {
 /// What a validate() returns: empty when the object is valid, else its first problem.
 using Problem = std::optional<FieldError>;
 
+/// The problem's text(), or "" when there is none.
+inline std::string problem_text(const Problem& problem) {
+  return problem ? problem->text() : std::string();
+}
+
 /// A caller's or a study file's mistake (negative mass, zero length, unknown key). Thrown once,
 /// where the value enters; the message names the quantity, the value, the unit and what was
 /// expected, e.g. "coupler.mass must be > 0 kg, got -1.2". Thrown from a FieldError it carries

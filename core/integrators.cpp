@@ -70,9 +70,9 @@ ARKODE_ERKTableID erk_table(Integrator integrator) {
 // The table of an ERK integrator. SUNDIALS before 6.6 takes every table whose last node c_s is 1
 // for "first same as last" (FSAL) and reuses its last stage's f as f(y_{n+1}) (llnl/sundials
 // issue #311, fixed in 6.6.0). For the tables where that is false (Heun-Euler 2(1), Verner 6(5),
-// Fehlberg 8(7)) the next step then starts from a wrong slope: Verner 6(5) converges at order 3
-// (measured with fixed steps on a pendulum: errors 9.0e-6, 1.2e-6, 1.5e-7 for h = 0.1, 0.05,
-// 0.025 s; the same table in a plain Runge-Kutta loop gives order 6). Such a table gets one more
+// Fehlberg 8(7)) the next step then starts from a wrong slope: with fixed steps Verner 6(5)
+// converges at order 3, while the same table in a plain Runge-Kutta loop gives order 6
+// (tests/core/integrators_test.cpp checks every pair's order). Such a table gets one more
 // stage, y_{n+1} itself (row b, node 1, weight 0), which makes it FSAL in truth: the same method
 // at the same cost (s right-hand sides per step, f(y_{n+1}) computed once).
 ARKodeButcherTable erk_butcher_table(Integrator integrator) {
@@ -128,89 +128,97 @@ Integration::Integration(const Problem& p)
       stop_at_outputs_(p.integrator == Integrator::kErk6 || p.integrator == Integrator::kErk8),
       max_steps_(p.max_steps) {
   assert(p.absolute_tolerance.size() == p.y0.size());
-  const auto n = static_cast<sunindextype>(p.y0.size());
   check_setup(SUNContext_Create(nullptr, &context_), "SUNContext_Create");
   y_ = vector_of(p.y0, context_, "N_VNew_Serial");
   atol_ = vector_of(p.absolute_tolerance, context_, "N_VNew_Serial");
 
   switch (package_) {
-    case Package::kCvode: {
-      // Adams-Moulton (orders 1-12) with a fixed-point corrector: no Jacobian, one or two
-      // right-hand sides per step on a non-stiff problem. BDF (orders 1-5) with a Newton
-      // corrector: dense linear solver, Jacobian by SUNDIALS' difference quotients.
-      const bool bdf = p.integrator == Integrator::kCvodeBdf;
-      memory_ = CVodeCreate(bdf ? CV_BDF : CV_ADAMS, context_);
-      check_allocated(memory_, "CVodeCreate");
-      check_setup(CVodeSetErrHandlerFn(memory_, keep_error, &error_text_), "CVodeSetErrHandlerFn");
-      check_setup(CVodeInit(memory_, p.rhs, 0.0, y_), "CVodeInit");
-      check_setup(CVodeSetUserData(memory_, p.user_data), "CVodeSetUserData");
-      check_setup(CVodeSVtolerances(memory_, p.tolerance, atol_), "CVodeSVtolerances");
-      if (bdf) {
-        matrix_ = SUNDenseMatrix(n, n, context_);
-        check_allocated(matrix_, "SUNDenseMatrix");
-        linear_ = SUNLinSol_Dense(y_, matrix_, context_);
-        check_allocated(linear_, "SUNLinSol_Dense");
-        check_setup(CVodeSetLinearSolver(memory_, linear_, matrix_), "CVodeSetLinearSolver");
-        if (p.projection != nullptr) {
-          check_setup(CVodeSetProjFn(memory_, p.projection), "CVodeSetProjFn");
-        }
-      } else {
-        assert(p.projection == nullptr);  // CVODE projects only with BDF
-        nonlinear_ = SUNNonlinSol_FixedPoint(y_, 0, context_);
-        check_allocated(nonlinear_, "SUNNonlinSol_FixedPoint");
-        check_setup(CVodeSetNonlinearSolver(memory_, nonlinear_), "CVodeSetNonlinearSolver");
-      }
-      check_setup(CVodeSetStopTime(memory_, p.t_end), "CVodeSetStopTime");
-      if (p.root != nullptr) check_setup(CVodeRootInit(memory_, 1, p.root), "CVodeRootInit");
+    case Package::kCvode:
+      set_up_cvode(p);
       break;
-    }
-    case Package::kArkode: {
-      assert(p.projection == nullptr);
-      memory_ = ERKStepCreate(p.rhs, 0.0, y_, context_);
-      check_allocated(memory_, "ERKStepCreate");
-      check_setup(ERKStepSetErrHandlerFn(memory_, keep_error, &error_text_),
-                  "ERKStepSetErrHandlerFn");
-      check_setup(ERKStepSetUserData(memory_, p.user_data), "ERKStepSetUserData");
-      check_setup(ERKStepSVtolerances(memory_, p.tolerance, atol_), "ERKStepSVtolerances");
-      // the table is copied by ERKStep
-      ARKodeButcherTable table = erk_butcher_table(p.integrator);
-      const int flag = ERKStepSetTable(memory_, table);
-      ARKodeButcherTable_Free(table);
-      check_setup(flag, "ERKStepSetTable");
-      if (p.fixed_step > 0)
-        check_setup(ERKStepSetFixedStep(memory_, p.fixed_step), "ERKStepSetFixedStep");
-      check_setup(ERKStepSetStopTime(memory_, p.t_end), "ERKStepSetStopTime");
-      if (p.root != nullptr) check_setup(ERKStepRootInit(memory_, 1, p.root), "ERKStepRootInit");
+    case Package::kArkode:
+      set_up_arkode(p);
       break;
-    }
-    case Package::kIda: {
-      assert(p.yp0.size() == p.y0.size() && p.differential.size() == p.y0.size());
-      assert(p.root == nullptr && p.projection == nullptr);
-      yp_ = vector_of(p.yp0, context_, "N_VNew_Serial");
-      std::vector<double> id(p.y0.size());
-      for (std::size_t i = 0; i < id.size(); ++i) id[i] = p.differential[i] ? 1.0 : 0.0;
-      id_ = vector_of(id, context_, "N_VNew_Serial");
-      memory_ = IDACreate(context_);
-      check_allocated(memory_, "IDACreate");
-      check_setup(IDASetErrHandlerFn(memory_, keep_error, &error_text_), "IDASetErrHandlerFn");
-      check_setup(IDAInit(memory_, p.residual, 0.0, y_, yp_), "IDAInit");
-      check_setup(IDASetUserData(memory_, p.user_data), "IDASetUserData");
-      check_setup(IDASVtolerances(memory_, p.tolerance, atol_), "IDASVtolerances");
-      // the algebraic components (multipliers) take no part in the local error test: in an
-      // index-2 system their error is of lower order and would only hold the step back
-      check_setup(IDASetId(memory_, id_), "IDASetId");
-      check_setup(IDASetSuppressAlg(memory_, SUNTRUE), "IDASetSuppressAlg");
-      matrix_ = SUNDenseMatrix(n, n, context_);
-      check_allocated(matrix_, "SUNDenseMatrix");
-      linear_ = SUNLinSol_Dense(y_, matrix_, context_);
-      check_allocated(linear_, "SUNLinSol_Dense");
-      check_setup(IDASetLinearSolver(memory_, linear_, matrix_), "IDASetLinearSolver");
-      check_setup(IDASetStopTime(memory_, p.t_end), "IDASetStopTime");
-      if (p.initial_step > 0)
-        check_setup(IDASetInitStep(memory_, p.initial_step), "IDASetInitStep");
+    case Package::kIda:
+      set_up_ida(p);
       break;
-    }
   }
+}
+
+void Integration::set_up_cvode(const Problem& p) {
+  // Adams-Moulton (orders 1-12) with a fixed-point corrector: no Jacobian, one or two
+  // right-hand sides per step on a non-stiff problem. BDF (orders 1-5) with a Newton
+  // corrector: dense linear solver, Jacobian by SUNDIALS' difference quotients.
+  const bool bdf = p.integrator == Integrator::kCvodeBdf;
+  memory_ = CVodeCreate(bdf ? CV_BDF : CV_ADAMS, context_);
+  check_allocated(memory_, "CVodeCreate");
+  check_setup(CVodeSetErrHandlerFn(memory_, keep_error, &error_text_), "CVodeSetErrHandlerFn");
+  check_setup(CVodeInit(memory_, p.rhs, 0.0, y_), "CVodeInit");
+  check_setup(CVodeSetUserData(memory_, p.user_data), "CVodeSetUserData");
+  check_setup(CVodeSVtolerances(memory_, p.tolerance, atol_), "CVodeSVtolerances");
+  if (bdf) {
+    set_up_dense_solver(p);
+    check_setup(CVodeSetLinearSolver(memory_, linear_, matrix_), "CVodeSetLinearSolver");
+    if (p.projection != nullptr) {
+      check_setup(CVodeSetProjFn(memory_, p.projection), "CVodeSetProjFn");
+    }
+  } else {
+    assert(p.projection == nullptr);  // CVODE projects only with BDF
+    nonlinear_ = SUNNonlinSol_FixedPoint(y_, 0, context_);
+    check_allocated(nonlinear_, "SUNNonlinSol_FixedPoint");
+    check_setup(CVodeSetNonlinearSolver(memory_, nonlinear_), "CVodeSetNonlinearSolver");
+  }
+  check_setup(CVodeSetStopTime(memory_, p.t_end), "CVodeSetStopTime");
+  if (p.root != nullptr) check_setup(CVodeRootInit(memory_, 1, p.root), "CVodeRootInit");
+}
+
+void Integration::set_up_arkode(const Problem& p) {
+  assert(p.projection == nullptr);
+  memory_ = ERKStepCreate(p.rhs, 0.0, y_, context_);
+  check_allocated(memory_, "ERKStepCreate");
+  check_setup(ERKStepSetErrHandlerFn(memory_, keep_error, &error_text_), "ERKStepSetErrHandlerFn");
+  check_setup(ERKStepSetUserData(memory_, p.user_data), "ERKStepSetUserData");
+  check_setup(ERKStepSVtolerances(memory_, p.tolerance, atol_), "ERKStepSVtolerances");
+  // the table is copied by ERKStep
+  ARKodeButcherTable table = erk_butcher_table(p.integrator);
+  const int flag = ERKStepSetTable(memory_, table);
+  ARKodeButcherTable_Free(table);
+  check_setup(flag, "ERKStepSetTable");
+  if (p.fixed_step > 0)
+    check_setup(ERKStepSetFixedStep(memory_, p.fixed_step), "ERKStepSetFixedStep");
+  check_setup(ERKStepSetStopTime(memory_, p.t_end), "ERKStepSetStopTime");
+  if (p.root != nullptr) check_setup(ERKStepRootInit(memory_, 1, p.root), "ERKStepRootInit");
+}
+
+void Integration::set_up_ida(const Problem& p) {
+  assert(p.yp0.size() == p.y0.size() && p.differential.size() == p.y0.size());
+  assert(p.root == nullptr && p.projection == nullptr);
+  yp_ = vector_of(p.yp0, context_, "N_VNew_Serial");
+  std::vector<double> id(p.y0.size());
+  for (std::size_t i = 0; i < id.size(); ++i) id[i] = p.differential[i] ? 1.0 : 0.0;
+  id_ = vector_of(id, context_, "N_VNew_Serial");
+  memory_ = IDACreate(context_);
+  check_allocated(memory_, "IDACreate");
+  check_setup(IDASetErrHandlerFn(memory_, keep_error, &error_text_), "IDASetErrHandlerFn");
+  check_setup(IDAInit(memory_, p.residual, 0.0, y_, yp_), "IDAInit");
+  check_setup(IDASetUserData(memory_, p.user_data), "IDASetUserData");
+  check_setup(IDASVtolerances(memory_, p.tolerance, atol_), "IDASVtolerances");
+  // the algebraic components (multipliers) take no part in the local error test: in an
+  // index-2 system their error is of lower order and would only hold the step back
+  check_setup(IDASetId(memory_, id_), "IDASetId");
+  check_setup(IDASetSuppressAlg(memory_, SUNTRUE), "IDASetSuppressAlg");
+  set_up_dense_solver(p);
+  check_setup(IDASetLinearSolver(memory_, linear_, matrix_), "IDASetLinearSolver");
+  check_setup(IDASetStopTime(memory_, p.t_end), "IDASetStopTime");
+  if (p.initial_step > 0) check_setup(IDASetInitStep(memory_, p.initial_step), "IDASetInitStep");
+}
+
+void Integration::set_up_dense_solver(const Problem& p) {
+  const auto n = static_cast<sunindextype>(p.y0.size());
+  matrix_ = SUNDenseMatrix(n, n, context_);
+  check_allocated(matrix_, "SUNDenseMatrix");
+  linear_ = SUNLinSol_Dense(y_, matrix_, context_);
+  check_allocated(linear_, "SUNLinSol_Dense");
 }
 
 Integration::~Integration() {

@@ -1,9 +1,9 @@
 #pragma once
-/// The SUNDIALS integrators of free motion behind one door (core/simulate.hpp `Integrator`):
+/// The SUNDIALS integrators of free motion behind one door (core/simulation.hpp `Integrator`):
 /// CVODE (Adams-Moulton, BDF), ARKODE ERKStep (embedded explicit Runge-Kutta pairs) for an ODE
-/// y' = f(t, y), and IDA for a DAE F(t, y, y') = 0. Used by core/simulate.cpp (the reduced
-/// equation in theta1) and core/opened_loop_dae.cpp (the opened loop's ODE and DAE). Internal to
-/// core: SUNDIALS types appear in no public header.
+/// y' = f(t, y), and IDA for a DAE F(t, y, y') = 0. Used by core/fourbar/simulate.cpp (the
+/// four-bar's reduced equation in theta1) and core/fourbar/opened_loop_dae.cpp (its opened loop's
+/// ODE and DAE). Internal to core: SUNDIALS types appear in no public header.
 ///
 /// One Integration owns every SUNDIALS object of one run (context, vectors, matrix, solvers,
 /// integrator memory) and frees them in reverse order of creation; it captures the integrator's
@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "core/fourbar/simulate.hpp"
+#include "core/simulation.hpp"
 
 namespace bd::core::integrators {
 
@@ -81,8 +81,8 @@ class Integration {
   /// True for the ERK pairs of order 6 and 8, whose steps always end at the output instants:
   /// ARKODE's Hermite interpolant has degree at most 5 and needs the right-hand side at interior
   /// points; between the long steps of these methods it is far less accurate than the steps
-  /// (paper example at tolerance 1e-10: 1.2e-6 rad (order 8) and 1.2e-8 rad (order 6) at the
-  /// samples against 1e-10 rad at the step ends), and costs four right-hand sides per output.
+  /// (by orders of magnitude on the paper example, docs/performance.md), and costs four
+  /// right-hand sides per output.
   bool stops_at_outputs() const { return stop_at_outputs_; }
 
   double t() const { return t_; }  // time reached [s]
@@ -94,6 +94,13 @@ class Integration {
 
  private:
   enum class Package { kCvode, kArkode, kIda };
+  // the constructor's steps for each package, after the context, y_ and atol_
+  void set_up_cvode(const Problem& p);
+  void set_up_arkode(const Problem& p);
+  void set_up_ida(const Problem& p);
+  // the dense matrix and linear solver of BDF and IDA's Newton iterations
+  void set_up_dense_solver(const Problem& p);
+
   Package package_;
   bool stop_at_outputs_;
   long max_steps_;

@@ -1,14 +1,13 @@
 #pragma once
-/// The angle of a planar vector, atan2(y, x), at half the C library's cost.
+/// The angle of a planar vector, atan2(y, x), at a fraction of the C library's cost.
 ///
 /// The dynamics returns θ2 and θ3 with every sample, so each evaluation takes the angles of two
-/// vectors. glibc's atan2 spends ~145 instructions on each, correctly rounded; polar_angle()
-/// ~75 and rounds a little more: against a long-double reference over 1.6 million vectors
-/// (tests/core/polar_angle_test.cpp) its largest error is 2.75e-16 rad, std::atan2's 2.22e-16
-/// (0.62 and 0.50 ulp of π). In units in the last place of the angle it is at most 1.5 ulp
-/// below 0.5 rad (the quotient's rounding counts twice where the result falls below a power of
-/// two the quotient is above) and 0.9 ulp above. Either is far below the position solve's own
-/// error in the angles (~1e-15 rad at worst, 1e-16 typical).
+/// vectors. glibc's atan2 rounds correctly, at a higher cost (docs/performance.md compares
+/// them); polar_angle() rounds a little more: in units in the last place of the angle it is within
+/// 1.5 ulp below 0.5 rad (the quotient's rounding counts twice where the result falls below a
+/// power of two the quotient is above) and within 1 ulp above, against a long-double reference
+/// (tests/core/polar_angle_test.cpp). Either is far below the position solve's own error in the
+/// angles.
 ///
 /// Method (the reduction of Sun's fdlibm): with a = min(|x|, |y|) and b = max(|x|, |y|),
 /// atan(a/b) = A + atan(r) with A = 0, atan(1/2) or π/4 and

@@ -66,7 +66,7 @@
 #include <string>
 #include <vector>
 
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "core/fourbar/model.hpp"
 #include "optimize/optimize.hpp"
 #include "optimize/problem.hpp"

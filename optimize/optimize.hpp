@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "balance/counterweight.hpp"
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "optimize/problem.hpp"
 
 namespace bd::optimize {

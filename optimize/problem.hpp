@@ -11,7 +11,7 @@
 
 #include "balance/counterweight.hpp"
 #include "core/fourbar/dynamics.hpp"
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/simulate.hpp"
 #include "core/input_error.hpp"

@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
-# Includes point one way only: core <- balance <- optimize <- studies <- cli; third-party
-# headers stay behind their one door (yaml-cpp in studies/, CLI11 in cli/, NLopt and Ipopt in
-# optimize/*.cpp).
+# Includes point one way only: core <- balance <- optimize <- studies <- cli. Within core, the
+# files at its root and in core/detail/ (what any linkage shares) are the floor below the
+# four-bar's own files in core/fourbar/ and never include them; core's internals (core/detail/,
+# core/fourbar/detail/) are included by core's sources, tests and benchmarks only, never by a
+# public header or a higher layer. Third-party headers stay behind their one door (yaml-cpp in
+# studies/, CLI11 in cli/, NLopt and Ipopt in optimize/*.cpp).
 cd "$(dirname "$0")/.." || exit 1
 fail=0
 forbid() {  # forbid DESCRIPTION REGEX PATH...
@@ -15,6 +18,12 @@ forbid() {  # forbid DESCRIPTION REGEX PATH...
   fi
 }
 forbid "core/ includes a higher layer" '(balance|optimize|studies|cli|tests)/' core
+forbid "core/'s shared floor includes the four-bar (core/fourbar/)" 'core/fourbar/' \
+  $(ls core/*.hpp core/*.cpp 2>/dev/null) core/detail
+forbid "a public core header includes core's internals" 'core/(fourbar/)?detail/' \
+  $(ls core/*.hpp core/fourbar/*.hpp 2>/dev/null)
+forbid "a layer above core includes core's internals" 'core/(fourbar/)?detail/' \
+  balance optimize studies cli
 forbid "balance/ includes a higher layer" '(optimize|studies|cli|tests)/' balance
 forbid "optimize/ includes a higher layer" '(studies|cli|tests)/' optimize
 forbid "studies/ includes a higher layer" '(cli|tests)/' studies

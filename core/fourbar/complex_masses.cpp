@@ -1,7 +1,7 @@
 // The closed loop with complex equivalent masses (paper §4.1).
 //
 // Notation. Planar vectors are complex numbers; ⟨x̄, ȳ⟩ = Re(x̄* ȳ) (§2.1), so ⟨i x̄, ȳ⟩ = x̄ × ȳ.
-// In the per-instant code they are Xy (core/xy.hpp): x̄ ȳ is cmul(x, y), x̄* ȳ cmul_conj.
+// In the per-instant code they are Xy (core/detail/xy.hpp): x̄ ȳ is cmul(x, y), x̄* ȳ cmul_conj.
 // Link k has the complex masses m̄kp = m_k (1 - s̄k/lk) at its first joint and m̄kq = m_k s̄k/lk at
 // its second (eq. 29); for the coupler m̄2p = m2a - i m2c at A1 and m̄2q = m2b + i m2c at A2.
 // With A0 = 0 and A2 = A3 - l̄3 the mass centres, times their masses, are (eq. 33)
@@ -42,9 +42,23 @@
 
 #include <cmath>
 
-#include "core/fourbar/formulation_support.hpp"
+#include "core/detail/complex_vector.hpp"
+#include "core/fourbar/detail/formulation_support.hpp"
 
 namespace bd::core {
+
+// the kernels' types and steps (core/detail/, core/fourbar/detail/)
+using detail::ClosedInstant;
+using detail::Complex;
+using detail::complex_mass_constants;
+using detail::ComplexMassConstants;
+using detail::CrankInput;
+using detail::evaluated;
+using detail::Failure;
+using detail::to_complex;
+using detail::to_vec;
+using detail::Xy;
+using detail::xy;
 
 namespace {
 
@@ -65,8 +79,8 @@ Complex com_offset(const Link& l) { return {l.e, l.f}; }
 // the coupler's complex masses per unit mass on their lever arms, p = m̄2p l̄1/m2 =
 // (1 - s̄2/l2) l̄1 at A1 and q = m̄2q l̄3/m2 = (s̄2/l2) l̄3 at A2 (c.w2 = s̄2/l2), eqs. 37-39 print
 // |m̄2p|²/m2, <m̄2p l̄1, m̄2q l̄3>/m2, ...; written with these unit-mass weights they are the same
-// numbers without the division, which loses accuracy when m2 is subnormal (measured: 25 % at
-// m2 = 4.9e-324 kg). The pose enters only through ζ13 = conj(l̄1) l̄3 = (l̄1·l̄3, l̄1 × l̄3):
+// numbers without the division, which loses accuracy when m2 is subnormal
+// (docs/failure-domains.md). The pose enters only through ζ13 = conj(l̄1) l̄3 = (l̄1·l̄3, l̄1 × l̄3):
 // m2 conj(p) q = kappa ζ13 with the constant kappa = m2 conj(1 - s̄2/l2) s̄2/l2.
 ComplexMassEquations equations(const FourBar& model, const ComplexMassConstants& c, const Xy& l1,
                                const Xy& l3) {
@@ -119,6 +133,8 @@ Expected<DynamicsSample, DynamicsError> one_instant(const FourBar& model, double
 
 }  // namespace
 
+namespace detail {
+
 ComplexMassConstants complex_mass_constants(const FourBar& model) {
   const Link &L1 = model.crank, &L2 = model.coupler, &L3 = model.rocker;
   const double m2 = L2.mass;
@@ -152,12 +168,17 @@ ComplexMassConstants complex_mass_constants(const FourBar& model) {
   return c;
 }
 
+}  // namespace detail
+
+namespace detail {
+
 std::optional<Failure> complex_masses_at(const FourBar& model, const ComplexMassConstants& c,
                                          const ClosedInstant& instant, CrankInput input,
                                          DynamicsSample& out) {
   // the instant gives the rates and the dependent accelerations θ̈_k = Θ_k θ̈1 + γ_k
   const ComplexMassEquations eq = equations(model, c, instant.l1, instant.l3);
-  const double Theta2 = instant.tf.Theta2, Theta3 = instant.tf.Theta3;
+  const double dtheta2_dtheta1 = instant.tf.dtheta2_dtheta1,
+               dtheta3_dtheta1 = instant.tf.dtheta3_dtheta1;
   const double gamma2 = instant.bias.gamma2, gamma3 = instant.bias.gamma3;
   const double omega1_sq = instant.state.omega1 * instant.state.omega1,
                omega3_sq = instant.state.omega3 * instant.state.omega3;
@@ -165,11 +186,12 @@ std::optional<Failure> complex_masses_at(const FourBar& model, const ComplexMass
 
   // reduced equation: δθ = Θ δθ1 keeps the loop closed, so Σ_j Θ_j Q^c_j = 0 and
   // (Θᵀ M Θ) θ̈1 = Θᵀ (Q - M γ - C θ̇²) + τ   (τ enters Q1, Θ1 = 1), with M12 = M23 = 0
-  const double inertia =
-      c.M11 + 2.0 * M13 * Theta3 + I2 * Theta2 * Theta2 + c.M33 * Theta3 * Theta3;
+  const double inertia = c.M11 + 2.0 * M13 * dtheta3_dtheta1 +
+                         I2 * dtheta2_dtheta1 * dtheta2_dtheta1 +
+                         c.M33 * dtheta3_dtheta1 * dtheta3_dtheta1;
   const double rhs = (eq.Q(0) - M13 * gamma3 - eq.C13 * omega3_sq) +
-                     Theta2 * (eq.Q(1) - I2 * gamma2) +
-                     Theta3 * (eq.Q(2) - c.M33 * gamma3 + eq.C13 * omega1_sq);
+                     dtheta2_dtheta1 * (eq.Q(1) - I2 * gamma2) +
+                     dtheta3_dtheta1 * (eq.Q(2) - c.M33 * gamma3 + eq.C13 * omega1_sq);
   double alpha1 = 0.0, tau = 0.0;
   if (!input.torque_unknown) {
     alpha1 = rhs / inertia;
@@ -198,7 +220,7 @@ std::optional<Failure> complex_masses_at(const FourBar& model, const ComplexMass
   // (b) rotation about S: eq. 40 gives each centre of mass's lever c̄_k about S times m_k; the
   // virtual work uses c̄_k/m_k = r̄_k - r̄_S (the rigid-rotation identity the corrected eq. 40
   // satisfies, tested). Taken directly, it divides by no mass; c̄_k/m_k would lose
-  // ~eps·m_tot/m_k at a small m_k (measured: 56 % at m1 = 1e-16 kg). It gives R_A3y.
+  // ~eps·m_tot/m_k at a small m_k (docs/failure-domains.md). It gives R_A3y.
   const Xy rS = -(cmul(c.a14, instant.l1) + c.a41 + cmul(c.a34, instant.l3));
   double W_S = tau + model.loads.crank.moment - model.crank.inertia * s.alpha1 +
                model.loads.coupler.moment - I2 * s.alpha2 + model.loads.rocker.moment -
@@ -222,6 +244,8 @@ std::optional<Failure> complex_masses_at(const FourBar& model, const ComplexMass
   const Xy RA3{RA3_rocker_side.x, RA3y};
   return complete_sample(model, Fsh - RA3, RA3, tau, out);
 }
+
+}  // namespace detail
 
 ComplexMassEquations complex_mass_equations(const FourBar& model, const Pose& pose) {
   const LinkVectors l = link_vectors(model, pose);
@@ -267,9 +291,9 @@ RotationAboutCentreOfMass rotation_about_centre_of_mass(const FourBar& model, co
   // eq. 40 = eq. 33 minus m_k r̄_S = -m_k (ā14 + ā41 + ā34) (eq. 32); for link 3 with
   // ā41 - l̄4 = ā43. The coupler mass at A1 is m̄2p = m2a - i m2c in all three lines.
   RotationAboutCentreOfMass c;
-  c.c1 = m1 * (a34 + a41) - (e2.mq + m3) * a14 - e2.mp * a12p;
-  c.c2 = (a34 + a41 + a12p) * e2.mp + (a14 + a43 + a32p) * e2.mq;
-  c.c3 = m3 * (a14 + a43) - (m1 + e2.mp) * a34 - e2.mq * a32p;
+  c.c1 = to_vec(m1 * (a34 + a41) - (e2.mq + m3) * a14 - e2.mp * a12p);
+  c.c2 = to_vec((a34 + a41 + a12p) * e2.mp + (a14 + a43 + a32p) * e2.mq);
+  c.c3 = to_vec(m3 * (a14 + a43) - (m1 + e2.mp) * a34 - e2.mq * a32p);
   return c;
 }
 

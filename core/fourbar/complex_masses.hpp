@@ -52,7 +52,7 @@ PrincipalVectorForms principal_vector_forms(const FourBar& model, const Pose& po
 /// principal vectors and the coupler's complex masses. In c̄3 the coupler mass at A1 enters as
 /// m1 + m2a - i m2c (as in eqs. 30-31, 33); the paper prints m1 + m2a + i m2c.
 struct RotationAboutCentreOfMass {
-  Complex c1, c2, c3;  // [kg m]
+  Vec2 c1, c2, c3;  // [kg m]
 };
 RotationAboutCentreOfMass rotation_about_centre_of_mass(const FourBar& model, const Pose& pose);
 

@@ -1,12 +1,15 @@
 #include "core/fourbar/counter_rotation.hpp"
 
 #include "core/fourbar/complex_masses.hpp"
-#include "core/fourbar/formulation_support.hpp"
+#include "core/fourbar/detail/formulation_support.hpp"
 #include "core/fourbar/kinematics.hpp"
 #include "core/fourbar/mass_matrix.hpp"
 #include "core/fourbar/opened_loop.hpp"
 
 namespace bd::core {
+
+// the kernels' types and steps (core/detail/, core/fourbar/detail/)
+using detail::nonsingular_pose;
 
 namespace {
 

@@ -1,6 +1,6 @@
 #pragma once
-/// Counter-rotating inertias in the dynamics (core/model.hpp CounterRotation): a disc on a frame
-/// shaft, geared to the crank or the rocker with ratio -1.
+/// Counter-rotating inertias in the dynamics (core/fourbar/model.hpp CounterRotation): a disc on a
+/// frame shaft, geared to the crank or the rocker with ratio -1.
 ///
 /// The disc turns at minus its link's rate, so its kinetic energy ½ J θ̇_k² is that of extra
 /// rotary inertia J on link k: the equations of motion of every formulation hold with I_k + J.

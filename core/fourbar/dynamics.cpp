@@ -6,8 +6,8 @@
 
 #include "core/fourbar/complex_masses.hpp"
 #include "core/fourbar/counter_rotation.hpp"
-#include "core/fourbar/formulation_support.hpp"
-#include "core/fourbar/instant_dynamics.hpp"
+#include "core/fourbar/detail/formulation_support.hpp"
+#include "core/fourbar/detail/instant_dynamics.hpp"
 #include "core/fourbar/mass_matrix.hpp"
 #include "core/fourbar/opened_loop.hpp"
 
@@ -65,6 +65,8 @@ Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model, d
   return inverse_dynamics_mass_matrix(model, theta1, omega1, alpha1);
 }
 
+namespace detail {
+
 DynamicsConstants dynamics_constants(const FourBar& model) {
   return {mass_matrix_constants(model), opened_loop_constants(model), complex_mass_constants(model),
           has_counter_rotations(model)};
@@ -91,5 +93,7 @@ Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model,
     return dynamics_at(model, constants, instant, CrankInput::inverse(alpha1), f, out);
   });
 }
+
+}  // namespace detail
 
 }  // namespace bd::core

@@ -3,7 +3,6 @@
 /// accelerations, the support reactions, the shaking force and moment, and the drive torque.
 #include <string>
 
-#include "core/fourbar/dynamics_constants.hpp"
 #include "core/expected.hpp"
 #include "core/fourbar/kinematics.hpp"
 #include "core/fourbar/model.hpp"
@@ -11,7 +10,9 @@
 
 namespace bd::core {
 
-/// Everything the dynamics gives at one instant (DESIGN.md conventions).
+/// Everything the dynamics gives at one instant, in the paper's conventions: SI units, angles in
+/// radians from the frame line A0→A3, and every reaction the force of the mechanism ON the
+/// ground.
 struct DynamicsSample {
   FourBarState state;  // angles [rad], rates [rad/s], accelerations [rad/s^2]
   Vec2 RA0{0, 0};      // force of the mechanism ON the ground at A0 [N]
@@ -23,6 +24,14 @@ struct DynamicsSample {
   double Msh{};
   double tau{};  // drive torque on the crank from the frame [N m] (0 in free motion)
 };
+
+/// |sin(theta3 - theta2)| below this counts as a singular (dead-centre) position, and the dynamics
+/// returns kSingular instead of a number. Near a dead centre theta1 is an ill-conditioned input:
+/// the closed loop's angles move like sqrt(theta1 - limit), and every formulation's relative
+/// error grows like eps/sin² (docs/failure-domains.md measures the factor and derives this
+/// threshold from it), so every value returned is good to better than 2e-9; within 0.06° of a
+/// dead centre the tool says "singular" rather than return a number it cannot vouch for.
+inline constexpr double kSingularSin = 1e-3;
 
 /// Why the dynamics could not be evaluated at an instant.
 struct DynamicsError {
@@ -38,7 +47,8 @@ struct DynamicsError {
   std::string what() const;
 };
 
-/// The formulations of the equations of motion (DESIGN.md "Formulations").
+/// The formulations of the equations of motion: three exact routes to the same dynamics, which
+/// agree to round-off with each other and with the Newton–Euler referee of the tests.
 enum class Formulation {
   kMassMatrix,     // constant equivalent mass matrix / truss element (paper §4.2)
   kOpenedLoop,     // opened kinematic loop with principal vectors, 5x5 solve (paper §3)
@@ -52,7 +62,7 @@ inline constexpr Formulation kFormulations[] = {Formulation::kMassMatrix, Formul
 
 /// Forward dynamics (free motion, tau = 0): the crank acceleration and everything else for crank
 /// angle theta1 [rad] and rate omega1 [rad/s] under the model's loads, with the model's
-/// counter-rotations (core/counter_rotation.hpp). The formulations' own entry points
+/// counter-rotations (core/fourbar/counter_rotation.hpp). The formulations' own entry points
 /// (forward_dynamics_mass_matrix, ...) model the bare linkage and ignore counter-rotations.
 Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model, double theta1,
                                                          double omega1,
@@ -62,21 +72,6 @@ Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model, d
 /// theta1 [rad], omega1 [rad/s], with everything else.
 Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model, double theta1,
                                                          double omega1, double alpha1,
-                                                         Formulation f = Formulation::kMassMatrix);
-
-/// The same two with the model's constants computed once by dynamics_constants(model): what a
-/// loop over many instants of one model calls (a simulation's right-hand side, a sweep). The
-/// results are those of the calls above bit for bit, at 10-30 % less cost (docs/performance.md).
-/// `constants` must come from this `model`. Models with counter-rotations take the one-instant
-/// route.
-Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model,
-                                                         const DynamicsConstants& constants,
-                                                         double theta1, double omega1,
-                                                         Formulation f = Formulation::kMassMatrix);
-Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model,
-                                                         const DynamicsConstants& constants,
-                                                         double theta1, double omega1,
-                                                         double alpha1,
                                                          Formulation f = Formulation::kMassMatrix);
 
 }  // namespace bd::core

@@ -7,9 +7,15 @@
 #include <cstdio>
 #include <limits>
 
-#include "core/fourbar/loop_closure.hpp"
+#include "core/fourbar/detail/loop_closure.hpp"
 
 namespace bd::core {
+
+// the kernels' types and steps (core/detail/, core/fourbar/detail/)
+using detail::close_loop;
+using detail::LoopXy;
+using detail::to_vec2;
+using detail::xy;
 
 namespace {
 
@@ -93,8 +99,8 @@ FourBarState solve_velocity(const FourBar& model, const Pose& pose, double omega
   s.theta2 = pose.theta2;
   s.theta3 = pose.theta3;
   s.omega1 = omega1;
-  s.omega2 = tf.Theta2 * omega1;
-  s.omega3 = tf.Theta3 * omega1;
+  s.omega2 = tf.dtheta2_dtheta1 * omega1;
+  s.omega3 = tf.dtheta3_dtheta1 * omega1;
   return s;
 }
 
@@ -110,8 +116,8 @@ FourBarState solve_acceleration(const FourBar& model, FourBarState s, double alp
   const TransferFunctions tf = transfer_functions(model, pose_of(s));
   const AccelerationBias g = acceleration_bias(model, s);
   s.alpha1 = alpha1;
-  s.alpha2 = tf.Theta2 * alpha1 + g.gamma2;
-  s.alpha3 = tf.Theta3 * alpha1 + g.gamma3;
+  s.alpha2 = tf.dtheta2_dtheta1 * alpha1 + g.gamma2;
+  s.alpha3 = tf.dtheta3_dtheta1 * alpha1 + g.gamma3;
   return s;
 }
 

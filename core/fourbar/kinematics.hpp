@@ -51,7 +51,7 @@ Expected<ClosedLoop, AssemblyError> solve_loop(const FourBar& model, double thet
 
 /// First-order kinematic transfer functions Θ2 = dθ2/dθ1, Θ3 = dθ3/dθ1 (eq. 7) [-].
 struct TransferFunctions {
-  double Theta2{}, Theta3{};
+  double dtheta2_dtheta1{}, dtheta3_dtheta1{};
 };
 TransferFunctions transfer_functions(const FourBar& model, const Pose& pose);
 /// The same from the link vectors of a closed pose (no trigonometry).

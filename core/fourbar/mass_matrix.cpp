@@ -2,10 +2,21 @@
 
 #include <cmath>
 
-#include "core/fourbar/formulation_support.hpp"
-#include "core/fourbar/instant_dynamics.hpp"
+#include "core/fourbar/detail/formulation_support.hpp"
+#include "core/fourbar/detail/instant_dynamics.hpp"
 
 namespace bd::core {
+
+// the kernels' types and steps (core/detail/, core/fourbar/detail/)
+using detail::ClosedInstant;
+using detail::CrankInput;
+using detail::evaluated;
+using detail::mass_matrix_at;
+using detail::mass_matrix_constants;
+using detail::MassMatrixConstants;
+using detail::to_vec2;
+using detail::Xy;
+using detail::xy;
 
 namespace {
 
@@ -92,6 +103,8 @@ SystemMassMatrices system_mass_matrices(const FourBar& model) {
   return out;
 }
 
+namespace detail {
+
 MassMatrixConstants mass_matrix_constants(const FourBar& model) {
   const Link &L1 = model.crank, &L2 = model.coupler, &L3 = model.rocker;
   const LinkBlocks M1 = link_blocks(L1), M2 = link_blocks(L2), M3 = link_blocks(L3);
@@ -119,6 +132,8 @@ MassMatrixConstants mass_matrix_constants(const FourBar& model) {
   c.inv_l1_sq = 1.0 / (L1.length * L1.length);
   return c;
 }
+
+}  // namespace detail
 
 Expected<DynamicsSample, DynamicsError> forward_dynamics_mass_matrix(const FourBar& model,
                                                                      double theta1, double omega1) {

@@ -5,6 +5,8 @@
 #include <cassert>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <utility>
 
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
@@ -44,17 +46,63 @@ double total_mass(const FourBar& model) {
 
 namespace {
 
-// throws "<what> must be <expected> <unit>, got <value>" unless ok
-void require(bool ok, const std::string& what, const char* expected, const char* unit,
+// throws "<field>[<index>] must be <expected> <unit>, got <value>" unless ok
+void require(bool ok, std::string field, int index, const char* expected, const char* unit,
              double value) {
   if (!ok) {
-    throw InputError(what + " must be " + expected + (unit[0] ? " " : "") + unit + ", got " +
-                     text::exact(value));
+    throw InputError(FieldError{std::move(field), index,
+                                std::string("must be ") + expected + (unit[0] ? " " : "") + unit +
+                                    ", got " + text::exact(value)});
   }
 }
 
-void check_finite(const std::string& what, const char* unit, double value) {
-  require(std::isfinite(value), what, "finite", unit, value);
+void require(bool ok, std::string field, const char* expected, const char* unit, double value) {
+  require(ok, std::move(field), -1, expected, unit, value);
+}
+
+void check_finite(std::string field, int index, const char* unit, double value) {
+  require(std::isfinite(value), std::move(field), index, "finite", unit, value);
+}
+
+void check_finite(std::string field, const char* unit, double value) {
+  check_finite(std::move(field), -1, unit, value);
+}
+
+// a planar vector's two components, as field[0] and field[1]
+void check_components(const std::string& field, const char* unit, const Vec2& v) {
+  check_finite(field, 0, unit, v.x());
+  check_finite(field, 1, unit, v.y());
+}
+
+void check_link(const Link& l, const std::string& name) {
+  require(std::isfinite(l.length) && l.length > 0, name + ".length", "> 0", "m", l.length);
+  require(std::isfinite(l.mass) && l.mass > 0, name + ".mass", "> 0", "kg", l.mass);
+  check_finite(name + ".e", "m", l.e);
+  check_finite(name + ".f", "m", l.f);
+  require(std::isfinite(l.inertia) && l.inertia >= 0, name + ".inertia", ">= 0", "kg m^2",
+          l.inertia);
+}
+
+void check_load(const LinkLoad& load, const std::string& name) {
+  check_components(name + ".force", "N", load.force);
+  check_finite(name + ".moment", "N m", load.moment);
+}
+
+// `pivot`: the joint of the link the disc is geared to [m]
+void check_counter_rotation(const CounterRotation& c, const std::string& name, const Vec2& pivot) {
+  require(std::isfinite(c.inertia) && c.inertia >= 0, name + ".inertia", ">= 0", "kg m^2",
+          c.inertia);
+  check_components(name + ".at", "m", c.at);
+  if (c.inertia > 0) {
+    // the disc as a whole: with J > 0 its shaft must be away from the pivot
+    const double d = (c.at - pivot).norm();
+    if (!(d > 0)) {
+      throw InputError(FieldError{name, -1,
+                                  ": distance of the shaft from the link's pivot must be > 0 m, "
+                                  "got " +
+                                      text::exact(d)});
+    }
+  }
 }
 
 }  // namespace
@@ -63,38 +111,15 @@ FourBar make_fourbar(const FourBar& candidate) {
   const FourBar& m = candidate;
   require(std::isfinite(m.frame_length) && m.frame_length > 0, "frame", "> 0", "m", m.frame_length);
   for (int k = 1; k <= 3; ++k) {
-    const Link& l = link(m, k);
-    const std::string name = link_name(k);
-    require(std::isfinite(l.length) && l.length > 0, name + ".length", "> 0", "m", l.length);
-    require(std::isfinite(l.mass) && l.mass > 0, name + ".mass", "> 0", "kg", l.mass);
-    check_finite(name + ".e", "m", l.e);
-    check_finite(name + ".f", "m", l.f);
-    require(std::isfinite(l.inertia) && l.inertia >= 0, name + ".inertia", ">= 0", "kg m^2",
-            l.inertia);
-    const LinkLoad& load = link_load(m, k);
-    check_finite("loads." + name + ".force[0]", "N", load.force.x());
-    check_finite("loads." + name + ".force[1]", "N", load.force.y());
-    check_finite("loads." + name + ".moment", "N m", load.moment);
+    check_link(link(m, k), link_name(k));
+    check_load(link_load(m, k), std::string("loads.") + link_name(k));
   }
-  check_finite("loads.gravity[0]", "m/s^2", m.loads.gravity.x());
-  check_finite("loads.gravity[1]", "m/s^2", m.loads.gravity.y());
-  const CounterRotation* rotations[2] = {&m.counter_rotations.crank, &m.counter_rotations.rocker};
-  const Vec2 pivots[2] = {Vec2(0, 0), Vec2(m.frame_length, 0)};
-  const char* names[2] = {"counter_rotations.crank", "counter_rotations.rocker"};
-  for (int i = 0; i < 2; ++i) {
-    const CounterRotation& c = *rotations[i];
-    const std::string name = names[i];
-    require(std::isfinite(c.inertia) && c.inertia >= 0, name + ".inertia", ">= 0", "kg m^2",
-            c.inertia);
-    check_finite(name + ".at[0]", "m", c.at.x());
-    check_finite(name + ".at[1]", "m", c.at.y());
-    if (c.inertia > 0) {
-      const double d = (c.at - pivots[i]).norm();
-      require(d > 0, name + ": distance of the shaft from the link's pivot", "> 0", "m", d);
-    }
-  }
+  check_components("loads.gravity", "m/s^2", m.loads.gravity);
+  check_counter_rotation(m.counter_rotations.crank, "counter_rotations.crank", Vec2(0, 0));
+  check_counter_rotation(m.counter_rotations.rocker, "counter_rotations.rocker",
+                         Vec2(m.frame_length, 0));
   if (m.branch != Branch::kPlus && m.branch != Branch::kMinus) {
-    throw InputError("branch must be +1 or -1");
+    throw InputError(FieldError{"branch", -1, "must be +1 or -1"});
   }
   return candidate;
 }

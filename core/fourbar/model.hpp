@@ -78,7 +78,11 @@ const LinkLoad& link_load(const FourBar& model, int k);
 /// @throws bd::InputError if a length or mass is not > 0 or finite, an inertia is < 0, or any
 ///         value is not finite, or a counter-rotation with J > 0 sits on its link's pivot; the
 ///         message names the link and quantity with its unit, e.g.
-///         "coupler.mass must be > 0 kg, got -1.2".
+///         "coupler.mass must be > 0 kg, got -1.2". Its FieldError's field is the value's path
+///         in the FourBar: "frame", "branch", "<link>.<length|mass|e|f|inertia>",
+///         "loads.<link>.moment", "loads.<link>.force" and "loads.gravity" with index 0 (x) or
+///         1 (y), "counter_rotations.<crank|rocker>.inertia", "counter_rotations.<side>.at"
+///         with index 0 or 1, and "counter_rotations.<side>" for a shaft on its link's pivot.
 FourBar make_fourbar(const FourBar& candidate);
 
 /// Name of link k ("crank", "coupler", "rocker").

@@ -4,10 +4,20 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/fourbar/formulation_support.hpp"
+#include "core/fourbar/detail/formulation_support.hpp"
 #include "core/fourbar/principal_vectors.hpp"
 
 namespace bd::core {
+
+// the kernels' types and steps (core/detail/, core/fourbar/detail/)
+using detail::ClosedInstant;
+using detail::CrankInput;
+using detail::evaluated;
+using detail::Failure;
+using detail::opened_loop_constants;
+using detail::OpenedLoopConstants;
+using detail::Xy;
+using detail::xy;
 
 namespace {
 
@@ -112,10 +122,10 @@ std::optional<Failure> solve(const OpenedLoopConstants& c, const FourBar& model,
   const double inv_det = 1.0 / cross(li, lj);
   // Σ i l̄ θ̈ = b2 with θ̈_k = 1, b2 = 0 (Θ) and with θ̈_k = 0 (g); i l̄ crossed with i l̄' is
   // l̄ × l̄', and x × i l̄ = x·l̄
-  double Theta[3], g[3];
-  Theta[k] = 1.0;
-  Theta[i] = -cross(lk, lj) * inv_det;
-  Theta[j] = -cross(li, lk) * inv_det;
+  double dtheta_dthetak[3], g[3];
+  dtheta_dthetak[k] = 1.0;
+  dtheta_dthetak[i] = -cross(lk, lj) * inv_det;
+  dtheta_dthetak[j] = -cross(li, lk) * inv_det;
   g[k] = 0.0;
   g[i] = dot(b2, lj) * inv_det;
   g[j] = -dot(b2, li) * inv_det;
@@ -128,11 +138,13 @@ std::optional<Failure> solve(const OpenedLoopConstants& c, const FourBar& model,
 
   double alpha[3];
   double tau = 0.0;
-  const double MTheta[3] = {M_times(Theta, 0), M_times(Theta, 1), M_times(Theta, 2)};
+  const double M_dtheta_dthetak[3] = {M_times(dtheta_dthetak, 0), M_times(dtheta_dthetak, 1),
+                                      M_times(dtheta_dthetak, 2)};
   const double alpha_k = !input.torque_unknown
-                             ? (dot3(Theta, b1) - dot3(MTheta, g)) / dot3(Theta, MTheta)
+                             ? (dot3(dtheta_dthetak, b1) - dot3(M_dtheta_dthetak, g)) /
+                                   dot3(dtheta_dthetak, M_dtheta_dthetak)
                              : input.alpha1;
-  for (int r = 0; r < 3; ++r) alpha[r] = Theta[r] * alpha_k + g[r];
+  for (int r = 0; r < 3; ++r) alpha[r] = dtheta_dthetak[r] * alpha_k + g[r];
   // rows i and j for R̄A3: i l̄_i · R̄ = q_i, i l̄_j · R̄ = q_j, so R̄ = (q_i l̄_j - q_j l̄_i)/det
   const double q[3] = {b1[0] - M_times(alpha, 0), b1[1] - M_times(alpha, 1),
                        b1[2] - M_times(alpha, 2)};
@@ -179,6 +191,8 @@ Expected<DynamicsSample, DynamicsError> one_instant(const FourBar& model, double
 
 }  // namespace
 
+namespace detail {
+
 OpenedLoopConstants opened_loop_constants(const FourBar& model) {
   const Link &L1 = model.crank, &L2 = model.coupler, &L3 = model.rocker;
   const double m1 = L1.mass, m2 = L2.mass, m3 = L3.mass, mt = m1 + m2 + m3;
@@ -193,10 +207,10 @@ OpenedLoopConstants opened_loop_constants(const FourBar& model) {
   // eq. 25 with F̄k = applied force + m_k ḡ. The paper prints the moments in principal vectors
   // divided by a mass ((m2+m3)/m1 <i ā12, F̄1>, (m1+m2)/m2 <i ā21, F̄2> + m3/m2 <i ā23, F̄2>,
   // m_tot/m3 <i ā32, F̄3>); those quotients are differences of O(m_tot) terms that are O(m_k),
-  // so at a small mass they lose ~eps·m_tot/m_k (measured: 8e-7 at m2 = 1e-8 kg,
-  // docs/failure-domains.md). Here the same moments, m_k r̄_k - m_k r̄_joint = m_k s̄_k l̄_k/l_k
-  // divided through exactly: <i s̄_k l̄_k/l_k, F̄k> = l̄_k × conj(s̄_k/l_k) F̄k, which divide by no
-  // mass; the forces on the links beyond act at the second joint, l̄_k × F̄.
+  // so at a small mass they lose ~eps·m_tot/m_k (docs/failure-domains.md). Here the same moments,
+  // m_k r̄_k - m_k r̄_joint = m_k s̄_k l̄_k/l_k divided through exactly: <i s̄_k l̄_k/l_k, F̄k> = l̄_k ×
+  // conj(s̄_k/l_k) F̄k, which divide by no mass; the forces on the links beyond act at the second
+  // joint, l̄_k × F̄.
   const Xy F1 = xy(model.loads.crank.force + m1 * model.loads.gravity);
   const Xy F2 = xy(model.loads.coupler.force + m2 * model.loads.gravity);
   const Xy F3 = xy(model.loads.rocker.force + m3 * model.loads.gravity);
@@ -217,6 +231,8 @@ OpenedLoopConstants opened_loop_constants(const FourBar& model) {
   return c;
 }
 
+}  // namespace detail
+
 OpenedLoopTerms opened_loop_terms(const FourBar& model, const Pose& pose) {
   const LinkVectors v = link_vectors(model, pose);
   const Terms t = terms(opened_loop_constants(model), model, {{xy(v.l1), xy(v.l2), xy(v.l3)}});
@@ -235,11 +251,15 @@ OpenedLoopTerms opened_loop_terms(const FourBar& model, const Pose& pose) {
   return out;
 }
 
+namespace detail {
+
 std::optional<Failure> opened_loop_at(const FourBar& model, const OpenedLoopConstants& c,
                                       const ClosedInstant& instant, CrankInput input,
                                       DynamicsSample& out) {
   return solve(c, model, instant.state, links_of(model, instant.state), input, Xy{}, out);
 }
+
+}  // namespace detail
 
 Expected<DynamicsSample, DynamicsError> forward_dynamics_opened_loop(const FourBar& model,
                                                                      double theta1, double omega1) {

@@ -5,9 +5,9 @@
 /// three angular accelerations and R̄A3; R̄A0 follows from the motion of the centre of mass
 /// (eq. 28).
 ///
-/// Signs (DESIGN.md): R̄A3 is the force of the mechanism ON the ground, so the ground pushes the
-/// mechanism with -R̄A3 and the virtual work of eq. 21 carries -<δr̄A3, R̄A3>; D_j = ∂r̄A3/∂θ_j.
-/// The drive torque tau acts on the crank from the frame and enters Q1.
+/// Signs: R̄A3 is the force of the mechanism ON the ground (as every reaction of DynamicsSample),
+/// so the ground pushes the mechanism with -R̄A3 and the virtual work of eq. 21 carries -<δr̄A3,
+/// R̄A3>; D_j = ∂r̄A3/∂θ_j. The drive torque tau acts on the crank from the frame and enters Q1.
 #include <Eigen/Core>
 
 #include "core/fourbar/dynamics.hpp"

@@ -10,15 +10,21 @@
 #include <optional>
 #include <string>
 
+#include "core/fourbar/detail/formulation_support.hpp"
+#include "core/fourbar/detail/free_motion.hpp"
 #include "core/fourbar/energy.hpp"
-#include "core/fourbar/formulation_support.hpp"
+#include "core/fourbar/kinematics.hpp"
+#include "core/fourbar/opened_loop.hpp"
 #include "core/input_error.hpp"
 #include "core/integrators.hpp"
-#include "core/fourbar/kinematics.hpp"
 #include "core/number_text.hpp"
-#include "core/fourbar/opened_loop.hpp"
 
 namespace bd::core {
+
+// the kernels' types and steps (core/detail/, core/fourbar/detail/)
+using detail::integrator_stopped;
+using detail::nonsingular_pose;
+using detail::output_time;
 
 namespace {
 
@@ -206,7 +212,7 @@ void fail(Trajectory& out, const DynamicsError& error, double t) {
 }
 
 void validate(const FreeScene& scene, const OpenedLoopDaeOptions& options) {
-  if (const std::string problem = options.validate(); !problem.empty()) throw InputError(problem);
+  throw_if(options.validate());
   validate_scene(scene);
 }
 
@@ -264,19 +270,17 @@ const char* to_string(DaeMethod m) {
   return "?";
 }
 
-std::string OpenedLoopDaeOptions::validate() const {
-  if (!(tolerance > 0.0 && tolerance < 1.0)) {
-    return "tolerance must be > 0 and < 1, got " + text::digits(tolerance, 10);
+Problem OpenedLoopDaeOptions::validate() const {
+  if (Problem problem = check_integration(tolerance, absolute_tolerance, max_steps)) {
+    return problem;
   }
-  if (!(absolute_tolerance > 0.0) || !std::isfinite(absolute_tolerance)) {
-    return "absolute_tolerance must be > 0, got " + text::digits(absolute_tolerance, 10);
-  }
-  if (max_steps < 1) return "max_steps must be >= 1, got " + std::to_string(max_steps);
   if (!(baumgarte_alpha >= 0.0) || !std::isfinite(baumgarte_alpha)) {
-    return "baumgarte_alpha must be >= 0 1/s, got " + text::digits(baumgarte_alpha, 10);
+    return FieldError{"baumgarte_alpha", -1,
+                      "must be >= 0 1/s, got " + text::digits(baumgarte_alpha, 10)};
   }
   if (!(baumgarte_beta >= 0.0) || !std::isfinite(baumgarte_beta)) {
-    return "baumgarte_beta must be >= 0 1/s, got " + text::digits(baumgarte_beta, 10);
+    return FieldError{"baumgarte_beta", -1,
+                      "must be >= 0 1/s, got " + text::digits(baumgarte_beta, 10)};
   }
   switch (method) {
     case DaeMethod::kAuto:
@@ -291,32 +295,37 @@ std::string OpenedLoopDaeOptions::validate() const {
     case DaeMethod::kIda:
       break;
     default:
-      return "method " + std::to_string(static_cast<int>(method)) + " is unknown";
+      return FieldError{"method", -1, std::to_string(static_cast<int>(method)) + " is unknown"};
   }
   switch (stabilisation) {
     case Stabilisation::kNone:
     case Stabilisation::kBaumgarte:
       if (method == DaeMethod::kIda) {
-        return std::string("method ida needs stabilisation ggl, got ") + to_string(stabilisation) +
-               ": IDA integrates the DAE in its stabilised index-2 form";
+        return FieldError{"method", -1,
+                          std::string("ida needs stabilisation ggl, got ") +
+                              to_string(stabilisation) +
+                              ": IDA integrates the DAE in its stabilised index-2 form"};
       }
       break;
     case Stabilisation::kProjection:
       if (method != DaeMethod::kAuto && method != DaeMethod::kBdf) {
-        return std::string("stabilisation projection needs method bdf (or auto), got ") +
-               to_string(method) + ": CVODE projects only with BDF";
+        return FieldError{"stabilisation", -1,
+                          std::string("projection needs method bdf (or auto), got ") +
+                              to_string(method) + ": CVODE projects only with BDF"};
       }
       break;
     case Stabilisation::kGgl:
       if (method != DaeMethod::kAuto && method != DaeMethod::kIda) {
-        return std::string("stabilisation ggl needs method ida (or auto), got ") +
-               to_string(method) + ": the GGL form is a DAE with algebraic equations";
+        return FieldError{"stabilisation", -1,
+                          std::string("ggl needs method ida (or auto), got ") + to_string(method) +
+                              ": the GGL form is a DAE with algebraic equations"};
       }
       break;
     default:
-      return "stabilisation " + std::to_string(static_cast<int>(stabilisation)) + " is unknown";
+      return FieldError{"stabilisation", -1,
+                        std::to_string(static_cast<int>(stabilisation)) + " is unknown"};
   }
-  return {};
+  return std::nullopt;
 }
 
 OpenedLoopDaeOptions opened_loop_dae_options(const SimulateOptions& options) {
@@ -410,6 +419,135 @@ Integrator integrator_of(DaeMethod method) {
   return Integrator::kCvodeAdams;
 }
 
+// The method a run uses: the options' own, or for kAuto the one its stabilisation needs.
+DaeMethod resolved_method(const OpenedLoopDaeOptions& options) {
+  return options.method != DaeMethod::kAuto                    ? options.method
+         : options.stabilisation == Stabilisation::kProjection ? DaeMethod::kBdf
+         : options.stabilisation == Stabilisation::kGgl        ? DaeMethod::kIda
+                                                               : DaeMethod::kAdams;
+}
+
+// room for `samples` samples and their drift, energy and branch
+void reserve(OpenedLoopDaeResult& out, std::size_t samples) {
+  for (auto* v : {&out.position_residual, &out.velocity_residual, &out.energy}) {
+    v->reserve(samples);
+  }
+  out.trajectory.t.reserve(samples);
+  out.trajectory.samples.reserve(samples);
+  out.branch.reserve(samples);
+}
+
+// What every integration of a run shares: its length, tolerance and step budget, and the
+// callbacks' data.
+integrators::Problem run_problem(const FreeScene& scene, const OpenedLoopDaeOptions& options,
+                                 DaeMotion& motion) {
+  integrators::Problem problem;
+  problem.tolerance = options.tolerance;
+  problem.t_end = scene.duration;
+  problem.max_steps = options.max_steps;
+  problem.user_data = &motion;
+  return problem;
+}
+
+// The integration of the six states θ, ω (kNone, kBaumgarte, kProjection) from the consistent
+// start: the closed pose and the rates it allows.
+//
+// Method. kNone and kBaumgarte: the six-state ODE is non-stiff (the eigenvalues of a slow
+// oscillator, and with Baumgarte -α ± sqrt(α² - β²) ~ -10 1/s, far below 1/h at the tolerances
+// used), so Adams-Moulton with a fixed-point corrector, as in core/fourbar/simulate.cpp, or an
+// explicit Runge-Kutta pair. kProjection: CVODE's projection interface (CVodeSetProjFn) exists
+// for BDF only, which needs a Newton corrector: dense 6x6 linear solver, difference-quotient
+// Jacobian. kGgl: see ggl_problem().
+integrators::Problem dae_problem(const FourBarState& start, const FreeScene& scene,
+                                 const OpenedLoopDaeOptions& options, DaeMethod method,
+                                 DaeMotion& motion) {
+  integrators::Problem problem = run_problem(scene, options, motion);
+  problem.integrator = integrator_of(method);
+  problem.y0 = {start.theta1, start.theta2, start.theta3, start.omega1, start.omega2, start.omega3};
+  problem.rhs = dae_rhs;
+  if (options.stabilisation == Stabilisation::kProjection) problem.projection = project;
+  // angles [rad], rates [rad/s]
+  problem.absolute_tolerance.assign(problem.y0.size(), options.absolute_tolerance);
+  return problem;
+}
+
+// kGgl: IDA (the GGL form's one method) on the ten unknowns, started from `start` and the
+// consistent values of the 5x5 solve there, `first` (θ' = ω, ω' = α, λ = R̄A3, μ = 0); λ and μ
+// are algebraic and take no part in the error test.
+integrators::Problem ggl_problem(const FourBarState& start, const DynamicsSample& first,
+                                 const FreeScene& scene, const OpenedLoopDaeOptions& options,
+                                 DaeMotion& motion) {
+  const FourBarState& s = first.state;
+  integrators::Problem problem = run_problem(scene, options, motion);
+  problem.integrator = Integrator::kIda;
+  problem.y0 = {start.theta1, start.theta2,  start.theta3,  start.omega1, start.omega2,
+                start.omega3, first.RA3.x(), first.RA3.y(), 0.0,          0.0};
+  problem.yp0 = {s.omega1, s.omega2, s.omega3, s.alpha1, s.alpha2, s.alpha3, 0, 0, 0, 0};
+  problem.differential = {true, true, true, true, true, true, false, false, false, false};
+  problem.residual = ggl_residual;
+  // IDA's own first step keeps |h y'| at the tolerance level (h ~ 1e-12 s at 1e-10 when the
+  // linkage moves), where the Newton iteration on the index-2 system fails: the multipliers'
+  // round-off grows like 1/h, and no first step is found at tight tolerances with omega1 != 0.
+  // The first step of the order-1 BDF has the local error h² |θ̈| / 2: take the h that puts
+  // it at the tolerance, at most 1 % of the run.
+  double angle = 1.0, acceleration = 0.0;
+  for (double a : {s.theta1, s.theta2, s.theta3}) angle = std::max(angle, std::abs(a));
+  for (double a : {s.alpha1, s.alpha2, s.alpha3})
+    acceleration = std::max(acceleration, std::abs(a));
+  const double error = options.tolerance * angle + options.absolute_tolerance;
+  problem.initial_step = acceleration > 0
+                             ? std::min(std::sqrt(2 * error / acceleration), 0.01 * scene.duration)
+                             : 0.01 * scene.duration;
+  // angles [rad], rates [rad/s]
+  problem.absolute_tolerance.assign(problem.y0.size(), options.absolute_tolerance);
+  // The multipliers take no part in the error test; their tolerances decide when the Newton
+  // iteration may stop. Their round-off grows like 1/h (μ ≈ -(α/h)(G Gᵀ)⁻¹ c at the
+  // predictor; λ likewise from G ω = 0) and with the size of the angles (sin and cos of a
+  // crank that has turned 100 times), so tolerances near the angles' make the iteration fail,
+  // which IDA answers by smaller steps still until it gives up. λ to 1e-5 of its size (at least
+  // 1 N) and μ to 1 1/(m s) let it stop in every case tried (the paper example from rest and
+  // moving, the triple rocker through its limits, a double crank; tolerances 1e-3 ... 1e-12),
+  // at the price of more steps than a tighter λ takes where that works.
+  const double force_scale = std::max(1.0, first.RA3.norm());
+  problem.absolute_tolerance[6] = problem.absolute_tolerance[7] = 1e-5 * force_scale;
+  problem.absolute_tolerance[8] = problem.absolute_tolerance[9] = 1.0;
+  return problem;
+}
+
+// True, with the trajectory's status and message set, when the integration stopped before
+// t_out (out of steps, or failed: where the dynamics itself failed, with its error); false when
+// it reached t_out.
+bool stopped_short(integrators::Integration::Outcome outcome,
+                   const integrators::Integration& integration, const DaeMotion& motion,
+                   const OpenedLoopDaeOptions& options, Trajectory& traj) {
+  using Outcome = integrators::Integration::Outcome;
+  if (outcome == Outcome::kReached) return false;
+  if (outcome != Outcome::kMaxSteps && motion.rhs_failed) {  // kFailed (no root function here)
+    fail(traj, motion.error, motion.error_t);
+    traj.message += "; integration stopped at t = " + text::digits(integration.t(), 10) + " s";
+  } else {
+    integrator_stopped(traj, integration, outcome, options.max_steps);
+  }
+  return true;
+}
+
+// The state of a sample on the closure (projected as kProjection does after every step); the
+// integration goes on from its own state. The unprojected state if the projection fails (it
+// cannot this close to the closure).
+FourBarState on_closure(FourBarState s, DaeMotion& motion) {
+  Eigen::Vector3d theta(s.theta1, s.theta2, s.theta3), omega(s.omega1, s.omega2, s.omega3);
+  if (project_onto_closure(*motion.model, motion.length_scale, theta, omega)) {
+    s.theta1 = theta(0);
+    s.theta2 = theta(1);
+    s.theta3 = theta(2);
+    s.omega1 = omega(0);
+    s.omega2 = omega(1);
+    s.omega3 = omega(2);
+    ++motion.projections;
+  }
+  return s;
+}
+
 }  // namespace
 
 OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FreeScene& scene,
@@ -417,17 +555,9 @@ OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FreeSce
   validate(scene, options);
   const auto samples = static_cast<std::size_t>(scene.samples);
   OpenedLoopDaeResult out;
-  out.method = options.method != DaeMethod::kAuto                    ? options.method
-               : options.stabilisation == Stabilisation::kProjection ? DaeMethod::kBdf
-               : options.stabilisation == Stabilisation::kGgl        ? DaeMethod::kIda
-                                                                     : DaeMethod::kAdams;
+  out.method = resolved_method(options);
   Trajectory& traj = out.trajectory;
-  for (auto* v : {&out.position_residual, &out.velocity_residual, &out.energy}) {
-    v->reserve(samples);
-  }
-  traj.t.reserve(samples);
-  traj.samples.reserve(samples);
-  out.branch.reserve(samples);
+  reserve(out, samples);
 
   DaeMotion motion;
   motion.model = &model;
@@ -454,110 +584,25 @@ OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FreeSce
   }
   record(out, model, 0.0, *first);
 
-  // Method. kNone and kBaumgarte: the six-state ODE is non-stiff (the eigenvalues of a slow
-  // oscillator, and with Baumgarte -α ± sqrt(α² - β²) ~ -10 1/s, far below 1/h at the tolerances
-  // used), so Adams-Moulton with a fixed-point corrector, as in core/simulate.cpp, or an explicit
-  // Runge-Kutta pair. kProjection: CVODE's projection interface (CVodeSetProjFn) exists for BDF
-  // only, which needs a Newton corrector: dense 6x6 linear solver, difference-quotient Jacobian.
-  // kGgl: IDA on the ten unknowns, started from the consistent values of the 5x5 solve
-  // (θ' = ω, ω' = α, λ = R̄A3, μ = 0); λ and μ are algebraic and take no part in the error test.
   const bool projection = options.stabilisation == Stabilisation::kProjection;
-  const bool ggl = options.stabilisation == Stabilisation::kGgl;
-  integrators::Problem problem;
-  problem.integrator = integrator_of(out.method);
-  problem.y0 = {start.theta1, start.theta2, start.theta3, start.omega1, start.omega2, start.omega3};
-  problem.tolerance = options.tolerance;
-  problem.t_end = scene.duration;
-  problem.max_steps = options.max_steps;
-  problem.user_data = &motion;
-  if (ggl) {
-    const FourBarState& s = first->state;
-    problem.y0.insert(problem.y0.end(), {first->RA3.x(), first->RA3.y(), 0.0, 0.0});
-    problem.yp0 = {s.omega1, s.omega2, s.omega3, s.alpha1, s.alpha2, s.alpha3, 0, 0, 0, 0};
-    problem.differential = {true, true, true, true, true, true, false, false, false, false};
-    problem.residual = ggl_residual;
-    // IDA's own first step keeps |h y'| at the tolerance level (h ~ 1e-12 s at 1e-10 when the
-    // linkage moves), where the Newton iteration on the index-2 system fails: the multipliers'
-    // round-off grows like 1/h (measured: no first step at tolerance 1e-10 with omega1 != 0).
-    // The first step of the order-1 BDF has the local error h² |θ̈| / 2: take the h that puts
-    // it at the tolerance, at most 1 % of the run.
-    double angle = 1.0, acceleration = 0.0;
-    for (double a : {s.theta1, s.theta2, s.theta3}) angle = std::max(angle, std::abs(a));
-    for (double a : {s.alpha1, s.alpha2, s.alpha3})
-      acceleration = std::max(acceleration, std::abs(a));
-    const double error = options.tolerance * angle + options.absolute_tolerance;
-    problem.initial_step =
-        acceleration > 0 ? std::min(std::sqrt(2 * error / acceleration), 0.01 * scene.duration)
-                         : 0.01 * scene.duration;
-  } else {
-    problem.rhs = dae_rhs;
-    if (projection) problem.projection = project;
-  }
-  // angles [rad], rates [rad/s]
-  problem.absolute_tolerance.assign(problem.y0.size(), options.absolute_tolerance);
-  if (ggl) {
-    // The multipliers take no part in the error test; their tolerances decide when the Newton
-    // iteration may stop. Their round-off grows like 1/h (μ ≈ -(α/h)(G Gᵀ)⁻¹ c at the
-    // predictor; λ likewise from G ω = 0) and with the size of the angles (sin and cos of a
-    // crank that has turned 100 times), so tolerances near the angles' make the iteration fail,
-    // which IDA answers by smaller steps still until it gives up. Measured on the paper example:
-    // 1e-12 on μ stops it at t = 1.2e-6 s (tolerance 1e-10); λ to 1e-9 N fails after 35-90 s at
-    // omega1 = 3 rad/s (theta1 ~ 140-550 rad), 1e-7 N at tolerance 1e-11. λ to 1e-5 of its
-    // size (at least 1 N) and μ to 1 1/(m s) ran every case measured (the paper example from
-    // rest and at 3 rad/s for 100 s, the triple rocker through its limits, a double crank) at
-    // tolerances 1e-3 ... 1e-12, at the price of up to 1.8 times the steps of the tighter λ.
-    const double force_scale = std::max(1.0, first->RA3.norm());
-    problem.absolute_tolerance[6] = problem.absolute_tolerance[7] = 1e-5 * force_scale;
-    problem.absolute_tolerance[8] = problem.absolute_tolerance[9] = 1.0;
-  }
-  integrators::Integration integration(problem);
-
+  integrators::Integration integration(
+      options.stabilisation == Stabilisation::kGgl
+          ? ggl_problem(start, *first, scene, options, motion)
+          : dae_problem(start, scene, options, out.method, motion));
   traj.status = SimulationStatus::kCompleted;
   traj.message = "completed";
-  const double last = static_cast<double>(samples - 1);
   for (std::size_t j = 1; j < samples; ++j) {
-    const double t_out =
-        j + 1 == samples ? scene.duration : scene.duration * static_cast<double>(j) / last;
     motion.rhs_failed = false;
     // with projection, stop the steps at each output instant so that the sample is a projected
     // step end (CVODE's interpolant between projected steps is itself off the closure by the
     // local error)
-    const auto outcome = integration.advance(t_out, projection);
-    const double t_reached = integration.t();
-    const double* y = integration.y();
-    if (outcome == integrators::Integration::Outcome::kMaxSteps) {
-      traj.status = SimulationStatus::kIntegratorFailed;
-      traj.message = "integrator stopped at t = " + text::digits(t_reached, 10) +
-                     " s, theta1 = " + text::digits(y[0], 10) +
-                     " rad: max_steps = " + std::to_string(options.max_steps) + " reached";
-      break;
-    }
-    if (outcome != integrators::Integration::Outcome::kReached) {  // no root function here
-      if (motion.rhs_failed) {
-        fail(traj, motion.error, motion.error_t);
-        traj.message += "; integration stopped at t = " + text::digits(t_reached, 10) + " s";
-      } else {
-        traj.status = SimulationStatus::kIntegratorFailed;
-        traj.message = "integrator failed at t = " + text::digits(t_reached, 10) +
-                       " s, theta1 = " + text::digits(y[0], 10) + " rad: " + integration.failure();
-      }
-      break;
-    }
+    const auto outcome = integration.advance(output_time(scene, j), projection);
+    if (stopped_short(outcome, integration, motion, options, traj)) break;
 
-    FourBarState s = state_of(y);
-    if (options.project_samples && !projection) {
-      // the sample on the closure; the integration goes on from its own state
-      Eigen::Vector3d theta(s.theta1, s.theta2, s.theta3), omega(s.omega1, s.omega2, s.omega3);
-      if (project_onto_closure(model, motion.length_scale, theta, omega)) {
-        s.theta1 = theta(0);
-        s.theta2 = theta(1);
-        s.theta3 = theta(2);
-        s.omega1 = omega(0);
-        s.omega2 = omega(1);
-        s.omega3 = omega(2);
-        ++motion.projections;
-      }  // (cannot fail this close to the closure; the unprojected state is kept if it does)
-    }
+    const double t_reached = integration.t();
+    const FourBarState s = options.project_samples && !projection
+                               ? on_closure(state_of(integration.y()), motion)
+                               : state_of(integration.y());
     ++motion.evaluations;
     const auto sample = forward_dynamics_opened_loop(model, s, closure_bias(motion, s));
     if (!sample) {

@@ -1,15 +1,15 @@
 #pragma once
 /// The opened-loop equations (paper §3, eqs. 22 and 27) integrated over time as a DAE of index
 /// one: the six states theta1..3, omega1..3 advance with the accelerations of the 5x5 solve
-/// (core/opened_loop.hpp), and the loop closure (eq. 26) holds only as far as its second
+/// (core/fourbar/opened_loop.hpp), and the loop closure (eq. 26) holds only as far as its second
 /// derivative (eq. 27) is integrated, so it drifts. Three remedies: none, Baumgarte
 /// stabilisation of eq. 27, or projection onto the closure and its rate form after every step.
 /// A fourth form keeps the closure itself as an equation: the DAE in the stabilised index-2
 /// form of Gear, Gupta and Leimkuhler (GGL), integrated by IDA.
 ///
-/// Unlike the reduced equation in theta1 (core/simulate.hpp), this form has no singularity at a
-/// limit (dead-centre) position of the crank, where coupler and rocker align: its 5x5 matrix is
-/// regular as long as the three moving links are not all parallel. A non-Grashof linkage in free
+/// Unlike the reduced equation in theta1 (core/fourbar/simulate.hpp), this form has no singularity
+/// at a limit (dead-centre) position of the crank, where coupler and rocker align: its 5x5 matrix
+/// is regular as long as the three moving links are not all parallel. A non-Grashof linkage in free
 /// motion is integrated straight through its limit positions: the crank reverses and the
 /// assembly branch flips (A2 crosses the line A1A3), as the real linkage does.
 #include <string>
@@ -18,6 +18,7 @@
 #include "core/fourbar/dynamics.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/simulate.hpp"
+#include "core/input_error.hpp"
 
 namespace bd::core {
 
@@ -73,8 +74,9 @@ struct OpenedLoopDaeOptions {
   /// the integration error (~tolerance), a force-balanced design would show a shaking force of
   /// that size; projected, it vanishes to round-off as on the exact motion.
   bool project_samples = false;
-  /// Empty when valid, else the problem in words.
-  std::string validate() const;
+  /// Empty when valid, else the first problem; its field is "tolerance", "absolute_tolerance",
+  /// "max_steps", "baumgarte_alpha", "baumgarte_beta", "method" or "stabilisation".
+  Problem validate() const;
 };
 
 /// A DAE run: the trajectory (samples with the state, all three accelerations and the reactions
@@ -84,9 +86,9 @@ struct OpenedLoopDaeResult {
   Trajectory trajectory;
   std::vector<double> position_residual;  // |l̄1 + l̄2 + l̄3 + l̄4| [m]
   std::vector<double> velocity_residual;  // |Σ i l̄k ωk| (rate of the closure) [m/s]
-  /// Kinetic energy plus load potential (core/energy.hpp) [J]; conserved in free motion. For a
-  /// state off the closure energy.hpp places the rocker from A3 (not from the open chain's A2),
-  /// an O(residual) difference.
+  /// Kinetic energy plus load potential (core/fourbar/energy.hpp) [J]; conserved in free motion.
+  /// For a state off the closure energy.hpp places the rocker from A3 (not from the open chain's
+  /// A2), an O(residual) difference.
   std::vector<double> energy;
   /// Branch of the sample: kPlus when A2 lies left of A1->A3, cross(A3 - A1, A2 - A1) >= 0, with
   /// A2 = l̄1 + l̄2 reached along the open chain.

@@ -1,11 +1,17 @@
 #include "core/fourbar/principal_vectors.hpp"
 
+#include "core/detail/complex_vector.hpp"
+
 namespace bd::core {
 
 namespace {
 
+using detail::Complex;
+using detail::to_complex;
+using detail::to_vec;
+
 // s̄_k / l_k
-Complex relative_com(const Link& l) { return Complex(l.e, l.f) / l.length; }
+ComplexCoefficient relative_com(const Link& l) { return Complex(l.e, l.f) / l.length; }
 
 // d/dt and d²/dt² of ā = c·l̄ turning at rate w, acceleration a: i w ā and (i a - w²) ā
 Vec2 rate(const Vec2& v, double w) { return w * perp(v); }
@@ -14,15 +20,15 @@ Vec2 accel(const Vec2& v, double w, double a) { return a * perp(v) - w * w * v; 
 }  // namespace
 
 EquivalentMasses equivalent_masses(const Link& l) {
-  const Complex q = l.mass * relative_com(l);
+  const ComplexMass q = l.mass * relative_com(l);
   return {l.mass - q, q, l.mass * (1 - l.e / l.length), l.mass * l.e / l.length,
           l.mass * l.f / l.length};
 }
 
 OpenedLoopFactors opened_loop_factors(const FourBar& m) {
   const double m1 = m.crank.mass, m2 = m.coupler.mass, m3 = m.rocker.mass, mt = m1 + m2 + m3;
-  const Complex s1 = relative_com(m.crank), s2 = relative_com(m.coupler),
-                s3 = relative_com(m.rocker);
+  const ComplexCoefficient s1 = relative_com(m.crank), s2 = relative_com(m.coupler),
+                           s3 = relative_com(m.rocker);
   // eq. 12
   OpenedLoopFactors f;
   f.a12 = (1.0 - s1) * m1 / mt;
@@ -38,7 +44,7 @@ OpenedLoopFactors opened_loop_factors(const FourBar& m) {
 FrameFactors frame_factors(const FourBar& m) {
   const double m1 = m.crank.mass, m3 = m.rocker.mass, mt = total_mass(m);
   const EquivalentMasses e2 = equivalent_masses(m.coupler);
-  const Complex s1 = relative_com(m.crank), s3 = relative_com(m.rocker);
+  const ComplexCoefficient s1 = relative_com(m.crank), s3 = relative_com(m.rocker);
   // eq. 30
   FrameFactors f;
   f.a14 = -(m1 * s1 + e2.mp) / mt;

@@ -4,26 +4,22 @@
 ///
 /// A principal vector ā_kj starts at the principal point P_k of link k and ends at the joint of
 /// link k with link j (or at the joint with the frame, j = 4). All are fixed in their link: each
-/// is a constant complex factor times the link vector l̄_k, so they turn with the link.
-#include <complex>
-
+/// is a constant complex factor times the link vector l̄_k, so they turn with the link. The
+/// vectors are Vec2; the complex masses and the factors are the paper's complex scalars
+/// (ComplexMass, ComplexCoefficient in core/types.hpp).
 #include "core/fourbar/kinematics.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/types.hpp"
 
 namespace bd::core {
 
-using Complex = std::complex<double>;
-inline Complex to_complex(const Vec2& v) { return {v.x(), v.y()}; }
-inline Vec2 to_vec(const Complex& z) { return {z.real(), z.imag()}; }
-
 /// The equivalent masses of a link (eq. 29 and §4.1): the complex masses at its first joint p and
 /// second joint q, m̄_p = m(1 - s̄/l) = m^a - i m^c and m̄_q = m s̄/l = m^b + i m^c, whose sum is m.
 struct EquivalentMasses {
-  Complex mp, mq;  // complex masses at the first and second joint [kg]
-  double ma{};     // real equivalent mass at p: m (1 - e/l) [kg]
-  double mb{};     // real equivalent mass at q: m e/l [kg]
-  double mc{};     // virtual equivalent mass: m f/l [kg]
+  ComplexMass mp, mq;  // complex masses at the first and second joint [kg]
+  double ma{};         // real equivalent mass at p: m (1 - e/l) [kg]
+  double mb{};         // real equivalent mass at q: m e/l [kg]
+  double mc{};         // virtual equivalent mass: m f/l [kg]
 };
 EquivalentMasses equivalent_masses(const Link& link);
 
@@ -48,11 +44,11 @@ FrameVectors frame_vectors(const FourBar& model, const LinkVectors& l);
 /// The same vectors as constant complex factors c with ā = c·l̄_k (c depends on the masses and
 /// centres of mass only). Used by the formulations and the balance conditions.
 struct OpenedLoopFactors {
-  Complex a12, a21, a23, a32, a14p, a34p;  // times l̄1, l̄2, l̄2, l̄3, l̄1, l̄3
+  ComplexCoefficient a12, a21, a23, a32, a14p, a34p;  // times l̄1, l̄2, l̄2, l̄3, l̄1, l̄3
 };
 OpenedLoopFactors opened_loop_factors(const FourBar& model);
 struct FrameFactors {
-  Complex a14, a41, a43, a34, a12p, a32p;  // times l̄1, l̄4, l̄4, l̄3, l̄1, l̄3
+  ComplexCoefficient a14, a41, a43, a34, a12p, a32p;  // times l̄1, l̄4, l̄4, l̄3, l̄1, l̄3
 };
 FrameFactors frame_factors(const FourBar& model);
 

@@ -10,18 +10,32 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "core/fourbar/counter_rotation.hpp"
-#include "core/fourbar/formulation_support.hpp"
-#include "core/input_error.hpp"
-#include "core/fourbar/instant_dynamics.hpp"
-#include "core/integrators.hpp"
+#include "core/fourbar/detail/formulation_support.hpp"
+#include "core/fourbar/detail/free_motion.hpp"
+#include "core/fourbar/detail/instant_dynamics.hpp"
 #include "core/fourbar/kinematics.hpp"
-#include "core/number_text.hpp"
 #include "core/fourbar/opened_loop.hpp"
 #include "core/fourbar/opened_loop_dae.hpp"
+#include "core/input_error.hpp"
+#include "core/integrators.hpp"
+#include "core/number_text.hpp"
 
 namespace bd::core {
+
+// the kernels' types and steps (core/detail/, core/fourbar/detail/)
+using detail::close_instant;
+using detail::ClosedInstant;
+using detail::CrankInput;
+using detail::CrankSweep;
+using detail::dynamics_at;
+using detail::dynamics_constants;
+using detail::DynamicsConstants;
+using detail::Failure;
+using detail::integrator_stopped;
+using detail::output_time;
 
 namespace {
 
@@ -158,49 +172,51 @@ int dead_centre_root(sunrealtype /*t*/, N_Vector y, sunrealtype* g, void* user_d
   return 0;
 }
 
+// rejects the input: `field` is wrong as `message` says
+[[noreturn]] void reject(std::string field, std::string message) {
+  throw InputError(FieldError{std::move(field), -1, std::move(message)});
+}
+
 void validate(const FreeScene& scene, const SimulateOptions& options) {
-  if (const std::string problem = options.validate(); !problem.empty()) throw InputError(problem);
+  throw_if(options.validate());
   validate_scene(scene);
 }
 
 void validate(const DrivenScene& scene, const SimulateOptions& options) {
-  if (const std::string problem = options.validate(); !problem.empty()) throw InputError(problem);
+  throw_if(options.validate());
   if (!std::isfinite(scene.theta1)) {
-    throw InputError("scene.theta1 must be finite, got " + text::digits(scene.theta1, 10));
+    reject("scene.theta1", "must be finite, got " + text::digits(scene.theta1, 10));
   }
   if (!(scene.omega1 != 0.0) || !std::isfinite(scene.omega1)) {
-    throw InputError("scene.omega1 must be finite and != 0 rad/s, got " +
-                     text::digits(scene.omega1, 10));
+    reject("scene.omega1", "must be finite and != 0 rad/s, got " + text::digits(scene.omega1, 10));
   }
   if (scene.revolutions < 1) {
-    throw InputError("scene.revolutions must be >= 1, got " + std::to_string(scene.revolutions));
+    reject("scene.revolutions", "must be >= 1, got " + std::to_string(scene.revolutions));
   }
   if (scene.samples < 1) {
-    throw InputError("scene.samples must be >= 1, got " + std::to_string(scene.samples));
+    reject("scene.samples", "must be >= 1, got " + std::to_string(scene.samples));
   }
   if (static_cast<long long>(scene.revolutions) * scene.samples > kMaxSamples) {
-    throw InputError("scene.revolutions * scene.samples must be <= 1e8, got " +
-                     std::to_string(static_cast<long long>(scene.revolutions) * scene.samples));
+    // two fields together: the scene as a whole
+    reject("", "scene.revolutions * scene.samples must be <= 1e8, got " +
+                   std::to_string(static_cast<long long>(scene.revolutions) * scene.samples));
   }
 }
 
 }  // namespace
 
-std::string SimulateOptions::validate() const {
-  if (!(tolerance > 0.0 && tolerance < 1.0)) {
-    return "tolerance must be > 0 and < 1, got " + text::digits(tolerance, 10);
+Problem SimulateOptions::validate() const {
+  if (Problem problem = check_integration(tolerance, absolute_tolerance, max_steps)) {
+    return problem;
   }
-  if (!(absolute_tolerance > 0.0) || !std::isfinite(absolute_tolerance)) {
-    return "absolute_tolerance must be > 0, got " + text::digits(absolute_tolerance, 10);
-  }
-  if (max_steps < 1) return "max_steps must be >= 1, got " + std::to_string(max_steps);
   switch (formulation) {
     case Formulation::kMassMatrix:
     case Formulation::kOpenedLoop:
     case Formulation::kComplexMasses:
       break;
     default:
-      return "formulation " + std::to_string(static_cast<int>(formulation)) + " is unknown";
+      return FieldError{"formulation", -1,
+                        std::to_string(static_cast<int>(formulation)) + " is unknown"};
   }
   switch (integrator) {
     case Integrator::kCvodeAdams:
@@ -214,40 +230,18 @@ std::string SimulateOptions::validate() const {
       break;
     case Integrator::kIda:
       if (formulation != Formulation::kOpenedLoop) {
-        return std::string("integrator ida needs formulation opened-loop, got ") +
-               to_string(formulation) +
-               ": IDA integrates the opened loop's DAE, while this formulation is an ODE in "
-               "theta1 (use cvode-adams, cvode-bdf or erk2 ... erk8)";
+        return FieldError{"integrator", -1,
+                          std::string("ida needs formulation opened-loop, got ") +
+                              to_string(formulation) +
+                              ": IDA integrates the opened loop's DAE, while this formulation "
+                              "is an ODE in theta1 (use cvode-adams, cvode-bdf or erk2 ... erk8)"};
       }
       break;
     default:
-      return "integrator " + std::to_string(static_cast<int>(integrator)) + " is unknown";
+      return FieldError{"integrator", -1,
+                        std::to_string(static_cast<int>(integrator)) + " is unknown"};
   }
-  return {};
-}
-
-const char* to_string(Integrator integrator) {
-  switch (integrator) {
-    case Integrator::kCvodeAdams:
-      return "cvode-adams";
-    case Integrator::kCvodeBdf:
-      return "cvode-bdf";
-    case Integrator::kErk2:
-      return "erk2";
-    case Integrator::kErk3:
-      return "erk3";
-    case Integrator::kErk4:
-      return "erk4";
-    case Integrator::kErk5:
-      return "erk5";
-    case Integrator::kErk6:
-      return "erk6";
-    case Integrator::kErk8:
-      return "erk8";
-    case Integrator::kIda:
-      return "ida";
-  }
-  return "?";
+  return std::nullopt;
 }
 
 SimulationStatus status_of(DynamicsError::Kind kind) {
@@ -264,63 +258,132 @@ SimulationStatus status_of(DynamicsError::Kind kind) {
 
 void validate_scene(const FreeScene& scene) {
   if (!std::isfinite(scene.theta1)) {
-    throw InputError("scene.theta1 must be finite, got " + text::digits(scene.theta1, 10));
+    reject("scene.theta1", "must be finite, got " + text::digits(scene.theta1, 10));
   }
   if (!std::isfinite(scene.omega1)) {
-    throw InputError("scene.omega1 must be finite, got " + text::digits(scene.omega1, 10));
+    reject("scene.omega1", "must be finite, got " + text::digits(scene.omega1, 10));
   }
   if (!(scene.duration > 0.0) || !std::isfinite(scene.duration)) {
-    throw InputError("scene.duration must be > 0 s, got " + text::digits(scene.duration, 10));
+    reject("scene.duration", "must be > 0 s, got " + text::digits(scene.duration, 10));
   }
   if (scene.samples < 2 || scene.samples > kMaxSamples) {
-    throw InputError("scene.samples must be >= 2 (and <= 1e8), got " +
-                     std::to_string(scene.samples));
+    reject("scene.samples", "must be >= 2 (and <= 1e8), got " + std::to_string(scene.samples));
   }
 }
 
-const char* to_string(SimulationStatus s) {
-  switch (s) {
-    case SimulationStatus::kNotRun:
-      return "not-run";
-    case SimulationStatus::kCompleted:
-      return "completed";
-    case SimulationStatus::kAssemblyFailed:
-      return "assembly-failed";
-    case SimulationStatus::kSingular:
-      return "singular";
-    case SimulationStatus::kIntegratorFailed:
-      return "integrator-failed";
+namespace {
+
+// Formulation::kOpenedLoop: the opened loop's own form, the DAE in theta1..theta3, kept on the
+// loop closure as the integrator allows (opened_loop_dae_options); it has no singularity at a
+// crank limit position and passes through it.
+Trajectory simulate_free_opened_loop(const FourBar& model, const FreeScene& scene,
+                                     const SimulateOptions& options) {
+  const OpenedLoopDaeOptions dae = opened_loop_dae_options(options);
+  if (!has_counter_rotations(model)) {
+    return simulate_opened_loop_dae(model, scene, dae).trajectory;
   }
-  return "?";
+  // discs: the motion from the equations with I_k + J_k, then each sample's reactions from the
+  // bare linkage loaded by the mesh forces at the sample's own state
+  // (core/fourbar/counter_rotation.hpp)
+  Trajectory out = simulate_opened_loop_dae(with_disc_inertia(model), scene, dae).trajectory;
+  for (std::size_t i = 0; i < out.samples.size(); ++i) {
+    const FourBarState& s = out.samples[i].state;
+    const MeshForces f = mesh_forces(model, s);
+    const auto bare = forward_dynamics_opened_loop(with_mesh_loads(model, s, f), s);
+    if (!bare) {  // cannot happen where the DAE itself evaluated; keep what came before
+      fail(out, bare.error(), out.t[i], s.theta1);
+      out.t.resize(i);
+      out.samples.resize(i);
+      break;
+    }
+    out.samples[i] = with_shaft_reactions(model, *bare, f);
+  }
+  return out;
 }
+
+// The integration of the reduced equation y = (theta1, omega1) from the scene's start.
+//
+// Method: options.integrator (docs/performance.md compares them). The crank equation is a
+// smooth, non-stiff ODE of two states (its Jacobian has the eigenvalues of a slow oscillator,
+// |lambda| ~ |omega1| + sqrt|d alpha1/d theta1|), solved at tight tolerances (1e-10): the
+// default, variable-order Adams-Moulton (orders 1-12) with a fixed-point corrector, reaches
+// them with few steps and no Jacobian; BDF (orders <= 5, Newton) and the explicit
+// Runge-Kutta pairs are there to be compared. Every one of them locates a dead centre by
+// root finding on |sin(theta3 - theta2)|, registered only where the coupler and rocker can
+// align: in a crank-rocker or double crank |A1A3| stays strictly between |l2 - l3| and
+// l2 + l3 at every crank angle, and there the root checks would only cost (an ERK pair's
+// Hermite dense output evaluates the dynamics for each check).
+integrators::Problem reduced_problem(const FourBar& model, const FreeScene& scene,
+                                     const SimulateOptions& options, FreeMotion& motion) {
+  integrators::Problem problem;
+  problem.integrator = options.integrator;
+  problem.y0 = {scene.theta1, scene.omega1};
+  problem.absolute_tolerance = {options.absolute_tolerance,   // theta1 [rad]
+                                options.absolute_tolerance};  // omega1 [rad/s]
+  problem.tolerance = options.tolerance;
+  problem.t_end = scene.duration;
+  problem.max_steps = options.max_steps;
+  problem.user_data = &motion;
+  problem.rhs = free_rhs;
+  const GrashofClass grashof = classify_grashof(model);
+  if (grashof != GrashofClass::kCrankRocker && grashof != GrashofClass::kDoubleCrank) {
+    problem.root = dead_centre_root;
+  }
+  return problem;
+}
+
+// True, with the trajectory's status and message set, when the integration stopped before
+// t_out: out of steps, failed, or at a limit position found by the root function; false when it
+// reached t_out (the state there is the next sample's).
+bool stopped_short(integrators::Integration::Outcome outcome,
+                   const integrators::Integration& integration, const FreeMotion& motion,
+                   const SimulateOptions& options, Trajectory& out) {
+  using Outcome = integrators::Integration::Outcome;
+  const double t_reached = integration.t();
+  const double theta1 = integration.y()[0];
+  switch (outcome) {
+    case Outcome::kReached:
+      return false;
+    case Outcome::kMaxSteps:
+      integrator_stopped(out, integration, outcome, options.max_steps);
+      return true;
+    case Outcome::kFailed:
+      if (motion.rhs_failed && motion.error.kind != DynamicsError::Kind::kNonFinite) {
+        // a trial step went into a dead centre or beyond it, where the loop cannot close, and
+        // the integrator could not step around it (ERKStep cannot retry): in free motion from
+        // an assembled start that is the crank reaching a limit position
+        out.status = SimulationStatus::kSingular;
+        out.message = "limit position reached after t = " + text::digits(t_reached, 10) +
+                      " s, theta1 = " + text::digits(theta1, 10) +
+                      " rad: the crank reaches a limit position within the integrator's next "
+                      "step (a trial step found: " +
+                      motion.error.what() + ")";
+      } else if (motion.rhs_failed) {
+        // the dynamics failed ahead of the last step and the integrator could not step around it
+        fail(out, motion.error, motion.error_t, motion.error_theta1);
+        out.message += "; integration stopped at t = " + text::digits(t_reached, 10) + " s";
+      } else {
+        integrator_stopped(out, integration, outcome, options.max_steps);
+      }
+      return true;
+    case Outcome::kRoot: {
+      // the crank reached a limit position before t_out: stop there
+      const auto pose = solve_position(*motion.model, theta1);
+      const double sin_mu = pose ? std::sin(pose->theta3 - pose->theta2) : 0.0;
+      fail(out, dead_centre_error(theta1, sin_mu), t_reached, theta1);
+      return true;
+    }
+  }
+  return true;
+}
+
+}  // namespace
 
 Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
                          const SimulateOptions& options) {
   validate(scene, options);
   if (options.formulation == Formulation::kOpenedLoop) {
-    // the opened loop's own form: the DAE in theta1..theta3, kept on the loop closure as the
-    // integrator allows (opened_loop_dae_options); it has no singularity at a crank limit
-    // position and passes through it
-    const OpenedLoopDaeOptions dae = opened_loop_dae_options(options);
-    if (!has_counter_rotations(model)) {
-      return simulate_opened_loop_dae(model, scene, dae).trajectory;
-    }
-    // discs: the motion from the equations with I_k + J_k, then each sample's reactions from the
-    // bare linkage loaded by the mesh forces at the sample's own state (core/counter_rotation.hpp)
-    Trajectory out = simulate_opened_loop_dae(with_disc_inertia(model), scene, dae).trajectory;
-    for (std::size_t i = 0; i < out.samples.size(); ++i) {
-      const FourBarState& s = out.samples[i].state;
-      const MeshForces f = mesh_forces(model, s);
-      const auto bare = forward_dynamics_opened_loop(with_mesh_loads(model, s, f), s);
-      if (!bare) {  // cannot happen where the DAE itself evaluated; keep what came before
-        fail(out, bare.error(), out.t[i], s.theta1);
-        out.t.resize(i);
-        out.samples.resize(i);
-        break;
-      }
-      out.samples[i] = with_shaft_reactions(model, *bare, f);
-    }
-    return out;
+    return simulate_free_opened_loop(model, scene, options);
   }
   const auto samples = static_cast<std::size_t>(scene.samples);
   Trajectory out;
@@ -342,80 +405,17 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
   out.t.push_back(0.0);
   out.samples.push_back(*first);
 
-  // Method: options.integrator (docs/performance.md compares them). The crank equation is a
-  // smooth, non-stiff ODE of two states (its Jacobian has the eigenvalues of a slow oscillator,
-  // |lambda| ~ |omega1| + sqrt|d alpha1/d theta1|), solved at tight tolerances (1e-10): the
-  // default, variable-order Adams-Moulton (orders 1-12) with a fixed-point corrector, reaches
-  // them with few steps and no Jacobian; BDF (orders <= 5, Newton) and the explicit
-  // Runge-Kutta pairs are there to be compared. Every one of them locates a dead centre by
-  // root finding on |sin(theta3 - theta2)|, registered only where the coupler and rocker can
-  // align: in a crank-rocker or double crank |A1A3| stays strictly between |l2 - l3| and
-  // l2 + l3 at every crank angle, and there the root checks would only cost (an ERK pair's
-  // Hermite dense output evaluates the dynamics for each check).
-  integrators::Problem problem;
-  problem.integrator = options.integrator;
-  problem.y0 = {scene.theta1, scene.omega1};
-  problem.absolute_tolerance = {options.absolute_tolerance,   // theta1 [rad]
-                                options.absolute_tolerance};  // omega1 [rad/s]
-  problem.tolerance = options.tolerance;
-  problem.t_end = scene.duration;
-  problem.max_steps = options.max_steps;
-  problem.user_data = &motion;
-  problem.rhs = free_rhs;
-  const GrashofClass grashof = classify_grashof(model);
-  if (grashof != GrashofClass::kCrankRocker && grashof != GrashofClass::kDoubleCrank) {
-    problem.root = dead_centre_root;
-  }
-  integrators::Integration integration(problem);
-
   // each output by the integrator's dense output, then the dynamics at that state
+  integrators::Integration integration(reduced_problem(model, scene, options, motion));
   out.status = SimulationStatus::kCompleted;
   out.message = "completed";
-  const double last = static_cast<double>(samples - 1);
   for (std::size_t j = 1; j < samples; ++j) {
-    const double t_out =
-        j + 1 == samples ? scene.duration : scene.duration * static_cast<double>(j) / last;
     motion.rhs_failed = false;
-    const auto outcome = integration.advance(t_out);
+    const auto outcome = integration.advance(output_time(scene, j));
+    if (stopped_short(outcome, integration, motion, options, out)) break;
+
     const double t_reached = integration.t();
     const double theta1 = integration.y()[0], omega1 = integration.y()[1];
-    if (outcome == integrators::Integration::Outcome::kMaxSteps) {
-      out.status = SimulationStatus::kIntegratorFailed;
-      out.message = "integrator stopped at t = " + text::digits(t_reached, 10) +
-                    " s, theta1 = " + text::digits(theta1, 10) +
-                    " rad: max_steps = " + std::to_string(options.max_steps) + " reached";
-      break;
-    }
-    if (outcome == integrators::Integration::Outcome::kFailed) {
-      if (motion.rhs_failed && motion.error.kind != DynamicsError::Kind::kNonFinite) {
-        // a trial step went into a dead centre or beyond it, where the loop cannot close, and
-        // the integrator could not step around it (ERKStep cannot retry): in free motion from
-        // an assembled start that is the crank reaching a limit position
-        out.status = SimulationStatus::kSingular;
-        out.message = "limit position reached after t = " + text::digits(t_reached, 10) +
-                      " s, theta1 = " + text::digits(theta1, 10) +
-                      " rad: the crank reaches a limit position within the integrator's next "
-                      "step (a trial step found: " +
-                      motion.error.what() + ")";
-      } else if (motion.rhs_failed) {
-        // the dynamics failed ahead of the last step and the integrator could not step around it
-        fail(out, motion.error, motion.error_t, motion.error_theta1);
-        out.message += "; integration stopped at t = " + text::digits(t_reached, 10) + " s";
-      } else {
-        out.status = SimulationStatus::kIntegratorFailed;
-        out.message = "integrator failed at t = " + text::digits(t_reached, 10) +
-                      " s, theta1 = " + text::digits(theta1, 10) + " rad: " + integration.failure();
-      }
-      break;
-    }
-    if (outcome == integrators::Integration::Outcome::kRoot) {
-      // the crank reached a limit position before t_out: stop there
-      const auto pose = solve_position(model, theta1);
-      const double sin_mu = pose ? std::sin(pose->theta3 - pose->theta2) : 0.0;
-      fail(out, dead_centre_error(theta1, sin_mu), t_reached, theta1);
-      break;
-    }
-
     ++motion.evaluations;
     auto sample = forward_dynamics(model, theta1, omega1, options.formulation);
     if (!sample || at_dead_centre(*sample, kDeadCentreSin, motion.error)) {
@@ -460,7 +460,8 @@ Trajectory simulate_driven(const FourBar& model, const DrivenScene& scene,
   out.message = "completed";
   // The model's constants once; the crank vector turned from sample to sample (CrankSweep); each
   // sample computed in its place in the trajectory by the inline kernels of
-  // core/instant_dynamics.hpp (a model with counter-rotations takes the one-instant route).
+  // core/fourbar/detail/instant_dynamics.hpp (a model with counter-rotations takes the one-instant
+  // route).
   const DynamicsConstants constants = dynamics_constants(model);
   CrankSweep crank(model.crank.length);
   // samples at most kMaxUnwrapStep apart in theta1 (the usual case) need no intermediate

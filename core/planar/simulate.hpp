@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "core/fourbar/simulate.hpp"
 #include "core/planar/dynamics.hpp"
 #include "core/series.hpp"
+#include "core/simulation.hpp"
 
 namespace bd::core::planar {
 

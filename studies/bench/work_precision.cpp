@@ -16,8 +16,9 @@
 #include <utility>
 #include <variant>
 
+#include "core/fourbar/metrics.hpp"
 #include "core/input_error.hpp"
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "core/number_text.hpp"
 #include "studies/run/files.hpp"
 
@@ -201,7 +202,7 @@ std::vector<WorkPrecisionRow> work_precision(const Study& study, const BenchOpti
   for (core::Formulation f : core::kFormulations) {
     const Reference reference = reference_of(f);
     for (core::Integrator integrator : core::kIntegrators) {
-      if (!simulate_options(f, integrator, 1e-10).validate().empty()) continue;
+      if (simulate_options(f, integrator, 1e-10).validate()) continue;
       const double start = cpu_seconds();
       std::string summary;
       for (double tolerance : options.tolerances) {

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "core/fourbar/metrics.hpp"
 #include "core/fourbar/simulate.hpp"
-#include "core/metrics.hpp"
 #include "optimize/optimize.hpp"
 #include "studies/run/files.hpp"
 #include "studies/study/study.hpp"

@@ -536,8 +536,7 @@ class StudyParser {
     if (const MapReader::Entry* x = m.find("thickness")) spec.thickness = positive(*x, "m");
     if (const MapReader::Entry* x = m.find("density")) spec.density = positive(*x, "kg/m^3");
     // anything else the balance layer objects to, at the side's key
-    const std::string problem = spec.validate();
-    if (!problem.empty()) r_.fail(e.key_mark, path + ": " + problem);
+    if (const auto problem = spec.validate()) r_.fail(e.key_mark, path + ": " + problem->text());
     return spec;
   }
 
@@ -1433,8 +1432,7 @@ class StudyParser {
     }
     core::SimulateOptions options;
     options.tolerance = tol;
-    const std::string problem = options.validate();
-    if (!problem.empty()) r_.fail(m, "tolerance: " + problem);
+    if (const auto problem = options.validate()) r_.fail(m, "tolerance: " + problem->text());
     return tol;
   }
 

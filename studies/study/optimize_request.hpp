@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "core/fourbar/metrics.hpp"
 #include "core/fourbar/model.hpp"
-#include "core/metrics.hpp"
 #include "optimize/optimize.hpp"
 #include "optimize/problem.hpp"
 

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <numbers>
 #include <random>
@@ -22,7 +23,8 @@
 namespace bd::balance {
 namespace {
 
-using core::Complex;
+// centre-of-mass offsets and mass moments in the paper's complex notation
+using Complex = std::complex<double>;
 
 TEST(Conditions, ResidualsAreTheFramePrincipalVectorsTimesTheTotalMass) {
   // eq. 30: ā14 = -(m1 s̄1/l1 + m̄2p) l̄1 / m, ā34 = (m̄2q + m3 (1 - s̄3/l3)) l̄3 / m

@@ -19,7 +19,7 @@
 #include "balance/conditions.hpp"
 #include "balance/counterweight.hpp"
 #include "core/input_error.hpp"
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/simulate.hpp"
 

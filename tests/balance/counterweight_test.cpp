@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <numbers>
 #include <optional>
@@ -29,12 +30,12 @@
 #include "balance/conditions.hpp"
 #include "core/fourbar/dynamics.hpp"
 #include "core/fourbar/energy.hpp"
-#include "core/input_error.hpp"
 #include "core/fourbar/kinematics.hpp"
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/samples.hpp"
 #include "core/fourbar/simulate.hpp"
+#include "core/input_error.hpp"
 
 namespace bd::balance {
 namespace {
@@ -307,13 +308,14 @@ TEST(ForceBalance, EverySpecIsRealisedAndBalances) {
       }
       // the mass moment about the pivot is what eq. 57 asks for
       const core::Link& l2 = model.coupler;
-      const core::Complex s2(l2.e, l2.f);
-      const core::Complex want = side == 0 ? -l2.mass * (1.0 - s2 / l2.length) * link.length
-                                           : l2.mass * s2 * link.length / l2.length;
-      const core::Complex own = side == 0
-                                    ? link.mass * core::Complex(link.e, link.f)
-                                    : link.mass * (core::Complex(link.e, link.f) - link.length);
-      const core::Complex got = own + cw->mass * core::to_complex(cw->position);
+      // (in the paper's complex notation)
+      using Complex = std::complex<double>;
+      const Complex s2(l2.e, l2.f);
+      const Complex want = side == 0 ? -l2.mass * (1.0 - s2 / l2.length) * link.length
+                                     : l2.mass * s2 * link.length / l2.length;
+      const Complex own = side == 0 ? link.mass * Complex(link.e, link.f)
+                                    : link.mass * (Complex(link.e, link.f) - link.length);
+      const Complex got = own + cw->mass * Complex(cw->position.x(), cw->position.y());
       EXPECT_LE(std::abs(got - want), 1e-13 * std::abs(want)) << at;
       added_mass += cw->mass;
       added_inertia += cw->inertia + cw->mass * cw->distance * cw->distance;
@@ -391,8 +393,9 @@ TEST(ForceBalance, InvalidSpecsAreInputErrors) {
   // the spec's own validate() says the same without the side
   s = {};
   s.mass = 0.0;
-  EXPECT_EQ(s.validate(), "mass must be > 0 kg, got 0");
-  EXPECT_EQ(CounterweightSpec{}.validate(), "");
+  EXPECT_EQ(problem_text(s.validate()), "mass must be > 0 kg, got 0");
+  EXPECT_EQ(s.validate()->field, "mass");
+  EXPECT_EQ(problem_text(CounterweightSpec{}.validate()), "");
 }
 
 }  // namespace

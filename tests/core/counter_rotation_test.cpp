@@ -1,5 +1,5 @@
 // Counter-rotating inertias (FourBar::counter_rotations): discs on frame shafts geared to the
-// crank (pivot A0) and the rocker (pivot A3) with ratio -1 (core/model.hpp).
+// crank (pivot A0) and the rocker (pivot A3) with ratio -1 (core/fourbar/model.hpp).
 //
 // (a) the Newton–Euler referee with discs obeys the power balance dT/dt = applied power, with
 //     T including ½ J_k ω_k², and core's kinetic_energy() holds that term;
@@ -18,7 +18,7 @@
 // A disc spins at -ω_k about its fixed shaft: its angular momentum about A0 is -J_k ω_k. With
 //     H = Σ [c_k × m_k v_k + I_k ω_k] - J_1 ω_1 - J_3 ω_3          (about the fixed point A0)
 //     dH/dt = A3 × (-RA3) + C1 × (-RC1) + C3 × (-RC3) + tau + Σ [c_k × (F_k + m_k g) + M_k]
-// and with Msh = A3 × RA3 - tau + C1 × RC1 + C3 × RC3 (DESIGN.md, core/dynamics.hpp):
+// and with Msh = A3 × RA3 - tau + C1 × RC1 + C3 × RC3 (core/fourbar/dynamics.hpp):
 //     Msh = Σ [c_k × (F_k + m_k g) + M_k] - dH/dt.
 // Power: pins and shafts are fixed points and the ideal mesh's forces on link and disc do equal
 // and opposite work (same velocity at the mesh point), so dT/dt = Σ (F_k + m_k g)·v_k + M_k ω_k

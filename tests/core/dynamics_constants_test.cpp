@@ -1,6 +1,6 @@
-// The model's constants computed once (core/dynamics_constants.hpp) and the routes that use them:
-// the dynamics overloads with DynamicsConstants, the crank vectors of a sweep (CrankSweep) and the
-// driven sweep built on both.
+// The model's constants computed once (core/fourbar/detail/dynamics_constants.hpp, internal to
+// core) and the routes that use them: the dynamics overloads with DynamicsConstants, the crank
+// vectors of a sweep (CrankSweep) and the driven sweep built on both.
 //
 // Tolerances. The overloads with constants run the same operations as the one-instant calls, so
 // they agree bit for bit. The sweep's crank vector differs from l1·(cos, sin) of the sample's
@@ -8,7 +8,7 @@
 // amplified by the position solve's condition (~1e2 on the paper example away from its dead
 // centres): 1e-13 of each quantity's scale leaves a margin of ~100 while a wrong angle, branch
 // or turn count shows at order one.
-#include "core/fourbar/dynamics_constants.hpp"
+#include "core/fourbar/detail/dynamics_constants.hpp"
 
 #include <gtest/gtest.h>
 
@@ -18,8 +18,8 @@
 #include <random>
 #include <string>
 
+#include "core/fourbar/detail/formulation_support.hpp"
 #include "core/fourbar/dynamics.hpp"
-#include "core/fourbar/formulation_support.hpp"
 #include "core/fourbar/mass_matrix.hpp"
 #include "core/fourbar/samples.hpp"
 #include "core/fourbar/simulate.hpp"
@@ -27,6 +27,13 @@
 
 namespace bd::core {
 namespace {
+
+using detail::CrankSweep;
+using detail::dynamics_constants;
+using detail::DynamicsConstants;
+using detail::mass_matrix_constants;
+using detail::MassMatrixConstants;
+using detail::Xy;
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
@@ -81,7 +88,7 @@ TEST(DynamicsConstants, OverloadsWithConstantsGiveTheOneInstantResultsBitForBit)
 
 TEST(DynamicsConstants, MassMatrixBlocksAreTheAssembledMatrix) {
   // d1, d2 and w1..w3 are the blocks of eq. 48's M and eq. 53's Mr: M = [d1 1, W2; W2ᵀ, d2 1]
-  // with W v = w ⊗ v, and Mr = [W1, 0; 0, W3ᵀ] (core/dynamics_constants.hpp)
+  // with W v = w ⊗ v, and Mr = [W1, 0; 0, W3ᵀ] (core/fourbar/detail/dynamics_constants.hpp)
   std::mt19937_64 rng(32);
   for (int i = 0; i < 10; ++i) {
     const FourBar model = samples::random_crank_rocker(rng);

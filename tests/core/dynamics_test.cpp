@@ -413,11 +413,12 @@ TEST(NewtonEulerReferee, MatchesLagrangeEquation) {
       FourBarState u = reference::newton_euler_forward(model, theta1, 1.0).state;
       u.alpha1 = u.alpha2 = u.alpha3 = 0.0;
       const reference::LinkageMotion m = reference::linkage_motion(model, u);
-      const std::array<double, 3> Theta{u.omega1, u.omega2, u.omega3};
+      const std::array<double, 3> dtheta_dtheta1{u.omega1, u.omega2, u.omega3};
       double mu = 0.0;
       for (int k = 1; k <= 3; ++k) {
         const Link& L = link(model, k);
-        mu += L.mass * m.com[k - 1].v.squaredNorm() + L.inertia * Theta[k - 1] * Theta[k - 1];
+        mu += L.mass * m.com[k - 1].v.squaredNorm() +
+              L.inertia * dtheta_dtheta1[k - 1] * dtheta_dtheta1[k - 1];
       }
       return std::array<double, 2>{mu, applied_power(model, u, 0.0)};
     };

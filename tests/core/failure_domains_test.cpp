@@ -7,7 +7,7 @@
 //   d = 1e-1 .. 1e-15 rad; the shared position stage (eps / d, d ~ sin² mu) dominates. We
 //   assert 50 eps / sin² mu, a margin of 6 over the worst measured.
 // - away from singular positions the formulations agree with the reference to ~1e-13
-//   relative; 1e-10 is the project's agreement tolerance (STYLE.md).
+//   relative; 1e-10 is the tolerance to which the project's formulations must agree.
 // - near a limit the product answers only above |sin mu| = 1e-3 (kSingularSin), where the
 //   bound is < 1.2e-8; below it every formulation says kSingular.
 // - vanishing masses: no formulation divides by a link mass (the principal-vector quotients
@@ -21,15 +21,14 @@
 #include <string>
 #include <vector>
 
-#include "tests/reference/reference_ld.hpp"
 #include "core/fourbar/complex_masses.hpp"
 #include "core/fourbar/dynamics.hpp"
-#include "core/fourbar/formulation_support.hpp"
 #include "core/fourbar/mass_matrix.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/opened_loop.hpp"
 #include "core/fourbar/samples.hpp"
 #include "tests/reference/newton_euler.hpp"
+#include "tests/reference/reference_ld.hpp"
 
 namespace bd::core {
 namespace {
@@ -46,19 +45,18 @@ struct Method {
 
 std::vector<Method> methods() {
   return {
-      {"mass-matrix", [](const FourBar& m, double t, double w) {
-         return forward_dynamics_mass_matrix(m, t, w);
-       },
+      {"mass-matrix",
+       [](const FourBar& m, double t, double w) { return forward_dynamics_mass_matrix(m, t, w); },
        [](const FourBar& m, double t, double w, double a) {
          return inverse_dynamics_mass_matrix(m, t, w, a);
        }},
-      {"opened-loop", [](const FourBar& m, double t, double w) {
-         return forward_dynamics_opened_loop(m, t, w);
-       },
+      {"opened-loop",
+       [](const FourBar& m, double t, double w) { return forward_dynamics_opened_loop(m, t, w); },
        [](const FourBar& m, double t, double w, double a) {
          return inverse_dynamics_opened_loop(m, t, w, a);
        }},
-      {"complex-masses", [](const FourBar& m, double t, double w) {
+      {"complex-masses",
+       [](const FourBar& m, double t, double w) {
          return forward_dynamics_complex_masses(m, t, w);
        },
        [](const FourBar& m, double t, double w, double a) {
@@ -197,8 +195,9 @@ double worst_error(const Method& method, const FourBar& model) {
     const Result f = method.forward(model, t1, 1.3);
     const Result v = method.inverse(model, t1, 1.3, 0.5);
     if (!f || !v) return std::numeric_limits<double>::infinity();
-    worst = std::max({worst, relative_error(*f, reference::ref_forward<ld>(model, *pose, 1.3), false),
-                      relative_error(*v, reference::ref_inverse<ld>(model, *pose, 1.3, 0.5), true)});
+    worst =
+        std::max({worst, relative_error(*f, reference::ref_forward<ld>(model, *pose, 1.3), false),
+                  relative_error(*v, reference::ref_inverse<ld>(model, *pose, 1.3, 0.5), true)});
   }
   return worst;
 }
@@ -220,8 +219,8 @@ TEST(FailureDomains, MassMatrixStaysAccurateAsAMassVanishes) {
 TEST(FailureDomains, TinyMassesGiveAValueOrAnErrorNeverASilentNaN) {
   for (const Method& m : methods()) {
     for (int k = 1; k <= 3; ++k) {
-      for (double mass : {1e-8, 1e-16, 1e-100, 1e-300, 1e-310,
-                          std::numeric_limits<double>::denorm_min()}) {
+      for (double mass :
+           {1e-8, 1e-16, 1e-100, 1e-300, 1e-310, std::numeric_limits<double>::denorm_min()}) {
         const FourBar model = with_mass(k, mass);
         for (double t1 : {0.1, 2.2, 4.3}) {
           for (const Result& r : {m.forward(model, t1, 1.3), m.inverse(model, t1, 1.3, 0.5)}) {
@@ -243,8 +242,7 @@ TEST(FailureDomains, TinyMassesGiveAValueOrAnErrorNeverASilentNaN) {
 TEST(FailureDomains, TinyMassesStayAccurate) {
   for (const Method& m : methods()) {
     for (int k = 1; k <= 3; ++k) {
-      for (double mass : {1e-8, 1e-16, 1e-100, 1e-300,
-                          std::numeric_limits<double>::denorm_min()}) {
+      for (double mass : {1e-8, 1e-16, 1e-100, 1e-300, std::numeric_limits<double>::denorm_min()}) {
         const double e = worst_error(m, with_mass(k, mass));
         EXPECT_LT(e, 1e-11) << m.name << ", m" << k << " = " << mass << " kg";
       }
@@ -262,8 +260,8 @@ TEST(FailureDomains, ZeroInertiaAndCentreOfMassOnAJointAreRegular) {
       if (variant == 2) l.e = l.length, l.f = 0, l.inertia = 0;
       model = make_fourbar(model);
       for (const Method& m : methods()) {
-        EXPECT_LT(worst_error(m, model), 1e-10) << m.name << ", link " << k << ", variant "
-                                                << variant;
+        EXPECT_LT(worst_error(m, model), 1e-10)
+            << m.name << ", link " << k << ", variant " << variant;
       }
     }
   }

@@ -17,10 +17,10 @@
 
 #include "core/fourbar/dynamics.hpp"
 #include "core/fourbar/energy.hpp"
-#include "core/input_error.hpp"
 #include "core/fourbar/opened_loop_dae.hpp"
 #include "core/fourbar/samples.hpp"
 #include "core/fourbar/simulate.hpp"
+#include "core/input_error.hpp"
 
 namespace bd::core {
 namespace {
@@ -61,7 +61,7 @@ TEST(Integrators, EveryIntegratorAndFormulationReproducesThePaperSimulation) {
       SimulateOptions options;
       options.formulation = f;
       options.integrator = integrator;
-      if (!options.validate().empty()) continue;  // ida with a reduced formulation
+      if (options.validate()) continue;  // ida with a reduced formulation
       ++runs;
       const std::string what = std::string(to_string(f)) + " / " + to_string(integrator);
       const Trajectory t = simulate_free(model, kPaperFree, options);
@@ -288,7 +288,7 @@ TEST(Integrators, InvalidCombinationsAreRejected) {
         std::string("integrator ida needs formulation opened-loop, got ") + to_string(f) +
         ": IDA integrates the opened loop's DAE, while this formulation "
         "is an ODE in theta1 (use cvode-adams, cvode-bdf or erk2 ... erk8)";
-    EXPECT_EQ(options.validate(), expected);
+    EXPECT_EQ(problem_text(options.validate()), expected);
     try {
       simulate_free(model, kPaperFree, options);
       ADD_FAILURE() << "no bd::InputError for " << to_string(f) << " / ida";
@@ -298,34 +298,35 @@ TEST(Integrators, InvalidCombinationsAreRejected) {
   }
   SimulateOptions unknown;
   unknown.integrator = static_cast<Integrator>(42);
-  EXPECT_EQ(unknown.validate(), "integrator 42 is unknown");
+  EXPECT_EQ(problem_text(unknown.validate()), "integrator 42 is unknown");
   for (Integrator integrator : kIntegrators) {
     SimulateOptions options;
     options.formulation = Formulation::kOpenedLoop;
     options.integrator = integrator;
-    EXPECT_EQ(options.validate(), "") << to_string(integrator);
-    EXPECT_EQ(opened_loop_dae_options(options).validate(), "") << to_string(integrator);
+    EXPECT_EQ(problem_text(options.validate()), "") << to_string(integrator);
+    EXPECT_EQ(problem_text(opened_loop_dae_options(options).validate()), "")
+        << to_string(integrator);
   }
 
   OpenedLoopDaeOptions dae;
   dae.method = DaeMethod::kIda;
-  EXPECT_EQ(dae.validate(),
+  EXPECT_EQ(problem_text(dae.validate()),
             "method ida needs stabilisation ggl, got none: IDA integrates the DAE in its "
             "stabilised index-2 form");
   dae.stabilisation = Stabilisation::kGgl;
-  EXPECT_EQ(dae.validate(), "");
+  EXPECT_EQ(problem_text(dae.validate()), "");
   dae.method = DaeMethod::kAdams;
-  EXPECT_EQ(dae.validate(),
+  EXPECT_EQ(problem_text(dae.validate()),
             "stabilisation ggl needs method ida (or auto), got adams: the GGL form is a DAE with "
             "algebraic equations");
   dae.method = DaeMethod::kErk5;
   dae.stabilisation = Stabilisation::kProjection;
-  EXPECT_EQ(dae.validate(),
+  EXPECT_EQ(problem_text(dae.validate()),
             "stabilisation projection needs method bdf (or auto), got erk5: CVODE projects only "
             "with BDF");
   EXPECT_THROW(simulate_opened_loop_dae(model, kPaperFree, dae), InputError);
   dae.stabilisation = Stabilisation::kBaumgarte;
-  EXPECT_EQ(dae.validate(), "");
+  EXPECT_EQ(problem_text(dae.validate()), "");
 }
 
 TEST(Integrators, OpenedLoopIntegratorsUseTheConstraintHandlingTheyAllow) {

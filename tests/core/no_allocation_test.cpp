@@ -1,5 +1,6 @@
-// The per-sample path allocates nothing (STYLE.md: fixed-size Eigen, no heap in a per-sample
-// loop). This test program counts heap allocations (tests/support/allocation_counter.hpp).
+// The per-sample path allocates nothing (the project's rule: fixed-size Eigen, no heap in a
+// per-sample loop). This test program counts heap allocations
+// (tests/support/allocation_counter.hpp).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -6,11 +6,17 @@
 
 #include <random>
 
+#include "core/detail/complex_vector.hpp"
 #include "core/fourbar/energy.hpp"
 #include "core/fourbar/samples.hpp"
 
 namespace bd::core {
 namespace {
+
+// the paper's complex notation for planar vectors
+using detail::Complex;
+using detail::to_complex;
+using detail::to_vec;
 
 FourBarState random_state(const FourBar& m, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(-1, 1);
@@ -35,7 +41,8 @@ TEST(PrincipalVectors, BothConstructionsTraceTheCentreOfMass) {
     const Vec2 a = mass_weighted_acceleration(m, s);
     // sums of a few terms of size <= ~4 m: round-off a few eps times that
     const double lscale = 10, vscale = 10 * (1 + v.norm()), ascale = 10 * (1 + a.norm());
-    for (const PointKinematics& S : {centre_of_mass_opened_loop(m, s), centre_of_mass_frame(m, s)}) {
+    for (const PointKinematics& S :
+         {centre_of_mass_opened_loop(m, s), centre_of_mass_frame(m, s)}) {
       EXPECT_LT((S.r - r).norm(), 1e-14 * lscale) << "trial " << trial;
       EXPECT_LT((S.v - v).norm(), 1e-14 * vscale) << "trial " << trial;
       EXPECT_LT((S.a - a).norm(), 1e-13 * ascale) << "trial " << trial;
@@ -52,7 +59,7 @@ TEST(PrincipalVectors, LinkVectorsAreDifferencesOfPrincipalVectors) {
   const FrameVectors f = frame_vectors(m, p);
   const double tol = 1e-14 * 10;
   EXPECT_LT((o.a12 - o.a14p - (j.A1 - j.A0)).norm(), tol);  // eq. 13
-  EXPECT_LT((o.a23 - o.a21 - (j.A2 - j.A1)).norm(), tol);  // eq. 12
+  EXPECT_LT((o.a23 - o.a21 - (j.A2 - j.A1)).norm(), tol);   // eq. 12
   EXPECT_LT((o.a34p - o.a32 - (j.A3 - j.A2)).norm(), tol);  // eq. 13
   EXPECT_LT((f.a41 - f.a43 - (j.A0 - j.A3)).norm(), tol);   // l̄4 = ā41 - ā43
   EXPECT_LT((f.a12p - f.a14 - (j.A1 - j.A0)).norm(), tol);  // eq. 31

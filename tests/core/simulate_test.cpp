@@ -9,10 +9,10 @@
 #include <string>
 
 #include "core/fourbar/energy.hpp"
-#include "core/input_error.hpp"
 #include "core/fourbar/kinematics.hpp"
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "core/fourbar/samples.hpp"
+#include "core/input_error.hpp"
 
 namespace bd::core {
 namespace {
@@ -353,17 +353,17 @@ TEST(Simulate, InvalidScenesThrowInputError) {
 
   SimulateOptions options;
   options.tolerance = 0.0;
-  EXPECT_EQ(options.validate(), "tolerance must be > 0 and < 1, got 0");
+  EXPECT_EQ(problem_text(options.validate()), "tolerance must be > 0 and < 1, got 0");
   expect_input_error([&] { simulate_free(model, kPaperFree, options); },
                      "tolerance must be > 0 and < 1, got 0");
   options = {};
   options.absolute_tolerance = -1e-3;
-  EXPECT_EQ(options.validate(), "absolute_tolerance must be > 0, got -0.001");
+  EXPECT_EQ(problem_text(options.validate()), "absolute_tolerance must be > 0, got -0.001");
   options = {};
   options.max_steps = 0;
   expect_input_error([&] { simulate_driven(model, {.omega1 = 1.0}, options); },
                      "max_steps must be >= 1, got 0");
-  EXPECT_EQ(SimulateOptions{}.validate(), "");
+  EXPECT_EQ(problem_text(SimulateOptions{}.validate()), "");
 }
 
 TEST(Simulate, TooFewStepsStopsWithIntegratorFailure) {

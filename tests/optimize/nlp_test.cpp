@@ -33,7 +33,7 @@
 #include "balance/counterweight.hpp"
 #include "core/fourbar/dynamics.hpp"
 #include "core/input_error.hpp"
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/samples.hpp"
 #include "core/fourbar/simulate.hpp"

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "core/input_error.hpp"
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "core/fourbar/samples.hpp"
 #include "core/fourbar/simulate.hpp"
 #include "optimize/optimize.hpp"

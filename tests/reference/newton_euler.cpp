@@ -114,8 +114,8 @@ core::DynamicsSample solve(const core::FourBar& model, double theta1, double ome
   state.theta2 = pose->theta2;
   state.theta3 = pose->theta3;
   state.omega1 = omega1;
-  state.omega2 = tf.Theta2 * omega1;
-  state.omega3 = tf.Theta3 * omega1;
+  state.omega2 = tf.dtheta2_dtheta1 * omega1;
+  state.omega3 = tf.dtheta3_dtheta1 * omega1;
   const core::AccelerationBias bias = core::acceleration_bias(model, state);
 
   // a0_k: the accelerations at alpha1 = 0
@@ -127,14 +127,14 @@ core::DynamicsSample solve(const core::FourBar& model, double theta1, double ome
   // J_k: the centre-of-mass velocities at unit crank rate
   core::FourBarState unit_rate = state;
   unit_rate.omega1 = 1.0;
-  unit_rate.omega2 = tf.Theta2;
-  unit_rate.omega3 = tf.Theta3;
+  unit_rate.omega2 = tf.dtheta2_dtheta1;
+  unit_rate.omega3 = tf.dtheta3_dtheta1;
   const LinkageMotion mJ = linkage_motion(model, unit_rate);
 
   const std::array<const core::Link*, 3> links{&model.crank, &model.coupler, &model.rocker};
   const std::array<const core::LinkLoad*, 3> loads{&model.loads.crank, &model.loads.coupler,
                                                    &model.loads.rocker};
-  const std::array<double, 3> Theta{1.0, tf.Theta2, tf.Theta3};
+  const std::array<double, 3> dtheta_dtheta1{1.0, tf.dtheta2_dtheta1, tf.dtheta3_dtheta1};
   const std::array<double, 3> gamma{0.0, bias.gamma2, bias.gamma3};
   const Vec2 A0{0.0, 0.0};
   const Vec2 A3{model.frame_length, 0.0};
@@ -169,7 +169,7 @@ core::DynamicsSample solve(const core::FourBar& model, double theta1, double ome
   for (int k = 0; k < 3; ++k) {
     const core::Link& L = *links[k];
     const Vec2 ak = m0.com[k].a + alpha1_known * mJ.com[k].v;
-    const double alphak = gamma[k] + Theta[k] * alpha1_known;
+    const double alphak = gamma[k] + dtheta_dtheta1[k] * alpha1_known;
     const int f = 3 * k;
     const int m = 3 * k + 2;
     // right-hand sides: m a - F - m g and I alpha - M
@@ -178,7 +178,7 @@ core::DynamicsSample solve(const core::FourBar& model, double theta1, double ome
     // the unknown alpha1 moved to the left
     if (unknown == Unknown::kAlpha1) {
       A.block<2, 1>(f, 8) = -L.mass * mJ.com[k].v;
-      A(m, 8) = -L.inertia * Theta[k];
+      A(m, 8) = -L.inertia * dtheta_dtheta1[k];
     }
   }
   const Eigen::Matrix2d I2 = Eigen::Matrix2d::Identity();
@@ -216,10 +216,10 @@ core::DynamicsSample solve(const core::FourBar& model, double theta1, double ome
     // disc: (M - C) x (g t) = -J alpha_k, alpha_k = Theta_k alpha1 + gamma_k
     A(row_m, col_g) = cross(M - D.C, t);
     if (unknown == Unknown::kAlpha1) {
-      A(row_m, 8) = D.J * Theta[k];
+      A(row_m, 8) = D.J * dtheta_dtheta1[k];
       b(row_m) = -D.J * gamma[k];
     } else {
-      b(row_m) = -D.J * (gamma[k] + Theta[k] * alpha1_known);
+      b(row_m) = -D.J * (gamma[k] + dtheta_dtheta1[k] * alpha1_known);
     }
     // link k: -g t at M
     A.block<2, 1>(3 * k, col_g) = -t;
@@ -234,8 +234,8 @@ core::DynamicsSample solve(const core::FourBar& model, double theta1, double ome
   core::DynamicsSample s;
   s.state = state;
   s.state.alpha1 = unknown == Unknown::kAlpha1 ? x(8) : alpha1_given;
-  s.state.alpha2 = tf.Theta2 * s.state.alpha1 + bias.gamma2;
-  s.state.alpha3 = tf.Theta3 * s.state.alpha1 + bias.gamma3;
+  s.state.alpha2 = tf.dtheta2_dtheta1 * s.state.alpha1 + bias.gamma2;
+  s.state.alpha3 = tf.dtheta3_dtheta1 * s.state.alpha1 + bias.gamma3;
   s.tau = unknown == Unknown::kTau ? x(8) : 0.0;
   s.RA0 = -x.segment<2>(0);
   s.RA3 = -x.segment<2>(6);

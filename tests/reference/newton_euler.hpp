@@ -1,5 +1,5 @@
 #pragma once
-/// The independent Newton–Euler referee (DESIGN.md "Formulations"): the four-bar solved link by
+/// The independent Newton–Euler referee of the dynamics formulations: the four-bar solved link by
 /// link from first principles, with the pin forces as unknowns. It shares no code with core's
 /// dynamics formulations; from core it takes only the model types and the closed-form kinematics
 /// (position, transfer functions, acceleration bias), which core's kinematics tests check against

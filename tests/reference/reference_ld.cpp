@@ -60,18 +60,18 @@ RefSample<T> solve(const core::FourBar& model, const RefPose<T>& pose, T omega1,
   const T c23 = cross2(lv[1], lv[2]);
   RefSample<T> s;
   s.pose = pose;
-  s.Theta2 = -cross2(lv[0], lv[2]) / c23;
-  s.Theta3 = cross2(lv[0], lv[1]) / c23;
+  s.dtheta2_dtheta1 = -cross2(lv[0], lv[2]) / c23;
+  s.dtheta3_dtheta1 = cross2(lv[0], lv[1]) / c23;
   s.omega1 = omega1;
-  s.omega2 = s.Theta2 * omega1;
-  s.omega3 = s.Theta3 * omega1;
+  s.omega2 = s.dtheta2_dtheta1 * omega1;
+  s.omega3 = s.dtheta3_dtheta1 * omega1;
   // second order: Σ αk i l̄k = b, b = Σ l̄k ωk² (eq. 8)
   const V2<T> b = lv[0] * (omega1 * omega1) + lv[1] * (s.omega2 * s.omega2) +
                   lv[2] * (s.omega3 * s.omega3);
   s.gamma2 = b.dot(lv[2]) / c23;
   s.gamma3 = -b.dot(lv[1]) / c23;
 
-  const std::array<T, 3> Th{T(1), s.Theta2, s.Theta3};
+  const std::array<T, 3> Th{T(1), s.dtheta2_dtheta1, s.dtheta3_dtheta1};
   const std::array<T, 3> ga{T(0), s.gamma2, s.gamma3};
   const std::array<T, 3> om{omega1, s.omega2, s.omega3};
   const T alpha1_known = inverse ? alpha1_given : T(0);
@@ -140,8 +140,8 @@ RefSample<T> solve(const core::FourBar& model, const RefPose<T>& pose, T omega1,
 
   s.alpha1 = inverse ? alpha1_given : x(8);
   s.tau = inverse ? x(8) : T(0);
-  s.alpha2 = s.Theta2 * s.alpha1 + s.gamma2;
-  s.alpha3 = s.Theta3 * s.alpha1 + s.gamma3;
+  s.alpha2 = s.dtheta2_dtheta1 * s.alpha1 + s.gamma2;
+  s.alpha3 = s.dtheta3_dtheta1 * s.alpha1 + s.gamma3;
   s.RA0x = -x(0);
   s.RA0y = -x(1);
   s.RA3x = -x(6);

@@ -22,17 +22,18 @@ struct RefPose {
   T sin_mu{};  // sin(theta3 - theta2) [-]
 };
 
-/// Everything at one instant (DESIGN.md conventions: reactions are forces ON the ground).
+/// Everything at one instant (core::DynamicsSample's conventions: reactions are forces ON the
+/// ground).
 template <class T>
 struct RefSample {
   RefPose<T> pose;
-  T Theta2{}, Theta3{};                // transfer functions [-]
-  T gamma2{}, gamma3{};                // velocity-product accelerations [rad/s^2]
-  T omega1{}, omega2{}, omega3{};      // [rad/s]
-  T alpha1{}, alpha2{}, alpha3{};      // [rad/s^2]
-  T RA0x{}, RA0y{}, RA3x{}, RA3y{};    // [N]
-  T tau{};                             // drive torque [N m]
-  T lu_rcond{};                        // 1/condition estimate of the 9x9 (|pivot| ratio) [-]
+  T dtheta2_dtheta1{}, dtheta3_dtheta1{};  // transfer functions dθ2/dθ1, dθ3/dθ1 [-]
+  T gamma2{}, gamma3{};                    // velocity-product accelerations [rad/s^2]
+  T omega1{}, omega2{}, omega3{};          // [rad/s]
+  T alpha1{}, alpha2{}, alpha3{};          // [rad/s^2]
+  T RA0x{}, RA0y{}, RA3x{}, RA3y{};        // [N]
+  T tau{};                                 // drive torque [N m]
+  T lu_rcond{};                            // 1/condition estimate of the 9x9 (|pivot| ratio) [-]
 };
 
 /// Closes the loop at theta1 [rad] on the model's branch; empty when |A1A3| lies outside

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "studies/studies.hpp"
 #include "studies/study/load_study.hpp"
 #include "tests/support/csv.hpp"

@@ -24,7 +24,7 @@
 
 #include "balance/synthesis.hpp"
 #include "core/input_error.hpp"
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 #include "studies/report/report.hpp"
 #include "studies/report/report_support.hpp"
 #include "studies/studies.hpp"

@@ -10,6 +10,7 @@
 #include "core/fourbar/dynamics.hpp"
 #include "core/fourbar/kinematics.hpp"
 #include "core/fourbar/samples.hpp"
+#include "core/fourbar/simulate.hpp"
 #include "core/planar/dynamics.hpp"
 #include "core/planar/from_fourbar.hpp"
 #include "core/planar/simulate.hpp"

@@ -1,18 +1,18 @@
 #pragma once
 /// The loop closure at one instant (paper eqs. 2-4), inline and in plain doubles: the first stage
 /// of every dynamics evaluation, compiled into it rather than called across translation units,
-/// and kept in registers (core/xy.hpp says why not in Vec2). Internal to core; the public
-/// entry point is solve_loop() (core/kinematics.hpp).
+/// and kept in registers (core/detail/xy.hpp says why not in Vec2). Internal to core, not part
+/// of its API; the public entry point is solve_loop() (core/fourbar/kinematics.hpp).
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
 
+#include "core/detail/xy.hpp"
 #include "core/fourbar/kinematics.hpp"
-#include "core/xy.hpp"
 #include "core/polar_angle.hpp"
 
-namespace bd::core {
+namespace bd::core::detail {
 
 /// A closed loop's link vectors [m].
 struct LoopXy {
@@ -24,8 +24,8 @@ inline double link_angle(const Xy& l) { return polar_angle(l.y, l.x); }
 
 /// solve_loop(model, theta1, l1, branch) in plain doubles, without the angles (link_angle()
 /// gives them; the dynamics does not need them, and a sweep computes them in a pass of their
-/// own): fills `loop`, or returns why the loop cannot close (core/formulation_support.hpp says
-/// why not as an Expected).
+/// own): fills `loop`, or returns why the loop cannot close
+/// (core/fourbar/detail/formulation_support.hpp says why not as an Expected).
 inline std::optional<AssemblyError> close_loop(const FourBar& model, double theta1, const Xy& l1,
                                                Branch branch, LoopXy& loop) {
   const double l2 = model.coupler.length, l3 = model.rocker.length, l4 = model.frame_length;
@@ -63,4 +63,4 @@ inline std::optional<AssemblyError> close_loop(const FourBar& model, double thet
   return std::nullopt;
 }
 
-}  // namespace bd::core
+}  // namespace bd::core::detail

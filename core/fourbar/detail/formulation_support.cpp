@@ -1,10 +1,10 @@
-#include "core/fourbar/formulation_support.hpp"
+#include "core/fourbar/detail/formulation_support.hpp"
 
 #include <fmt/printf.h>
 
 #include <cstdio>
 
-namespace bd::core {
+namespace bd::core::detail {
 
 DynamicsError Failure::error() const {
   std::string buf;
@@ -36,4 +36,4 @@ Expected<Pose, DynamicsError> nonsingular_pose(const FourBar& model, double thet
   return pose_of(instant.state);
 }
 
-}  // namespace bd::core
+}  // namespace bd::core::detail

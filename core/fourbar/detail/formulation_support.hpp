@@ -2,8 +2,8 @@
 /// Steps every formulation of the dynamics shares: closing the loop with the singularity check,
 /// the kinematics of the instant, and completing a sample (shaking force and moment, the
 /// non-finite check); and each formulation's evaluation with its model constants, the route of
-/// the loops over many instants (dynamics.hpp's overloads with DynamicsConstants, the driven
-/// sweep). Internal to core.
+/// the loops over many instants (the overloads with DynamicsConstants, the driven sweep).
+/// Internal to core, not part of its API (core/detail/xy.hpp says what the detail folders hold).
 ///
 /// How the hot path is written, and why (docs/performance.md has the measurements): an
 /// evaluation is a chain of dependent steps (sincos, two square roots, divisions, two atan2,
@@ -11,9 +11,8 @@
 /// shows directly.
 /// - The per-instant stages are inline, so a loop over instants compiles an evaluation as one
 ///   piece; calls across translation units that passed the instant's kinematics through memory
-///   cost ~20 % (forward evaluation 129 ns against 106 ns once the rates and the acceleration
-///   bias were inline).
-/// - They compute in plain doubles (Xy, core/xy.hpp says why not Vec2), fill their results
+///   cost a good share of an evaluation.
+/// - They compute in plain doubles (Xy, core/detail/xy.hpp says why not Vec2), fill their results
 ///   field by field into the caller's objects, and report failure as a small value (Failure):
 ///   results passed as whole structs are written as doubles and copied by the compiler in
 ///   16-byte pieces, which cannot be forwarded from the store buffer either.
@@ -21,22 +20,14 @@
 #include <limits>
 #include <optional>
 
+#include "core/detail/xy.hpp"
+#include "core/fourbar/detail/dynamics_constants.hpp"
+#include "core/fourbar/detail/loop_closure.hpp"
 #include "core/fourbar/dynamics.hpp"
-#include "core/fourbar/dynamics_constants.hpp"
 #include "core/fourbar/kinematics.hpp"
-#include "core/fourbar/loop_closure.hpp"
 #include "core/fourbar/model.hpp"
-#include "core/xy.hpp"
 
-namespace bd::core {
-
-/// |sin(theta3 - theta2)| below this counts as a singular (dead-centre) position, and the dynamics
-/// returns kSingular instead of a number. Near a dead centre theta1 is an ill-conditioned input:
-/// the closed loop's angles move like sqrt(theta1 - limit), and every formulation's relative
-/// error is measured to grow like 7.8·eps/sin² (docs/failure-domains.md). At this threshold that
-/// bound is 1.7e-9, so every value returned is good to better than 2e-9; within 0.06° of a dead
-/// centre the tool says "singular" rather than return a number it cannot vouch for.
-inline constexpr double kSingularSin = 1e-3;
+namespace bd::core::detail {
 
 /// The pose at theta1 on the model's branch, or kAssembly / kSingular.
 Expected<Pose, DynamicsError> nonsingular_pose(const FourBar& model, double theta1);
@@ -90,16 +81,16 @@ inline std::optional<Failure> close_instant(const FourBar& model, double theta1,
   c.inv_l2_x_l3 = 1.0 / l2_x_l3;
   // eq. 7 via cross products: l̄1 + l̄2 Θ2 + l̄3 Θ3 = 0 (eq. 5) crossed with l̄3 and with l̄2
   // (the operations of transfer_functions(), kinematics.hpp)
-  c.tf.Theta2 = cross(c.l3, c.l1) * c.inv_l2_x_l3;
-  c.tf.Theta3 = cross(c.l1, c.l2) * c.inv_l2_x_l3;
+  c.tf.dtheta2_dtheta1 = cross(c.l3, c.l1) * c.inv_l2_x_l3;
+  c.tf.dtheta3_dtheta1 = cross(c.l1, c.l2) * c.inv_l2_x_l3;
   c.state.theta1 = theta1;
   // the angles: two atan2, the longest chain of the instant, but only its outputs need them, so
   // they run alongside the rest
   c.state.theta2 = link_angle(c.l2);
   c.state.theta3 = link_angle(c.l3);
   c.state.omega1 = omega1;
-  c.state.omega2 = c.tf.Theta2 * omega1;
-  c.state.omega3 = c.tf.Theta3 * omega1;
+  c.state.omega2 = c.tf.dtheta2_dtheta1 * omega1;
+  c.state.omega3 = c.tf.dtheta3_dtheta1 * omega1;
   c.state.alpha1 = c.state.alpha2 = c.state.alpha3 = 0.0;
   // eq. 8: Σ l̄k α_k = -i b with b = Σ l̄k ω_k²; crossed with l̄3 and l̄2 (eqs. 9-10), as
   // acceleration_bias()
@@ -125,8 +116,8 @@ inline void set_state(const ClosedInstant& c, double alpha1, FourBarState& s) {
   s.omega2 = c.state.omega2;
   s.omega3 = c.state.omega3;
   s.alpha1 = alpha1;
-  s.alpha2 = c.tf.Theta2 * alpha1 + c.bias.gamma2;
-  s.alpha3 = c.tf.Theta3 * alpha1 + c.bias.gamma3;
+  s.alpha2 = c.tf.dtheta2_dtheta1 * alpha1 + c.bias.gamma2;
+  s.alpha3 = c.tf.dtheta3_dtheta1 * alpha1 + c.bias.gamma3;
 }
 
 /// Fills the reactions RA0, RA3 [N], Fsh = RA0 + RA3, tau [N m] and Msh = l4·RA3y - tau of `s`,
@@ -167,7 +158,7 @@ struct CrankInput {
 /// partly filled). The opened loop takes its link vectors from the state's angles, so that it
 /// agrees bit for bit with its state form, forward_dynamics_opened_loop(model, state). (The mass
 /// matrix's, mass_matrix_at(), and dynamics_at(), which calls one of them, are inline in
-/// core/instant_dynamics.hpp.)
+/// core/fourbar/detail/instant_dynamics.hpp.)
 std::optional<Failure> complex_masses_at(const FourBar& model, const ComplexMassConstants& c,
                                          const ClosedInstant& instant, CrankInput input,
                                          DynamicsSample& out);
@@ -232,4 +223,4 @@ inline Xy CrankSweep::l1(double theta1) {
   return anchor_ + cmul(anchor_, Xy{cos_delta_m1, sin_delta});
 }
 
-}  // namespace bd::core
+}  // namespace bd::core::detail

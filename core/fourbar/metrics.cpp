@@ -1,4 +1,4 @@
-#include "core/metrics.hpp"
+#include "core/fourbar/metrics.hpp"
 
 #include <algorithm>
 #include <array>

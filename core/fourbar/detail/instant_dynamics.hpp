@@ -1,17 +1,18 @@
 #pragma once
 /// The dynamics at one closed instant with the model's constants, inline, for the loops over
-/// instants (dynamics.hpp's overloads with DynamicsConstants, the driven sweep): the default
-/// formulation, the mass matrix (core/mass_matrix.hpp, paper §4.2), is compiled into each of
-/// them; the others are calls (core/formulation_support.hpp says why). Internal to core.
+/// instants (the overloads with DynamicsConstants, the driven sweep): the default formulation,
+/// the mass matrix (core/fourbar/mass_matrix.hpp, paper §4.2), is compiled into each of them; the
+/// others are calls (core/fourbar/detail/formulation_support.hpp says why). Internal to core, not
+/// part of its API (core/detail/xy.hpp says what the detail folders hold).
 #include <optional>
 
-#include "core/fourbar/dynamics_constants.hpp"
-#include "core/fourbar/formulation_support.hpp"
-#include "core/xy.hpp"
+#include "core/detail/xy.hpp"
+#include "core/fourbar/detail/dynamics_constants.hpp"
+#include "core/fourbar/detail/formulation_support.hpp"
 
-namespace bd::core {
+namespace bd::core::detail {
 
-namespace mass_matrix_detail {
+namespace mass_matrix_blocks {
 
 // M·v for the moving joints' accelerations v = [v_A1; v_A2] (eq. 48 in the constants' block form)
 struct JointPair {
@@ -24,7 +25,7 @@ inline double dot(const JointPair& a, const JointPair& b) {
   return dot(a.A1, b.A1) + dot(a.A2, b.A2);
 }
 
-}  // namespace mass_matrix_detail
+}  // namespace mass_matrix_blocks
 
 /// The mass-matrix formulation at a closed instant of `model`, whose constants are `c` (model
 /// without counter-rotations): fills `out` and returns std::nullopt, or returns why not.
@@ -36,27 +37,27 @@ inline std::optional<Failure> mass_matrix_at(const FourBar& model, const MassMat
 
   // accelerations of the moving joints [A1, A2]: r̈ = J·alpha1 + c (eqs. 50-51), with
   // A1 = l̄1 and A2 = A3 - l̄3; A0 and A3 do not move
-  const mass_matrix_detail::JointPair J{il1, -instant.tf.Theta3 * il3};
-  const mass_matrix_detail::JointPair bias{
+  const mass_matrix_blocks::JointPair J{il1, -instant.tf.dtheta3_dtheta1 * il3};
+  const mass_matrix_blocks::JointPair bias{
       -(omega1 * omega1) * instant.l1, (omega3 * omega3) * instant.l3 - instant.bias.gamma3 * il3};
 
   // nodal forces (eq. 46): the constant shares of the forces, and each link's moment as the
   // couple ±(M_k/l_k²)·i l̄k at its second and first joint
   const Xy couple1 = c.couple1 * il1, couple2 = c.couple2 * il2, couple3 = c.couple3 * il3;
-  const mass_matrix_detail::JointPair F{c.F_A1 + couple1 - couple2, c.F_A2 + couple2 - couple3};
+  const mass_matrix_blocks::JointPair F{c.F_A1 + couple1 - couple2, c.F_A2 + couple2 - couple3};
   const Xy F_A0 = c.F_A0 - couple1, F_A3 = c.F_A3 + couple3;
 
   // reduced equation (eq. 47 with the virtual displacements of eq. 50): Jᵀ(M r̈ - F) = tau.
   // Forward: alpha1 from it, then M r̈ = alpha1 M J + M c; inverse: M r̈ at once.
   double alpha1 = input.alpha1, tau = 0;
-  mass_matrix_detail::JointPair Ma;  // M r̈
+  mass_matrix_blocks::JointPair Ma;  // M r̈
   if (!input.torque_unknown) {
-    const mass_matrix_detail::JointPair MJ = mass_matrix_detail::times_M(c, J),
-                                        Mc = mass_matrix_detail::times_M(c, bias);
+    const mass_matrix_blocks::JointPair MJ = mass_matrix_blocks::times_M(c, J),
+                                        Mc = mass_matrix_blocks::times_M(c, bias);
     alpha1 = (dot(J, F) - dot(J, Mc)) / dot(J, MJ);
     Ma = {alpha1 * MJ.A1 + Mc.A1, alpha1 * MJ.A2 + Mc.A2};
   } else {
-    Ma = mass_matrix_detail::times_M(c, {alpha1 * J.A1 + bias.A1, alpha1 * J.A2 + bias.A2});
+    Ma = mass_matrix_blocks::times_M(c, {alpha1 * J.A1 + bias.A1, alpha1 * J.A2 + bias.A2});
     tau = dot(J, Ma) - dot(J, F);
   }
 
@@ -103,4 +104,4 @@ inline std::optional<Failure> dynamics_at(const FourBar& model, const DynamicsCo
   return mass_matrix_at(model, c.mass_matrix, instant, input, out);
 }
 
-}  // namespace bd::core
+}  // namespace bd::core::detail

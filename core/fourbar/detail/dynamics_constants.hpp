@@ -1,4 +1,6 @@
 #pragma once
+/// Internal to core, not part of its API (core/detail/xy.hpp says what the detail folders hold).
+///
 /// The constants of a model that the dynamics of every instant needs: each formulation's
 /// coefficients that depend on the masses, inertias, lengths and loads but not on the state
 /// (link mass matrices, nodal-force shares, equivalent masses, principal-vector factors, weights
@@ -7,15 +9,17 @@
 /// once, instead of at every instant; the one-instant entry points compute what their
 /// formulation needs per call.
 ///
-/// Planar vectors are Xy (core/xy.hpp), the type of the per-instant kernels; they stand for
-/// complex numbers where the paper writes them: w = (u, v) multiplies as u + i v (cmul).
+/// Planar vectors are Xy (core/detail/xy.hpp), the type of the per-instant kernels; they stand
+/// for complex numbers where the paper writes them: w = (u, v) multiplies as u + i v (cmul).
+#include "core/detail/xy.hpp"
+#include "core/expected.hpp"
+#include "core/fourbar/dynamics.hpp"
 #include "core/fourbar/model.hpp"
-#include "core/xy.hpp"
 #include "core/types.hpp"
 
-namespace bd::core {
+namespace bd::core::detail {
 
-/// Mass-matrix formulation (core/mass_matrix.hpp). The 2x2 blocks of a link's mass matrix
+/// Mass-matrix formulation (core/fourbar/mass_matrix.hpp). The 2x2 blocks of a link's mass matrix
 /// (eq. 45) are a scalar on the diagonal and a complex multiplication off it: with joints p, q,
 /// M_e = [I_q/l² 1, B; Bᵀ, I_p/l² 1] and B·v = w ⊗ v, w = (-I_red/l², m f/l), Bᵀ·v = conj(w) ⊗ v.
 struct MassMatrixConstants {
@@ -30,7 +34,7 @@ struct MassMatrixConstants {
 };
 MassMatrixConstants mass_matrix_constants(const FourBar& model);
 
-/// Complex-masses formulation (core/complex_masses.hpp), in the notation of eqs. 29-40.
+/// Complex-masses formulation (core/fourbar/complex_masses.hpp), in the notation of eqs. 29-40.
 struct ComplexMassConstants {
   Xy w1, w2, w3;        // s̄_k / l_k [-]
   Xy mq1, mp2, mq2;     // complex masses m̄1q, m̄2p, m̄2q (eq. 29) [kg]
@@ -48,7 +52,7 @@ struct ComplexMassConstants {
 };
 ComplexMassConstants complex_mass_constants(const FourBar& model);
 
-/// Opened-loop formulation (core/opened_loop.hpp), eqs. 12-25.
+/// Opened-loop formulation (core/fourbar/opened_loop.hpp), eqs. 12-25.
 struct OpenedLoopConstants {
   double M11{}, M22{}, M33{};  // the diagonal of the mass matrix (constant) [kg m^2]
   /// M_jk = -Re(kappa_jk ζ_jk), C_jk = Im(kappa_jk ζ_jk) with ζ_jk = conj(l̄_j) l̄_k:
@@ -73,4 +77,20 @@ struct DynamicsConstants {
 /// The constants of `model` for all formulations; valid for that model only.
 DynamicsConstants dynamics_constants(const FourBar& model);
 
-}  // namespace bd::core
+/// forward_dynamics() and inverse_dynamics() (core/fourbar/dynamics.hpp) with the model's
+/// constants computed once by dynamics_constants(model): what a loop over many instants of one
+/// model calls (a simulation's right-hand side, a sweep). The results are those of the public
+/// calls bit for bit, at less cost (docs/performance.md).
+/// `constants` must come from this `model`. Models with counter-rotations take the one-instant
+/// route.
+Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model,
+                                                         const DynamicsConstants& constants,
+                                                         double theta1, double omega1,
+                                                         Formulation f = Formulation::kMassMatrix);
+Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model,
+                                                         const DynamicsConstants& constants,
+                                                         double theta1, double omega1,
+                                                         double alpha1,
+                                                         Formulation f = Formulation::kMassMatrix);
+
+}  // namespace bd::core::detail
