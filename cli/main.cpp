@@ -18,6 +18,7 @@
 
 #include "cli/sweep_display.hpp"
 #include "core/fourbar/metrics.hpp"
+#include "core/number_text.hpp"
 #include "studies/report/report.hpp"
 #include "studies/studies.hpp"
 #include "studies/study/load_study.hpp"
@@ -252,12 +253,11 @@ void print_balance(const st::Study& study, const st::RunResult& r) {
     std::printf("  %-7s  counter-rotation J = %.6g kg m^2 on a shaft at [%.6g, %.6g] m\n", sides[i],
                 discs[i]->inertia, discs[i]->at.x(), discs[i]->at.y());
   }
-  if (run.method.formulation == r.method.formulation && run.method.reason == r.method.reason) {
-    std::printf("  balanced design: method %s as above",
-                bd::core::to_string(run.method.formulation));
+  if (run.method.method == r.method.method && run.method.reason == r.method.reason) {
+    std::printf("  balanced design: method %s as above", st::to_string(run.method.method));
   } else {
-    std::printf("  balanced design: method %s (%s%s)", bd::core::to_string(run.method.formulation),
-                study.formulation ? "" : "auto: ", run.method.reason.c_str());
+    std::printf("  balanced design: method %s (%s%s)", st::to_string(run.method.method),
+                study.method == st::Method::kAuto ? "auto: " : "", run.method.reason.c_str());
   }
   std::printf(", %zu samples, status %s\n", run.trajectory.samples.size(),
               bd::core::to_string(run.trajectory.status));
@@ -284,9 +284,8 @@ void print_optimize(const st::Study& study, const st::RunResult& r) {
   }
   std::printf("  verified with %s: largest relative difference %.3g\n",
               bd::core::to_string(o.verified_with), o.verification_error);
-  std::printf("  optimum: method %s, %zu samples, status %s\n",
-              bd::core::to_string(run.method.formulation), run.trajectory.samples.size(),
-              bd::core::to_string(run.trajectory.status));
+  std::printf("  optimum: method %s, %zu samples, status %s\n", st::to_string(run.method.method),
+              run.trajectory.samples.size(), bd::core::to_string(run.trajectory.status));
   if (!run.pareto.empty()) {
     std::size_t found = 0;
     for (const bd::optimize::ParetoPoint& p : run.pareto) found += p.result.ok() ? 1 : 0;
@@ -297,36 +296,67 @@ void print_optimize(const st::Study& study, const st::RunResult& r) {
   print_comparison(study, r);
 }
 
-void print_summary(const st::Study& study, const st::RunResult& r) {
-  const bd::core::Metrics& m = r.metrics;
+// the scene in one line
+void print_scene(const st::Study& study) {
   if (const auto* free = std::get_if<bd::core::FreeScene>(&study.scene)) {
     std::printf("%s: free motion over %g s from theta1 = %g rad, omega1 = %g rad/s\n",
                 study.name.c_str(), free->duration, free->theta1, free->omega1);
-  } else {
-    const auto& d = std::get<bd::core::DrivenScene>(study.scene);
+  } else if (const auto* d = std::get_if<bd::core::DrivenScene>(&study.scene)) {
     std::printf("%s: driven at omega1 = %g rad/s for %d revolution%s from theta1 = %g rad\n",
-                study.name.c_str(), d.omega1, d.revolutions, d.revolutions == 1 ? "" : "s",
-                d.theta1);
+                study.name.c_str(), d->omega1, d->revolutions, d->revolutions == 1 ? "" : "s",
+                d->theta1);
+  } else if (const auto* pf = std::get_if<bd::core::planar::FreeScene>(&study.scene)) {
+    std::printf("%s: free motion over %g s from the %s\n", study.name.c_str(), pf->duration,
+                pf->start.empty() ? "drawn position" : "scene's start");
+  } else {
+    const auto& pd = std::get<bd::core::planar::DrivenScene>(study.scene);
+    std::string speeds;
+    for (std::size_t k = 0; k < pd.speeds.size(); ++k) {
+      speeds += (k ? ", " : "") + study.planar().inputs[k].name + " at " +
+                bd::text::digits(pd.speeds[k], 6) +
+                (study.planar().inputs[k].kind == bd::core::planar::Input::Kind::kAngle ? " rad/s"
+                                                                                        : " m/s");
+    }
+    if (pd.duration > 0) {
+      std::printf("%s: driven (%s) for %g s\n", study.name.c_str(), speeds.c_str(), pd.duration);
+    } else {
+      std::printf("%s: driven (%s) for %d revolution%s\n", study.name.c_str(), speeds.c_str(),
+                  pd.revolutions, pd.revolutions == 1 ? "" : "s");
+    }
   }
-  std::printf("  method   %s (%s%s)\n", bd::core::to_string(r.method.formulation),
-              study.formulation ? "" : "auto: ", r.method.reason.c_str());
-  std::printf("  samples  %zu, status %s", r.trajectory.samples.size(),
-              bd::core::to_string(r.trajectory.status));
-  if (std::holds_alternative<bd::core::FreeScene>(study.scene)) {
-    std::printf(", %ld integrator steps, %ld dynamics evaluations", r.trajectory.steps,
-                r.trajectory.rhs_evaluations);
+}
+
+// the metrics in pairs (RMS, then peak, per quantity); a peak alone on its own line
+void print_metrics(const st::MetricList& metrics, bool driven) {
+  for (std::size_t k = 0; k < metrics.size(); ++k) {
+    const st::MetricValue& m = metrics[k];
+    const std::string symbol = m.name.substr(0, m.name.rfind('_'));
+    if (symbol.rfind("tau", 0) == 0 && !driven) continue;  // 0 in free motion without a drive
+    const bool pair = k + 1 < metrics.size() && m.name.size() > 4 &&
+                      m.name.compare(m.name.size() - 4, 4, "_rms") == 0;
+    if (pair) {
+      const st::MetricValue& peak = metrics[k + 1];
+      std::printf("  %-8s rms %.6g %s, max %.6g %s\n", ("|" + symbol + "|").c_str(), m.value,
+                  m.unit.c_str(), peak.value, peak.unit.c_str());
+      ++k;
+    } else {
+      std::printf("  %-8s max %.6g %s\n", ("|" + symbol + "|").c_str(), m.value, m.unit.c_str());
+    }
+  }
+}
+
+void print_summary(const st::Study& study, const st::RunResult& r) {
+  print_scene(study);
+  std::printf("  method   %s (%s%s)\n", st::to_string(r.method.method),
+              study.method == st::Method::kAuto ? "auto: " : "", r.method.reason.c_str());
+  const st::RunStatus status = r.status();
+  std::printf("  samples  %zu, status %s", status.samples, bd::core::to_string(status.status));
+  if (st::is_free(study.scene)) {
+    std::printf(", %ld integrator steps, %ld dynamics evaluations", status.steps,
+                status.rhs_evaluations);
   }
   std::printf("\n");
-  // the metric table's rows in pairs: each quantity's RMS, then its peak
-  const bool driven = std::holds_alternative<bd::core::DrivenScene>(study.scene);
-  for (std::size_t k = 0; k + 1 < bd::core::kMetricCount; k += 2) {
-    const bd::core::MetricInfo& rms = bd::core::kMetricTable[k];
-    const bd::core::MetricInfo& peak = bd::core::kMetricTable[k + 1];
-    if (rms.quantity == bd::core::Quantity::kDriveTorque && !driven) continue;  // 0 in free motion
-    const std::string symbol = std::string(rms.name).substr(0, std::string(rms.name).find('_'));
-    std::printf("  %-8s rms %.6g %s, max %.6g %s\n", ("|" + symbol + "|").c_str(), m.*rms.field,
-                rms.unit, m.*peak.field, peak.unit);
-  }
+  print_metrics(r.metric_list, !st::is_free(study.scene));
   if (study.balance && r.balanced) print_balance(study, r);
   if (study.optimize && r.optimized) print_optimize(study, r);
   std::printf("  wrote    %s\n", r.timeseries.string().c_str());

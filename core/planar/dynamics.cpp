@@ -48,8 +48,11 @@ std::string row_name(const System& s, int row) {
       return "node " + l.nodes[static_cast<std::size_t>(r.node)].name + " on link " +
              l.links[static_cast<std::size_t>(r.link)].name;
     }
-    case System::RowRef::Kind::kSlider:
-      return "slider " + l.sliders[static_cast<std::size_t>(ref.index)].name;
+    case System::RowRef::Kind::kSlider: {
+      const Slider& sl = l.sliders[static_cast<std::size_t>(ref.index)];
+      return "slider " + sl.name + " (node " + l.nodes[static_cast<std::size_t>(sl.node)].name +
+             " on its guide)";
+    }
     case System::RowRef::Kind::kInput:
       return "input " + l.inputs[static_cast<std::size_t>(ref.index)].name;
   }
@@ -175,6 +178,22 @@ std::vector<double> drawn_inputs(const Model& model) {
     }
   }
   return z;
+}
+
+Expected<bool, PlanarError> check_drawn(const Model& model) {
+  const System& s = model.system();
+  NodeVectors x;
+  for (const Node& n : s.linkage.nodes) x.push_back(n.position);
+  VectorXd g;
+  detail::constraint_values(s, x, {}, g);
+  if (g.size() == 0) return true;
+  Eigen::Index worst = 0;
+  const double misfit = g.cwiseAbs().maxCoeff(&worst);
+  if (misfit <= 1e-9 * model.length_scale()) return true;
+  return Unexpected<PlanarError>(
+      PlanarError{PlanarError::Kind::kAssembly, "the drawn positions do not close " +
+                                                    row_name(s, static_cast<int>(worst)) +
+                                                    ": off by " + text::digits(misfit, 3) + " m"});
 }
 
 int mobility(const Model& model) {

@@ -125,6 +125,11 @@ Expected<bool, PlanarError> assemble(const Model& model, Workspace& ws,
 /// The inputs' values in the drawn configuration.
 std::vector<double> drawn_inputs(const Model& model);
 
+/// Checks that the drawn positions close every constraint (a sliding node on its guide) to 1e-9 of
+/// the length scale; otherwise the error names the constraint that does not close and by how
+/// much.
+Expected<bool, PlanarError> check_drawn(const Model& model);
+
 /// The degrees of freedom of the drawn configuration: coordinates minus the rank of the
 /// constraints' Jacobian (the structural rows).
 int mobility(const Model& model);

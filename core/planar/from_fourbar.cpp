@@ -35,4 +35,34 @@ Linkage linkage_of(const FourBar& m, double theta1) {
   return make_linkage(l);
 }
 
+core::Trajectory fourbar_trajectory(const Trajectory& planar) {
+  const Series& t = planar.table;
+  auto col = [&](const char* name) { return static_cast<std::size_t>(t.column(name)); };
+  const std::size_t c_t = col("t"), th1 = col("theta_crank"), th2 = col("theta_coupler"),
+                    th3 = col("theta_rocker"), om1 = col("omega_crank"), om2 = col("omega_coupler"),
+                    om3 = col("omega_rocker"), al1 = col("alpha_crank"), al2 = col("alpha_coupler"),
+                    al3 = col("alpha_rocker"), r0 = col("RA0x"), r3 = col("RA3x"), f = col("Fshx"),
+                    m = col("Msh"), tau = col("tau");
+  core::Trajectory out;
+  out.t.reserve(t.rows());
+  out.samples.reserve(t.rows());
+  for (std::size_t i = 0; i < t.rows(); ++i) {
+    DynamicsSample d;
+    d.state = {t.at(i, th1), t.at(i, om1), t.at(i, al1), t.at(i, th2), t.at(i, th3),
+               t.at(i, om2), t.at(i, om3), t.at(i, al2), t.at(i, al3)};
+    d.RA0 = Vec2(t.at(i, r0), t.at(i, r0 + 1));
+    d.RA3 = Vec2(t.at(i, r3), t.at(i, r3 + 1));
+    d.Fsh = Vec2(t.at(i, f), t.at(i, f + 1));
+    d.Msh = t.at(i, m);
+    d.tau = t.at(i, tau);
+    out.t.push_back(t.at(i, c_t));
+    out.samples.push_back(d);
+  }
+  out.status = planar.status;
+  out.message = planar.message;
+  out.steps = planar.steps;
+  out.rhs_evaluations = planar.rhs_evaluations;
+  return out;
+}
+
 }  // namespace bd::core::planar

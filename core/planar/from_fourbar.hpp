@@ -5,7 +5,9 @@
 /// (the rocker's centre of mass measured from A2, as in the four-bar); the links' loads at their
 /// centres of mass; the crank's angle as the input.
 #include "core/fourbar/model.hpp"
+#include "core/fourbar/simulate.hpp"
 #include "core/planar/model.hpp"
+#include "core/planar/simulate.hpp"
 
 namespace bd::core::planar {
 
@@ -13,5 +15,10 @@ namespace bd::core::planar {
 /// @throws bd::InputError if the loop cannot close at theta1, or the four-bar has counter-rotating
 ///         inertias (the general engine models them from the balancing layer's gears).
 Linkage linkage_of(const FourBar& fourbar, double theta1);
+
+/// The general engine's samples of that linkage as the four-bar's (its crank, coupler and rocker
+/// angles as theta1..3, the reactions at A0 and A3, the shaking force and moment, the drive
+/// torque), with the same status and message.
+core::Trajectory fourbar_trajectory(const Trajectory& planar);
 
 }  // namespace bd::core::planar

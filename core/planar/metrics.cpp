@@ -20,25 +20,29 @@ std::vector<ColumnMetric> metric_table(const Model& model) {
     const std::string column = one ? "tau" : "tau_" + in.name;
     const bool angle = in.kind == Input::Kind::kAngle;
     both(column, angle ? "N m" : "N",
-         std::string(angle ? "the drive torque" : "the drive force") + (one ? "" : " of " + in.name) +
-             " |" + column + "|",
+         std::string(angle ? "the drive torque" : "the drive force") +
+             (one ? "" : " of " + in.name) + " |" + column + "|",
          {column});
   }
   for (int g : model.ground_nodes()) {
     const std::string name = "R" + l.nodes[static_cast<std::size_t>(g)].name;
-    both(name, "N", "the bearing force |" + name + "| at ground node " +
-                        l.nodes[static_cast<std::size_t>(g)].name,
+    both(name, "N",
+         "the bearing force |" + name + "| at ground node " +
+             l.nodes[static_cast<std::size_t>(g)].name,
          {name + "x", name + "y"});
   }
   for (int s : model.frame_guides()) {
     const std::string name = "R" + l.sliders[static_cast<std::size_t>(s)].name;
-    both(name, "N", "the guide force |" + name + "| of slider " +
-                        l.sliders[static_cast<std::size_t>(s)].name,
+    both(name, "N",
+         "the guide force |" + name + "| of slider " + l.sliders[static_cast<std::size_t>(s)].name,
          {name + "x", name + "y"});
   }
   for (const JointForce& j : model.joints()) {
     const std::string name = "F" + j.name;
-    t.push_back({name + "_max", "N", "peak of the joint force |" + name + "|", Statistic::kMax,
+    t.push_back({name + "_max",
+                 "N",
+                 "peak of the joint force |" + name + "|",
+                 Statistic::kMax,
                  {name + "x", name + "y"}});
   }
   return t;

@@ -14,9 +14,9 @@
 namespace bd::core::planar {
 
 struct ColumnMetric {
-  std::string name;                  // "Fsh_rms", "RA0_max", "FA1_max"
-  std::string unit;                  // "N", "N m"
-  std::string words;                 // "RMS of the shaking force |Fsh|"
+  std::string name;   // "Fsh_rms", "RA0_max", "FA1_max"
+  std::string unit;   // "N", "N m"
+  std::string words;  // "RMS of the shaking force |Fsh|"
   Statistic statistic = Statistic::kRms;
   std::vector<std::string> columns;  // one column, or the x and y columns of a vector
 };

@@ -45,26 +45,21 @@ void check_links(const Linkage& l) {
     const Link& link = l.links[k];
     check_name("links", k, link.name, names);
     if (link.nodes.size() < 2) {
-      fail("links", k,
-           " '" + link.name + "' must join at least 2 nodes, got " +
-               std::to_string(link.nodes.size()));
+      fail("links", k, " must join at least 2 nodes, got " + std::to_string(link.nodes.size()));
     }
     std::set<int> seen;
     for (int n : link.nodes) {
       check_node(l, "links", k, "a node of the link", n);
       if (!seen.insert(n).second) {
-        fail("links", k,
-             " '" + link.name + "' names node " + l.nodes[static_cast<std::size_t>(n)].name +
-                 " twice");
+        fail("links", k, " names node " + l.nodes[static_cast<std::size_t>(n)].name + " twice");
       }
     }
     const Vec2 d = l.nodes[static_cast<std::size_t>(link.nodes[1])].position -
                    l.nodes[static_cast<std::size_t>(link.nodes[0])].position;
     if (!(d.norm() > 0)) {
       fail("links", k,
-           " '" + link.name + "': its first two nodes " +
-               l.nodes[static_cast<std::size_t>(link.nodes[0])].name + " and " +
-               l.nodes[static_cast<std::size_t>(link.nodes[1])].name +
+           ": its first two nodes " + l.nodes[static_cast<std::size_t>(link.nodes[0])].name +
+               " and " + l.nodes[static_cast<std::size_t>(link.nodes[1])].name +
                " coincide; they set the link's length and direction");
     }
     check_value("links", k, "mass", link.mass, link.mass >= 0, ">= 0", "kg");
@@ -82,12 +77,12 @@ void check_sliders(const Linkage& l) {
     check_node(l, "sliders", k, "the sliding node", s.node);
     if (l.nodes[static_cast<std::size_t>(s.node)].ground) {
       fail("sliders", k,
-           " '" + s.name + "': its node " + l.nodes[static_cast<std::size_t>(s.node)].name +
+           ": its node " + l.nodes[static_cast<std::size_t>(s.node)].name +
                " is fixed to the frame and cannot slide");
     }
     if (s.link < 0) {
       if (!finite(s.from) || !finite(s.to) || !((s.to - s.from).norm() > 0)) {
-        fail("sliders", k, " '" + s.name + "': the guide needs two distinct finite points");
+        fail("sliders", k, ": the guide needs two distinct finite points");
       }
       continue;
     }
@@ -97,17 +92,17 @@ void check_sliders(const Linkage& l) {
       check_node(l, "sliders", k, "a guide node", n);
       if (std::find(nodes.begin(), nodes.end(), n) == nodes.end()) {
         fail("sliders", k,
-             " '" + s.name + "': the guide's node " + l.nodes[static_cast<std::size_t>(n)].name +
+             ": the guide's node " + l.nodes[static_cast<std::size_t>(n)].name +
                  " is not on link " + l.links[static_cast<std::size_t>(s.link)].name);
       }
     }
     if (s.from_node == s.to_node || !((l.nodes[static_cast<std::size_t>(s.to_node)].position -
                                        l.nodes[static_cast<std::size_t>(s.from_node)].position)
                                           .norm() > 0)) {
-      fail("sliders", k, " '" + s.name + "': the guide's two nodes coincide (a guide of length 0)");
+      fail("sliders", k, ": the guide's two nodes coincide (a guide of length 0)");
     }
     if (std::find(nodes.begin(), nodes.end(), s.node) != nodes.end()) {
-      fail("sliders", k, " '" + s.name + "': the sliding node is on the guide's own link");
+      fail("sliders", k, ": the sliding node is on the guide's own link");
     }
   }
 }
@@ -126,7 +121,7 @@ void check_inputs(const Linkage& l) {
       });
       if (!grounded) {
         fail("inputs", k,
-             " '" + in.name + "': link " + link.name +
+             ": link " + link.name +
                  " has no ground node to turn about (a drive acts between the frame "
                  "and a link pivoted on it)");
       }
@@ -217,8 +212,7 @@ Linkage make_linkage(const Linkage& candidate) {
   std::set<std::string> names;
   for (std::size_t i = 0; i < l.nodes.size(); ++i) {
     check_name("nodes", i, l.nodes[i].name, names);
-    if (!finite(l.nodes[i].position))
-      fail("nodes", i, " '" + l.nodes[i].name + "' must be at a finite position");
+    if (!finite(l.nodes[i].position)) fail("nodes", i, " must be at a finite position");
   }
   if (l.links.empty())
     throw InputError(FieldError{"links", -1, ": a linkage needs at least one link"});

@@ -55,19 +55,20 @@ std::vector<double> start_of(const Model& model, Workspace& ws, const std::vecto
   const int dof = model.inputs();
   if (const int m = mobility(model); m != dof) {
     throw InputError(FieldError{"linkage.inputs", -1,
-                                ": the linkage has " + std::to_string(m) +
-                                    " degree" + (m == 1 ? "" : "s") + " of freedom and " +
-                                    std::to_string(dof) + " input" + (dof == 1 ? "" : "s") +
+                                ": the linkage has " + std::to_string(m) + " degree" +
+                                    (m == 1 ? "" : "s") + " of freedom and " + std::to_string(dof) +
+                                    " input" + (dof == 1 ? "" : "s") +
                                     "; give one input per degree of freedom"});
   }
   std::vector<double> z = start.empty() ? drawn_inputs(model) : start;
   if (static_cast<int>(z.size()) != dof) {
     throw InputError(FieldError{std::string(scene) + ".start", -1,
-                                "must give " + std::to_string(dof) + " values (one per input), got " +
-                                    std::to_string(z.size())});
+                                "must give " + std::to_string(dof) +
+                                    " values (one per input), got " + std::to_string(z.size())});
   }
   for (double v : z) {
-    if (!std::isfinite(v)) throw InputError(FieldError{std::string(scene) + ".start", -1, "must be finite"});
+    if (!std::isfinite(v))
+      throw InputError(FieldError{std::string(scene) + ".start", -1, "must be finite"});
   }
   if (auto ok = assemble(model, ws, z); !ok) {
     throw InputError(FieldError{std::string(scene) + ".start", -1,
@@ -129,7 +130,8 @@ void append_row(const Model& model, const Instant& in, Series& table) {
   const Linkage& l = model.linkage();
   std::vector<double>& v = table.values;
   v.push_back(in.t);
-  for (std::size_t k = 0; k < l.links.size(); ++k) v.insert(v.end(), {in.angle[k], in.omega[k], in.alpha[k]});
+  for (std::size_t k = 0; k < l.links.size(); ++k)
+    v.insert(v.end(), {in.angle[k], in.omega[k], in.alpha[k]});
   for (std::size_t k = 0; k < l.sliders.size(); ++k) {
     v.insert(v.end(), {in.slide[k], in.slide_rate[k], in.slide_acceleration[k]});
   }
@@ -151,7 +153,8 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
   const int dof = model.inputs();
   check_count(scene.speeds, dof, "scene.speeds", "speeds");
   if (scene.samples < 1) {
-    throw InputError(FieldError{"scene.samples", -1, "must be >= 1, got " + std::to_string(scene.samples)});
+    throw InputError(
+        FieldError{"scene.samples", -1, "must be >= 1, got " + std::to_string(scene.samples)});
   }
   // the time span: turns of the first angle input, or the duration
   double period = 0;
@@ -170,8 +173,8 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
   if (!by_duration && scene.revolutions < 1) {
     throw InputError(FieldError{"scene.revolutions", -1, "must be >= 1"});
   }
-  const long long rows = by_duration ? scene.samples
-                                     : static_cast<long long>(scene.samples) * scene.revolutions;
+  const long long rows =
+      by_duration ? scene.samples : static_cast<long long>(scene.samples) * scene.revolutions;
   if (rows > kMaxSamples || (by_duration && rows < 2)) {
     throw InputError(FieldError{"scene.samples", -1, "must be between 2 and 1e8 in all"});
   }
@@ -186,8 +189,9 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
   std::vector<Vec2> guess = ws.instant.x;
   double t_prev = 0;
   for (long long i = 0; i < rows; ++i) {
-    const double t = by_duration ? scene.duration * static_cast<double>(i) / static_cast<double>(rows - 1)
-                                 : period * static_cast<double>(i) / scene.samples;
+    const double t = by_duration
+                         ? scene.duration * static_cast<double>(i) / static_cast<double>(rows - 1)
+                         : period * static_cast<double>(i) / scene.samples;
     for (std::size_t k = 0; k < z.size(); ++k) z[k] = start[k] + scene.speeds[k] * t;
     // the previous sample carried forward to second order: Newton then needs two or three steps
     if (i > 0) {
@@ -227,7 +231,7 @@ struct Motion {
   bool failed{};
   PlanarError error;
   double error_t{};
-  double root_sign = 1;  // the sign of the normalised determinant at the start
+  double root_sign = 1;     // the sign of the normalised determinant at the start
   std::vector<Vec2> cache;  // positions of the last successful evaluation (Newton's guess)
   // dae route scratch
   MatrixXd kkt;
@@ -286,7 +290,8 @@ int reduced_root(sunrealtype, N_Vector y, sunrealtype* g, void* data) {
 // dae route: y = (q, q̇); the accelerations and the structural multipliers from
 //   [M  -Gᵀ] [q̈]   [F                        ]
 //   [G   0 ] [λ ] = [-γ - 2α G q̇ - α² g(q)    ]
-Expected<bool, PlanarError> dae_accelerations(Motion& m, double t, const double* y, bool stabilise) {
+Expected<bool, PlanarError> dae_accelerations(Motion& m, double t, const double* y,
+                                              bool stabilise) {
   const System& s = m.model->system();
   Workspace& ws = *m.ws;
   const int n = s.n, r = s.structural_rows;
@@ -322,7 +327,8 @@ Expected<bool, PlanarError> dae_accelerations(Motion& m, double t, const double*
   ws.lambda.setZero(s.rows);
   ws.lambda.head(r) = sol.tail(r);
   if (!ws.qdd.allFinite()) {
-    return Unexpected<PlanarError>(PlanarError{PlanarError::Kind::kNonFinite, "non-finite accelerations"});
+    return Unexpected<PlanarError>(
+        PlanarError{PlanarError::Kind::kNonFinite, "non-finite accelerations"});
   }
   return true;
 }
@@ -414,8 +420,8 @@ bool advance_ok(Trajectory& out, const Motion& m, integrators::Integration& inte
   const std::string at = "t = " + text::digits(integration.t(), 10) + " s";
   if (outcome == Outcome::kMaxSteps) {
     out.status = SimulationStatus::kIntegratorFailed;
-    out.message = "integrator stopped at " + at + ": max_steps = " +
-                  std::to_string(options.max_steps) + " reached";
+    out.message = "integrator stopped at " + at +
+                  ": max_steps = " + std::to_string(options.max_steps) + " reached";
   } else if (outcome == Outcome::kRoot) {
     out.status = SimulationStatus::kSingular;
     out.message = "limit position reached at " + where +
@@ -453,8 +459,8 @@ Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scen
   ++m.evaluations;
   auto first = reduced_state(m, 0.0, y0.data());
   if (first && std::abs(normalised_determinant(ws)) <= kLimitDeterminant) {
-    first = Unexpected<PlanarError>(PlanarError{PlanarError::Kind::kSingular,
-                                                "the start is a limit position of the inputs"});
+    first = Unexpected<PlanarError>(
+        PlanarError{PlanarError::Kind::kSingular, "the start is a limit position of the inputs"});
   }
   if (!first) {
     fail(out, first.error(), 0.0);
@@ -481,7 +487,8 @@ Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scen
     m.failed = false;
     const auto outcome = integration.advance(output_time(scene, j));
     const std::vector<double> z(integration.y(), integration.y() + dof);
-    if (!advance_ok(out, m, integration, outcome, options, state_text(model, integration.t(), z))) break;
+    if (!advance_ok(out, m, integration, outcome, options, state_text(model, integration.t(), z)))
+      break;
     ++m.evaluations;
     const auto ok = reduced_state(m, integration.t(), integration.y());
     if (!ok) {
@@ -508,7 +515,8 @@ Trajectory free_dae(const Model& model, Workspace& ws, const FreeScene& scene,
   m.route = Route::kDae;
   m.baumgarte = options.baumgarte;
   // the start: positions assembled, velocities from the inputs' rates
-  if (auto ok = inverse_dynamics(model, ws, 0.0, rates, std::vector<double>(rates.size(), 0.0)); !ok) {
+  if (auto ok = inverse_dynamics(model, ws, 0.0, rates, std::vector<double>(rates.size(), 0.0));
+      !ok) {
     fail(out, ok.error(), 0.0);
     return out;
   }
@@ -542,7 +550,9 @@ Trajectory free_dae(const Model& model, Workspace& ws, const FreeScene& scene,
   for (std::size_t j = 1; j < static_cast<std::size_t>(scene.samples); ++j) {
     m.failed = false;
     const auto outcome = integration.advance(output_time(scene, j));
-    if (!advance_ok(out, m, integration, outcome, options, "t = " + text::digits(integration.t(), 10) + " s")) break;
+    if (!advance_ok(out, m, integration, outcome, options,
+                    "t = " + text::digits(integration.t(), 10) + " s"))
+      break;
     y.assign(integration.y(), integration.y() + y0.size());
     project(model, ws, y.data());
     ++m.evaluations;
@@ -559,21 +569,26 @@ Trajectory free_dae(const Model& model, Workspace& ws, const FreeScene& scene,
 
 }  // namespace
 
-Trajectory simulate_free(const Model& model, const FreeScene& scene, const SimulateOptions& options) {
+Trajectory simulate_free(const Model& model, const FreeScene& scene,
+                         const SimulateOptions& options) {
   const int dof = model.inputs();
   if (!(scene.duration > 0) || !std::isfinite(scene.duration)) {
-    throw InputError(FieldError{"scene.duration", -1, "must be > 0 s, got " + text::exact(scene.duration)});
+    throw InputError(
+        FieldError{"scene.duration", -1, "must be > 0 s, got " + text::exact(scene.duration)});
   }
   if (scene.samples < 2 || scene.samples > kMaxSamples) {
-    throw InputError(FieldError{"scene.samples", -1, "must be between 2 and 1e8, got " + std::to_string(scene.samples)});
+    throw InputError(FieldError{"scene.samples", -1,
+                                "must be between 2 and 1e8, got " + std::to_string(scene.samples)});
   }
   if (!(options.tolerance > 0 && options.tolerance < 1)) {
-    throw InputError(FieldError{"tolerance", -1, "must be > 0 and < 1, got " + text::exact(options.tolerance)});
+    throw InputError(
+        FieldError{"tolerance", -1, "must be > 0 and < 1, got " + text::exact(options.tolerance)});
   }
   if (options.integrator == Integrator::kIda) {
     throw InputError(FieldError{"integrator", -1, ": ida is not available for planar linkages"});
   }
-  const std::vector<double> rates = scene.rates.empty() ? std::vector<double>(static_cast<std::size_t>(dof), 0.0) : scene.rates;
+  const std::vector<double> rates =
+      scene.rates.empty() ? std::vector<double>(static_cast<std::size_t>(dof), 0.0) : scene.rates;
   check_count(rates, dof, "scene.rates", "rates");
   Workspace ws(model);
   const std::vector<double> start = start_of(model, ws, scene.start, "scene");

@@ -18,7 +18,6 @@
 
 #include "core/fourbar/metrics.hpp"
 #include "core/input_error.hpp"
-#include "core/fourbar/metrics.hpp"
 #include "core/number_text.hpp"
 #include "studies/run/files.hpp"
 
@@ -176,7 +175,7 @@ std::vector<WorkPrecisionRow> work_precision(const Study& study, const BenchOpti
     if (it == computed.end()) {
       const core::SimulateOptions o =
           simulate_options(f, core::Integrator::kErk8, options.reference_tolerance);
-      it = computed.emplace(f, core::simulate_free(study.model, *scene, o)).first;
+      it = computed.emplace(f, core::simulate_free(study.fourbar(), *scene, o)).first;
     }
     return it->second;
   };
@@ -208,7 +207,7 @@ std::vector<WorkPrecisionRow> work_precision(const Study& study, const BenchOpti
       for (double tolerance : options.tolerances) {
         const core::SimulateOptions o = simulate_options(f, integrator, tolerance);
         auto [trajectory, timing] =
-            timed(options, [&] { return core::simulate_free(study.model, *scene, o); });
+            timed(options, [&] { return core::simulate_free(study.fourbar(), *scene, o); });
         WorkPrecisionRow row;
         row.formulation = f;
         row.integrator = integrator;
@@ -257,7 +256,7 @@ std::vector<DrivenConvergenceRow> driven_convergence(const Study& study,
     one.samples = samples;
     core::SimulateOptions o;
     o.formulation = f;
-    return core::simulate_driven(study.model, one, o);
+    return core::simulate_driven(study.fourbar(), one, o);
   };
   std::map<core::Formulation, core::Metrics> references;
   std::map<core::Formulation, bool> reference_ok;

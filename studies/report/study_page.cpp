@@ -221,7 +221,7 @@ const char* branch_text(core::Branch b) { return b == core::Branch::kPlus ? "+1"
 }  // namespace
 
 std::string linkage_tables_html(const Study& study) {
-  const core::FourBar& m = study.model;
+  const core::FourBar& m = study.fourbar();
   std::string h =
       "<table><tr><th>link</th><th>length l [m]</th><th>mass m [kg]</th>"
       "<th>s [m]</th><th>&sigma; [rad]</th><th>e [m]</th><th>f [m]</th>"
@@ -385,14 +385,14 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
 
   // the linkage at four samples evenly spread over the run, and the path of S; the second
   // design's alike, from its own model (counterweights merged into its links) and samples
-  const Drawing original = drawing(study.model, ts);
+  const Drawing original = drawing(study.fourbar(), ts);
   const std::vector<PoseSample>& poses = original.poses;
   std::optional<core::FourBar> second_model;
   if (second == "balanced" && study.balance) {
     second_model = study.balance->model;
   } else if (second == "optimized" && fs::exists(dir / "optimized.yaml")) {
     try {
-      second_model = load_study((dir / "optimized.yaml").string()).model;
+      second_model = load_study((dir / "optimized.yaml").string()).fourbar();
     } catch (const std::exception& e) {
       throw std::runtime_error("cannot draw the optimised design: " + std::string(e.what()));
     }
@@ -481,8 +481,8 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
   }
   std::string datablocks;
   // one scale of marker size for the links' masses of both designs
-  double mass_ref =
-      std::max({study.model.crank.mass, study.model.coupler.mass, study.model.rocker.mass});
+  double mass_ref = std::max(
+      {study.fourbar().crank.mass, study.fourbar().coupler.mass, study.fourbar().rocker.mass});
   if (second_model) {
     mass_ref = std::max({mass_ref, second_model->crank.mass, second_model->coupler.mass,
                          second_model->rocker.mass});
@@ -493,7 +493,7 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
       "opened-loop principal points P1, P2, P3 (open circles) and the system centre of mass S "
       "(filled squares), with the path S traces over all ";
   if (!poses.empty()) {
-    Chart c = linkage_chart(study.model, original, "o", mass_ref, datablocks);
+    Chart c = linkage_chart(study.fourbar(), original, "o", mass_ref, datablocks);
     c.id = "linkage";
     c.heading = "The linkage";
     c.commands = "set title 'The linkage at " + std::to_string(poses.size()) +

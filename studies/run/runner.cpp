@@ -25,23 +25,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-core::Trajectory simulate(const Study& study, const MethodChoice& method) {
-  core::SimulateOptions options;
-  options.formulation = method.formulation;
-  options.integrator = method.integrator;
-  options.tolerance = study.tolerance;
-  if (const auto* free = std::get_if<core::FreeScene>(&study.scene)) {
-    return core::simulate_free(study.model, *free, options);
-  }
-  return core::simulate_driven(study.model, std::get<core::DrivenScene>(study.scene), options);
-}
-
-
 // solves an optimize study's problem and simulates the optimum; not run when the original's
 // simulation stopped early (its metrics are the normalisers)
 OptimizedRun optimize_study(const Study& study, const RunResult& original) {
   OptimizedRun o;
-  if (!original.trajectory.ok()) {
+  if (!original.status().ok()) {
     o.result.message = "not run: the original design's simulation stopped early (" +
                        original.trajectory.message + ")";
     return o;
@@ -58,8 +46,9 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original) {
                                     static_cast<int>(req.link_parameters.size()));
   if (!o.found()) return o;
   const Study best = optimized_study(study, o.result.design);
-  o.method = choose_method(best);
-  o.trajectory = simulate(best, o.method);
+  const Simulation sim = simulate(best);
+  o.method = sim.method;
+  o.trajectory = sim.fourbar;
   o.metrics = core::metrics(o.trajectory);
   if (req.pareto) {
     o.pareto = optimize::pareto_front(problem, req.pareto->first, req.pareto->second,
@@ -69,6 +58,29 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original) {
 }
 
 }  // namespace
+
+void write_table(const core::Series& table, const fs::path& file) {
+  AtomicFile out(file);
+  fmt::memory_buffer line;
+  for (std::size_t k = 0; k < table.width(); ++k) {
+    fmt::format_to(std::back_inserter(line), "{}{}", k ? "," : "", table.columns[k]);
+  }
+  line.push_back('\n');
+  for (std::size_t i = 0; i < table.rows(); ++i) {
+    const std::span<const double> row = table.row(i);
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      if (k) line.push_back(',');
+      text::append_exact(line, row[k]);
+    }
+    line.push_back('\n');
+    if (line.size() > (1 << 16)) {  // written in blocks of about 64 kB
+      if (std::fwrite(line.data(), 1, line.size(), out.get()) != line.size()) break;
+      line.clear();
+    }
+  }
+  std::fwrite(line.data(), 1, line.size(), out.get());
+  out.commit();  // a failed write shows here, as the file's error state
+}
 
 void write_timeseries(const core::Trajectory& trajectory, const fs::path& file) {
   AtomicFile out(file);
@@ -101,8 +113,8 @@ std::vector<ComparisonRow> comparison(const Study& study, const RunResult& resul
     mass = study.balance->added_mass;
     inertia = study.balance->added_inertia;
   } else {
-    mass = added_mass(study.model, result.optimized->result.design);
-    inertia = added_inertia(study.model, result.optimized->result.design);
+    mass = added_mass(study.fourbar(), result.optimized->result.design);
+    inertia = added_inertia(study.fourbar(), result.optimized->result.design);
   }
   std::vector<std::pair<std::string, std::pair<double, double>>> items;
   for (const core::MetricInfo& info : core::kMetricTable) {
@@ -205,7 +217,7 @@ std::string pareto_csv(const Study& study, const OptimizedRun& run) {
     const optimize::OptimizeResult& r = point.result;
     text += text::exact(point.epsilon);
     if (r.ok()) {
-      const double mass = added_mass(study.model, r.design);
+      const double mass = added_mass(study.fourbar(), r.design);
       text += "," + text::exact(metric_value(r.metrics, p.first, mass)) + "," +
               text::exact(metric_value(r.metrics, p.second, mass));
     } else {
@@ -221,17 +233,28 @@ std::string pareto_csv(const Study& study, const OptimizedRun& run) {
   return text;
 }
 
+RunStatus simulation_status(const RunResult& r) {
+  if (!r.planar.table.columns.empty()) {
+    return {r.planar.status, r.planar.message, r.planar.table.rows(), r.planar.steps,
+            r.planar.rhs_evaluations};
+  }
+  return {r.trajectory.status, r.trajectory.message, r.trajectory.samples.size(),
+          r.trajectory.steps, r.trajectory.rhs_evaluations};
+}
+
 RunResult compute_study(const Study& study) {
   RunResult result;
-  result.method = choose_method(study);
-  result.trajectory = simulate(study, result.method);
-  result.metrics = core::metrics(result.trajectory);
-  std::optional<Study> balanced;
+  Simulation sim = simulate(study);
+  result.method = sim.method;
+  result.metric_list = metric_list(study, sim);
+  result.trajectory = std::move(sim.fourbar);
+  result.planar = std::move(sim.planar);
+  if (study.is_fourbar()) result.metrics = core::metrics(result.trajectory);
   if (study.balance) {
-    balanced = balanced_study(study);
+    const Simulation balanced = simulate(balanced_study(study));
     BalancedRun b;
-    b.method = choose_method(*balanced);
-    b.trajectory = simulate(*balanced, b.method);
+    b.method = balanced.method;
+    b.trajectory = balanced.fourbar;
     b.metrics = core::metrics(b.trajectory);
     result.balanced = std::move(b);
   }
@@ -249,7 +272,11 @@ void write_run(const Study& study, RunResult& result, const fs::path& out_dir) {
   }
   result.timeseries = out_dir / "timeseries.csv";
   result.summary = out_dir / "summary.json";
-  write_timeseries(result.trajectory, result.timeseries);
+  if (study.is_fourbar()) {
+    write_timeseries(result.trajectory, result.timeseries);
+  } else {
+    write_table(result.planar.table, result.timeseries);
+  }
   if (result.balanced) {
     BalancedRun& b = *result.balanced;
     b.timeseries = out_dir / "balanced-timeseries.csv";

@@ -13,6 +13,7 @@
 #include "core/fourbar/simulate.hpp"
 #include "optimize/optimize.hpp"
 #include "studies/run/files.hpp"
+#include "studies/run/simulation.hpp"
 #include "studies/study/study.hpp"
 
 namespace bd::studies {
@@ -61,11 +62,17 @@ struct OptimizedRun {
   }
 };
 
+struct RunResult;
+/// How the original design's simulation of a run ended.
+RunStatus simulation_status(const RunResult& result);
+
 /// What a run did and where its files are.
 struct RunResult {
   MethodChoice method;                    // formulation used, and why (the original design)
-  core::Trajectory trajectory;            // every sample computed, and the simulation's status
-  core::Metrics metrics;                  // over the samples computed
+  core::Trajectory trajectory;            // a four-bar study: every sample computed and the status
+  core::Metrics metrics;                  // a four-bar study: over the samples computed
+  core::planar::Trajectory planar;        // a planar study: the samples' table and the status
+  MetricList metric_list;                 // every study: its metrics in its table's order
   std::filesystem::path timeseries;       // out_dir/timeseries.csv
   std::filesystem::path summary;          // out_dir/summary.json
   std::optional<BalancedRun> balanced;    // set when the study has a balance section
@@ -73,14 +80,16 @@ struct RunResult {
   std::vector<std::string> warnings;      // what went wrong besides the run (the report page)
   /// True when every simulation ran to the end (the original's, the balanced design's, the
   /// optimum's) and an optimize study found its optimum.
+  /// How the original design's simulation ended (either linkage type).
+  RunStatus status() const { return simulation_status(*this); }
   bool ok() const {
-    return trajectory.ok() && (!balanced || balanced->trajectory.ok()) &&
+    return status().ok() && (!balanced || balanced->trajectory.ok()) &&
            (!optimized || (optimized->found() && optimized->trajectory.ok()));
   }
   /// True when a simulation stopped early (the original's, the balanced design's or the
   /// optimum's): exit code 3.
   bool stopped_early() const {
-    return !trajectory.ok() || (balanced && !balanced->trajectory.ok()) ||
+    return !status().ok() || (balanced && !balanced->trajectory.ok()) ||
            (optimized && optimized->found() && !optimized->trajectory.ok());
   }
 };
@@ -125,6 +134,11 @@ RunResult compute_study(const Study& study);
 /// files are complete.
 /// @throws std::runtime_error if an output file cannot be written (the message names it).
 void write_run(const Study& study, RunResult& result, const std::filesystem::path& out_dir);
+
+/// Writes a table of samples as CSV: its column names, then one row per sample, "%.17g" (a
+/// planar linkage's timeseries.csv).
+/// @throws std::runtime_error if the file cannot be written.
+void write_table(const core::Series& table, const std::filesystem::path& file);
 
 /// Writes the samples as timeseries.csv content (header, one row per sample, "%.17g").
 /// @throws std::runtime_error if the file cannot be written.

@@ -15,12 +15,13 @@ using Json = nlohmann::ordered_json;
 
 Json vec(const Vec2& v) { return Json::array({v.x(), v.y()}); }
 
-// the metrics in the table's order
-Json metrics_json(const core::Metrics& m) {
+// the metrics in their table's order
+Json metrics_json(const MetricList& metrics) {
   Json j = Json::object();
-  for (const core::MetricInfo& info : core::kMetricTable) j[info.name] = m.*info.field;
+  for (const MetricValue& m : metrics) j[m.name] = m.value;
   return j;
 }
+Json metrics_json(const core::Metrics& m) { return metrics_json(metric_list(m)); }
 
 // after / before per metric; null where before is 0
 Json reduction_json(const core::Metrics& before, const core::Metrics& after) {
@@ -34,8 +35,12 @@ Json reduction_json(const core::Metrics& before, const core::Metrics& after) {
 
 Json method_json(const Study& study, const MethodChoice& method) {
   return {{"requested", study.method_name()},
-          {"used", core::to_string(method.formulation)},
+          {"used", to_string(method.method)},
           {"reason", method.reason}};
+}
+
+Json inputs_json(const std::vector<double>& values) {
+  return values.empty() ? Json("as drawn") : Json(values);
 }
 
 Json scene_json(const Scene& scene) {
@@ -46,22 +51,43 @@ Json scene_json(const Scene& scene) {
             {"duration", free->duration},
             {"samples", free->samples}};
   }
-  const auto& driven = std::get<core::DrivenScene>(scene);
-  return {{"type", "driven"},
-          {"theta1", driven.theta1},
-          {"omega1", driven.omega1},
-          {"revolutions", driven.revolutions},
-          {"samples", driven.samples}};
+  if (const auto* driven = std::get_if<core::DrivenScene>(&scene)) {
+    return {{"type", "driven"},
+            {"theta1", driven->theta1},
+            {"omega1", driven->omega1},
+            {"revolutions", driven->revolutions},
+            {"samples", driven->samples}};
+  }
+  if (const auto* free = std::get_if<core::planar::FreeScene>(&scene)) {
+    return {{"type", "free"},
+            {"start", inputs_json(free->start)},
+            {"rates", free->rates},
+            {"duration", free->duration},
+            {"samples", free->samples}};
+  }
+  const auto& driven = std::get<core::planar::DrivenScene>(scene);
+  Json j = {{"type", "driven"}, {"start", inputs_json(driven.start)}, {"speeds", driven.speeds}};
+  if (driven.duration > 0) {
+    j["duration"] = driven.duration;
+  } else {
+    j["revolutions"] = driven.revolutions;
+  }
+  j["samples"] = driven.samples;
+  return j;
 }
 
-// a trajectory's run facts (status, counts), added to `j`
+// a run's facts (status, counts), added to `j`
+void add_run_fields(Json& j, const RunStatus& r) {
+  j["samples"] = r.samples;
+  j["status"] = core::to_string(r.status);
+  j["ok"] = r.ok();
+  j["message"] = r.message;
+  j["steps"] = r.steps;
+  j["rhs_evaluations"] = r.rhs_evaluations;
+}
 void add_run_fields(Json& j, const core::Trajectory& tr) {
-  j["samples"] = tr.samples.size();
-  j["status"] = core::to_string(tr.status);
-  j["ok"] = tr.ok();
-  j["message"] = tr.message;
-  j["steps"] = tr.steps;
-  j["rhs_evaluations"] = tr.rhs_evaluations;
+  add_run_fields(j,
+                 RunStatus{tr.status, tr.message, tr.samples.size(), tr.steps, tr.rhs_evaluations});
 }
 
 Json counterweight_json(const char* link, balance::CounterweightShape shape,
@@ -133,7 +159,7 @@ Json optimum_counterweights_json(const OptimizeRequest& request,
 // the problem as the study states it: solver, terms, constraints
 Json problem_json(const OptimizeRequest& req, const MethodChoice& method) {
   Json j = {{"algorithm", optimize::to_string(req.options.algorithm)},
-            {"formulation", core::to_string(method.formulation)}};
+            {"formulation", to_string(method.method)}};
   Json terms = Json::array();
   for (const optimize::Term& t : req.objective) {
     terms.push_back({{"metric", optimize::to_string(t.metric)}, {"weight", t.weight}});
@@ -175,8 +201,8 @@ Json optimize_json(const Study& study, const RunResult& result) {
   j["variables"] = variables;
   j["counterweights"] = found ? optimum_counterweights_json(req, r.counterweights) : Json::array();
   if (found) {
-    j["added_mass"] = added_mass(study.model, r.design);
-    j["added_inertia"] = added_inertia(study.model, r.design);
+    j["added_mass"] = added_mass(study.fourbar(), r.design);
+    j["added_inertia"] = added_inertia(study.fourbar(), r.design);
     j["verified_with"] = core::to_string(r.verified_with);
     j["verification_error"] = r.verification_error;
   }
@@ -210,8 +236,8 @@ std::string summary_json(const Study& study, const RunResult& result) {
             {"method", method_json(study, result.method)},
             {"scene", scene_json(study.scene)},
             {"tolerance", study.tolerance}};
-  add_run_fields(j, result.trajectory);
-  j["metrics"] = metrics_json(result.metrics);
+  add_run_fields(j, result.status());
+  j["metrics"] = metrics_json(result.metric_list);
   if (study.balance && result.balanced) {
     const BalancedRun& b = *result.balanced;
     j["balance"] = balance_json(*study.balance);

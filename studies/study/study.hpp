@@ -1,6 +1,11 @@
 #pragma once
-/// A study: one linkage with its loads, one scene, and how to compute it (DESIGN.md "Study file
-/// (v1)"). Built by load_study()/parse_study() from a study.yaml, or directly in code.
+/// A study: one linkage with its loads, one scene, and how to compute it
+/// (docs/study-format.md). Built by load_study()/parse_study() from a study.yaml, or in code.
+///
+/// The linkage is of one of two types, and the scene is of that type:
+/// - `fourbar`: the planar 4R four-bar (core/fourbar/), with its closed-form formulations;
+/// - `planar`: any planar linkage on the paper's truss elements (core/planar/).
+/// Sections that exist for the four-bar only (balance, optimize) need a four-bar study.
 #include <optional>
 #include <string>
 #include <variant>
@@ -9,46 +14,68 @@
 #include "core/fourbar/dynamics.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/simulate.hpp"
+#include "core/planar/model.hpp"
+#include "core/planar/simulate.hpp"
 #include "optimize/problem.hpp"
 #include "studies/study/optimize_request.hpp"
 #include "studies/study/sweep_request.hpp"
 
 namespace bd::studies {
 
-/// The scene to simulate: free motion (forward dynamics, integrated) or driven motion (constant
-/// crank speed, kinetostatics per sample).
-using Scene = std::variant<core::FreeScene, core::DrivenScene>;
+/// The study's linkage: a four-bar or a general planar linkage.
+using Linkage = std::variant<core::FourBar, core::planar::Linkage>;
+
+/// The scene to simulate: the four-bar's free or driven scene, or a planar linkage's.
+using Scene = std::variant<core::FreeScene, core::DrivenScene, core::planar::FreeScene,
+                           core::planar::DrivenScene>;
 
 /// "free" or "driven".
 const char* scene_type(const Scene& scene);
+/// True for a free scene (of either linkage type).
+bool is_free(const Scene& scene);
+/// The initial crank angle of a four-bar's scene [rad] (precondition: a four-bar scene).
+double crank_angle_at_start(const Scene& scene);
 
-/// Method names accepted by the study file's `method` key, in the order the docs list them.
-inline constexpr const char* kMethodNames[] = {"auto", "opened-loop", "complex-masses",
-                                               "mass-matrix"};
-
-/// The formulation named `name` ("mass-matrix", "opened-loop", "complex-masses"), else nothing.
-std::optional<core::Formulation> formulation_named(const std::string& name);
+/// How a study is computed: `auto`, one of the four-bar's formulations, or the general engine
+/// (`truss`: the reduced equations in the inputs; `truss-dae`: every node coordinate, the
+/// constraints as a stabilised DAE).
+enum class Method { kAuto, kMassMatrix, kOpenedLoop, kComplexMasses, kTruss, kTrussDae };
+/// "auto", "opened-loop", "complex-masses", "mass-matrix", "truss", "truss-dae".
+const char* to_string(Method method);
+/// Every method, in the order the docs list them.
+inline constexpr Method kMethods[] = {Method::kAuto,          Method::kOpenedLoop,
+                                      Method::kComplexMasses, Method::kMassMatrix,
+                                      Method::kTruss,         Method::kTrussDae};
+/// The method named `name`, else nothing.
+std::optional<Method> method_named(const std::string& name);
+/// The four-bar formulation of a method (mass-matrix, opened-loop, complex-masses), else nothing.
+std::optional<core::Formulation> formulation_of(Method method);
 
 struct Study {
-  std::string name;     // used in output names: [A-Za-z0-9._-], not starting with '.'
-  core::FourBar model;  // linkage and loads, checked by core::make_fourbar()
-  Scene scene;          // free or driven
-  /// The formulation asked for; empty means `auto` (the runner picks, and says why).
-  std::optional<core::Formulation> formulation;
-  double tolerance = 1e-10;  // integrator relative tolerance (free scenes) [-]
-  std::string source;        // the study file as named by the user ("" when built in code)
+  std::string name;  // used in output names: [A-Za-z0-9._-], not starting with '.'
+  Linkage linkage;   // with its loads, checked by core::make_fourbar() or make_linkage()
+  Scene scene;       // of the linkage's type
+  Method method = Method::kAuto;  // auto: the runner picks, and says why
+  double tolerance = 1e-10;       // integrator relative tolerance (free scenes) [-]
+  std::string source;             // the study file as named by the user ("" when built in code)
   /// The study file's `balance:` section, synthesised at load time; empty when absent.
   std::optional<balance::BalancedDesign> balance;
   /// The study file's `optimize:` section, checked at load time and solved by the runner; empty
   /// when absent. A study has a balance section or an optimize section, never both.
   std::optional<OptimizeRequest> optimize;
   /// The study file's `sweep:` section, checked at load time; empty when absent. A study with
-  /// a sweep is run point by point (run_sweep() in studies/sweep.hpp); its own model and scene
-  /// are the file's values, valid on their own.
+  /// a sweep is run point by point (run_sweep() in studies/studies.hpp); its own linkage and
+  /// scene are the file's values, valid on their own.
   std::optional<SweepRequest> sweep;
 
-  /// "auto" or the requested formulation's name.
-  std::string method_name() const;
+  bool is_fourbar() const { return std::holds_alternative<core::FourBar>(linkage); }
+  /// The four-bar of a four-bar study (precondition: is_fourbar()).
+  const core::FourBar& fourbar() const { return std::get<core::FourBar>(linkage); }
+  core::FourBar& fourbar() { return std::get<core::FourBar>(linkage); }
+  /// The linkage of a planar study (precondition: !is_fourbar()).
+  const core::planar::Linkage& planar() const { return std::get<core::planar::Linkage>(linkage); }
+  /// "auto" or the requested method's name.
+  std::string method_name() const { return to_string(method); }
 };
 
 /// The study of the balanced design: name `<name>-balanced`, the balanced model, the same scene,
@@ -61,28 +88,7 @@ Study optimized_study(const Study& study, const core::FourBar& design);
 
 /// The design problem of an optimize study: the request's variables, objective, constraints,
 /// with the study's model as the original, its scene and tolerance, and the formulation its run
-/// uses (choose_method(study)). Precondition: study.optimize is set.
+/// uses (choose_method(study), studies/run/method.hpp). Precondition: study.optimize is set.
 optimize::DesignProblem design_problem(const Study& study);
-
-/// The formulation and integrator a run uses, and why (for the console and summary.json).
-struct MethodChoice {
-  core::Formulation formulation = core::Formulation::kMassMatrix;
-  /// Free scenes: the integrator of the formulation's equations (core::SimulateOptions);
-  /// unused in driven scenes.
-  core::Integrator integrator = core::Integrator::kCvodeAdams;
-  std::string reason;
-};
-/// Resolves `auto` (DESIGN.md: the leanest formulation and evaluation path for the outputs,
-/// never one inside its failure domain; docs/failure-domains.md "What auto must avoid"), and the
-/// integrator of a free scene, as docs/performance.md "Recommendation" measured them:
-/// - a free scene whose crank cannot turn fully: opened-loop, whose DAE passes the crank's limit
-///   positions (the reduced equation in theta1 would stop at the first one), integrated by
-///   kErk8 at tolerances below 1e-8 and by kErk5 from 1e-8 up (Baumgarte stabilisation);
-/// - otherwise mass-matrix, the cheapest exact formulation per evaluation, integrated by
-///   kCvodeAdams, on the front of the reduced equation's work-precision chart at every
-///   tolerance measured.
-/// An explicit method is used as asked, with the integrator auto would give that formulation;
-/// the reason then notes what auto would do differently.
-MethodChoice choose_method(const Study& study);
 
 }  // namespace bd::studies

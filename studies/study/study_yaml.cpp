@@ -41,7 +41,7 @@ std::string study_yaml(const Study& study, const std::string& header) {
   y += "name: \"" + study.name + "\"\n\n";  // letters, digits, '.', '_', '-': no escapes needed
 
   // linkage: links in the paper's polar form (see link_line)
-  const core::FourBar& m = study.model;
+  const core::FourBar& m = study.fourbar();
   y += "linkage:\n";
   y += "  type: fourbar\n";
   y += "  frame: " + text::exact(m.frame_length) + "\n";

@@ -1,6 +1,7 @@
 // Loading and validating study files: every kind of mistake is one line FILE:LINE:COLUMN: message
 // with the place of the offending value, and valid files load with their defaults.
 #include "studies/study/load_study.hpp"
+#include "studies/study/method.hpp"
 
 #include <gtest/gtest.h>
 
@@ -168,11 +169,11 @@ TEST(LoadStudy, OtherMistakes) {
 TEST(LoadStudy, EveryFormulationCanBeRequested) {
   for (const char* name : {"mass-matrix", "opened-loop", "complex-masses"}) {
     const Study s = parse_study(kBase + "method: " + name + "\n", "study.yaml");
-    ASSERT_TRUE(s.formulation.has_value()) << name;
-    EXPECT_STREQ(core::to_string(*s.formulation), name);
+    ASSERT_TRUE(formulation_of(s.method).has_value()) << name;
+    EXPECT_STREQ(core::to_string(*formulation_of(s.method)), name);
     EXPECT_EQ(s.method_name(), name);
   }
-  EXPECT_FALSE(parse_study(kBase + "method: auto\n", "study.yaml").formulation.has_value());
+  EXPECT_EQ(parse_study(kBase + "method: auto\n", "study.yaml").method, Method::kAuto);
 }
 
 TEST(LoadStudy, DrivenSceneNeedsANonZeroSpeed) {
@@ -190,12 +191,12 @@ TEST(LoadStudy, DefaultsApply) {
   const Study s = parse_study(kBase, "study.yaml");
   EXPECT_EQ(s.name, "t");
   EXPECT_EQ(s.source, "study.yaml");
-  EXPECT_FALSE(s.formulation.has_value());
+  EXPECT_EQ(s.method, Method::kAuto);
   EXPECT_EQ(s.method_name(), "auto");
   EXPECT_EQ(s.tolerance, 1e-10);
-  EXPECT_EQ(s.model.loads.gravity, Vec2(0, 0));
-  EXPECT_EQ(s.model.loads.crank.force, Vec2(0, 0));
-  EXPECT_EQ(s.model.loads.rocker.moment, 0.0);
+  EXPECT_EQ(s.fourbar().loads.gravity, Vec2(0, 0));
+  EXPECT_EQ(s.fourbar().loads.crank.force, Vec2(0, 0));
+  EXPECT_EQ(s.fourbar().loads.rocker.moment, 0.0);
   const auto* free = std::get_if<core::FreeScene>(&s.scene);
   ASSERT_NE(free, nullptr);
   EXPECT_EQ(free->theta1, 1.0);
@@ -215,31 +216,31 @@ TEST(LoadStudy, DefaultsApply) {
 
   // partial loads: only what is given is non-zero
   const Study l = parse_study(kBase + "loads:\n  coupler: {moment: 0.5}\n", "study.yaml");
-  EXPECT_EQ(l.model.loads.coupler.moment, 0.5);
-  EXPECT_EQ(l.model.loads.coupler.force, Vec2(0, 0));
-  EXPECT_EQ(l.model.loads.gravity, Vec2(0, 0));
+  EXPECT_EQ(l.fourbar().loads.coupler.moment, 0.5);
+  EXPECT_EQ(l.fourbar().loads.coupler.force, Vec2(0, 0));
+  EXPECT_EQ(l.fourbar().loads.gravity, Vec2(0, 0));
 }
 
 TEST(LoadStudy, CartesianCentreOfMass) {
   const Study s =
       parse_study(edit("    s: 0.6\n    sigma: 0.3\n", "    e: 0.5\n    f: -0.1\n"), "study.yaml");
-  EXPECT_EQ(s.model.crank.e, 0.5);
-  EXPECT_EQ(s.model.crank.f, -0.1);
+  EXPECT_EQ(s.fourbar().crank.e, 0.5);
+  EXPECT_EQ(s.fourbar().crank.f, -0.1);
   const Study m = parse_study(edit("  branch: 1\n", "  branch: -1\n"), "study.yaml");
-  EXPECT_EQ(m.model.branch, core::Branch::kMinus);
+  EXPECT_EQ(m.fourbar().branch, core::Branch::kMinus);
 }
 
 TEST(LoadStudy, ExamplesLoad) {
   const Study s = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar.yaml");
   EXPECT_EQ(s.name, "paper-fourbar");
-  EXPECT_EQ(s.model.frame_length, 3.2);
-  EXPECT_EQ(s.model.branch, core::Branch::kPlus);
-  EXPECT_NEAR(s.model.crank.e, 0.6 * std::cos(0.3), 1e-15);
-  EXPECT_NEAR(s.model.rocker.f, 1.66 * std::sin(-0.4), 1e-15);
-  EXPECT_EQ(s.model.coupler.inertia, 3.1);
-  EXPECT_EQ(s.model.loads.coupler.force, Vec2(1.3, -1.4));
-  EXPECT_EQ(s.model.loads.rocker.moment, 0.19);
-  EXPECT_EQ(s.model.loads.gravity, Vec2(0, 0));
+  EXPECT_EQ(s.fourbar().frame_length, 3.2);
+  EXPECT_EQ(s.fourbar().branch, core::Branch::kPlus);
+  EXPECT_NEAR(s.fourbar().crank.e, 0.6 * std::cos(0.3), 1e-15);
+  EXPECT_NEAR(s.fourbar().rocker.f, 1.66 * std::sin(-0.4), 1e-15);
+  EXPECT_EQ(s.fourbar().coupler.inertia, 3.1);
+  EXPECT_EQ(s.fourbar().loads.coupler.force, Vec2(1.3, -1.4));
+  EXPECT_EQ(s.fourbar().loads.rocker.moment, 0.19);
+  EXPECT_EQ(s.fourbar().loads.gravity, Vec2(0, 0));
   const auto& free = std::get<core::FreeScene>(s.scene);
   EXPECT_EQ(free.theta1, 1.0);
   EXPECT_EQ(free.duration, 5.0);
@@ -247,7 +248,7 @@ TEST(LoadStudy, ExamplesLoad) {
 
   const Study d = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml");
   EXPECT_EQ(d.name, "paper-fourbar-driven");
-  EXPECT_EQ(d.model.loads.crank.force, Vec2(0, 0));
+  EXPECT_EQ(d.fourbar().loads.crank.force, Vec2(0, 0));
   const auto& driven = std::get<core::DrivenScene>(d.scene);
   EXPECT_DOUBLE_EQ(driven.omega1, 2 * M_PI);
   EXPECT_EQ(driven.theta1, 0.0);
@@ -276,10 +277,10 @@ TEST(LoadStudy, CounterRotationsOnTheLinkage) {
                                    "    crank: {inertia: 0.5, at: [0, -1]}\n"
                                    "    rocker: {inertia: 1.5, at: [3.2, -2]}\n"),
                               "study.yaml");
-  EXPECT_EQ(s.model.counter_rotations.crank.inertia, 0.5);
-  EXPECT_EQ(s.model.counter_rotations.crank.at, Vec2(0, -1));
-  EXPECT_EQ(s.model.counter_rotations.rocker.inertia, 1.5);
-  EXPECT_EQ(s.model.counter_rotations.rocker.at, Vec2(3.2, -2));
+  EXPECT_EQ(s.fourbar().counter_rotations.crank.inertia, 0.5);
+  EXPECT_EQ(s.fourbar().counter_rotations.crank.at, Vec2(0, -1));
+  EXPECT_EQ(s.fourbar().counter_rotations.rocker.inertia, 1.5);
+  EXPECT_EQ(s.fourbar().counter_rotations.rocker.at, Vec2(3.2, -2));
   EXPECT_FALSE(s.balance.has_value());
 
   // each side optional; none by default
@@ -287,9 +288,9 @@ TEST(LoadStudy, CounterRotationsOnTheLinkage) {
       parse_study(edit("inertia: 2.1}\n",
                        "inertia: 2.1}\n  counter_rotations: {rocker: {inertia: 1, at: [4, 0]}}\n"),
                   "study.yaml");
-  EXPECT_EQ(one.model.counter_rotations.crank.inertia, 0.0);
-  EXPECT_EQ(one.model.counter_rotations.rocker.inertia, 1.0);
-  EXPECT_FALSE(core::has_counter_rotations(parse_study(kBase, "study.yaml").model));
+  EXPECT_EQ(one.fourbar().counter_rotations.crank.inertia, 0.0);
+  EXPECT_EQ(one.fourbar().counter_rotations.rocker.inertia, 1.0);
+  EXPECT_FALSE(core::has_counter_rotations(parse_study(kBase, "study.yaml").fourbar()));
 }
 
 TEST(LoadStudy, CounterRotationMistakes) {
@@ -336,9 +337,9 @@ TEST(LoadStudy, ForceBalanceAloneSynthesisesTheDesignAtLoadTime) {
   EXPECT_NEAR(b.rocker_counterweight->distance, 2.0, 1e-15);
   EXPECT_EQ(b.crank_counterweight->inertia, 0.0);
   EXPECT_DOUBLE_EQ(b.added_mass, b.crank_counterweight->mass + b.rocker_counterweight->mass);
-  EXPECT_GT(b.model.crank.mass, s.model.crank.mass);  // the original is kept as it was
-  EXPECT_EQ(s.model.crank.mass, 2.1);
-  EXPECT_EQ(b.model.coupler.mass, s.model.coupler.mass);
+  EXPECT_GT(b.model.crank.mass, s.fourbar().crank.mass);  // the original is kept as it was
+  EXPECT_EQ(s.fourbar().crank.mass, 2.1);
+  EXPECT_EQ(b.model.coupler.mass, s.fourbar().coupler.mass);
   EXPECT_FALSE(core::has_counter_rotations(b.model));
 
   // `balance:` with nothing under it: the defaults (force full, moment none)
@@ -488,7 +489,7 @@ TEST(LoadStudy, BalanceExamplesLoad) {
   const Study m = load_study(BD_SOURCE_DIR "/studies/examples/berkof-inline-moment-balanced.yaml");
   ASSERT_TRUE(m.balance.has_value());
   EXPECT_TRUE(m.balance->conditions.moment_balanced());
-  EXPECT_EQ(m.model.coupler.inertia, 6.48);
+  EXPECT_EQ(m.fourbar().coupler.inertia, 6.48);
 }
 
 // ---- optimize ----
@@ -579,7 +580,7 @@ TEST(LoadStudy, OptimizeSectionReadsEveryKey) {
 
   // the design problem: the study's model, scene, tolerance and the formulation its run uses
   const optimize::DesignProblem p = design_problem(s);
-  EXPECT_EQ(p.original.coupler.mass, s.model.coupler.mass);
+  EXPECT_EQ(p.original.coupler.mass, s.fourbar().coupler.mass);
   EXPECT_TRUE(std::holds_alternative<core::DrivenScene>(p.scene));
   EXPECT_EQ(p.formulation, choose_method(s).formulation);
   EXPECT_EQ(p.tolerance, s.tolerance);

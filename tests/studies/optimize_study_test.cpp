@@ -4,6 +4,7 @@
 
 #include "balance/counterweight.hpp"
 #include "core/fourbar/samples.hpp"
+#include "studies/study/method.hpp"
 #include "studies/study/optimize_request.hpp"
 #include "studies/study/study.hpp"
 
@@ -72,7 +73,7 @@ TEST(OptimizeStudy, TextsSayWhatIsMinimisedUnderWhichConstraints) {
 TEST(OptimizeStudy, DesignProblemAndOptimizedStudyComeFromTheStudy) {
   Study s;
   s.name = "t";
-  s.model = core::samples::paper_fourbar_unloaded();
+  s.fourbar() = core::samples::paper_fourbar_unloaded();
   s.scene = core::DrivenScene{0.0, 6.28, 1, 90};
   s.tolerance = 1e-9;
   OptimizeRequest r;
@@ -81,21 +82,21 @@ TEST(OptimizeStudy, DesignProblemAndOptimizedStudyComeFromTheStudy) {
   r.force_balance = true;
   s.optimize = r;
   const optimize::DesignProblem p = design_problem(s);
-  EXPECT_EQ(p.original.crank.mass, s.model.crank.mass);
+  EXPECT_EQ(p.original.crank.mass, s.fourbar().crank.mass);
   EXPECT_EQ(std::get<core::DrivenScene>(p.scene).samples, 90);
   EXPECT_EQ(p.formulation, choose_method(s).formulation);
   EXPECT_EQ(p.tolerance, 1e-9);
   EXPECT_TRUE(p.force_balance);
   EXPECT_EQ(p.counterweights.size(), 1u);
-  s.formulation = core::Formulation::kOpenedLoop;  // a requested method is used as asked
+  s.method = Method::kOpenedLoop;  // a requested method is used as asked
   EXPECT_EQ(design_problem(s).formulation, core::Formulation::kOpenedLoop);
 
-  core::FourBar design = s.model;
+  core::FourBar design = s.fourbar();
   design.crank.mass = 5.0;
   const Study o = optimized_study(s, design);
   EXPECT_EQ(o.name, "t-optimized");
-  EXPECT_EQ(o.model.crank.mass, 5.0);
-  EXPECT_EQ(o.formulation, s.formulation);
+  EXPECT_EQ(o.fourbar().crank.mass, 5.0);
+  EXPECT_EQ(o.method, s.method);
   EXPECT_EQ(o.tolerance, 1e-9);
   EXPECT_FALSE(o.optimize.has_value());
   EXPECT_FALSE(o.balance.has_value());

@@ -21,6 +21,7 @@
 #include "core/fourbar/metrics.hpp"
 #include "studies/studies.hpp"
 #include "studies/study/load_study.hpp"
+#include "studies/study/method.hpp"
 #include "tests/support/csv.hpp"
 #include "tests/support/json_view.hpp"
 #include "tests/support/models.hpp"
@@ -175,7 +176,7 @@ TEST_F(RunnerTest, SimulationStoppedEarlyKeepsItsSamplesAndSaysWhy) {
   // crank 2.5 on frame 3.2 with rocker 2: the crank cannot turn fully, so driving it from
   // pi/2 reaches an angle where the loop cannot close
   Study study = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml");
-  study.model.crank = core::link_from_polar(2.5, 2.1, 0.6, 0.3, 1.1);
+  study.fourbar().crank = core::link_from_polar(2.5, 2.1, 0.6, 0.3, 1.1);
   std::get<core::DrivenScene>(study.scene).theta1 = M_PI / 2;
   const RunResult r = run_study(study, dir_);
   ASSERT_FALSE(r.ok());
@@ -389,7 +390,7 @@ TEST_F(RunnerTest, BalancedYamlLoadsBackToTheSynthesisedDesignAndReproducesItsRu
     const Study back = load_study(r.balanced->study_file.string());
     EXPECT_EQ(back.name, study.name + "-balanced");
     EXPECT_FALSE(back.balance.has_value());
-    bd::testing::expect_same_model(study.balance->model, back.model);
+    bd::testing::expect_same_model(study.balance->model, back.fourbar());
 
     // and running it reproduces balanced-timeseries.csv: inputs a few ulps apart, outputs within
     // 1e-12 of each column's scale (the dynamics is well conditioned away from dead centres)
@@ -404,8 +405,8 @@ TEST_F(RunnerTest, BalanceStudyStoppedEarlyKeepsEveryFile) {
   // the crank (2.5) cannot turn fully: both designs stop where the loop cannot close
   Study study =
       load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven-force-balanced.yaml");
-  study.model.crank = core::link_from_polar(2.5, 2.1, 0.6, 0.3, 1.1);
-  study.balance = balance::balance_design(study.model, study.balance->request);
+  study.fourbar().crank = core::link_from_polar(2.5, 2.1, 0.6, 0.3, 1.1);
+  study.balance = balance::balance_design(study.fourbar(), study.balance->request);
   std::get<core::DrivenScene>(study.scene).theta1 = M_PI / 2;
   const RunResult r = run_study(study, dir_);
   EXPECT_FALSE(r.ok());
@@ -465,7 +466,7 @@ TEST_F(RunnerTest, OptimizeStudyWritesTheOptimumAndTheComparison) {
   // force balance (point masses at l1 and l3), which is one of the feasible designs
   EXPECT_LT(o.metrics.Fsh_max, 1e-6 * r.metrics.Fsh_max);
   const balance::BalancedDesign textbook =
-      balance::balance_design(study.model, balance::BalanceRequest{});
+      balance::balance_design(study.fourbar(), balance::BalanceRequest{});
   const core::Trajectory t = core::simulate_driven(
       textbook.model, std::get<core::DrivenScene>(study.scene), core::SimulateOptions{});
   const core::Metrics m = core::metrics(t);
@@ -483,7 +484,7 @@ TEST_F(RunnerTest, OptimizeStudyWritesTheOptimumAndTheComparison) {
   EXPECT_EQ(cmp[2].before, r.metrics.Msh_rms);
   EXPECT_EQ(cmp[2].after, o.metrics.Msh_rms);
   EXPECT_EQ(cmp[10].metric, "added_mass");
-  EXPECT_EQ(cmp[10].after, added_mass(study.model, o.result.design));
+  EXPECT_EQ(cmp[10].after, added_mass(study.fourbar(), o.result.design));
   EXPECT_EQ(cmp[11].metric, "added_inertia");
   char buf[128];
   std::snprintf(buf, sizeof buf, "Msh_rms,%.17g,%.17g,%.17g", r.metrics.Msh_rms, o.metrics.Msh_rms,
@@ -572,7 +573,7 @@ TEST_F(RunnerTest, OptimizedYamlLoadsBackToTheOptimumAndReproducesItsRun) {
     const Study back = load_study(o.study_file.string());
     EXPECT_EQ(back.name, study.name + "-optimized");
     EXPECT_FALSE(back.optimize.has_value());
-    bd::testing::expect_same_model(o.result.design, back.model);
+    bd::testing::expect_same_model(o.result.design, back.fourbar());
 
     // running it reproduces optimized-timeseries.csv to 1e-12 of each column's scale
     const RunResult again = run_study(back, out / "again");
@@ -663,7 +664,7 @@ TEST_F(RunnerTest, OptimizationIsNotRunWhenTheOriginalStopsEarly) {
       "  objective: {Msh_rms: 1}\n"
       "  variables: {counterweights: {crank: }}\n",
       "stops.yaml");
-  study.model.crank = core::link_from_polar(2.5, 2.1, 0.6, 0.3, 1.1);
+  study.fourbar().crank = core::link_from_polar(2.5, 2.1, 0.6, 0.3, 1.1);
   std::get<core::DrivenScene>(study.scene).theta1 = M_PI / 2;
   const RunResult r = run_study(study, dir_);
   EXPECT_FALSE(r.ok());

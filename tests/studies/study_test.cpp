@@ -1,4 +1,5 @@
 // The method chooser: what `auto` picks for each kind of scene and linkage, and why.
+#include "studies/study/method.hpp"
 #include "studies/study/study.hpp"
 
 #include <gtest/gtest.h>
@@ -11,7 +12,7 @@ namespace {
 Study study_of(const core::FourBar& model, Scene scene) {
   Study s;
   s.name = "t";
-  s.model = model;
+  s.fourbar() = model;
   s.scene = scene;
   return s;
 }
@@ -41,7 +42,7 @@ TEST(ChooseMethod, FreeCrankReachingLimitPositionsTakesTheOpenedLoopDae) {
 
 TEST(ChooseMethod, RequestedMethodIsUsedAndTheReasonSaysWhatAutoWouldDo) {
   Study s = study_of(core::samples::triple_rocker(), core::FreeScene{0.0, 1.0, 20.0, 2001});
-  s.formulation = core::Formulation::kMassMatrix;
+  s.method = Method::kMassMatrix;
   const MethodChoice c = choose_method(s);
   EXPECT_EQ(c.formulation, core::Formulation::kMassMatrix);
   EXPECT_NE(c.reason.find("requested in the study file"), std::string::npos) << c.reason;
@@ -73,9 +74,9 @@ TEST(ChooseMethod, OpenedLoopIntegratorFollowsTheTolerance) {
   EXPECT_NE(c.reason.find("Dormand-Prince 5(4) Runge-Kutta pair"), std::string::npos) << c.reason;
   // a requested formulation gets the integrator auto would give it
   Study paper = study_of(core::samples::paper_fourbar(), core::FreeScene{1.0, 0.0, 5.0, 501});
-  paper.formulation = core::Formulation::kOpenedLoop;
+  paper.method = Method::kOpenedLoop;
   EXPECT_EQ(choose_method(paper).integrator, core::Integrator::kErk8);
-  paper.formulation = core::Formulation::kComplexMasses;
+  paper.method = Method::kComplexMasses;
   EXPECT_EQ(choose_method(paper).integrator, core::Integrator::kCvodeAdams);
   // every choice is a valid combination
   for (const Study& t : {s, paper}) {
@@ -87,11 +88,15 @@ TEST(ChooseMethod, OpenedLoopIntegratorFollowsTheTolerance) {
 }
 
 TEST(ChooseMethod, FormulationNames) {
-  EXPECT_EQ(formulation_named("opened-loop"), core::Formulation::kOpenedLoop);
-  EXPECT_EQ(formulation_named("complex-masses"), core::Formulation::kComplexMasses);
-  EXPECT_EQ(formulation_named("mass-matrix"), core::Formulation::kMassMatrix);
-  EXPECT_FALSE(formulation_named("auto").has_value());
-  EXPECT_FALSE(formulation_named("newton-euler").has_value());
+  EXPECT_EQ(method_named("opened-loop"), Method::kOpenedLoop);
+  EXPECT_EQ(method_named("complex-masses"), Method::kComplexMasses);
+  EXPECT_EQ(method_named("mass-matrix"), Method::kMassMatrix);
+  EXPECT_EQ(method_named("auto"), Method::kAuto);
+  EXPECT_EQ(method_named("truss"), Method::kTruss);
+  EXPECT_EQ(method_named("truss-dae"), Method::kTrussDae);
+  EXPECT_FALSE(method_named("newton-euler").has_value());
+  EXPECT_EQ(formulation_of(Method::kOpenedLoop), core::Formulation::kOpenedLoop);
+  EXPECT_FALSE(formulation_of(Method::kTruss).has_value());
 }
 
 }  // namespace

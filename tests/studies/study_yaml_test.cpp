@@ -13,6 +13,7 @@
 
 #include "core/fourbar/samples.hpp"
 #include "studies/study/load_study.hpp"
+#include "studies/study/method.hpp"
 #include "tests/support/models.hpp"
 
 namespace bd::studies {
@@ -23,7 +24,7 @@ namespace fs = std::filesystem;
 // %.17g reads back to the same double; e, f to within a few ulps (polar form)
 void expect_same_study(const Study& a, const Study& b) {
   EXPECT_EQ(a.name, b.name);
-  bd::testing::expect_same_model(a.model, b.model);
+  bd::testing::expect_same_model(a.fourbar(), b.fourbar());
   ASSERT_EQ(a.scene.index(), b.scene.index());
   if (const auto* fa = std::get_if<core::FreeScene>(&a.scene)) {
     const auto& fb = std::get<core::FreeScene>(b.scene);
@@ -39,7 +40,7 @@ void expect_same_study(const Study& a, const Study& b) {
     EXPECT_EQ(da.revolutions, db.revolutions);
     EXPECT_EQ(da.samples, db.samples);
   }
-  EXPECT_EQ(a.formulation, b.formulation);
+  EXPECT_EQ(a.method, b.method);
   EXPECT_EQ(a.tolerance, b.tolerance);
   EXPECT_FALSE(b.balance.has_value());
 }
@@ -64,13 +65,13 @@ TEST(StudyYaml, LoadsCounterRotationsAndAnExplicitMethodRoundTrip) {
   std::mt19937_64 rng(7);
   Study s;
   s.name = "odd-numbers_1.0";
-  s.model =
+  s.fourbar() =
       core::samples::with_paper_loads(core::samples::random_crank_rocker(rng), Vec2(0.1, -9.81));
-  s.model.counter_rotations.crank = {0.1 / 3.0, Vec2(-0.25, -1.0 / 7.0)};
-  s.model.counter_rotations.rocker = {2.0 / 3.0, Vec2(s.model.frame_length, 1.0 / 3e5)};
-  s.model = core::make_fourbar(s.model);
+  s.fourbar().counter_rotations.crank = {0.1 / 3.0, Vec2(-0.25, -1.0 / 7.0)};
+  s.fourbar().counter_rotations.rocker = {2.0 / 3.0, Vec2(s.fourbar().frame_length, 1.0 / 3e5)};
+  s.fourbar() = core::make_fourbar(s.fourbar());
   s.scene = core::FreeScene{-0.1 / 3.0, 2.0 / 3.0, 1.0 / 7.0, 17};
-  s.formulation = core::Formulation::kOpenedLoop;
+  s.method = Method::kOpenedLoop;
   s.tolerance = 1.0 / 3.0 * 1e-9;
   const std::string text = study_yaml(s, "line one\n\nline three");
   EXPECT_EQ(text.rfind("# line one\n#\n# line three\n", 0), 0u) << text;

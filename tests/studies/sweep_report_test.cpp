@@ -92,7 +92,7 @@ class SweepFolder {
 
   // the row of point i at `values`: the study simulated there (and its balanced design)
   std::string row(std::size_t i, const std::vector<double>& values) const {
-    core::FourBar model = study_.model;
+    core::FourBar model = study_.fourbar();
     Scene scene = study_.scene;
     for (std::size_t j = 0; j < params_.size(); ++j) {
       const std::string& p = params_[j].path;
@@ -107,7 +107,11 @@ class SweepFolder {
         const core::Link& c = model.coupler;
         model.coupler = core::link_from_polar(c.length, c.mass, v, c.sigma(), c.inertia);
       } else if (p == "scene.omega1")
-        std::visit([&](auto& s) { s.omega1 = v; }, scene);
+        if (auto* f = std::get_if<core::FreeScene>(&scene)) {
+          f->omega1 = v;
+        } else {
+          std::get<core::DrivenScene>(scene).omega1 = v;
+        }
       else
         ADD_FAILURE() << "the test cannot set " << p;
     }
@@ -121,17 +125,12 @@ class SweepFolder {
       return r + ",bad-input," + csv_quoted(e.what()) + "\n";
     }
     const auto simulate = [&](const core::FourBar& m) {
-      return std::visit(
-          [&](const auto& s) {
-            if constexpr (std::is_same_v<std::decay_t<decltype(s)>, core::FreeScene>) {
-              core::SimulateOptions o;
-              o.tolerance = 1e-8;
-              return core::simulate_free(m, s, o);
-            } else {
-              return core::simulate_driven(m, s);
-            }
-          },
-          scene);
+      if (const auto* f = std::get_if<core::FreeScene>(&scene)) {
+        core::SimulateOptions o;
+        o.tolerance = 1e-8;
+        return core::simulate_free(m, *f, o);
+      }
+      return core::simulate_driven(m, std::get<core::DrivenScene>(scene));
     };
     const core::Trajectory t = simulate(model);
     for (const double v : metric_values(core::metrics(t))) r += "," + g17(v);

@@ -93,7 +93,7 @@ TEST(SweepLoad, SectionWithDefaults) {
   // the file's text, for point_study()
   EXPECT_EQ(r.study_text, text);
   // the study itself is the file's own values
-  EXPECT_EQ(study.model.coupler.mass, 3.0);
+  EXPECT_EQ(study.fourbar().coupler.mass, 3.0);
   // a study without a sweep has none
   EXPECT_FALSE(parse_study(kStudy, "sweep.yaml").sweep.has_value());
 }
@@ -561,10 +561,10 @@ TEST(PointStudy, SetsEachPathAndNothingElse) {
   const Study base = parse_study(kPointStudy, "sweep.yaml");
   const double values[] = {1.25, -7.5, 0.1};
   const Study point = point_study(base, values);
-  EXPECT_EQ(point.model.coupler.mass, 1.25);
+  EXPECT_EQ(point.fourbar().coupler.mass, 1.25);
   ASSERT_TRUE(std::holds_alternative<core::DrivenScene>(point.scene));
   EXPECT_EQ(std::get<core::DrivenScene>(point.scene).omega1, -7.5);
-  EXPECT_EQ(point.model.loads.crank.force[1], 0.1);
+  EXPECT_EQ(point.fourbar().loads.crank.force[1], 0.1);
   EXPECT_EQ(point.name, base.name);
   EXPECT_EQ(point.source, "sweep.yaml");
   EXPECT_FALSE(point.sweep.has_value());
@@ -572,26 +572,26 @@ TEST(PointStudy, SetsEachPathAndNothingElse) {
   // everything else as in the base study: its complete study file, every number "%.17g",
   // differs only in those three values
   Study expected = base;
-  expected.model.coupler.mass = 1.25;
+  expected.fourbar().coupler.mass = 1.25;
   std::get<core::DrivenScene>(expected.scene).omega1 = -7.5;
-  expected.model.loads.crank.force[1] = 0.1;
+  expected.fourbar().loads.crank.force[1] = 0.1;
   EXPECT_EQ(study_yaml(point, ""), study_yaml(expected, ""));
-  EXPECT_EQ(point.formulation, base.formulation);
+  EXPECT_EQ(point.method, base.method);
   EXPECT_EQ(point.tolerance, base.tolerance);
   // the base is untouched, and its own values are the file's
-  EXPECT_EQ(base.model.coupler.mass, 3.0);
+  EXPECT_EQ(base.fourbar().coupler.mass, 3.0);
   EXPECT_EQ(std::get<core::DrivenScene>(base.scene).omega1, 6.0);
   // the design's points set exactly their values ("%.17g" reads back to the same double)
   for (const auto& p : sweep_points(*base.sweep)) {
     const Study s = point_study(base, p);
-    EXPECT_EQ(s.model.coupler.mass, p[0]);
+    EXPECT_EQ(s.fourbar().coupler.mass, p[0]);
     EXPECT_EQ(std::get<core::DrivenScene>(s.scene).omega1, p[1]);
-    EXPECT_EQ(s.model.loads.crank.force[1], p[2]);
+    EXPECT_EQ(s.fourbar().loads.crank.force[1], p[2]);
   }
   // a value that needs all 17 digits survives the text
   const double third = 1.0 / 3.0;
   const double fine[] = {third, 2.0, 1.2};
-  EXPECT_EQ(point_study(base, fine).model.coupler.mass, third);
+  EXPECT_EQ(point_study(base, fine).fourbar().coupler.mass, third);
 }
 
 TEST(PointStudy, InvalidValueIsReportedAtItsPlaceInTheFile) {
@@ -662,11 +662,11 @@ TEST(PointStudy, AlternatingStudiesKeepTheirOwnValues) {
     EXPECT_THROW(point_study(a, bad), StudyError);
     const Study pa = point_study(a, va);
     const Study pb = point_study(b, vb);
-    EXPECT_EQ(pa.model.coupler.mass, 2.5);
-    EXPECT_EQ(pa.model.frame_length, 3.2);
+    EXPECT_EQ(pa.fourbar().coupler.mass, 2.5);
+    EXPECT_EQ(pa.fourbar().frame_length, 3.2);
     EXPECT_EQ(pa.source, "a.yaml");
-    EXPECT_EQ(pb.model.frame_length, 3.3);
-    EXPECT_EQ(pb.model.coupler.mass, 3.0);
+    EXPECT_EQ(pb.fourbar().frame_length, 3.3);
+    EXPECT_EQ(pb.fourbar().coupler.mass, 3.0);
     EXPECT_EQ(std::get<core::DrivenScene>(pb.scene).omega1, 6.0);
     EXPECT_EQ(pb.source, "b.yaml");
   }
@@ -683,9 +683,9 @@ TEST(PointStudy, ThreadsDoNotInterfere) {
       for (int c = 0; c < kCalls; ++c) {
         const double v[] = {1.0 + t + 0.01 * c, 1.0 + c, 0.5 * t};
         const Study s = point_study(base, v);
-        const bool ok = s.model.coupler.mass == v[0] &&
+        const bool ok = s.fourbar().coupler.mass == v[0] &&
                         std::get<core::DrivenScene>(s.scene).omega1 == v[1] &&
-                        s.model.loads.crank.force[1] == v[2];
+                        s.fourbar().loads.crank.force[1] == v[2];
         if (!ok) ++wrong[static_cast<std::size_t>(t)];
       }
     });
@@ -719,9 +719,9 @@ TEST(SweepExample, PaperFourbarSweepIsA21By21Grid) {
   // every point is a valid study (no bad-input rows); s comes back through e, f within ulps
   for (const auto& p : points) {
     const Study s = point_study(study, p);
-    EXPECT_EQ(s.model.coupler.mass, p[0]);
-    EXPECT_NEAR(s.model.coupler.s(), p[1], 4 * std::numeric_limits<double>::epsilon() * p[1]);
-    EXPECT_NEAR(s.model.coupler.sigma(), study.model.coupler.sigma(), 1e-15);
+    EXPECT_EQ(s.fourbar().coupler.mass, p[0]);
+    EXPECT_NEAR(s.fourbar().coupler.s(), p[1], 4 * std::numeric_limits<double>::epsilon() * p[1]);
+    EXPECT_NEAR(s.fourbar().coupler.sigma(), study.fourbar().coupler.sigma(), 1e-15);
     ASSERT_TRUE(s.balance.has_value());
   }
 }

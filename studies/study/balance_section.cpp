@@ -1,0 +1,182 @@
+// The balance section of a four-bar study: what to balance and with what, synthesised at load
+// time (balance/synthesis.hpp); a synthesis that is not possible is reported at the key asking.
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "studies/study/sections.hpp"
+#include "studies/study/yaml_reader.hpp"
+
+namespace bd::studies::detail {
+
+balance::CounterweightShape read_shape(const Reporter& r_, const MapReader::Entry& shape,
+                                       const std::string& path) {
+  const std::string t = read_text(r_, shape, path + ".shape");
+  if (t != "point" && t != "disc") {
+    r_.fail(mark_of(shape.value, shape.key_mark),
+            path + ".shape must be point or disc, got " + describe(shape.value));
+  }
+  return t == "disc" ? balance::CounterweightShape::kDisc : balance::CounterweightShape::kPoint;
+}
+
+namespace {
+
+class BalanceReader {
+ public:
+  explicit BalanceReader(const Reporter& r) : r_(r) {}
+
+  // balance: {force, moment, counterweights, counter_rotations}, then the synthesis itself
+  balance::BalancedDesign read_balance(const MapReader::Entry& e, const core::FourBar& model) {
+    balance::BalanceRequest request;
+    YAML::Mark force_mark = e.key_mark, moment_mark = e.key_mark;
+    if (!e.value.IsNull()) {  // `balance:` with nothing under it: the defaults
+      const MapReader b(r_, e.value, "balance", e.key_mark,
+                        "(force, moment, counterweights, counter_rotations)");
+      b.check_keys({"force", "moment", "counterweights", "counter_rotations"});
+      if (const MapReader::Entry* f = b.find("force")) {
+        request.force = read_full_or_none(*f, "balance.force");
+        force_mark = mark_of(f->value, f->key_mark);
+      }
+      if (const MapReader::Entry* m = b.find("moment")) {
+        request.moment = read_full_or_none(*m, "balance.moment");
+        moment_mark = mark_of(m->value, m->key_mark);
+      }
+      if (request.moment && !request.force) {
+        r_.fail(moment_mark,
+                "balance.moment: full needs balance.force: full (a moment balance starts from a "
+                "force-balanced design)");
+      }
+      if (const MapReader::Entry* cw = b.find("counterweights")) {
+        if (!request.force) {
+          r_.fail(cw->key_mark, "balance.counterweights are used only with balance.force: full");
+        }
+        read_counterweights(*cw, request);
+      }
+      if (const MapReader::Entry* cr = b.find("counter_rotations")) {
+        if (!request.moment) {
+          r_.fail(cr->key_mark,
+                  "balance.counter_rotations are used only with balance.moment: full");
+        }
+        read_shafts(*cr, model.frame_length, request);
+      }
+    }
+    // the synthesis: its complaint is reported at the key that asked for it
+    try {
+      return balance::balance_design(model, request);
+    } catch (const balance::SynthesisError& err) {
+      if (err.step() == balance::SynthesisError::Step::kMoment) {
+        r_.fail(moment_mark, std::string("balance.moment: full is not possible: ") + err.what());
+      }
+      r_.fail(force_mark, std::string("balance.force: full is not possible: ") + err.what());
+    }
+  }
+
+  bool read_full_or_none(const MapReader::Entry& e, const std::string& path) {
+    const std::string v = read_text(r_, e, path);
+    if (v != "full" && v != "none") {
+      r_.fail(mark_of(e.value, e.key_mark),
+              path + " must be full or none, got " + describe(e.value));
+    }
+    return v == "full";
+  }
+
+  void read_counterweights(const MapReader::Entry& e, balance::BalanceRequest& request) {
+    if (e.value.IsNull()) return;
+    const MapReader cw(r_, e.value, "balance.counterweights", e.key_mark, "(crank, rocker)");
+    cw.check_keys({"crank", "rocker"});
+    if (const MapReader::Entry* c = cw.find("crank")) {
+      request.crank_counterweight = read_counterweight(*c, "balance.counterweights.crank");
+    }
+    if (const MapReader::Entry* r = cw.find("rocker")) {
+      request.rocker_counterweight = read_counterweight(*r, "balance.counterweights.rocker");
+    }
+  }
+
+  balance::CounterweightSpec read_counterweight(const MapReader::Entry& e,
+                                                const std::string& path) {
+    balance::CounterweightSpec spec;
+    if (e.value.IsNull()) return spec;
+    const MapReader m(r_, e.value, path, e.key_mark,
+                      "(shape, mass, distance, radius, thickness, density)");
+    m.check_keys({"shape", "mass", "distance", "radius", "thickness", "density"});
+    if (const MapReader::Entry* shape = m.find("shape")) spec.shape = read_shape(*shape, path);
+    const bool disc = spec.shape == balance::CounterweightShape::kDisc;
+    auto positive = [&](const MapReader::Entry& x, const char* unit) {
+      const double v = read_number(r_, x, path + "." + x.key, unit);
+      if (!(v > 0)) {
+        r_.fail(mark_of(x.value, x.key_mark),
+                path + "." + x.key + " must be > 0 " + unit + ", got " + text::exact(v));
+      }
+      return v;
+    };
+    // a disc's size: only for shape: disc
+    for (const char* key : {"radius", "thickness", "density"}) {
+      const MapReader::Entry* x = m.find(key);
+      if (x && !disc) {
+        r_.fail(x->key_mark, path + "." + key + " needs shape: disc (a point mass has no size)");
+      }
+    }
+    // at most one of mass, distance, radius is given; the rest is solved
+    const MapReader::Entry* given = nullptr;
+    for (const char* key : {"mass", "distance", "radius"}) {
+      const MapReader::Entry* x = m.find(key);
+      if (!x) continue;
+      if (given) {
+        const MapReader::Entry* later = given->key_mark.pos > x->key_mark.pos ? given : x;
+        r_.fail(later->key_mark, path +
+                                     ": give at most one of mass, distance and radius (the "
+                                     "rest is solved), got both " +
+                                     given->key + " and " + x->key);
+      }
+      given = x;
+    }
+    if (const MapReader::Entry* x = m.find("mass")) spec.mass = positive(*x, "kg");
+    if (const MapReader::Entry* x = m.find("distance")) spec.distance = positive(*x, "m");
+    if (const MapReader::Entry* x = m.find("radius")) spec.radius = positive(*x, "m");
+    if (const MapReader::Entry* x = m.find("thickness")) spec.thickness = positive(*x, "m");
+    if (const MapReader::Entry* x = m.find("density")) spec.density = positive(*x, "kg/m^3");
+    // anything else the balance layer objects to, at the side's key
+    if (const auto problem = spec.validate()) r_.fail(e.key_mark, path + ": " + problem->text());
+    return spec;
+  }
+
+  // balance.counter_rotations: {crank: {at}, rocker: {at}}
+  void read_shafts(const MapReader::Entry& e, double frame, balance::BalanceRequest& request) {
+    if (e.value.IsNull()) return;
+    const MapReader cr(r_, e.value, "balance.counter_rotations", e.key_mark, "(crank, rocker)");
+    cr.check_keys({"crank", "rocker"});
+    std::optional<Vec2>* targets[] = {&request.crank_at, &request.rocker_at};
+    for (int i = 0; i < 2; ++i) {
+      const std::string side = kSides[i];
+      const MapReader::Entry* x = cr.find(side);
+      if (!x) continue;
+      const std::string path = "balance.counter_rotations." + side;
+      const MapReader m(r_, x->value, path, x->key_mark, "(at)");
+      m.check_keys({"at"});
+      const MapReader::Entry& at = m.require("at", "the shaft position [x, y] on the frame in m");
+      *targets[i] = read_shaft(at, path + ".at", i, frame);
+    }
+  }
+
+  balance::CounterweightShape read_shape(const MapReader::Entry& shape, const std::string& path) {
+    return detail::read_shape(r_, shape, path);
+  }
+  Vec2 read_shaft(const MapReader::Entry& at, const std::string& path, int side, double frame) {
+    return detail::read_shaft(r_, at, path, side, frame);
+  }
+
+ private:
+  const Reporter& r_;
+};
+
+}  // namespace
+
+balance::BalancedDesign read_balance(const Reporter& r, const MapReader::Entry& e,
+                                     const core::FourBar& model) {
+  return BalanceReader(r).read_balance(e, model);
+}
+
+}  // namespace bd::studies::detail

@@ -1,0 +1,196 @@
+#pragma once
+/// Internal to studies/study/: reading a study file's YAML tree. One Reporter names the file in
+/// every mistake (FILE:LINE:COLUMN: message); a MapReader reads one map with its keys checked
+/// once (no unknown, no duplicate); read_number() and friends read one value with its path and
+/// unit in the message. The loader (load_study.cpp) and each section's reader share them.
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "core/number_text.hpp"
+#include "core/types.hpp"
+#include "studies/study/load_study.hpp"
+
+namespace bd::studies::detail {
+
+// the largest number of rows a study may ask for (keeps a typo from filling the disk)
+inline constexpr double kMaxRows = 1e7;
+
+inline std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+// what a node holds, in words, for "expected X, got Y"
+inline std::string describe(const YAML::Node& n) {
+  if (!n.IsDefined() || n.IsNull()) return "nothing";
+  if (n.IsSequence()) return "a list";
+  if (n.IsMap()) return "a map";
+  std::string text = n.Scalar();
+  if (text.size() > 40) text = text.substr(0, 37) + "...";
+  return "'" + text + "'";
+}
+
+// reports mistakes at places in one study file
+class Reporter {
+ public:
+  explicit Reporter(std::string source) : source_(std::move(source)) {}
+  const std::string& source() const { return source_; }
+
+  [[noreturn]] void fail(const YAML::Mark& mark, const std::string& message) const {
+    if (mark.is_null()) throw StudyError(source_, 1, 1, message);
+    throw StudyError(source_, mark.line + 1, mark.column + 1, message);
+  }
+
+ private:
+  std::string source_;
+};
+
+// where a value is: its own mark, else its key's (an empty value is marked at the next token,
+// often on the next line, so it is reported at its key)
+inline YAML::Mark mark_of(const YAML::Node& value, const YAML::Mark& fallback) {
+  if (!value.IsDefined() || value.IsNull()) return fallback;
+  const YAML::Mark m = value.Mark();
+  return m.is_null() ? fallback : m;
+}
+
+// a YAML map with its keys checked once: no unknown, no duplicate, all plain names
+class MapReader {
+ public:
+  struct Entry {
+    std::string key;
+    YAML::Mark key_mark;
+    YAML::Node value;
+  };
+
+  // `path` names the map in messages ("" for the top level); `where` is the place of the key
+  // that introduces it (used for missing keys); `shape` is the expected content, in words
+  MapReader(const Reporter& r, const YAML::Node& node, std::string path, const YAML::Mark& where,
+            const std::string& shape)
+      : r_(r), path_(std::move(path)), where_(where) {
+    if (!node.IsMap()) {
+      r_.fail(mark_of(node, where_), (path_.empty() ? std::string("a study file") : path_) +
+                                         " must be a map " + shape + ", got " + describe(node));
+    }
+    for (auto it = node.begin(); it != node.end(); ++it) {
+      const YAML::Node key = it->first;
+      const YAML::Mark km = mark_of(key, where_);
+      if (!key.IsScalar()) {
+        r_.fail(km, "keys" + in() + " must be plain names, got " + describe(key));
+      }
+      const std::string name = key.Scalar();
+      for (const Entry& e : entries_) {
+        if (e.key == name) {
+          r_.fail(km, "duplicate key '" + name + "'" + in() + " (first given at line " +
+                          std::to_string(e.key_mark.line + 1) + ")");
+        }
+      }
+      entries_.push_back({name, km, it->second});
+    }
+  }
+
+  // every key must be one of `allowed`; `context` replaces the path in the message if given
+  void check_keys(const std::vector<std::string>& allowed, const std::string& context = "") const {
+    for (const Entry& e : entries_) {
+      bool ok = false;
+      for (const std::string& a : allowed) ok = ok || (a == e.key);
+      if (!ok) {
+        r_.fail(e.key_mark, "unknown key '" + e.key + "'" + (context.empty() ? in() : context) +
+                                "; allowed keys: " + join(allowed));
+      }
+    }
+  }
+
+  const Entry* find(const std::string& key) const {
+    for (const Entry& e : entries_) {
+      if (e.key == key) return &e;
+    }
+    return nullptr;
+  }
+  bool has(const std::string& key) const { return find(key) != nullptr; }
+
+  const Entry& require(const std::string& key, const std::string& meaning) const {
+    const Entry* e = find(key);
+    if (!e) {
+      r_.fail(where_, (path_.empty() ? std::string() : path_ + ": ") + "missing required key '" +
+                          key + "' (" + meaning + ")");
+    }
+    return *e;
+  }
+
+  std::string full(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  const YAML::Mark& where() const { return where_; }
+  const std::vector<Entry>& entries() const { return entries_; }
+
+ private:
+  std::string in() const { return path_.empty() ? " at the top level" : " in " + path_; }
+
+  const Reporter& r_;
+  std::string path_;
+  YAML::Mark where_;
+  std::vector<Entry> entries_;
+};
+
+// a finite number; `unit` in words for messages ("m", "kg", "rad/s", "" for none)
+inline double read_number(const Reporter& r, const YAML::Node& node, const YAML::Mark& fallback,
+                          const std::string& path, const std::string& unit) {
+  const std::string in_unit = unit.empty() ? "" : " in " + unit;
+  double value = 0.0;
+  if (!node.IsScalar() || !YAML::convert<double>::decode(node, value)) {
+    r.fail(mark_of(node, fallback),
+           path + " must be a number" + in_unit + ", got " + describe(node));
+  }
+  if (!std::isfinite(value)) {
+    r.fail(mark_of(node, fallback),
+           path + " must be a finite number" + in_unit + ", got " + describe(node));
+  }
+  return value;
+}
+
+inline double read_number(const Reporter& r, const MapReader::Entry& e, const std::string& path,
+                          const std::string& unit) {
+  return read_number(r, e.value, e.key_mark, path, unit);
+}
+
+// a whole number in [lo, hi]
+inline int read_count(const Reporter& r, const MapReader::Entry& e, const std::string& path,
+                      double lo, double hi) {
+  const double v = read_number(r, e, path, "");
+  const YAML::Mark m = mark_of(e.value, e.key_mark);
+  if (v != std::floor(v)) r.fail(m, path + " must be a whole number, got " + describe(e.value));
+  if (v < lo) r.fail(m, path + " must be >= " + text::exact(lo) + ", got " + text::exact(v));
+  if (v > hi) r.fail(m, path + " must be <= " + text::exact(hi) + ", got " + text::exact(v));
+  return static_cast<int>(v);
+}
+
+inline std::string read_text(const Reporter& r, const MapReader::Entry& e,
+                             const std::string& path) {
+  if (!e.value.IsScalar()) {
+    r.fail(mark_of(e.value, e.key_mark), path + " must be text, got " + describe(e.value));
+  }
+  return e.value.Scalar();
+}
+
+// [x, y] with each element checked; element marks go to `marks` when given
+inline Vec2 read_vec2(const Reporter& r, const MapReader::Entry& e, const std::string& path,
+                      const std::string& unit, YAML::Mark marks[2]) {
+  const YAML::Mark m = mark_of(e.value, e.key_mark);
+  if (!e.value.IsSequence() || e.value.size() != 2) {
+    r.fail(m, path + " must be a list of 2 numbers [x, y] in " + unit + ", got " +
+                  (e.value.IsSequence() ? "a list of " + std::to_string(e.value.size())
+                                        : describe(e.value)));
+  }
+  Vec2 v;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const YAML::Node item = e.value[i];
+    marks[i] = mark_of(item, m);
+    v[static_cast<Eigen::Index>(i)] =
+        read_number(r, item, m, path + "[" + std::to_string(i) + "]", unit);
+  }
+  return v;
+}
+
+}  // namespace bd::studies::detail
