@@ -98,6 +98,12 @@ std::string fmt(double v, const char* f) {
   return buf;
 }
 
+std::string xy(const Vec2& v) { return fmt(v.x(), "%.10g") + "," + fmt(v.y(), "%.10g"); }
+
+std::string vec_text(const Vec2& v) {
+  return "(" + fmt(v.x(), "%.4g") + ", " + fmt(v.y(), "%.4g") + ")";
+}
+
 // a number as written in a data file: shown to 6 significant digits, the exact text on hover
 std::string num_cell(const std::string& written) {
   if (written.empty()) return "<td class=\"n\">&ndash;</td>";

@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/types.hpp"
+
 namespace bd::studies::report_support {
 
 /// A JSON document as summary.json and sweep.json hold it: objects keep their file order.
@@ -31,6 +33,11 @@ struct Csv {
 Csv read_csv(const std::filesystem::path& p);
 /// The numbers of a CSV row (an empty field is NaN).
 std::vector<double> numbers(const std::vector<std::string>& row);
+
+/// A point as gnuplot data, "x,y" (10 digits).
+std::string xy(const Vec2& v);
+/// A point for a table, "(x, y)" (4 digits).
+std::string vec_text(const Vec2& v);
 
 /// `text` with & < > " escaped for HTML.
 std::string esc(const std::string& text);

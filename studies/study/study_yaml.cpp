@@ -28,6 +28,114 @@ std::string load_line(const char* name, const core::LinkLoad& l) {
          ", moment: " + text::exact(l.moment) + "}\n";
 }
 
+std::string list(const std::vector<double>& v) {
+  std::string s = "[";
+  for (std::size_t k = 0; k < v.size(); ++k) s += (k ? ", " : "") + text::exact(v[k]);
+  return s + "]";
+}
+
+std::string effort(const core::planar::TimeFunction& f) {
+  using K = core::planar::TimeFunction::Kind;
+  if (f.kind == K::kConstant) return text::exact(f.value);
+  if (f.kind == K::kHarmonic) {
+    return "{mean: " + text::exact(f.mean) + ", amplitude: " + text::exact(f.amplitude) +
+           ", frequency: " + text::exact(f.frequency) + ", phase: " + text::exact(f.phase) + "}";
+  }
+  std::string s = "{table: [";
+  for (std::size_t k = 0; k < f.times.size(); ++k) {
+    s += (k ? ", [" : "[") + text::exact(f.times[k]) + ", " + text::exact(f.values[k]) + "]";
+  }
+  return s + "]}";
+}
+
+// a planar linkage's linkage and loads sections (names are plain: letters, digits, '_', '-')
+std::string planar_linkage_yaml(const core::planar::Linkage& l) {
+  auto node = [&](int i) { return l.nodes[static_cast<std::size_t>(i)].name; };
+  std::string y = "linkage:\n  type: planar\n  nodes:\n";
+  for (const core::planar::Node& n : l.nodes) {
+    y += "    " + n.name + ": {at: " + vec(n.position) + (n.ground ? ", ground: true" : "") + "}\n";
+  }
+  y += "  links:\n";
+  for (const core::planar::Link& k : l.links) {
+    std::string nodes;
+    for (int i : k.nodes) nodes += (nodes.empty() ? "" : ", ") + node(i);
+    y += "    " + k.name + ": {nodes: [" + nodes + "], mass: " + text::exact(k.mass) +
+         ", e: " + text::exact(k.e) + ", f: " + text::exact(k.f) +
+         ", inertia: " + text::exact(k.inertia) + "}\n";
+  }
+  if (!l.point_masses.empty()) {
+    y += "  point_masses:\n";
+    for (const core::planar::PointMass& p : l.point_masses) {
+      y += "    " + node(p.node) + ": " + text::exact(p.mass) + "\n";
+    }
+  }
+  if (!l.sliders.empty()) {
+    y += "  sliders:\n";
+    for (const core::planar::Slider& sl : l.sliders) {
+      const std::string guide =
+          sl.link < 0 ? "[" + vec(sl.from) + ", " + vec(sl.to) + "]"
+                      : "{link: " + l.links[static_cast<std::size_t>(sl.link)].name +
+                            ", from: " + node(sl.from_node) + ", to: " + node(sl.to_node) + "}";
+      y += "    " + sl.name + ": {node: " + node(sl.node) + ", guide: " + guide + "}\n";
+    }
+  }
+  if (!l.springs.empty()) {
+    y += "  springs:\n";
+    for (const core::planar::Spring& sp : l.springs) {
+      y += "    " + sp.name + ": {between: [" + node(sp.a) + ", " + node(sp.b) +
+           "], stiffness: " + text::exact(sp.stiffness) +
+           ", free_length: " + text::exact(sp.free_length) +
+           ", damping: " + text::exact(sp.damping) + "}\n";
+    }
+  }
+  y += "  inputs:\n";
+  for (const core::planar::Input& in : l.inputs) {
+    if (in.kind == core::planar::Input::Kind::kAngle) {
+      y += "    " + in.name + ": {link: " + l.links[static_cast<std::size_t>(in.link)].name +
+           ", torque: " + effort(in.effort) + "}\n";
+    } else {
+      y += "    " + in.name + ": {slider: " + l.sliders[static_cast<std::size_t>(in.slider)].name +
+           ", force: " + effort(in.effort) + "}\n";
+    }
+  }
+  y += "\nloads:\n  gravity: " + vec(l.loads.gravity) + "\n";
+  if (!l.loads.link_loads.empty()) {
+    y += "  links:\n";
+    for (const core::planar::LinkLoad& ld : l.loads.link_loads) {
+      y += "    " + l.links[static_cast<std::size_t>(ld.link)].name + ": {force: " + vec(ld.force) +
+           ", moment: " + text::exact(ld.moment) + "}\n";
+    }
+  }
+  if (!l.loads.node_forces.empty()) {
+    y += "  nodes:\n";
+    for (const core::planar::NodeForce& nf : l.loads.node_forces) {
+      y += "    " + node(nf.node) + ": {force: " + vec(nf.force) + "}\n";
+    }
+  }
+  return y;
+}
+
+std::string planar_scene_yaml(const Scene& scene) {
+  std::string y = "\nscene:\n";
+  if (const auto* f = std::get_if<core::planar::FreeScene>(&scene)) {
+    y += "  type: free\n";
+    if (!f->start.empty()) y += "  start: " + list(f->start) + "\n";
+    if (!f->rates.empty()) y += "  rates: " + list(f->rates) + "\n";
+    y += "  duration: " + text::exact(f->duration) + "\n";
+    return y + "  samples: " + std::to_string(f->samples) + "\n";
+  }
+  const auto& d = std::get<core::planar::DrivenScene>(scene);
+  y += "  type: driven\n";
+  if (!d.start.empty()) y += "  start: " + list(d.start) + "\n";
+  y += "  speeds: " + list(d.speeds) + "\n";
+  if (d.duration > 0) {
+    y += "  duration: " + text::exact(d.duration) + "\n";
+  } else {
+    y += "  revolutions: " + std::to_string(d.revolutions) + "\n";
+  }
+  return y + "  samples: " + std::to_string(d.samples) + "\n";
+}
+
 }  // namespace
 
 std::string study_yaml(const Study& study, const std::string& header) {
@@ -39,6 +147,11 @@ std::string study_yaml(const Study& study, const std::string& header) {
     y += "\n";
   }
   y += "name: \"" + study.name + "\"\n\n";  // letters, digits, '.', '_', '-': no escapes needed
+  if (!study.is_fourbar()) {
+    y += planar_linkage_yaml(study.planar()) + planar_scene_yaml(study.scene);
+    y += "\nmethod: " + study.method_name() + "\n";
+    return y + "tolerance: " + text::exact(study.tolerance) + "\n";
+  }
 
   // linkage: links in the paper's polar form (see link_line)
   const core::FourBar& m = study.fourbar();

@@ -15,16 +15,16 @@
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/principal_vectors.hpp"
 #include "studies/bench/work_precision.hpp"
+#include "studies/report/pages.hpp"
 #include "studies/report/report.hpp"
 #include "studies/report/report_support.hpp"
+#include "studies/report/study_parts.hpp"
 #include "studies/run/runner.hpp"
 #include "studies/study/load_study.hpp"
 
-namespace bd::studies {
+namespace bd::studies::report_support {
 
 namespace fs = std::filesystem;
-
-using namespace report_support;  // NOLINT(google-build-using-namespace): the page builders
 
 namespace {
 
@@ -66,12 +66,6 @@ PoseSample pose_sample(const core::FourBar& model, const std::vector<double>& x,
   p.S = core::centre_of_mass_frame(model, s).r;
   for (int k = 1; k <= 3; ++k) p.G[k - 1] = core::centre_of_mass(model, k, p.pose);
   return p;
-}
-
-std::string xy(const Vec2& v) { return fmt(v.x(), "%.10g") + "," + fmt(v.y(), "%.10g"); }
-
-std::string vec_text(const Vec2& v) {
-  return "(" + fmt(v.x(), "%.4g") + ", " + fmt(v.y(), "%.4g") + ")";
 }
 
 // a design drawn at four samples spread evenly over its run, and the path S traces over all
@@ -220,8 +214,7 @@ const char* branch_text(core::Branch b) { return b == core::Branch::kPlus ? "+1"
 
 }  // namespace
 
-std::string linkage_tables_html(const Study& study) {
-  const core::FourBar& m = study.fourbar();
+std::string fourbar_linkage_tables(const core::FourBar& m) {
   std::string h =
       "<table><tr><th>link</th><th>length l [m]</th><th>mass m [kg]</th>"
       "<th>s [m]</th><th>&sigma; [rad]</th><th>e [m]</th><th>f [m]</th>"
@@ -264,128 +257,26 @@ std::string linkage_tables_html(const Study& study) {
 
 namespace {
 
-// the run facts of summary.json (or of its balanced_run / optimized_run) as a table
-std::string run_table(const Json& run, const std::string& what) {
-  std::string h = "<table>";
-  if (const Json* method = member(run, "method")) {
-    h += "<tr><th>method</th><td><b>" + esc(text(*method, "used")) + "</b> (requested " +
-         esc(text(*method, "requested")) + ")<br>" + esc(text(*method, "reason")) + "</td></tr>";
-  }
-  const bool ok = text(run, "ok") == "true";
-  h += "<tr><th>status</th><td class=\"" + std::string(ok ? "good" : "bad") + "\">" +
-       esc(text(run, "status")) + "</td></tr>";
-  h += "<tr><th>message</th><td>" + esc(text(run, "message")) + "</td></tr>";
-  h += "<tr><th>samples</th><td>" + esc(text(run, "samples")) + "</td></tr>";
-  h += "<tr><th>integrator steps, dynamics evaluations</th><td>" + esc(text(run, "steps")) + ", " +
-       esc(text(run, "rhs_evaluations")) + "</td></tr>";
-  if (!ok) {
-    h += "<tr><td colspan=\"2\" class=\"bad\">The " + what +
-         " simulation stopped early: the charts and metrics cover the samples computed.</td></tr>";
-  }
-  return h + "</table>";
-}
+// the four-bar's charts: its angles, reactions, shaking force and moment, drive torque and
+// bearing loads over the run, the linkage drawn at a few samples, and the Pareto front; the
+// second design's dashed over the original's. Returns the drawings of both designs too.
+struct FourBarCharts {
+  std::vector<Chart> charts;
+  std::string datablocks;
+  Drawing original, second;
+};
 
-}  // namespace
-
-std::string find_gnuplot() {
-  const char* env = std::getenv("BD_GNUPLOT");
-  const std::string name = env && *env ? env : "gnuplot";
-  if (name.find('/') != std::string::npos) return executable(name) ? name : std::string();
-  const char* path = std::getenv("PATH");
-  std::istringstream dirs(path ? path : "/usr/bin:/bin");
-  for (std::string d; std::getline(dirs, d, ':');) {
-    const fs::path p = fs::path(d.empty() ? "." : d) / name;
-    if (executable(p)) return p.string();
-  }
-  return {};
-}
-
-std::string report_html(const Study& study, const fs::path& dir, const std::string& gnuplot) {
-  const fs::path summary_file = dir / "summary.json";
-  if (!fs::exists(summary_file)) {
-    throw std::runtime_error(summary_file.string() + " not found: not the output folder of a run");
-  }
-  const Json summary = parse_json(read_file(summary_file), summary_file.string());
-  const Csv ts = read_csv(dir / "timeseries.csv");
-
-  // the second design, if any
-  std::string second, second_label, second_file;
-  if (member(summary, "balanced_run") && fs::exists(dir / "balanced-timeseries.csv")) {
-    second = "balanced";
-    second_label = "balanced";
-    second_file = "balanced-timeseries.csv";
-  } else if (member(summary, "optimized_run") && fs::exists(dir / "optimized-timeseries.csv")) {
-    second = "optimized";
-    second_label = "optimised";
-    second_file = "optimized-timeseries.csv";
-  }
-  const bool has_comparison = !second.empty() && fs::exists(dir / "comparison.csv");
-  const bool has_pareto = fs::exists(dir / "pareto.csv");
-
-  const std::string name = text(summary, "study").empty() ? study.name : text(summary, "study");
-  std::string h =
-      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-      "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
-      "<title>" +
-      esc(name) + " &mdash; balance-design report</title>\n<style>" + kStyle +
-      "</style>\n</head>\n<body>\n";
-  h += "<h1>" + esc(name) + "</h1>\n<p>balance-design report of the study <code>" +
-       esc(text(summary, "source").empty() ? std::string("(built in code)")
-                                           : text(summary, "source")) +
-       "</code>. Every number below is read from the data files of this folder; hover over a "
-       "number to see it as written there.</p>\n";
-
-  // status first: whether the run can be trusted
-  const bool ok = text(summary, "ok") == "true";
-  h += "<h2>Simulation</h2>\n";
-  if (!ok) {
-    h += "<p class=\"notice bad\">The simulation stopped early: " + esc(text(summary, "message")) +
-         "</p>\n";
-  }
-  h += run_table(summary, "original design's");
-  if (const Json* scene = member(summary, "scene")) {
-    h += "<h3>Scene</h3>" + json_table(*scene);
-    h += "<p>Integrator relative tolerance " + esc(text(summary, "tolerance")) + ".</p>\n";
-  }
-
-  h += "<h2>Linkage</h2>\n" + linkage_tables_html(study);
-
-  // metrics, side by side with the second design's when there is one
-  h += "<h2>Metrics</h2>\n<table><tr><th>metric</th><th>original</th>";
-  const Json* metrics = member(summary, "metrics");
-  const Json* second_metrics = second.empty() ? nullptr : member(summary, second + "_metrics");
-  const Json* reduction = member(summary, "reduction");
-  if (second_metrics) h += "<th>" + esc(second_label) + "</th><th>ratio</th>";
-  h += "</tr>";
-  if (metrics) {
-    for (const auto& [k, v] : metrics->items()) {
-      h += "<tr><th>" + esc(k) + "</th>" + json_cell(v);
-      if (second_metrics) {
-        const Json* s = member(*second_metrics, k);
-        const Json* r = reduction ? member(*reduction, k) : nullptr;
-        h += (s ? json_cell(*s) : "<td></td>") + (r ? json_cell(*r) : "<td></td>");
-      }
-      h += "</tr>";
-    }
-  }
-  h += "</table>\n<p>Fsh, Msh: shaking force [N] and moment about A0 [N m] on the frame; tau: "
-       "drive torque [N m]; RA0, RA3: forces on the ground at the bearings [N]. RMS over the "
-       "samples, max of magnitudes.</p>\n";
-
-  if (has_comparison) {
-    h += "<h2>Comparison</h2>\n<p>From <a href=\"comparison.csv\">comparison.csv</a>: the original "
-         "(before) and the " +
-         second_label + " design (after), ratio after/before.</p>" +
-         csv_table(read_csv(dir / "comparison.csv"));
-  }
-  Csv pareto;
-  if (has_pareto) {
-    pareto = read_csv(dir / "pareto.csv");
-  }
-
+FourBarCharts fourbar_charts(const Study& study, const fs::path& dir, const SecondDesign& sd,
+                             const Csv& ts, const Csv* pareto) {
+  FourBarCharts out;
+  const std::string second = sd.key, second_label = sd.label, second_file = sd.file;
+  const bool has_pareto = pareto != nullptr;
+  std::vector<Chart>& charts = out.charts;
+  std::string& datablocks = out.datablocks;
   // the linkage at four samples evenly spread over the run, and the path of S; the second
   // design's alike, from its own model (counterweights merged into its links) and samples
-  const Drawing original = drawing(study.fourbar(), ts);
+  out.original = drawing(study.fourbar(), ts);
+  const Drawing& original = out.original;
   const std::vector<PoseSample>& poses = original.poses;
   std::optional<core::FourBar> second_model;
   if (second == "balanced" && study.balance) {
@@ -397,17 +288,14 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
       throw std::runtime_error("cannot draw the optimised design: " + std::string(e.what()));
     }
   }
-  Drawing second_drawing;
-  if (second_model) second_drawing = drawing(*second_model, read_csv(dir / second_file));
+  if (second_model) out.second = drawing(*second_model, read_csv(dir / second_file));
+  const Drawing& second_drawing = out.second;
 
   // charts
   const fs::path abs_dir = fs::absolute(dir);
   const std::string ts_file = gp_string((abs_dir / "timeseries.csv").string());
   const std::string ts2_file = second.empty() ? "" : gp_string((abs_dir / second_file).string());
-  const std::string drive_x = std::holds_alternative<core::DrivenScene>(study.scene)
-                                  ? "t [s] (crank driven at constant speed)"
-                                  : "t [s]";
-  std::vector<Chart> charts;
+  const std::string drive_x = time_axis(study.scene);
   if (!ts.rows.empty()) {
     charts.push_back(
         {"angles", "Link angles",
@@ -479,7 +367,6 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
                           overlay,
                       drive});
   }
-  std::string datablocks;
   // one scale of marker size for the links' masses of both designs
   double mass_ref = std::max(
       {study.fourbar().crank.mass, study.fourbar().coupler.mass, study.fourbar().rocker.mass});
@@ -523,39 +410,24 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
                 "balanced, S stays in one place.";
     charts.push_back(c);
   }
-  if (has_pareto && pareto.header.size() >= 3) {
+  if (has_pareto && pareto->header.size() >= 3) {
     charts.push_back({"pareto", "Pareto front",
                       "Each point a design found by the epsilon-constraint method (pareto.csv); "
                       "points without a design are left out.",
-                      "set title 'Pareto front'\nset xlabel " + gp_string(pareto.header[1]) +
-                          "\nset ylabel " + gp_string(pareto.header[2]) + "\nplot " +
+                      "set title 'Pareto front'\nset xlabel " + gp_string(pareto->header[1]) +
+                          "\nset ylabel " + gp_string(pareto->header[2]) + "\nplot " +
                           gp_string((abs_dir / "pareto.csv").string()) +
                           " skip 1 using 2:3 with linespoints lw 2 pt 7 title 'front'"});
   }
 
-  h += "<h2>Charts</h2>\n";
-  if (gnuplot.empty()) {
-    h += "<p class=\"notice\">The charts need gnuplot, which was not found on this machine "
-         "(install it, e.g. <code>apt-get install gnuplot-nox</code>, then rebuild this page with "
-         "<code>balance-design report DIR</code>). The tables and the data files below hold every "
-         "number.</p>\n";
-  } else {
-    const std::vector<std::string> svgs = draw(gnuplot, datablocks, charts);
-    for (std::size_t i = 0; i < charts.size(); ++i) {
-      h += "<h3>" + esc(charts[i].heading) + "</h3>\n<figure class=\"chart\" id=\"chart-" +
-           charts[i].id + "\">\n" + svgs[i] + "\n<figcaption>" + esc(charts[i].caption) +
-           "</figcaption>\n</figure>\n";
-    }
-  }
-  if (!poses.empty()) {
-    h += "<h3>The linkage at the drawn samples</h3>" + poses_table(original);
-  }
-  if (!second_drawing.poses.empty()) {
-    h += "<h3>The " + std::string(second == "balanced" ? "balanced" : "optimised") +
-         " linkage at the drawn samples</h3>" + poses_table(second_drawing);
-  }
+  return out;
+}
 
-  if (!second.empty()) {
+// the balanced or optimised design's section (or the notice that no optimum was found)
+std::string second_design_section(const Json& summary, const SecondDesign& sd) {
+  std::string h;
+  const std::string second = sd.key, second_label = sd.label;
+  if (sd.present()) {
     const char* section = second == "balanced" ? "balance" : "optimize";
     h += std::string("<h2>") + (second == "balanced" ? "Balanced design" : "Optimised design") +
          "</h2>\n";
@@ -567,6 +439,36 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
     h +=
         "<h2>Optimisation</h2>\n<p class=\"notice bad\">No optimum was found.</p>" + json_table(*s);
   }
+  return h;
+}
+
+}  // namespace
+
+std::string fourbar_report_html(const Study& study, const fs::path& dir, const std::string& gnuplot,
+                                const Json& summary) {
+  const Csv ts = read_csv(dir / "timeseries.csv");
+  const SecondDesign second = second_design(summary, dir);
+  const bool has_pareto = fs::exists(dir / "pareto.csv");
+  Csv pareto;
+  if (has_pareto) pareto = read_csv(dir / "pareto.csv");
+  std::string h = page_start(study, summary) + simulation_section(summary);
+  h += "<h2>Linkage</h2>\n" + fourbar_linkage_tables(study.fourbar());
+  h +=
+      metrics_section(summary, second,
+                      "Fsh, Msh: shaking force [N] and moment about A0 [N m] on the frame; tau: "
+                      "drive torque [N m]; RA0, RA3: forces on the ground at the bearings [N]. RMS "
+                      "over the samples, max of magnitudes.");
+  h += comparison_section(dir, second);
+  const FourBarCharts c = fourbar_charts(study, dir, second, ts, has_pareto ? &pareto : nullptr);
+  h += charts_section(gnuplot, c.datablocks, c.charts);
+  if (!c.original.poses.empty()) {
+    h += "<h3>The linkage at the drawn samples</h3>" + poses_table(c.original);
+  }
+  if (!c.second.poses.empty()) {
+    h += "<h3>The " + std::string(second.key == "balanced" ? "balanced" : "optimised") +
+         " linkage at the drawn samples</h3>" + poses_table(c.second);
+  }
+  h += second_design_section(summary, second);
   if (has_pareto) {
     h += "<h2>Pareto front</h2>\n<p>From <a href=\"pareto.csv\">pareto.csv</a>.</p>" +
          csv_table(pareto);
@@ -579,11 +481,4 @@ std::string report_html(const Study& study, const fs::path& dir, const std::stri
                        "work-precision.csv", "driven-convergence.csv"});
 }
 
-fs::path write_report(const Study& study, const fs::path& dir) {
-  const std::string html = report_html(study, dir, find_gnuplot());
-  const fs::path target = dir / "report.html";
-  write_text_file(html, target);  // whole or not at all (runner.hpp)
-  return target;
-}
-
-}  // namespace bd::studies
+}  // namespace bd::studies::report_support

@@ -1,0 +1,259 @@
+// A planar linkage's study page: its tables and the charts of its run, read from the folder's
+// timeseries.csv by column name (core/planar/simulate.hpp lists the columns).
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "studies/report/pages.hpp"
+#include "studies/report/study_parts.hpp"
+#include "studies/run/files.hpp"
+
+namespace bd::studies::report_support {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using core::planar::Linkage;
+
+std::string node_name(const Linkage& l, int i) { return l.nodes[static_cast<std::size_t>(i)].name; }
+
+std::string nodes_of(const Linkage& l, const std::vector<int>& nodes) {
+  std::string s;
+  for (int n : nodes) s += (s.empty() ? "" : ", ") + node_name(l, n);
+  return s;
+}
+
+std::string effort_text(const core::planar::TimeFunction& f, const char* unit) {
+  using K = core::planar::TimeFunction::Kind;
+  if (f.kind == K::kConstant) return f.value == 0 ? "none" : fmt(f.value) + " " + unit;
+  if (f.kind == K::kTable)
+    return "table of " + std::to_string(f.times.size()) + " values [" + unit + "]";
+  return fmt(f.mean) + " + " + fmt(f.amplitude) + " sin(2π " + fmt(f.frequency) + " Hz t + " +
+         fmt(f.phase) + ") " + unit;
+}
+
+// the gnuplot column (1-based) of `name` in the timeseries header; 0 when absent
+int gp_column(const Csv& ts, const std::string& name) {
+  const auto it = std::find(ts.header.begin(), ts.header.end(), name);
+  return it == ts.header.end() ? 0 : static_cast<int>(it - ts.header.begin()) + 1;
+}
+
+// one line per column over t, `expr` the gnuplot expression of a column index (magnitude or value)
+std::string lines_over_t(const std::string& file,
+                         const std::vector<std::pair<std::string, std::string>>& items) {
+  std::string plot;
+  for (std::size_t k = 0; k < items.size(); ++k) {
+    plot += (k ? ", " : "") + (k ? std::string("''") : file) +
+            " skip 1 using 1:" + items[k].second + " with lines lw 2 title " +
+            gp_string(items[k].first);
+  }
+  return plot;
+}
+
+// |(x, y)| of the columns <name>x, <name>y as a gnuplot expression
+std::string magnitude(const Csv& ts, const std::string& name) {
+  const int cx = gp_column(ts, name + "x"), cy = gp_column(ts, name + "y");
+  return "(sqrt($" + std::to_string(cx) + "**2+$" + std::to_string(cy) + "**2))";
+}
+
+// the linkage at four samples evenly spread over the run: links through their nodes, the ground
+// nodes, the frame guides
+Chart linkage_chart(const Linkage& l, const Csv& ts, std::string& datablocks) {
+  const std::size_t n = ts.rows.size();
+  std::vector<std::size_t> picks;
+  for (std::size_t k = 0; k < 4 && k < n; ++k) picks.push_back(k * n / std::min<std::size_t>(4, n));
+  auto node_at = [&](const std::vector<double>& row, int i) {
+    const core::planar::Node& node = l.nodes[static_cast<std::size_t>(i)];
+    if (node.ground) return node.position;
+    return Vec2(row[static_cast<std::size_t>(gp_column(ts, "x_" + node.name) - 1)],
+                row[static_cast<std::size_t>(gp_column(ts, "y_" + node.name) - 1)]);
+  };
+  datablocks += "$plinks << EOD\n";
+  std::string entries;
+  for (std::size_t k = 0; k < picks.size(); ++k) {
+    const std::vector<double> row = numbers(ts.rows[picks[k]]);
+    for (const core::planar::Link& link : l.links) {
+      for (int i : link.nodes) datablocks += xy(node_at(row, i)) + "\n";
+      if (link.nodes.size() > 2) datablocks += xy(node_at(row, link.nodes[0])) + "\n";
+      datablocks += "\n";
+    }
+    datablocks += "\n";  // a new data set per sample (index k)
+    entries += std::string(k ? ", " : "") + "$plinks index " + std::to_string(k) +
+               " using 1:2 with linespoints lw 2 pt 7 ps 0.6 lt " + std::to_string(k + 1) +
+               " title " + gp_string("t = " + fmt(row[0], "%.3g") + " s");
+  }
+  datablocks += "EOD\n$pground << EOD\n";
+  for (const core::planar::Node& node : l.nodes) {
+    if (node.ground) datablocks += xy(node.position) + "\n";
+  }
+  datablocks += "EOD\n$pguides << EOD\n";
+  for (const core::planar::Slider& s : l.sliders) {
+    if (s.link < 0) datablocks += xy(s.from) + "\n" + xy(s.to) + "\n\n";
+  }
+  datablocks += "EOD\n";
+  std::string cmd = "set title 'The linkage at " + std::to_string(picks.size()) +
+                    " samples'\nset size ratio -1\nset xlabel 'x [m]'\nset ylabel 'y [m]'\n"
+                    "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n"
+                    "set key outside right top vertical Left reverse\n";
+  for (const core::planar::Node& node : l.nodes) {
+    if (node.ground)
+      cmd +=
+          "set label " + gp_string(node.name) + " at " + xy(node.position) + " offset 0.6,-0.8\n";
+  }
+  cmd += "plot " + entries +
+         ", $pground using 1:2 with points pt 9 ps 1.8 lc 'gray30' title 'ground nodes'";
+  const bool guides = std::any_of(l.sliders.begin(), l.sliders.end(),
+                                  [](const core::planar::Slider& s) { return s.link < 0; });
+  if (guides) cmd += ", $pguides using 1:2 with lines lw 1 dt 2 lc 'gray30' title 'frame guides'";
+  Chart c;
+  c.id = "linkage";
+  c.heading = "The linkage";
+  c.caption =
+      "Links through their nodes (a ternary link as a closed outline) at samples spread "
+      "evenly over the run, one colour per sample; ground nodes as triangles, guides fixed "
+      "in the frame dashed. From the node columns of timeseries.csv.";
+  c.commands = cmd;
+  c.square = true;
+  return c;
+}
+
+std::vector<Chart> planar_charts(const Study& study, const fs::path& dir, const Csv& ts,
+                                 std::string& datablocks) {
+  const Linkage& l = study.planar();
+  const std::string file = gp_string((fs::absolute(dir) / "timeseries.csv").string());
+  const std::string taxis = "\nset xlabel " + gp_string(time_axis(study.scene)) + "\n";
+  std::vector<Chart> charts;
+  if (ts.rows.empty()) return charts;
+  std::vector<std::pair<std::string, std::string>> angles, supports, drives, joints;
+  for (const core::planar::Link& link : l.links) {
+    angles.push_back({"θ " + link.name, std::to_string(gp_column(ts, "theta_" + link.name))});
+  }
+  for (const std::string& c : ts.header) {
+    if (c.size() > 2 && c[0] == 'R' && c.back() == 'x') {
+      supports.push_back(
+          {"|" + c.substr(0, c.size() - 1) + "|", magnitude(ts, c.substr(0, c.size() - 1))});
+    }
+    if (c.size() > 2 && c[0] == 'F' && c.back() == 'x' && c.rfind("Fsh", 0) != 0) {
+      joints.push_back(
+          {"|" + c.substr(0, c.size() - 1) + "|", magnitude(ts, c.substr(0, c.size() - 1))});
+    }
+    if (c.rfind("tau", 0) == 0) drives.push_back({c, std::to_string(gp_column(ts, c))});
+  }
+  charts.push_back({"angles", "Link angles",
+                    "Every link's angle (its first-to-second node direction) over the run.",
+                    "set title 'Link angles'" + taxis + "set ylabel 'angle [rad]'\nplot " +
+                        lines_over_t(file, angles)});
+  charts.push_back({"reactions", "Support reactions",
+                    "Magnitudes of the forces of the mechanism on the frame at each ground node "
+                    "and frame guide.",
+                    "set title 'Support reactions'" + taxis +
+                        "set ylabel 'force on the frame [N]'\nplot " +
+                        lines_over_t(file, supports)});
+  charts.push_back(
+      {"hodograph", "Shaking-force hodograph",
+       "The tip of the shaking force over the run, equal axes.",
+       "set title 'Shaking-force hodograph'\nset size ratio -1\nset xlabel 'Fshx [N]'\n"
+       "set ylabel 'Fshy [N]'\nplot " +
+           file + " skip 1 using " + std::to_string(gp_column(ts, "Fshx")) + ":" +
+           std::to_string(gp_column(ts, "Fshy")) + " with lines lw 2 title 'shaking force'",
+       true});
+  charts.push_back(
+      {"shaking-moment", "Shaking moment", "Shaking moment on the frame about the origin.",
+       "set title 'Shaking moment about the origin'" + taxis + "set ylabel 'Msh [N m]'\nplot " +
+           lines_over_t(file, {{"Msh", std::to_string(gp_column(ts, "Msh"))}})});
+  charts.push_back({"drive", "Drive efforts",
+                    "The drives' torques [N m] or forces [N] on their inputs, from the frame.",
+                    "set title 'Drive efforts'" + taxis +
+                        "set ylabel 'torque [N m] or force [N]'\nplot " +
+                        lines_over_t(file, drives)});
+  if (!joints.empty()) {
+    charts.push_back({"joints", "Joint forces", "Magnitudes of the joint forces on their links.",
+                      "set title 'Joint forces'" + taxis + "set ylabel 'joint force [N]'\nplot " +
+                          lines_over_t(file, joints)});
+  }
+  charts.push_back(linkage_chart(l, ts, datablocks));
+  return charts;
+}
+
+}  // namespace
+
+std::string planar_linkage_tables(const Linkage& l) {
+  std::string h = "<table><tr><th>node</th><th>drawn at [m]</th><th></th></tr>";
+  for (const core::planar::Node& n : l.nodes) {
+    h += "<tr><th>" + esc(n.name) + "</th><td>" + vec_text(n.position) + "</td><td>" +
+         (n.ground ? "ground" : "") + "</td></tr>";
+  }
+  h += "</table><table><tr><th>link</th><th>nodes</th><th>mass m [kg]</th><th>e [m]</th>"
+       "<th>f [m]</th><th>inertia I [kg m&sup2;]</th></tr>";
+  for (const core::planar::Link& k : l.links) {
+    h += "<tr><th>" + esc(k.name) + "</th><td>" + esc(nodes_of(l, k.nodes)) +
+         "</td><td class=\"n\">" + fmt(k.mass) + "</td><td class=\"n\">" + fmt(k.e) +
+         "</td><td class=\"n\">" + fmt(k.f) + "</td><td class=\"n\">" + fmt(k.inertia) +
+         "</td></tr>";
+  }
+  h += "</table>";
+  if (!l.point_masses.empty()) {
+    h += "<table><tr><th>point mass at</th><th>mass [kg]</th></tr>";
+    for (const core::planar::PointMass& p : l.point_masses) {
+      h += "<tr><th>" + esc(node_name(l, p.node)) + "</th><td class=\"n\">" + fmt(p.mass) +
+           "</td></tr>";
+    }
+    h += "</table>";
+  }
+  if (!l.sliders.empty()) {
+    h += "<table><tr><th>slider</th><th>node</th><th>guide</th></tr>";
+    for (const core::planar::Slider& s : l.sliders) {
+      const std::string guide =
+          s.link < 0 ? "fixed in the frame, " + vec_text(s.from) + " to " + vec_text(s.to)
+                     : "on link " + l.links[static_cast<std::size_t>(s.link)].name + ", " +
+                           node_name(l, s.from_node) + " to " + node_name(l, s.to_node);
+      h += "<tr><th>" + esc(s.name) + "</th><td>" + esc(node_name(l, s.node)) + "</td><td>" +
+           esc(guide) + "</td></tr>";
+    }
+    h += "</table>";
+  }
+  if (!l.springs.empty()) {
+    h += "<table><tr><th>spring</th><th>between</th><th>k [N/m]</th><th>free length [m]</th>"
+         "<th>c [N s/m]</th></tr>";
+    for (const core::planar::Spring& s : l.springs) {
+      h += "<tr><th>" + esc(s.name) + "</th><td>" +
+           esc(node_name(l, s.a) + ", " + node_name(l, s.b)) + "</td><td class=\"n\">" +
+           fmt(s.stiffness) + "</td><td class=\"n\">" + fmt(s.free_length) +
+           "</td><td class=\"n\">" + fmt(s.damping) + "</td></tr>";
+    }
+    h += "</table>";
+  }
+  h += "<table><tr><th>input</th><th>what moves</th><th>drive effort (free scenes)</th></tr>";
+  for (const core::planar::Input& in : l.inputs) {
+    const bool angle = in.kind == core::planar::Input::Kind::kAngle;
+    const std::string what =
+        angle ? "angle of link " + l.links[static_cast<std::size_t>(in.link)].name
+              : "position of slider " + l.sliders[static_cast<std::size_t>(in.slider)].name;
+    h += "<tr><th>" + esc(in.name) + "</th><td>" + esc(what) + "</td><td>" +
+         esc(effort_text(in.effort, angle ? "N m" : "N")) + "</td></tr>";
+  }
+  h += "</table><p>Gravity " + vec_text(l.loads.gravity) + " m/s&sup2;; total mass " +
+       fmt(core::planar::total_mass(l)) + " kg.</p>";
+  return h;
+}
+
+std::string planar_report_html(const Study& study, const fs::path& dir, const std::string& gnuplot,
+                               const Json& summary) {
+  const Csv ts = read_csv(dir / "timeseries.csv");
+  std::string h = page_start(study, summary) + simulation_section(summary);
+  h += "<h2>Linkage</h2>\n" + planar_linkage_tables(study.planar());
+  h +=
+      metrics_section(summary, {},
+                      "Fsh, Msh: shaking force [N] and moment about the origin [N m] on the frame; "
+                      "tau: drive torques [N m] or forces [N]; R&lt;name&gt;: forces on the frame "
+                      "at a ground node or guide [N]; F&lt;joint&gt;: joint forces on their links "
+                      "[N]. RMS over the samples, max of magnitudes.");
+  std::string datablocks;
+  const std::vector<Chart> charts = planar_charts(study, dir, ts, datablocks);
+  h += charts_section(gnuplot, datablocks, charts);
+  return h + data_files_html(dir, {"timeseries.csv", "summary.json"});
+}
+
+}  // namespace bd::studies::report_support

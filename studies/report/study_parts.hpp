@@ -1,0 +1,40 @@
+#pragma once
+/// Internal to studies/report/: the parts of a study's report page that every linkage type shares
+/// (the head, the simulation and scene, the metrics table, the charts, the data files); the
+/// linkage's own tables and charts come from fourbar_page.cpp or planar_page.cpp.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "studies/report/report_support.hpp"
+#include "studies/study/study.hpp"
+
+namespace bd::studies::report_support {
+
+/// The run's second design, when the folder has one: "balanced" or "optimized", its label
+/// ("balanced", "optimised") and its samples' file.
+struct SecondDesign {
+  std::string key, label, file;
+  bool present() const { return !key.empty(); }
+};
+SecondDesign second_design(const Json& summary, const std::filesystem::path& dir);
+
+/// The page's head and title, and its first paragraph.
+std::string page_start(const Study& study, const Json& summary);
+/// The run facts of summary.json (or of its balanced_run / optimized_run) as a table.
+std::string run_table(const Json& run, const std::string& what);
+/// "Simulation": the status first, the run facts and the scene.
+std::string simulation_section(const Json& summary);
+/// "Metrics": the metrics of summary.json, beside the second design's and their ratio.
+std::string metrics_section(const Json& summary, const SecondDesign& second,
+                            const std::string& notes);
+/// "Comparison" (comparison.csv), when the folder has it.
+std::string comparison_section(const std::filesystem::path& dir, const SecondDesign& second);
+/// "Charts": each chart drawn by gnuplot with its heading and caption, or the notice that the
+/// charts need gnuplot.
+std::string charts_section(const std::string& gnuplot, const std::string& datablocks,
+                           const std::vector<Chart>& charts);
+/// The gnuplot axis label of the time axis of a scene.
+std::string time_axis(const Scene& scene);
+
+}  // namespace bd::studies::report_support
