@@ -95,6 +95,18 @@ MetricList metric_list(const core::Metrics& metrics) {
   return list;
 }
 
+std::vector<std::string> metric_names(const Study& study) {
+  std::vector<std::string> names;
+  if (study.is_fourbar()) {
+    for (const core::MetricInfo& info : core::kMetricTable) names.emplace_back(info.name);
+  } else {
+    for (const auto& m : core::planar::metric_table(core::planar::Model(study.planar()))) {
+      names.push_back(m.name);
+    }
+  }
+  return names;
+}
+
 MetricList metric_list(const Study& study, const Simulation& simulation) {
   if (!simulation.is_planar) return metric_list(core::metrics(simulation.fourbar));
   const core::planar::Model model(study.planar());

@@ -54,5 +54,7 @@ Simulation simulate(const Study& study, const MethodChoice& method);
 MetricList metric_list(const Study& study, const Simulation& simulation);
 /// A four-bar's metrics in the table's order.
 MetricList metric_list(const core::Metrics& metrics);
+/// The names of the metrics a run of the study has, in its table's order.
+std::vector<std::string> metric_names(const Study& study);
 
 }  // namespace bd::studies

@@ -42,14 +42,8 @@ using Json = nlohmann::ordered_json;
 
 namespace {
 
-// the metrics in the table's order: the sweep.csv columns after the parameters
+// a second design's metrics in the four-bar's table: the sweep.csv columns after its prefix
 constexpr std::size_t kMetrics = core::kMetricCount;
-
-std::vector<double> metric_values(const core::Metrics& m) {
-  std::vector<double> values;
-  for (const core::MetricInfo& info : core::kMetricTable) values.push_back(m.*info.field);
-  return values;
-}
 
 // the statuses a row may have (sweep.hpp, sweep_columns())
 constexpr const char* kStatuses[] = {"ok", "stopped-early", "no-optimum", "bad-input", "error"};
@@ -88,7 +82,7 @@ void second_design_cells(std::string& row, const core::Metrics* metrics, double 
     row.append(kMetrics + 2, ',');
     return;
   }
-  for (double v : metric_values(*metrics)) row += "," + text::exact(v);
+  for (const MetricValue& m : metric_list(*metrics)) row += "," + text::exact(m.value);
   row += "," + text::exact(added_mass) + "," + text::exact(added_inertia);
 }
 
@@ -113,7 +107,7 @@ PointRow point_row(const Study& base, int index, std::span<const double> values,
   try {
     const Study study = point_study(base, values);
     const RunResult r = compute_study(study);
-    for (double v : metric_values(r.metrics)) body += "," + text::exact(v);
+    for (const MetricValue& m : r.metric_list) body += "," + text::exact(m.value);
     if (base.balance) {
       const bool have = study.balance && r.balanced;
       const auto [mass, inertia] = have ? added(study, r) : std::pair<double, double>{};
@@ -341,7 +335,7 @@ std::vector<std::string> sweep_columns(const Study& study) {
   if (study.sweep) {
     for (const SweepParameter& p : study.sweep->parameters) columns.push_back(p.path);
   }
-  for (const core::MetricInfo& m : core::kMetricTable) columns.push_back(m.name);
+  for (const std::string& m : metric_names(study)) columns.push_back(m);
   for (const char* prefix : {"balanced_", "optimized_"}) {
     if (prefix[0] == 'b' ? !study.balance : !study.optimize) continue;
     for (const core::MetricInfo& m : core::kMetricTable)
