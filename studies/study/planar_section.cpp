@@ -126,7 +126,7 @@ class PlanarSection::Impl {
     const double v = read_number(r_, x, path, unit);
     if (!(v > 0))
       r_.fail(mark_of(x.value, x.key_mark),
-              path + " must be > 0 " + unit + ", got " + text::exact(v));
+              path + " must be > 0 " + unit + ", got " + text::shortest(v));
     return v;
   }
 
@@ -134,7 +134,7 @@ class PlanarSection::Impl {
     const double v = read_number(r_, x, path, unit);
     if (v < 0)
       r_.fail(mark_of(x.value, x.key_mark),
-              path + " must be >= 0 " + unit + ", got " + text::exact(v));
+              path + " must be >= 0 " + unit + ", got " + text::shortest(v));
     return v;
   }
 
@@ -487,6 +487,8 @@ class PlanarSection::Impl {
         r_.fail(linkage_mark_, "linkage: " + ok.error().detail);
       }
       return checked;
+    } catch (const StudyError&) {
+      throw;  // already placed
     } catch (const InputError& err) {
       if (const auto& f = err.field()) {
         const auto it = places_.find(f->field + "[" + std::to_string(f->index) + "]");
