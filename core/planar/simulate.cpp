@@ -327,6 +327,19 @@ Expected<bool, PlanarError> dae_accelerations(Motion& m, double t, const double*
   return true;
 }
 
+// Keeps the link angles continuous through every evaluation: the dae route integrates node
+// coordinates, not angles, and its samples may lie further apart than half a turn of a link, so
+// continuing the angles from one sample to the next would lose whole turns. Consecutive
+// evaluations of the integrator are a fraction of a step apart.
+void continue_angles(const System& s, Instant& in) {
+  for (std::size_t k = 0; k < s.elements.size(); ++k) {
+    const System::ElementRow& e = s.elements[k];
+    const Vec2 d = in.x[static_cast<std::size_t>(e.q)] - in.x[static_cast<std::size_t>(e.p)];
+    const double a = std::atan2(d.y(), d.x());
+    in.angle[k] = a + kTwoPi * std::round((in.angle[k] - a) / kTwoPi);
+  }
+}
+
 int dae_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* data) {
   Motion& m = *static_cast<Motion*>(data);
   ++m.evaluations;
@@ -337,6 +350,7 @@ int dae_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* data) {
     m.error_t = t;
     return 1;
   }
+  continue_angles(m.model->system(), m.ws->instant);
   const int n = m.model->system().n;
   double* d = N_VGetArrayPointer(ydot);
   const double* yv = N_VGetArrayPointer(y);
