@@ -145,6 +145,32 @@ inline void random_loads(cp::Linkage& l, Rng& rng) {
   }
 }
 
+/// Sometimes (probability p) a spring-damper from a random moving node to a new ground node
+/// "S" placed 1.5 to 3 sizes away from the linkage's nodes (so it never shrinks to length 0):
+/// stiffness such that a stretch of the linkage's size stores 10 to 40 % of energy_of(), free
+/// length random, damping dissipating about 1 % of energy_of() over 0.3 s at 20 rad/s.
+inline void maybe_spring(cp::Linkage& l, Rng& rng, double p = 0.5) {
+  if (!coin(rng, p)) return;
+  std::vector<int> moving;
+  Vec2 mid(0, 0);
+  for (std::size_t i = 0; i < l.nodes.size(); ++i) {
+    mid += l.nodes[i].position;
+    if (!l.nodes[i].ground) moving.push_back(static_cast<int>(i));
+  }
+  mid /= static_cast<double>(l.nodes.size());
+  const double size = size_of(l), energy = energy_of(l);
+  const int a = moving[static_cast<std::size_t>(uniform(rng, 0, static_cast<double>(moving.size()) - 1e-9))];
+  const int anchor = add_node(l, "S", mid + polar(size * uniform(rng, 1.5, 3.0), uniform(rng, -kPi, kPi)), true);
+  cp::Spring sp;
+  sp.name = "spring";
+  sp.a = coin(rng) ? a : anchor;
+  sp.b = sp.a == a ? anchor : a;
+  sp.stiffness = uniform(rng, 0.2, 0.8) * energy / (size * size);
+  sp.free_length = node_distance(l, a, anchor) * uniform(rng, 0.5, 1.2);
+  sp.damping = uniform(rng, 0, 1) * 0.01 * energy / (0.3 * std::pow(20 * size, 2));
+  l.springs.push_back(sp);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Slider-cranks
 
@@ -174,6 +200,7 @@ inline cp::Linkage slider_crank(Rng& rng, bool inline_guide) {
   l.point_masses.push_back({b, uniform(rng, 0.1, 2.0)});
   maybe_point_mass(l, rng, a, 0.5);
   l.inputs.push_back(angle_input("crank", 0));
+  maybe_spring(l, rng);
   random_loads(l, rng);
   return cp::make_linkage(l);
 }
@@ -227,6 +254,7 @@ inline cp::Linkage quick_return(Rng& rng, bool rotating, bool shaper) {
     l.point_masses.push_back({p, uniform(rng, 0.2, 3.0)});
   }
   l.inputs.push_back(angle_input("crank", 0));
+  maybe_spring(l, rng);
   random_loads(l, rng);
   return cp::make_linkage(l);
 }
@@ -335,6 +363,7 @@ inline std::optional<cp::Linkage> six_bar(Rng& rng, bool stephenson) {
   add_link(l, rng, "link6", coin(rng) ? std::vector<int>{e, d} : std::vector<int>{d, e});
   for (int n : {a, b, c, d}) maybe_point_mass(l, rng, n, 0.5);
   l.inputs.push_back(angle_input("crank", 0));
+  maybe_spring(l, rng);
   random_loads(l, rng);
   return cp::make_linkage(l);
 }
@@ -381,7 +410,8 @@ inline cp::Linkage five_bar(Rng& rng) {
     for (int n : {a1, c, a3}) maybe_point_mass(l, rng, n, 0.5);
     l.inputs.push_back(angle_input("left", 0));
     l.inputs.push_back(angle_input("right", 3));
-    random_loads(l, rng);
+    maybe_spring(l, rng);
+  random_loads(l, rng);
     return cp::make_linkage(l);
   }
 }
