@@ -127,5 +127,76 @@ TEST(RefereeDriven, TwoInputFiveBars) {
   run_family("five-bar, two inputs", 108, 36, [](Rng& r) { return five_bar(r); });
 }
 
+// The comparison is sharp: an engine linkage that differs from the referee's mechanism by 1e-5
+// (relative) in one datum, or drops a load's moment, is told apart by more than ten times the
+// tolerance; the referee with a node's point mass on the other link (not the host) differs in
+// that joint's force only. (Not the crank's inertia: at constant speed it carries no load.)
+core::Series driven_table(const cp::Linkage& l, double speed) {
+  cp::DrivenScene scene;
+  scene.speeds = {speed};
+  scene.samples = 60;
+  const cp::Trajectory tr = cp::simulate_driven(cp::Model(l), scene);
+  EXPECT_TRUE(tr.ok()) << tr.message;
+  return tr.table;
+}
+
+TEST(RefereeDriven, TheComparisonSeesSmallModellingErrors) {
+  Rng rng(109);
+  for (int i = 0; i < 6; ++i) {
+    const cp::Linkage l = six_bar_or_retry(rng, i % 2 == 1);
+    const cp::Model model(l);
+    const Glue g = glue_of(l);
+    const core::Series engine = driven_table(l, 20.0);
+    const core::Series ref =
+        reference_table(model, g, rf::driven(g.mechanism, {20.0}, 0.0, engine.column_values("t")));
+    const std::string name = "six-bar #" + std::to_string(i);
+    EXPECT_LT(compare_tables(model, engine, ref, name).overall, kTol) << name;
+    auto gap = [&](const cp::Linkage& changed) {
+      return compare_tables(model, driven_table(changed, 20.0), ref, name).overall;
+    };
+    constexpr double d = 1e-5;
+    for (std::size_t k = 0; k < l.links.size(); ++k) {
+      const double L = cp::element_length(l, static_cast<int>(k));
+      cp::Linkage c = l;
+      c.links[k].f += d * L;
+      EXPECT_GT(gap(c), 10 * kTol) << name << ": f of link " << k << " changed by 1e-5 L";
+      c = l;
+      c.links[k].e += d * L;
+      EXPECT_GT(gap(c), 10 * kTol) << name << ": e of link " << k << " changed by 1e-5 L";
+      c = l;
+      c.links[k].mass *= 1 + d;
+      EXPECT_GT(gap(c), 10 * kTol) << name << ": mass of link " << k << " times 1 + 1e-5";
+      if (k == 0) continue;
+      c = l;
+      c.links[k].inertia *= 1 + d;
+      EXPECT_GT(gap(c), 10 * kTol) << name << ": inertia of link " << k << " times 1 + 1e-5";
+    }
+    cp::Linkage c = l;
+    c.loads.link_loads[0].moment = 0;
+    EXPECT_GT(gap(c), 10 * kTol) << name << ": a link load's moment dropped";
+    c = l;
+    c.loads.gravity *= 1 + d;
+    EXPECT_GT(gap(c), 10 * kTol) << name << ": gravity times 1 + 1e-5";
+  }
+  // a point mass on the node's other link: the same motion, different joint forces
+  Rng r2(110);
+  const cp::Linkage l = slider_crank(r2, false);  // point mass at the piston B, in the rod only
+  cp::Linkage with_pin_mass = l;
+  with_pin_mass.point_masses.push_back({1, 0.7});  // node A: crank (first) and rod
+  const cp::Model model(with_pin_mass);
+  Glue g = glue_of(with_pin_mass);
+  const core::Series engine = driven_table(with_pin_mass, 20.0);
+  const auto times = engine.column_values("t");
+  EXPECT_LT(compare_tables(model, engine, reference_table(model, g, rf::driven(g.mechanism, {20.0}, 0.0, times)), "A").overall, kTol);
+  // the referee with the mass on the rod instead of the crank (the host)
+  auto& crank = g.mechanism.bodies[0].point_masses;
+  g.mechanism.bodies[1].point_masses.push_back(crank.back());
+  crank.pop_back();
+  const Agreement moved = compare_tables(model, engine, reference_table(model, g, rf::driven(g.mechanism, {20.0}, 0.0, times)), "B");
+  EXPECT_LT(moved.worst.at(Family::kAngularAcceleration), kTol) << "the motion does not depend on it";
+  EXPECT_LT(moved.worst.at(Family::kShakingForce), kTol) << "nor the shaking force";
+  EXPECT_GT(moved.worst.at(Family::kJointForce), 1e-3) << "the joint force at A does";
+}
+
 }  // namespace
 }  // namespace bd::testing::planar
