@@ -205,6 +205,35 @@ inline cp::Linkage slider_crank(Rng& rng, bool inline_guide) {
   return cp::make_linkage(l);
 }
 
+/// The stroke of a slider_crank()'s piston: the slide values (as the engine measures them, from
+/// the guide's `from` towards `to`) of the two dead centres around the drawn one, where the
+/// piston's distance from the crank's pivot is rod - crank and rod + crank.
+struct Stroke {
+  double drawn, lo, hi;
+};
+inline Stroke stroke_of(const cp::Linkage& l) {
+  const Vec2 O = l.nodes[0].position;
+  const double r = node_distance(l, 0, 1), rod = node_distance(l, 1, 2);
+  const cp::Slider& s = l.sliders[0];
+  const Vec2 u = (s.to - s.from).normalized();
+  // |from + x u - O| = d  <=>  x^2 + 2 b x + c - d^2 = 0 with b = u.(from - O), c = |from - O|^2
+  const double b = u.dot(s.from - O), c = (s.from - O).squaredNorm();
+  const double drawn = u.dot(l.nodes[2].position - s.from);
+  auto roots = [&](double d) {
+    const double disc = std::sqrt(b * b - c + d * d);
+    return std::pair<double, double>{-b - disc, -b + disc};
+  };
+  const auto [outer_lo, outer_hi] = roots(rod + r);
+  const auto [inner_lo, inner_hi] = roots(rod - r);
+  // the drawn piston lies between an inner and an outer root on one side of the foot of O
+  return drawn > -b ? Stroke{drawn, inner_hi, outer_hi} : Stroke{drawn, outer_lo, inner_lo};
+}
+/// The slider_crank() driven by its piston's slide instead of the crank.
+inline cp::Linkage driven_by_piston(cp::Linkage l) {
+  l.inputs = {slide_input("piston", 0)};
+  return cp::make_linkage(l);
+}
+
 /// Inverted slider-crank (quick return): crank O-A about O, the rocker through its pivot Q and
 /// its end R, the crank pin A sliding on the rocker's line Q-R (a block of mass at A). With
 /// `rotating` the crank is longer than OQ (Whitworth: the rocker turns too), else shorter (the

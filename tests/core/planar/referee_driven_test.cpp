@@ -127,6 +127,45 @@ TEST(RefereeDriven, TwoInputFiveBars) {
   run_family("five-bar, two inputs", 108, 36, [](Rng& r) { return five_bar(r); });
 }
 
+// Slider-cranks driven by their piston (a slide input on a frame guide, its effort a force along
+// the guide), from the drawn position to 80 % of the way to the farther dead centre. Drawn at
+// least 5 % of the stroke from either dead centre: nearer, the crank turns so fast that the
+// referee's Newton, continued from one sample to the next, may land on the mirror branch (the
+// engine there: tests/core/planar/singular_test.cpp).
+TEST(RefereeDriven, SliderCranksDrivenByTheirPiston) {
+  Rng rng(111);
+  Agreement all;
+  for (int i = 0; i < 36; ++i) {
+    const cp::Linkage l = driven_by_piston(slider_crank(rng, coin(rng)));
+    const cp::Model model(l);
+    const Stroke st = stroke_of(l);
+    if (std::min(st.drawn - st.lo, st.hi - st.drawn) < 0.05 * (st.hi - st.lo)) {
+      --i;
+      continue;
+    }
+    const double to = st.hi - st.drawn > st.drawn - st.lo ? st.hi : st.lo;
+    cp::DrivenScene scene;
+    scene.speeds = {(to > st.drawn ? 1 : -1) * uniform(rng, 0.5, 2.0)};
+    scene.duration = 0.8 * std::abs(to - st.drawn) / std::abs(scene.speeds[0]);
+    scene.samples = 120;
+    const cp::Trajectory tr = cp::simulate_driven(model, scene);
+    ASSERT_TRUE(tr.ok()) << tr.message;
+    const Glue g = glue_of(l);
+    const std::string label = "piston-driven slider-crank #" + std::to_string(i);
+    const std::vector<double> times = tr.table.column_values("t");
+    const std::vector<rf::Sample> ref = rf::driven(g.mechanism, scene.speeds, 0.0, times);
+    Agreement a = compare_tables(model, tr.table, reference_table(model, g, ref), label);
+    core::Series reference_instants;
+    reference_instants.columns = instant_columns(model);
+    for (const rf::Sample& s : ref) append_reference_instant(g, s, reference_instants);
+    a.merge(compare_tables(model, engine_instants(model, scene.speeds, times), reference_instants, label));
+    expect_agreement(a, kTol, label);
+    all.merge(a);
+  }
+  std::printf("slider-crank driven by its piston, 36 strokes, worst relative differences:\n%s",
+              all.text().c_str());
+}
+
 // The comparison is sharp: an engine linkage that differs from the referee's mechanism by 1e-5
 // (relative) in one datum, or drops a load's moment, is told apart by more than ten times the
 // tolerance; the referee with a node's point mass on the other link (not the host) differs in
