@@ -458,8 +458,8 @@ struct Agreement {
 /// its family carries the round-off of the family's larger terms it is computed from, e.g. the
 /// angular acceleration of a crank turning at constant speed, 0 exactly, is a difference of
 /// centripetal terms of size omega^2: the angular accelerations' family size is the larger of
-/// max |alpha| and max omega^2; a slide acceleration's, of max |a| and max v^2 / the linkage's
-/// size). Positions (x_, y_, s_) are relative to the linkage's
+/// max |alpha| and max omega^2; a slide acceleration's, of max |a|, max v^2 / the linkage's
+/// size and that size times the angular accelerations' family size). Positions (x_, y_, s_) are relative to the linkage's
 /// size (model.length_scale()); angles to max(1 rad, their largest magnitude); time exactly.
 inline Agreement compare_tables(const cp::Model& model, const core::Series& engine,
                                 const core::Series& reference, const std::string& label) {
@@ -497,10 +497,13 @@ inline Agreement compare_tables(const cp::Model& model, const core::Series& engi
   family_scale[Family::kAngularAcceleration] =
       std::max(family_scale[Family::kAngularAcceleration],
                family_scale[Family::kAngularRate] * family_scale[Family::kAngularRate]);
-  // likewise a slide acceleration (0 exactly for a piston driven at constant speed): v^2 / size
-  family_scale[Family::kAcceleration] =
-      std::max(family_scale[Family::kAcceleration],
-               family_scale[Family::kRate] * family_scale[Family::kRate] / model.length_scale());
+  // likewise a slide acceleration (0 exactly for a piston driven at constant speed) is formed
+  // from node accelerations: its size is the linkage's acceleration, max(|alpha|, omega^2) times
+  // its size, or v^2 / size
+  family_scale[Family::kAcceleration] = std::max(
+      {family_scale[Family::kAcceleration],
+       family_scale[Family::kRate] * family_scale[Family::kRate] / model.length_scale(),
+       family_scale[Family::kAngularAcceleration] * model.length_scale()});
   for (Quantity& q : qs) {
     switch (q.family) {
       case Family::kTime: q.scale = 0; break;

@@ -328,7 +328,10 @@ struct Dyad {
   Vec2 E;
   double l5{}, l6{}, side{};
 };
-inline std::optional<Dyad> random_dyad(Rng& rng, const std::vector<Vec2>& path) {
+/// With `limited`, the dyad cannot follow the whole path: l5 + l6 lies between the smallest and
+/// the largest distance of C from E (the dyad stretches straight and the linkage locks at a
+/// limit), and only the drawn point (the path's first) is checked for its transmission angle.
+inline std::optional<Dyad> random_dyad(Rng& rng, const std::vector<Vec2>& path, bool limited = false) {
   Dyad dy;
   Vec2 mid(0, 0);
   for (const Vec2& p : path) mid += p;
@@ -341,10 +344,16 @@ inline std::optional<Dyad> random_dyad(Rng& rng, const std::vector<Vec2>& path) 
     lo = std::min(lo, (p - dy.E).norm());
     hi = std::max(hi, (p - dy.E).norm());
   }
-  const double sum = hi * uniform(rng, 1.15, 1.6), diff = lo * uniform(rng, -0.5, 0.5);
+  const double sum = limited ? lo + (hi - lo) * uniform(rng, 0.3, 0.7) : hi * uniform(rng, 1.15, 1.6);
+  const double diff = lo * uniform(rng, -0.5, 0.5);
   dy.l5 = (sum + diff) / 2;
   dy.l6 = (sum - diff) / 2;
   dy.side = coin(rng) ? 1.0 : -1.0;
+  if (limited) {
+    const auto D = circle_intersection(path.front(), dy.l5, dy.E, dy.l6, dy.side);
+    if (!D || D->sin_angle < kTransmission) return std::nullopt;
+    return dy;
+  }
   for (const Vec2& p : path) {
     const auto D = circle_intersection(p, dy.l5, dy.E, dy.l6, dy.side);
     if (!D || D->sin_angle < kTransmission) return std::nullopt;
@@ -355,8 +364,10 @@ inline std::optional<Dyad> random_dyad(Rng& rng, const std::vector<Vec2>& path) 
 /// Watt II six-bar: the crank-rocker O-A-B-Q whose rocker is a ternary link {Q, B, C}, and the
 /// dyad C-D-E to the ground pivot E. Links crank, coupler, rocker (ternary), link5, link6.
 /// Stephenson III (`stephenson`): the coupler is the ternary link {A, B, C} instead.
-inline std::optional<cp::Linkage> six_bar(Rng& rng, bool stephenson) {
-  const auto fb = random_crank_rocker(rng);
+/// With `limited`, the dyad locks at some crank angle (random_dyad()); drawn where C is nearest
+/// E, so the crank can turn some way either way before the lock.
+inline std::optional<cp::Linkage> six_bar(Rng& rng, bool stephenson, bool limited = false) {
+  auto fb = random_crank_rocker(rng);
   if (!fb) return std::nullopt;
   // C as a point of the ternary link, in the frame of its two other joints (x along, y left)
   const double cx = uniform(rng, -0.3, 1.3), cy = uniform(rng, 0.2, 0.8) * (coin(rng) ? 1 : -1);
@@ -368,7 +379,19 @@ inline std::optional<cp::Linkage> six_bar(Rng& rng, bool stephenson) {
   };
   std::vector<Vec2> path;
   for (int i = 0; i < 720; ++i) path.push_back(C_at(fb->theta0 + 2 * kPi * i / 720));
-  const auto dy = random_dyad(rng, path);
+  std::optional<Dyad> dy;
+  if (limited) {  // the lengths from the whole path, then drawn where C is nearest E
+    dy = random_dyad(rng, path, true);
+    if (!dy) return std::nullopt;
+    std::size_t nearest = 0;
+    for (std::size_t i = 0; i < path.size(); ++i)
+      if ((path[i] - dy->E).norm() < (path[nearest] - dy->E).norm()) nearest = i;
+    fb->theta0 += 2 * kPi * static_cast<double>(nearest) / 720;
+    const auto D = circle_intersection(C_at(fb->theta0), dy->l5, dy->E, dy->l6, dy->side);
+    if (!D || D->sin_angle < kTransmission) return std::nullopt;
+  } else {
+    dy = random_dyad(rng, path);
+  }
   if (!dy) return std::nullopt;
   cp::Linkage l;
   const Vec2 A = fb->A(fb->theta0), B = fb->B(fb->theta0)->p, C = C_at(fb->theta0);
