@@ -288,6 +288,22 @@ inline cp::Linkage quick_return(Rng& rng, bool rotating, bool shaper) {
   return cp::make_linkage(l);
 }
 
+/// The stroke of a quick_return()'s block along the rocker (as the engine measures it, from the
+/// guide's from_node towards its to_node): its dead centres are where the crank lies along the
+/// line of the pivots, |QA| = |OQ - OA| and OQ + OA.
+inline Stroke block_stroke_of(const cp::Linkage& l) {
+  const double h = node_distance(l, 0, 2), r = node_distance(l, 0, 1);
+  const double qa = node_distance(l, 2, 1), reach = node_distance(l, 2, 3);
+  const bool from_q = l.sliders[0].from_node == 2;
+  const double near = std::abs(h - r), far = h + r;
+  return from_q ? Stroke{qa, near, far} : Stroke{reach - qa, reach - far, reach - near};
+}
+/// The quick_return() driven by its block's slide along the rocker instead of the crank.
+inline cp::Linkage driven_by_block(cp::Linkage l) {
+  l.inputs = {slide_input("block", 0)};
+  return cp::make_linkage(l);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Four-bar loops and six-bars
 

@@ -128,15 +128,18 @@ TEST(RefereeDriven, TwoInputFiveBars) {
 }
 
 // Slider-cranks driven by their piston (a slide input on a frame guide, its effort a force along
-// the guide), from the drawn position to 80 % of the way to the farther dead centre. Drawn at
-// least 5 % of the stroke from either dead centre: nearer, the crank turns so fast that the
-// referee's Newton, continued from one sample to the next, may land on the mirror branch (the
-// engine there: tests/core/planar/singular_test.cpp).
-TEST(RefereeDriven, SliderCranksDrivenByTheirPiston) {
-  Rng rng(111);
+// the guide), and quick returns, Whitworths and shapers driven by their block's slide along the
+// rocker (a slide input on a link's guide: the force acts on the block and, opposite, on the
+// rocker), from the drawn position to 80 % of the way to the farther dead centre. Drawn at least
+// 5 % of the stroke from either dead centre: nearer, the crank turns so fast that the referee's
+// Newton, continued from one sample to the next, may land on the mirror branch (the engine
+// there: tests/core/planar/singular_test.cpp).
+template <class Make, class StrokeOf>
+void run_slide_driven(const char* family, std::uint64_t seed, Make make, StrokeOf stroke_of) {
+  Rng rng(seed);
   Agreement all;
   for (int i = 0; i < 36; ++i) {
-    const cp::Linkage l = driven_by_piston(slider_crank(rng, coin(rng)));
+    const cp::Linkage l = make(rng);
     const cp::Model model(l);
     const Stroke st = stroke_of(l);
     if (std::min(st.drawn - st.lo, st.hi - st.drawn) < 0.05 * (st.hi - st.lo)) {
@@ -151,7 +154,7 @@ TEST(RefereeDriven, SliderCranksDrivenByTheirPiston) {
     const cp::Trajectory tr = cp::simulate_driven(model, scene);
     ASSERT_TRUE(tr.ok()) << tr.message;
     const Glue g = glue_of(l);
-    const std::string label = "piston-driven slider-crank #" + std::to_string(i);
+    const std::string label = std::string(family) + " #" + std::to_string(i);
     const std::vector<double> times = tr.table.column_values("t");
     const std::vector<rf::Sample> ref = rf::driven(g.mechanism, scene.speeds, 0.0, times);
     Agreement a = compare_tables(model, tr.table, reference_table(model, g, ref), label);
@@ -162,8 +165,18 @@ TEST(RefereeDriven, SliderCranksDrivenByTheirPiston) {
     expect_agreement(a, kTol, label);
     all.merge(a);
   }
-  std::printf("slider-crank driven by its piston, 36 strokes, worst relative differences:\n%s",
-              all.text().c_str());
+  std::printf("%s, 36 strokes, worst relative differences:\n%s", family, all.text().c_str());
+}
+
+TEST(RefereeDriven, SliderCranksDrivenByTheirPiston) {
+  run_slide_driven("slider-crank driven by its piston", 111,
+                   [](Rng& r) { return driven_by_piston(slider_crank(r, coin(r))); },
+                   [](const cp::Linkage& l) { return stroke_of(l); });
+}
+TEST(RefereeDriven, QuickReturnsDrivenByTheirBlockAlongTheRocker) {
+  run_slide_driven("quick return / Whitworth / shaper driven by its block", 112,
+                   [](Rng& r) { return driven_by_block(quick_return(r, coin(r), coin(r))); },
+                   [](const cp::Linkage& l) { return block_stroke_of(l); });
 }
 
 // The comparison is sharp: an engine linkage that differs from the referee's mechanism by 1e-5

@@ -74,15 +74,15 @@ AtStates engine_at_referee_states(const cp::Model& model, const std::vector<rf::
 }
 
 // the worst relative differences: [reduced, dae] x [asked, tight], and at the referee's states
-struct Run {
+struct FreeRun {
   Agreement a[2][2], instantaneous;
   double speedup = 0;  // the largest |input rate| over the run / its start
   long steps = 0;      // the most steps an engine run took at the asked tolerance
 };
 
-Run free_agreement(const cp::Linkage& linkage, const std::vector<double>& rates, double duration,
+FreeRun free_agreement(const cp::Linkage& linkage, const std::vector<double>& rates, double duration,
                    int samples, const std::string& label) {
-  Run out;
+  FreeRun out;
   const cp::Model model(linkage);
   const Glue g = glue_of(linkage);
   std::vector<double> times;
@@ -149,7 +149,7 @@ cp::TimeFunction random_effort(Rng& rng, double size) {
 template <class Make>
 void run_family(const char* family, std::uint64_t seed, int count, double duration, Make make) {
   Rng rng(seed);
-  Run all;
+  FreeRun all;
   const auto start = std::chrono::steady_clock::now();
   for (int i = 0; i < count; ++i) {
     cp::Linkage l = make(rng);
@@ -158,7 +158,7 @@ void run_family(const char* family, std::uint64_t seed, int count, double durati
       in.effort = random_effort(rng, 0.005 * energy_of(l));  // as random_loads()' moments
       rates.push_back((coin(rng) ? 1.0 : -1.0) * uniform(rng, 10.0, 30.0));
     }
-    const Run r = free_agreement(l, rates, duration, 31, std::string(family) + " #" + std::to_string(i));
+    const FreeRun r = free_agreement(l, rates, duration, 31, std::string(family) + " #" + std::to_string(i));
     for (int a = 0; a < 2; ++a)
       for (int b = 0; b < 2; ++b) all.a[a][b].merge(r.a[a][b]);
     all.instantaneous.merge(r.instantaneous);
@@ -195,6 +195,41 @@ TEST(RefereeFree, StephensonSixBars) {
 }
 TEST(RefereeFree, TwoInputFiveBarsWithTwoEfforts) {
   run_family("five-bar, two inputs", 205, 12, 0.3, [](Rng& r) { return five_bar(r); });
+}
+
+// Slide inputs with efforts: slider-cranks pushed by a force on their piston (along a frame
+// guide; the drive's reaction is on the frame) and quick returns by a force on their block
+// (along the rocker; the reaction is on the rocker), started away from the dead centres towards
+// the farther one and run for half the time the starting rate would take to reach it.
+TEST(RefereeFree, SlideInputsWithForces) {
+  Rng rng(206);
+  FreeRun all;
+  for (int i = 0; i < 12; ++i) {
+    const bool piston = i % 2 == 0;
+    cp::Linkage l = piston ? driven_by_piston(slider_crank(rng, coin(rng)))
+                           : driven_by_block(quick_return(rng, coin(rng), coin(rng)));
+    const Stroke st = piston ? stroke_of(l) : block_stroke_of(l);
+    if (std::min(st.drawn - st.lo, st.hi - st.drawn) < 0.2 * (st.hi - st.lo)) {
+      --i;
+      continue;
+    }
+    const double to = st.hi - st.drawn > st.drawn - st.lo ? st.hi : st.lo;
+    const double rate = (to > st.drawn ? 1 : -1) * uniform(rng, 0.5, 2.0);
+    const double force = 0.005 * energy_of(l) / size_of(l);  // as the moments, per metre
+    l.inputs[0].effort = random_effort(rng, force);
+    const double duration = 0.5 * std::abs(to - st.drawn) / std::abs(rate);
+    const FreeRun r = free_agreement(l, {rate}, duration, 31,
+                                 std::string(piston ? "slider-crank pushed by its piston #"
+                                                    : "quick return pushed along its rocker #") +
+                                     std::to_string(i));
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b) all.a[a][b].merge(r.a[a][b]);
+    all.instantaneous.merge(r.instantaneous);
+  }
+  std::printf("slide inputs with forces: at the referee's states %.2e; reduced %.2e / %.2e, dae "
+              "%.2e / %.2e at tolerance %.0e / %.0e\n",
+              all.instantaneous.overall, all.a[0][0].overall, all.a[0][1].overall,
+              all.a[1][0].overall, all.a[1][1].overall, kAskedTolerance, kTightTolerance);
 }
 
 }  // namespace
