@@ -25,6 +25,13 @@ constexpr int kNewtonIterations = 40;
 // A factorisation whose reciprocal condition estimate is below this is a singular position:
 // velocities and forces there would lose more than half of their digits.
 constexpr double kSingularRcond = 1e-8;
+// A converged position whose reciprocal condition estimate is below this is a singular position
+// too. At a singular position hit to round-off (a driven sample landing on a dead centre) the
+// root is double and Newton ends within ~sqrt(round-off) of it: the estimate there is ~1e-8, not
+// 0, and the rates, which grow like 1/sqrt of the distance to the singular position, come out at
+// 1e8 times their size (a piston driven onto its dead centre gave a drive force of 1e30 N).
+// 1e-6 calls singular what lies within ~1e-12 (relative) of one.
+constexpr double kSingularSolution = 1e-6;
 
 std::string inputs_text(const Model& model, const std::vector<double>& inputs) {
   std::string s;
@@ -254,6 +261,13 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
     ws.q += step;
     detail::nodes_from_q(s, ws.q, in.x);
     if (s.n == 0 || step.cwiseAbs().maxCoeff() <= step_limit) {
+      if (s.n > 0 && !(ws.lu.rcond() >= kSingularSolution)) {
+        return Unexpected<PlanarError>(
+            PlanarError{PlanarError::Kind::kSingular,
+                        "singular position at " + inputs_text(model, inputs) +
+                            " (the constraints and inputs lose rank: reciprocal condition " +
+                            text::digits(ws.lu.rcond(), 2) + ")"});
+      }
       in.input = inputs;
       return true;
     }

@@ -186,7 +186,12 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
   out.table.values.reserve(static_cast<std::size_t>(rows) * out.table.width());
   const std::vector<double> zero(static_cast<std::size_t>(dof), 0.0);
   std::vector<double> z(static_cast<std::size_t>(dof));
-  std::vector<Vec2> guess = ws.instant.x;
+  std::vector<Vec2> guess = ws.instant.x, previous = ws.instant.x;
+  std::vector<double> z_previous = start, z_step(z.size());
+  // the sign of the constraints' and inputs' determinant tells the assembly branch: it changes
+  // only through a singular position, where the branches meet
+  auto branch = [&ws]() { return ws.lu.determinant() < 0 ? -1 : 1; };
+  const int drawn_branch = branch();
   double t_prev = 0;
   for (long long i = 0; i < rows; ++i) {
     const double t = by_duration
@@ -196,12 +201,26 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
     // the previous sample carried forward to second order: Newton then needs two or three steps
     if (i > 0) {
       const double h = t - t_prev;
+      previous = ws.instant.x;
       for (std::size_t n = 0; n < guess.size(); ++n) {
         guess[n] = ws.instant.x[n] + h * ws.instant.v[n] + 0.5 * h * h * ws.instant.a[n];
       }
     }
     auto ok = solve_position(model, ws, guess, z);
+    if (ok && i > 0 && branch() != drawn_branch) {
+      // near a singular position the prediction can overshoot onto another branch (the rates
+      // grow without bound there): continue from the previous sample's positions in small steps
+      constexpr int kSubsteps = 16;
+      guess = previous;
+      for (int j = 1; j <= kSubsteps && ok; ++j) {
+        for (std::size_t k = 0; k < z.size(); ++k)
+          z_step[k] = z_previous[k] + (z[k] - z_previous[k]) * j / kSubsteps;
+        ok = solve_position(model, ws, guess, z_step);
+        guess = ws.instant.x;
+      }
+    }
     if (ok) ok = inverse_dynamics(model, ws, t, scene.speeds, zero);
+    z_previous = z;
     ++out.rhs_evaluations;
     if (!ok) {
       fail(out, ok.error(), t);
@@ -333,6 +352,19 @@ Expected<bool, PlanarError> dae_accelerations(Motion& m, double t, const double*
   return true;
 }
 
+// Keeps the link angles continuous through every evaluation: the dae route integrates node
+// coordinates, not angles, and its samples may lie further apart than half a turn of a link, so
+// continuing the angles from one sample to the next would lose whole turns. Consecutive
+// evaluations of the integrator are a fraction of a step apart.
+void continue_angles(const System& s, Instant& in) {
+  for (std::size_t k = 0; k < s.elements.size(); ++k) {
+    const System::ElementRow& e = s.elements[k];
+    const Vec2 d = in.x[static_cast<std::size_t>(e.q)] - in.x[static_cast<std::size_t>(e.p)];
+    const double a = std::atan2(d.y(), d.x());
+    in.angle[k] = a + kTwoPi * std::round((in.angle[k] - a) / kTwoPi);
+  }
+}
+
 int dae_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* data) {
   Motion& m = *static_cast<Motion*>(data);
   ++m.evaluations;
@@ -343,6 +375,7 @@ int dae_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* data) {
     m.error_t = t;
     return 1;
   }
+  continue_angles(m.model->system(), m.ws->instant);
   const int n = m.model->system().n;
   double* d = N_VGetArrayPointer(ydot);
   const double* yv = N_VGetArrayPointer(y);

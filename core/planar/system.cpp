@@ -31,6 +31,15 @@ double continued_angle(const Vec2& d, double near) {
   return a + 2 * kPi * std::round((near - a) / (2 * kPi));
 }
 
+// the angle from the direction `target` [rad] to d, in [-π, π], exact to round-off for any
+// |target|: continued_angle(d, target) - target would carry the round-off of target's whole
+// turns (ulp(80 rad) = 1.4e-14 rad), which after some 13 turns exceeds what Newton's stopping
+// test on the positions (1e-14 of the length scale) can see converge
+double angle_from(double target, const Vec2& d) {
+  const Vec2 u(std::cos(target), std::sin(target));
+  return std::atan2(cross(u, d), u.dot(d));
+}
+
 }  // namespace
 
 System::System(const Linkage& l) : linkage(l) {
@@ -201,7 +210,7 @@ void constraint_values(const System& s, const NodeVectors& x, const std::vector<
   for (const System::InputRow& in : s.inputs) {
     const double target = inputs[static_cast<std::size_t>(in.input)];
     g[in.row] = in.angle
-                    ? in.length * (input_angle(s, in, x, target) - target)
+                    ? in.length * angle_from(target, at(x, in.q) - at(x, in.p))
                     : slide_position(s, s.sliders[static_cast<std::size_t>(in.slider)], x) - target;
   }
 }
