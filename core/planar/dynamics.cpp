@@ -22,6 +22,9 @@ constexpr double kPi = 3.14159265358979323846;
 // the position is then exact to round-off (the previous step was ~1e-8 of the scale or less)
 constexpr double kNewtonStep = 1e-14;
 constexpr int kNewtonIterations = 40;
+// a last Newton step below this (times the linkage's size) leaves the Jacobian unchanged to
+// round-off: its factorisation is kept
+constexpr double kRefactorStep = 4 * std::numeric_limits<double>::epsilon();
 // A factorisation whose reciprocal condition estimate is below this is a singular position:
 // velocities and forces there would lose more than half of their digits.
 constexpr double kSingularRcond = 1e-8;
@@ -32,6 +35,17 @@ constexpr double kSingularRcond = 1e-8;
 // 1e8 times their size (a piston driven onto its dead centre gave a drive force of 1e30 N).
 // 1e-6 calls singular what lies within ~1e-12 (relative) of one.
 constexpr double kSingularSolution = 1e-6;
+// Newton's guard: a factorisation whose smallest pivot is below this fraction of its largest is
+// checked by the condition estimate (far cheaper than estimating it at every iteration)
+constexpr double kSingularPivot = 1e-4;
+// pivots within this ratio of each other leave the condition estimate far above kSingularSolution
+// (the rows have gradients of unit length and the systems are small)
+constexpr double kWellConditionedPivot = 1e-2;
+
+double pivot_ratio(const Eigen::PartialPivLU<MatrixXd>& lu) {
+  const auto d = lu.matrixLU().diagonal().cwiseAbs();
+  return d.minCoeff() / d.maxCoeff();
+}
 
 std::string inputs_text(const Model& model, const std::vector<double>& inputs) {
   std::string s;
@@ -168,7 +182,14 @@ Workspace::Workspace(const Model& model) {
   MT.setZero(s.n, model.inputs());
   reduced.setZero(model.inputs(), model.inputs());
   lu = Eigen::PartialPivLU<MatrixXd>(std::max(s.n, 1));
+  ldlt = Eigen::LDLT<MatrixXd>(std::max(model.inputs(), 1));
+  step.setZero(s.n);
+  c.setZero(s.n);
+  right.setZero(model.inputs());
+  zdd.setZero(model.inputs());
   trial = instant.x;
+  on_link.assign(model.linkage().links.size() * model.linkage().nodes.size(), Vec2(0, 0));
+
 }
 
 std::vector<double> drawn_inputs(const Model& model) {
@@ -230,7 +251,7 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
                                                       " free coordinates left by the constraints"});
   }
   in.x = guess;
-  ws.q = detail::q_from_nodes(s, in.x);
+  detail::q_from_nodes(s, in.x, ws.q);
   const double step_limit = kNewtonStep * model.length_scale();
   for (int it = 0; it < kNewtonIterations; ++it) {
     detail::constraint_values(s, in.x, inputs, ws.g);
@@ -240,7 +261,10 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
           PlanarError::Kind::kNonFinite, "non-finite constraint at " + inputs_text(model, inputs)});
     }
     ws.lu.compute(ws.G);
-    if (s.n > 0 && !(ws.lu.rcond() >= kSingularRcond)) {
+    // inside the iterations a cheap guard (the smallest pivot against the largest; the rows
+    // have gradients of unit length), the condition estimate where it matters, at the end
+    if (s.n > 0 && !(pivot_ratio(ws.lu) >= kSingularPivot) &&
+        !(ws.lu.rcond() >= kSingularRcond)) {
       // a singular Jacobian at a closed position is a singular position; away from closure it
       // means Newton cannot go on
       Eigen::Index worst = 0;
@@ -257,11 +281,21 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
                       "the linkage cannot be assembled at " + inputs_text(model, inputs) + ": " +
                           row_name(s, static_cast<int>(worst)) + " does not close"});
     }
-    const VectorXd step = ws.lu.solve(-ws.g);
-    ws.q += step;
+    ws.step.noalias() = ws.lu.solve(ws.g);
+    ws.q -= ws.step;
     detail::nodes_from_q(s, ws.q, in.x);
-    if (s.n == 0 || step.cwiseAbs().maxCoeff() <= step_limit) {
-      if (s.n > 0 && !(ws.lu.rcond() >= kSingularSolution)) {
+    const double last_step = s.n > 0 ? ws.step.cwiseAbs().maxCoeff() : 0.0;
+    if (last_step <= step_limit) {
+      // the factorisation serves the rates and accelerations: it must be the one at the
+      // solution, not at the iterate before it (up to step_limit away, a relative error of
+      // 1e-14 in every rate that the integrator would see as noise)
+      if (last_step > kRefactorStep * model.length_scale()) {
+        detail::constraint_jacobian(s, in.x, s.rows, ws.G);
+        ws.lu.compute(ws.G);
+      }
+      // a factorisation with well-sized pivots is well conditioned; estimate only the others
+      if (s.n > 0 && !(pivot_ratio(ws.lu) >= kWellConditionedPivot) &&
+          !(ws.lu.rcond() >= kSingularSolution)) {
         return Unexpected<PlanarError>(
             PlanarError{PlanarError::Kind::kSingular,
                         "singular position at " + inputs_text(model, inputs) +
@@ -371,24 +405,17 @@ void forces(const Model& model, Workspace& ws) {
 
   // per link and node: the force on the link from the joint there (f = inertia - load - the
   // link's own constraint forces); stored densely, links x nodes
-  std::vector<Vec2> on_link(l.links.size() * nodes, Vec2(0, 0));
+  std::vector<Vec2>& on_link = ws.on_link;
+  std::fill(on_link.begin(), on_link.end(), Vec2(0, 0));
   auto f = [&](int link, int node) -> Vec2& {
     return on_link[static_cast<std::size_t>(link) * nodes + static_cast<std::size_t>(node)];
   };
-  const Vec2& gravity = l.loads.gravity;
-  std::vector<Vec2> load(l.links.size(), Vec2(0, 0));
-  std::vector<double> moment(l.links.size(), 0.0);
-  for (std::size_t k = 0; k < l.links.size(); ++k) load[k] = l.links[k].mass * gravity;
-  for (const LinkLoad& ld : l.loads.link_loads) {
-    load[static_cast<std::size_t>(ld.link)] += ld.force;
-    moment[static_cast<std::size_t>(ld.link)] += ld.moment;
-  }
   for (std::size_t k = 0; k < l.links.size(); ++k) {
     const System::ElementRow& e = s.elements[k];
     Vec4 acc;
     acc << in.a[static_cast<std::size_t>(e.p)], in.a[static_cast<std::size_t>(e.q)];
     const Vec4 inertia = s.element_M[k] * acc;
-    const Vec4 applied = element_nodal_forces(s.com_weights[k], load[k], moment[k],
+    const Vec4 applied = element_nodal_forces(s.com_weights[k], s.link_force[k], s.link_moment[k],
                                               in.x[static_cast<std::size_t>(e.p)],
                                               in.x[static_cast<std::size_t>(e.q)]);
     f(static_cast<int>(k), e.p) += inertia.segment<2>(0) - applied.segment<2>(0);
@@ -517,29 +544,29 @@ Expected<bool, PlanarError> forward_dynamics(const Model& model, Workspace& ws, 
   const int dof = model.inputs();
   velocities(model, ws, rates);
   // q̇ = T ż: T's columns solve G T = E (E the input rows, scaled as the rows are)
-  ws.T.setZero(s.n, dof);
-  for (const System::InputRow& in : s.inputs) {
-    VectorXd e = VectorXd::Zero(s.n);
-    e[in.row] = in.angle ? in.length : 1.0;
-    ws.T.col(in.input) = ws.lu.solve(e);
-  }
+  ws.MT.setZero(s.n, dof);  // the input rows' unit columns, scaled as the rows are
+  for (const System::InputRow& in : s.inputs) ws.MT(in.row, in.input) = in.angle ? in.length : 1.0;
+  ws.T.noalias() = ws.lu.solve(ws.MT);
   // q̈ = T z̈ + c with G c = -γ
   detail::constraint_bias(s, ws.instant.x, ws.instant.v, s.rows, ws.gamma);
-  const VectorXd c = ws.lu.solve(-ws.gamma);
+  ws.c.noalias() = ws.lu.solve(ws.gamma);  // c = -G⁻¹ γ, the sign applied below
   detail::applied_forces(s, ws.instant.x, ws.instant.v, nullptr, ws.F);
-  ws.MT = s.M * ws.T;
-  ws.reduced = ws.T.transpose() * ws.MT;
-  VectorXd right = ws.T.transpose() * (ws.F - s.M * c);
-  for (int k = 0; k < dof; ++k) right[k] += efforts[static_cast<std::size_t>(k)];
-  Eigen::LDLT<MatrixXd> ldlt(ws.reduced);
-  if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-14)) {
+  ws.MT.noalias() = s.M * ws.T;
+  ws.reduced.noalias() = ws.T.transpose() * ws.MT;
+  ws.rhs.noalias() = s.M * ws.c;
+  ws.rhs += ws.F;  // F - M c with c = -G⁻¹ γ
+  ws.right.noalias() = ws.T.transpose() * ws.rhs;
+  for (int k = 0; k < dof; ++k) ws.right[k] += efforts[static_cast<std::size_t>(k)];
+  ws.ldlt.compute(ws.reduced);
+  if (ws.ldlt.info() != Eigen::Success || !(ws.ldlt.rcond() > 1e-14)) {
     return Unexpected<PlanarError>(PlanarError{PlanarError::Kind::kSingular,
                                                "the reduced inertia of the inputs is singular at " +
                                                    inputs_text(model, ws.instant.input)});
   }
-  const VectorXd zdd = ldlt.solve(right);
-  ws.qdd = ws.T * zdd + c;
-  ws.instant.input_acceleration.assign(zdd.data(), zdd.data() + dof);
+  ws.zdd.noalias() = ws.ldlt.solve(ws.right);
+  ws.qdd.noalias() = ws.T * ws.zdd;
+  ws.qdd -= ws.c;
+  ws.instant.input_acceleration.assign(ws.zdd.data(), ws.zdd.data() + dof);
   auto done = finish(model, ws, t);
   // the efforts are given: the input rows' multipliers reproduce them to round-off
   ws.instant.effort = efforts;

@@ -104,10 +104,12 @@ class Workspace {
   explicit Workspace(const Model& model);
   Instant instant;  // the last instant evaluated
   // scratch
-  Eigen::VectorXd q, qd, qdd, g, gamma, F, rhs, lambda;
+  Eigen::VectorXd q, qd, qdd, g, gamma, F, rhs, lambda, step, c, right, zdd;
   Eigen::MatrixXd G, T, MT, reduced;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu;
+  Eigen::LDLT<Eigen::MatrixXd> ldlt;
   std::vector<Vec2> trial;
+  std::vector<Vec2> on_link;  // force recovery: per link and node, the force from the joint
 };
 
 /// Solves the positions with the inputs at `inputs` by Newton's method from `guess` (node

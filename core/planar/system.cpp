@@ -133,6 +133,13 @@ System::System(const Linkage& l) : linkage(l) {
       }
     }
   }
+  link_force.assign(l.links.size(), Vec2(0, 0));
+  link_moment.assign(l.links.size(), 0.0);
+  for (std::size_t k = 0; k < l.links.size(); ++k) link_force[k] = l.links[k].mass * l.loads.gravity;
+  for (const LinkLoad& ld : l.loads.link_loads) {
+    link_force[static_cast<std::size_t>(ld.link)] += ld.force;
+    link_moment[static_cast<std::size_t>(ld.link)] += ld.moment;
+  }
   node_mass.assign(l.nodes.size(), 0.0);
   for (const PointMass& pm : l.point_masses) {
     node_mass[static_cast<std::size_t>(pm.node)] += pm.mass;
@@ -158,12 +165,17 @@ void node_rates_from(const System& s, const VectorXd& qd, NodeVectors& v) {
   }
 }
 
-VectorXd q_from_nodes(const System& s, const NodeVectors& x) {
-  VectorXd q(s.n);
+void q_from_nodes(const System& s, const NodeVectors& x, VectorXd& q) {
+  q.resize(s.n);
   for (std::size_t i = 0; i < s.coord.size(); ++i) {
     const int c = s.coord[i];
     if (c >= 0) q.segment<2>(c) = x[i];
   }
+}
+
+VectorXd q_from_nodes(const System& s, const NodeVectors& x) {
+  VectorXd q;
+  q_from_nodes(s, x, q);
   return q;
 }
 
@@ -336,18 +348,11 @@ void applied_forces(const System& s, const NodeVectors& x, const NodeVectors& v,
   const Linkage& l = s.linkage;
   const Vec2& g = l.loads.gravity;
   // weights at the centres of mass, and the links' loads (eq. 46)
-  std::vector<Vec2> force(l.links.size(), Vec2(0, 0));
-  std::vector<double> moment(l.links.size(), 0.0);
-  for (std::size_t k = 0; k < l.links.size(); ++k) force[k] = l.links[k].mass * g;
-  for (const LinkLoad& ld : l.loads.link_loads) {
-    force[static_cast<std::size_t>(ld.link)] += ld.force;
-    moment[static_cast<std::size_t>(ld.link)] += ld.moment;
-  }
   for (std::size_t k = 0; k < l.links.size(); ++k) {
-    if (force[k].isZero(0.0) && moment[k] == 0.0) continue;
+    if (s.link_force[k].isZero(0.0) && s.link_moment[k] == 0.0) continue;
     const System::ElementRow& e = s.elements[k];
-    const Vec4 f =
-        element_nodal_forces(s.com_weights[k], force[k], moment[k], at(x, e.p), at(x, e.q));
+    const Vec4 f = element_nodal_forces(s.com_weights[k], s.link_force[k], s.link_moment[k],
+                                        at(x, e.p), at(x, e.q));
     add_force(s, F, e.p, f.segment<2>(0));
     add_force(s, F, e.q, f.segment<2>(2));
   }

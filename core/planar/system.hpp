@@ -80,6 +80,8 @@ struct System {
   std::vector<ElementMass> element_mass;  // per link
   std::vector<Mat4> element_M;            // per link
   std::vector<PointWeights> com_weights;  // per link: its centre of mass on the element
+  std::vector<Vec2> link_force;           // per link: its weight and load at its centre of mass [N]
+  std::vector<double> link_moment;        // per link: its load's moment [N m]
   MatrixXd M;                             // n x n, constant
   std::vector<double> node_mass;          // per node: point masses there [kg]
 
@@ -92,6 +94,7 @@ void nodes_from_q(const System& s, const VectorXd& q, NodeVectors& x);
 void node_rates_from(const System& s, const VectorXd& qd, NodeVectors& v);
 /// q from the node positions (the moving nodes' coordinates).
 VectorXd q_from_nodes(const System& s, const NodeVectors& x);
+void q_from_nodes(const System& s, const NodeVectors& x, VectorXd& q);
 
 /// The angle of input row k from node positions, continued to within π of `near` [rad].
 double input_angle(const System& s, const System::InputRow& in, const NodeVectors& x, double near);
