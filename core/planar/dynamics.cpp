@@ -25,6 +25,11 @@ constexpr int kNewtonIterations = 40;
 // a last Newton step below this (times the linkage's size) leaves the Jacobian unchanged to
 // round-off: its factorisation is kept
 constexpr double kRefactorStep = 4 * std::numeric_limits<double>::epsilon();
+// the chord method (solve_position): each step must shrink the last at least by this factor, the
+// first step must stay within this fraction of the linkage's size, and it takes at most this many
+constexpr double kChordContraction = 0.25;
+constexpr double kChordReach = 1e-2;
+constexpr int kChordIterations = 12;
 // A factorisation whose reciprocal condition estimate is below this is a singular position:
 // velocities and forces there would lose more than half of their digits.
 constexpr double kSingularRcond = 1e-8;
@@ -239,6 +244,48 @@ int mobility(const Model& model) {
 // ---------------------------------------------------------------------------------------------
 // positions
 
+namespace {
+
+Unexpected<PlanarError> singular_at(const Model& model, const Workspace& ws,
+                                    const std::vector<double>& inputs) {
+  return Unexpected<PlanarError>(
+      PlanarError{PlanarError::Kind::kSingular,
+                  "singular position at " + inputs_text(model, inputs) +
+                      " (the constraints and inputs lose rank: reciprocal condition " +
+                      text::digits(ws.lu.rcond(), 2) + ")"});
+}
+
+// The chord method from ws.instant.x (the guess): Newton's steps with the factorisation of the
+// last solved position, whose Jacobian differs from the one here by about the distance moved (a
+// driven or integrated sample's step). Each iteration costs a constraint evaluation and two
+// triangular solves instead of a Jacobian and a factorisation. It converges linearly; a
+// contraction worse than kChordContraction, or too many steps, hands over to Newton. On success
+// the position is exact to round-off: after the step that moves no coordinate by more than the
+// step limit, one more (the remaining error shrinks by the contraction again).
+bool chord_iterations(const Model& model, Workspace& ws, const std::vector<double>& inputs) {
+  const System& s = model.system();
+  Instant& in = ws.instant;
+  const double step_limit = kNewtonStep * model.length_scale();
+  double previous = std::numeric_limits<double>::infinity();
+  bool converged = false;
+  for (int it = 0; it < kChordIterations; ++it) {
+    detail::constraint_values(s, in.x, inputs, ws.g);
+    ws.step.noalias() = ws.lu.solve(ws.g);
+    const double size = ws.step.cwiseAbs().maxCoeff();
+    if (!std::isfinite(size) || (it == 0 && size > kChordReach * model.length_scale()) ||
+        (size > kChordContraction * previous && size > kRefactorStep * model.length_scale()))
+      return false;  // (below kRefactorStep the steps are round-off and need not shrink)
+    ws.q -= ws.step;
+    detail::nodes_from_q(s, ws.q, in.x);
+    if (converged) return true;
+    converged = size <= step_limit;
+    previous = size;
+  }
+  return false;
+}
+
+}  // namespace
+
 Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
                                            const std::vector<Vec2>& guess,
                                            const std::vector<double>& inputs) {
@@ -250,6 +297,30 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
                                                       std::to_string(s.n - s.structural_rows) +
                                                       " free coordinates left by the constraints"});
   }
+  if (s.n == 0) {
+    in.x = guess;
+    in.input = inputs;
+    return true;
+  }
+  // the final factorisation, at the solution: the rates, accelerations and multipliers use it
+  auto solved = [&]() -> Expected<bool, PlanarError> {
+    detail::constraint_jacobian(s, in.x, s.rows, ws.G);
+    ws.lu.compute(ws.G);
+    ws.factorised = false;
+    // a factorisation with well-sized pivots is well conditioned; estimate only the others
+    if (!ws.G.allFinite() ||
+        (!(pivot_ratio(ws.lu) >= kWellConditionedPivot) && !(ws.lu.rcond() >= kSingularSolution)))
+      return singular_at(model, ws, inputs);
+    ws.factorised = true;
+    in.input = inputs;
+    return true;
+  };
+  if (ws.factorised) {
+    in.x = guess;
+    detail::q_from_nodes(s, in.x, ws.q);
+    if (chord_iterations(model, ws, inputs)) return solved();
+  }
+  ws.factorised = false;
   in.x = guess;
   detail::q_from_nodes(s, in.x, ws.q);
   const double step_limit = kNewtonStep * model.length_scale();
@@ -262,20 +333,13 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
     }
     ws.lu.compute(ws.G);
     // inside the iterations a cheap guard (the smallest pivot against the largest; the rows
-    // have gradients of unit length), the condition estimate where it matters, at the end
-    if (s.n > 0 && !(pivot_ratio(ws.lu) >= kSingularPivot) &&
-        !(ws.lu.rcond() >= kSingularRcond)) {
+    // have gradients of unit length), the condition estimate only where it is poor
+    if (!(pivot_ratio(ws.lu) >= kSingularPivot) && !(ws.lu.rcond() >= kSingularRcond)) {
       // a singular Jacobian at a closed position is a singular position; away from closure it
       // means Newton cannot go on
       Eigen::Index worst = 0;
       const double residual = s.rows > 0 ? ws.g.cwiseAbs().maxCoeff(&worst) : 0.0;
-      if (residual <= 1e-9 * model.length_scale()) {
-        return Unexpected<PlanarError>(
-            PlanarError{PlanarError::Kind::kSingular,
-                        "singular position at " + inputs_text(model, inputs) +
-                            " (the constraints and inputs lose rank: reciprocal condition " +
-                            text::digits(ws.lu.rcond(), 2) + ")"});
-      }
+      if (residual <= 1e-9 * model.length_scale()) return singular_at(model, ws, inputs);
       return Unexpected<PlanarError>(
           PlanarError{PlanarError::Kind::kAssembly,
                       "the linkage cannot be assembled at " + inputs_text(model, inputs) + ": " +
@@ -284,24 +348,15 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
     ws.step.noalias() = ws.lu.solve(ws.g);
     ws.q -= ws.step;
     detail::nodes_from_q(s, ws.q, in.x);
-    const double last_step = s.n > 0 ? ws.step.cwiseAbs().maxCoeff() : 0.0;
+    const double last_step = ws.step.cwiseAbs().maxCoeff();
     if (last_step <= step_limit) {
-      // the factorisation serves the rates and accelerations: it must be the one at the
-      // solution, not at the iterate before it (up to step_limit away, a relative error of
-      // 1e-14 in every rate that the integrator would see as noise)
-      if (last_step > kRefactorStep * model.length_scale()) {
-        detail::constraint_jacobian(s, in.x, s.rows, ws.G);
-        ws.lu.compute(ws.G);
-      }
-      // a factorisation with well-sized pivots is well conditioned; estimate only the others
-      if (s.n > 0 && !(pivot_ratio(ws.lu) >= kWellConditionedPivot) &&
-          !(ws.lu.rcond() >= kSingularSolution)) {
-        return Unexpected<PlanarError>(
-            PlanarError{PlanarError::Kind::kSingular,
-                        "singular position at " + inputs_text(model, inputs) +
-                            " (the constraints and inputs lose rank: reciprocal condition " +
-                            text::digits(ws.lu.rcond(), 2) + ")"});
-      }
+      // the rates and accelerations need the factorisation at the solution, not at the iterate
+      // before it (up to step_limit away: a relative error of 1e-14 in every rate, which an
+      // integrator at tight tolerance sees as noise)
+      if (last_step > kRefactorStep * model.length_scale()) return solved();
+      if (!(pivot_ratio(ws.lu) >= kWellConditionedPivot) && !(ws.lu.rcond() >= kSingularSolution))
+        return singular_at(model, ws, inputs);
+      ws.factorised = true;
       in.input = inputs;
       return true;
     }
@@ -360,7 +415,7 @@ void velocities(const Model& model, Workspace& ws, const std::vector<double>& ra
     const double r = rates[static_cast<std::size_t>(in.input)];
     ws.rhs[in.row] = in.angle ? in.length * r : r;
   }
-  ws.qd = ws.lu.solve(ws.rhs);
+  ws.qd.noalias() = ws.lu.solve(ws.rhs);
   detail::node_rates_from(s, ws.qd, ws.instant.v);
   ws.instant.input_rate = rates;
 }
@@ -500,8 +555,9 @@ Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t) 
   in.t = t;
   detail::node_rates_from(s, ws.qdd, in.a);
   detail::applied_forces(s, in.x, in.v, nullptr, ws.F);
-  ws.rhs = s.M * ws.qdd - ws.F;
-  ws.lambda = ws.lu.transpose().solve(ws.rhs);
+  ws.rhs.noalias() = s.M * ws.qdd;
+  ws.rhs -= ws.F;
+  ws.lambda.noalias() = ws.lu.transpose().solve(ws.rhs);
   for (const System::InputRow& ir : s.inputs) {
     in.effort[static_cast<std::size_t>(ir.input)] =
         ir.angle ? ws.lambda[ir.row] * ir.length : ws.lambda[ir.row];
@@ -532,7 +588,7 @@ Expected<bool, PlanarError> inverse_dynamics(const Model& model, Workspace& ws, 
     const double z = accelerations[static_cast<std::size_t>(in.input)];
     ws.rhs[in.row] += in.angle ? in.length * z : z;
   }
-  ws.qdd = ws.lu.solve(ws.rhs);
+  ws.qdd.noalias() = ws.lu.solve(ws.rhs);
   ws.instant.input_acceleration = accelerations;
   return finish(model, ws, t);
 }

@@ -107,6 +107,7 @@ class Workspace {
   Eigen::VectorXd q, qd, qdd, g, gamma, F, rhs, lambda, step, c, right, zdd;
   Eigen::MatrixXd G, T, MT, reduced;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu;
+  bool factorised = false;  // lu holds the Jacobian at the last position solve_position solved
   Eigen::LDLT<Eigen::MatrixXd> ldlt;
   std::vector<Vec2> trial;
   std::vector<Vec2> on_link;  // force recovery: per link and node, the force from the joint

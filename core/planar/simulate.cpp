@@ -186,8 +186,9 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
   out.table.values.reserve(static_cast<std::size_t>(rows) * out.table.width());
   const std::vector<double> zero(static_cast<std::size_t>(dof), 0.0);
   std::vector<double> z(static_cast<std::size_t>(dof));
-  std::vector<Vec2> guess = ws.instant.x, previous = ws.instant.x;
+  std::vector<Vec2> guess = ws.instant.x, previous = ws.instant.x, a_previous;
   std::vector<double> z_previous = start, z_step(z.size());
+  double h_previous = 0;
   // the sign of the constraints' and inputs' determinant tells the assembly branch: it changes
   // only through a singular position, where the branches meet
   auto branch = [&ws]() { return ws.lu.determinant() < 0 ? -1 : 1; };
@@ -198,14 +199,19 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
                          ? scene.duration * static_cast<double>(i) / static_cast<double>(rows - 1)
                          : period * static_cast<double>(i) / scene.samples;
     for (std::size_t k = 0; k < z.size(); ++k) z[k] = start[k] + scene.speeds[k] * t;
-    // the previous sample carried forward to second order: Newton then needs two or three steps
+    // the previous sample carried forward to third order (the jerk from the last two samples'
+    // accelerations): the chord method then needs a few steps
     if (i > 0) {
       const double h = t - t_prev;
       previous = ws.instant.x;
       for (std::size_t n = 0; n < guess.size(); ++n) {
-        guess[n] = ws.instant.x[n] + h * ws.instant.v[n] + 0.5 * h * h * ws.instant.a[n];
+        const Vec2 jerk = i > 1 ? Vec2((ws.instant.a[n] - a_previous[n]) / h_previous) : Vec2(0, 0);
+        guess[n] = ws.instant.x[n] +
+                   h * (ws.instant.v[n] + h / 2 * (ws.instant.a[n] + h / 3 * jerk));
       }
+      h_previous = h;
     }
+    a_previous = ws.instant.a;
     auto ok = solve_position(model, ws, guess, z);
     if (ok && i > 0 && branch() != drawn_branch) {
       // near a singular position the prediction can overshoot onto another branch (the rates
