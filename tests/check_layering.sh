@@ -27,6 +27,21 @@ forbid "a layer above core includes core's internals" 'core/(fourbar/)?detail/' 
 forbid "balance/ includes a higher layer" '(optimize|studies|cli|tests)/' balance
 forbid "optimize/ includes a higher layer" '(studies|cli|tests)/' optimize
 forbid "studies/ includes a higher layer" '(cli|tests)/' studies
+# core's two linkage types stand side by side: the four-bar knows nothing of the general engine,
+# and the general engine sees the four-bar only where it maps one onto itself (from_fourbar)
+forbid "core/fourbar/ includes the general engine (core/planar/)" 'core/planar/' core/fourbar
+forbid "core/planar/ includes the four-bar outside from_fourbar" 'core/fourbar/' \
+  $(ls core/planar/*.hpp core/planar/*.cpp 2>/dev/null | grep -v from_fourbar)
+# inside studies/: study <- run <- {bench, sweep} <- report <- studies.hpp (the facade)
+forbid "studies/study/ includes a higher floor of studies/" 'studies/(run|bench|sweep|report)/|studies/studies' \
+  studies/study
+forbid "studies/run/ includes a higher floor of studies/" 'studies/(bench|sweep|report)/|studies/studies' \
+  studies/run
+forbid "studies/bench/ includes a higher floor of studies/" 'studies/(sweep|report)/|studies/studies' \
+  studies/bench
+forbid "studies/sweep/ includes a higher floor of studies/" 'studies/(bench|report)/|studies/studies' \
+  studies/sweep
+forbid "studies/report/ includes the facade" 'studies/studies' studies/report
 forbid "yaml-cpp outside studies/" 'yaml-cpp/' core balance optimize cli
 forbid "CLI11 outside cli/" 'CLI/' core balance optimize studies
 forbid "NLopt or Ipopt outside optimize/*.cpp" '(nlopt|coin/|coin-or/|IpIpopt)' \

@@ -396,9 +396,15 @@ Expected<bool, PlanarError> assemble(const Model& model, Workspace& ws,
   return true;
 }
 
+void efforts_at(const Model& model, double t, std::vector<double>& out) {
+  const std::vector<Input>& inputs = model.linkage().inputs;
+  out.resize(inputs.size());
+  for (std::size_t k = 0; k < inputs.size(); ++k) out[k] = inputs[k].effort(t);
+}
+
 std::vector<double> efforts_at(const Model& model, double t) {
   std::vector<double> e;
-  for (const Input& in : model.linkage().inputs) e.push_back(in.effort(t));
+  efforts_at(model, t, e);
   return e;
 }
 
@@ -557,7 +563,11 @@ Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t) 
   detail::applied_forces(s, in.x, in.v, nullptr, ws.F);
   ws.rhs.noalias() = s.M * ws.qdd;
   ws.rhs -= ws.F;
-  ws.lambda.noalias() = ws.lu.transpose().solve(ws.rhs);
+  // Gᵀ λ = rhs with G = P⁻¹ L U: Uᵀ, then Lᵀ, then the permutation, in place (no temporary)
+  ws.lambda = ws.rhs;
+  ws.lu.matrixLU().triangularView<Eigen::Upper>().transpose().solveInPlace(ws.lambda);
+  ws.lu.matrixLU().triangularView<Eigen::UnitLower>().transpose().solveInPlace(ws.lambda);
+  ws.lambda = ws.lu.permutationP().transpose() * ws.lambda;
   for (const System::InputRow& ir : s.inputs) {
     in.effort[static_cast<std::size_t>(ir.input)] =
         ir.angle ? ws.lambda[ir.row] * ir.length : ws.lambda[ir.row];

@@ -159,5 +159,7 @@ void finish_outputs(const Model& model, Workspace& ws);
 
 /// The efforts of the model's inputs at time t (their TimeFunctions).
 std::vector<double> efforts_at(const Model& model, double t);
+/// The same into `out` (resized to the inputs).
+void efforts_at(const Model& model, double t, std::vector<double>& out);
 
 }  // namespace bd::core::planar

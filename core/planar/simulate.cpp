@@ -258,9 +258,11 @@ struct Motion {
   double error_t{};
   double root_sign = 1;     // the sign of the normalised determinant at the start
   std::vector<Vec2> cache;  // positions of the last successful evaluation (Newton's guess)
+  std::vector<double> z, zd, efforts;  // scratch: the inputs, their rates, the drives' efforts
   // dae route scratch
   MatrixXd kkt;
-  VectorXd kkt_rhs;
+  VectorXd kkt_rhs, kkt_solution, rate_residual;
+  std::vector<double> none;  // no input values: the structural rows only
   Eigen::PartialPivLU<MatrixXd> kkt_lu;
 };
 
@@ -274,9 +276,11 @@ double normalised_determinant(Workspace& ws) {
 // reduced route: y = (z, ż)
 Expected<bool, PlanarError> reduced_state(Motion& m, double t, const double* y) {
   const int dof = m.dof;
-  const std::vector<double> z(y, y + dof), zd(y + dof, y + 2 * dof);
-  auto ok = solve_position(*m.model, *m.ws, m.cache, z);
-  if (ok) ok = forward_dynamics(*m.model, *m.ws, t, zd, efforts_at(*m.model, t));
+  m.z.assign(y, y + dof);
+  m.zd.assign(y + dof, y + 2 * dof);
+  efforts_at(*m.model, t, m.efforts);
+  auto ok = solve_position(*m.model, *m.ws, m.cache, m.z);
+  if (ok) ok = forward_dynamics(*m.model, *m.ws, t, m.zd, m.efforts);
   if (ok) m.cache = m.ws->instant.x;
   return ok;
 }
@@ -303,8 +307,8 @@ int reduced_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* data) {
 int reduced_root(sunrealtype, N_Vector y, sunrealtype* g, void* data) {
   Motion& m = *static_cast<Motion*>(data);
   const double* yv = N_VGetArrayPointer(y);
-  const std::vector<double> z(yv, yv + m.dof);
-  if (!solve_position(*m.model, *m.ws, m.cache, z)) {
+  m.z.assign(yv, yv + m.dof);
+  if (!solve_position(*m.model, *m.ws, m.cache, m.z)) {
     g[0] = -1;  // beyond a limit: the root lies before
     return 0;
   }
@@ -326,8 +330,8 @@ Expected<bool, PlanarError> dae_accelerations(Motion& m, double t, const double*
   detail::node_rates_from(s, ws.qd, ws.instant.v);
   detail::constraint_jacobian(s, ws.instant.x, r, ws.G);
   detail::constraint_bias(s, ws.instant.x, ws.instant.v, r, ws.gamma);
-  const std::vector<double> efforts = efforts_at(*m.model, t);
-  detail::applied_forces(s, ws.instant.x, ws.instant.v, &efforts, ws.F);
+  efforts_at(*m.model, t, m.efforts);
+  detail::applied_forces(s, ws.instant.x, ws.instant.v, &m.efforts, ws.F);
   m.kkt.setZero(n + r, n + r);
   m.kkt.topLeftCorner(n, n) = s.M;
   m.kkt.topRightCorner(n, r) = -ws.G.transpose();
@@ -336,10 +340,10 @@ Expected<bool, PlanarError> dae_accelerations(Motion& m, double t, const double*
   m.kkt_rhs.head(n) = ws.F;
   m.kkt_rhs.tail(r) = -ws.gamma;
   if (stabilise && m.baumgarte > 0) {
-    std::vector<double> none;
-    detail::constraint_values(s, ws.instant.x, none, ws.g);
+    detail::constraint_values(s, ws.instant.x, m.none, ws.g);
     const double a = m.baumgarte;
-    m.kkt_rhs.tail(r) -= 2 * a * (ws.G * ws.qd) + a * a * ws.g.head(r);
+    m.rate_residual.noalias() = ws.G * ws.qd;
+    m.kkt_rhs.tail(r) -= 2 * a * m.rate_residual + a * a * ws.g.head(r);
   }
   m.kkt_lu.compute(m.kkt);
   if (!(m.kkt_lu.rcond() > 1e-12)) {
@@ -347,10 +351,10 @@ Expected<bool, PlanarError> dae_accelerations(Motion& m, double t, const double*
         PlanarError::Kind::kSingular,
         "the constraints lose rank (a lock-up or a branch point): the linkage cannot move on"});
   }
-  const VectorXd sol = m.kkt_lu.solve(m.kkt_rhs);
-  ws.qdd = sol.head(n);
+  m.kkt_solution.noalias() = m.kkt_lu.solve(m.kkt_rhs);
+  ws.qdd = m.kkt_solution.head(n);
   ws.lambda.setZero(s.rows);
-  ws.lambda.head(r) = sol.tail(r);
+  ws.lambda.head(r) = m.kkt_solution.tail(r);
   if (!ws.qdd.allFinite()) {
     return Unexpected<PlanarError>(
         PlanarError{PlanarError::Kind::kNonFinite, "non-finite accelerations"});
@@ -424,11 +428,11 @@ Expected<bool, PlanarError> dae_instant(Motion& m, double t, const double* y) {
   Instant& in = ws.instant;
   in.t = t;
   detail::node_rates_from(s, ws.qdd, in.a);
-  const std::vector<double> efforts = efforts_at(model, t);
+  efforts_at(model, t, m.efforts);
   for (const System::InputRow& ir : s.inputs) {
     const std::size_t k = static_cast<std::size_t>(ir.input);
-    in.effort[k] = efforts[k];
-    ws.lambda[ir.row] = ir.angle ? efforts[k] / ir.length : efforts[k];
+    in.effort[k] = m.efforts[k];
+    ws.lambda[ir.row] = ir.angle ? m.efforts[k] / ir.length : m.efforts[k];
   }
   detail::finish_outputs(model, ws);
   // the inputs as the nodes give them
@@ -450,10 +454,12 @@ Expected<bool, PlanarError> dae_instant(Motion& m, double t, const double* y) {
   return true;
 }
 
-// the outcome of one advance, as the trajectory's status; false when the run stops
+// the outcome of one advance, as the trajectory's status; false when the run stops. `where()`
+// says where a limit position was reached (written only then).
+template <class Where>
 bool advance_ok(Trajectory& out, const Motion& m, integrators::Integration& integration,
                 integrators::Integration::Outcome outcome, const SimulateOptions& options,
-                const std::string& where) {
+                Where where) {
   using Outcome = integrators::Integration::Outcome;
   if (outcome == Outcome::kReached) return true;
   const std::string at = "t = " + text::digits(integration.t(), 10) + " s";
@@ -463,7 +469,7 @@ bool advance_ok(Trajectory& out, const Motion& m, integrators::Integration& inte
                   ": max_steps = " + std::to_string(options.max_steps) + " reached";
   } else if (outcome == Outcome::kRoot) {
     out.status = SimulationStatus::kSingular;
-    out.message = "limit position reached at " + where +
+    out.message = "limit position reached at " + where() +
                   ": the inputs stop being coordinates of the motion there (the dae route "
                   "goes through it)";
   } else if (m.failed) {
@@ -488,6 +494,7 @@ Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scen
   const int dof = model.inputs();
   Trajectory out;
   out.table.columns = columns(model);
+  out.table.values.reserve(static_cast<std::size_t>(scene.samples) * out.table.width());
   Motion m;
   m.model = &model;
   m.ws = &ws;
@@ -525,9 +532,11 @@ Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scen
   for (std::size_t j = 1; j < static_cast<std::size_t>(scene.samples); ++j) {
     m.failed = false;
     const auto outcome = integration.advance(output_time(scene, j));
-    const std::vector<double> z(integration.y(), integration.y() + dof);
-    if (!advance_ok(out, m, integration, outcome, options, state_text(model, integration.t(), z)))
-      break;
+    const auto where = [&] {
+      return state_text(model, integration.t(),
+                        std::vector<double>(integration.y(), integration.y() + dof));
+    };
+    if (!advance_ok(out, m, integration, outcome, options, where)) break;
     ++m.evaluations;
     const auto ok = reduced_state(m, integration.t(), integration.y());
     if (!ok) {
@@ -547,6 +556,7 @@ Trajectory free_dae(const Model& model, Workspace& ws, const FreeScene& scene,
   const System& s = model.system();
   Trajectory out;
   out.table.columns = columns(model);
+  out.table.values.reserve(static_cast<std::size_t>(scene.samples) * out.table.width());
   Motion m;
   m.model = &model;
   m.ws = &ws;
@@ -589,9 +599,8 @@ Trajectory free_dae(const Model& model, Workspace& ws, const FreeScene& scene,
   for (std::size_t j = 1; j < static_cast<std::size_t>(scene.samples); ++j) {
     m.failed = false;
     const auto outcome = integration.advance(output_time(scene, j));
-    if (!advance_ok(out, m, integration, outcome, options,
-                    "t = " + text::digits(integration.t(), 10) + " s"))
-      break;
+    const auto where = [&] { return "t = " + text::digits(integration.t(), 10) + " s"; };
+    if (!advance_ok(out, m, integration, outcome, options, where)) break;
     y.assign(integration.y(), integration.y() + y0.size());
     project(model, ws, y.data());
     ++m.evaluations;

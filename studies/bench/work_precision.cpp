@@ -84,7 +84,7 @@ core::SimulateOptions simulate_options(core::Formulation f, core::Integrator int
   return o;
 }
 
-// the other formulation that references f (DESIGN.md: they must agree to round-off)
+// the other formulation that references f (docs/architecture.md: the formulations agree to round-off)
 core::Formulation other_formulation(core::Formulation f) {
   return f == core::Formulation::kMassMatrix ? core::Formulation::kComplexMasses
                                              : core::Formulation::kMassMatrix;

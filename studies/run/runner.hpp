@@ -1,6 +1,6 @@
 #pragma once
 /// Running a study: simulate its scene, then write timeseries.csv and summary.json
-/// (DESIGN.md "Outputs (v1 contract)"); for a study with a balance section also the balanced
+/// (docs/study-format.md, "Outputs"); for a study with a balance section also the balanced
 /// design's balanced-timeseries.csv, balanced.yaml and comparison.csv; for a study with an
 /// optimize section the optimum's optimized-timeseries.csv, optimized.yaml, comparison.csv and,
 /// with a Pareto front, pareto.csv.

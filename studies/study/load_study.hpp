@@ -1,5 +1,5 @@
 #pragma once
-/// Loading and validating a study file (DESIGN.md "Study file (v1)", docs/study-format.md).
+/// Loading and validating a study file (docs/study-format.md).
 #include <string>
 
 #include "core/input_error.hpp"

@@ -14,7 +14,7 @@ std::string vec(const Vec2& v) {
   return "[" + text::exact(v.x()) + ", " + text::exact(v.y()) + "]";
 }
 
-// the paper's polar form s, sigma (what people read and what the issue asks for); reading it
+// the paper's polar form s, sigma (what people read and write); reading it
 // back reproduces e, f to within a few ulps (s e^{i sigma} rounds), which the comment records
 std::string link_line(const char* name, const core::Link& l) {
   return std::string("  ") + name + ": {length: " + text::exact(l.length) +

@@ -1,4 +1,4 @@
-// Every shipped example study runs as is (STYLE.md: "Each studies/examples/*.yaml runs as is").
+// Every shipped example study runs as is: users start from them.
 #include <gtest/gtest.h>
 
 #include <filesystem>
