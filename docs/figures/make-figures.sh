@@ -14,6 +14,8 @@ trap 'rm -rf "$tmp"' EXIT
 "$bin" run studies/examples/paper-fourbar-driven-force-balanced.yaml --out "$tmp/driven-balanced" \
   >/dev/null
 "$bin" run studies/examples/paper-fourbar-sweep.yaml --out "$tmp/sweep" --progress none >/dev/null
+"$bin" run studies/examples/engine-slider-crank.yaml --out "$tmp/engine" >/dev/null
+"$bin" run studies/examples/watt-sixbar.yaml --out "$tmp/watt" >/dev/null
 
 # extract_chart PAGE ID FILE: the chart `ID` of a report.html, as the page draws it, written as a
 # standalone SVG file (the page inlines it without an XML prolog or a size)
@@ -41,6 +43,11 @@ extract_chart "$tmp/driven-balanced/report.html" hodograph "$out/report-hodograp
 # the shaking moment over the sweep's 21 x 21 grid, original and force balanced, from the sweep's
 # report.html
 extract_chart "$tmp/sweep/report.html" sweep-Msh "$out/sweep-shaking-moment.svg"
+# general planar linkages: the engine's slider-crank at 3000 rpm and the Watt six-bar
+extract_chart "$tmp/engine/report.html" linkage "$out/engine-slider-crank-linkage.svg"
+extract_chart "$tmp/engine/report.html" hodograph "$out/engine-slider-crank-hodograph.svg"
+extract_chart "$tmp/watt/report.html" linkage "$out/watt-sixbar-linkage.svg"
+extract_chart "$tmp/watt/report.html" joints "$out/watt-sixbar-joints.svg"
 
 gnuplot <<GP
 set datafile separator ','

@@ -2,6 +2,7 @@
 // timeseries.csv by column name (core/planar/simulate.hpp lists the columns).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -89,8 +90,20 @@ Chart linkage_chart(const Linkage& l, const Csv& ts, std::string& datablocks) {
     if (node.ground) datablocks += xy(node.position) + "\n";
   }
   datablocks += "EOD\n$pguides << EOD\n";
+  // a frame guide over the stretch its node travels, and a little more (the line the study
+  // gives may be far longer: a cylinder axis given as [0, 0] to [1, 0])
   for (const core::planar::Slider& s : l.sliders) {
-    if (s.link < 0) datablocks += xy(s.from) + "\n" + xy(s.to) + "\n\n";
+    if (s.link >= 0) continue;
+    const Vec2 u = (s.to - s.from).normalized();
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const auto& text_row : ts.rows) {
+      const double along = u.dot(node_at(numbers(text_row), s.node) - s.from);
+      lo = std::min(lo, along);
+      hi = std::max(hi, along);
+    }
+    if (!(hi >= lo)) lo = hi = 0;
+    const double margin = std::max(0.25 * (hi - lo), 1e-3);
+    datablocks += xy(s.from + (lo - margin) * u) + "\n" + xy(s.from + (hi + margin) * u) + "\n\n";
   }
   datablocks += "EOD\n";
   std::string cmd = "set title 'The linkage at " + std::to_string(picks.size()) +
