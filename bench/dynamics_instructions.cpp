@@ -11,6 +11,11 @@
 //                             the same with core::detail::DynamicsConstants computed once, as a
 //                             simulation or a sweep calls them
 //   driven                    N driven revolutions of 360 samples (as BM_DrivenRevolution)
+//   planar:forward, planar:inverse
+//                             N instants of the general engine on the same four-bar: a position
+//                             solve from the previous instant's nodes, then forward or inverse
+//                             dynamics with every force (core::planar)
+//   planar:driven             N driven revolutions of 360 samples on the general engine
 // The instants: the paper's four-bar, theta1 from 1 rad in steps of 1e-3 rad, omega1 2 rad/s,
 // alpha1 0.5 rad/s^2. Instructions per evaluation = (count(KIND, N) - count(none, 0)) / N.
 #include <cstdio>
@@ -22,6 +27,9 @@
 #include "core/fourbar/kinematics.hpp"
 #include "core/fourbar/samples.hpp"
 #include "core/fourbar/simulate.hpp"
+#include "core/planar/dynamics.hpp"
+#include "core/planar/from_fourbar.hpp"
+#include "core/planar/simulate.hpp"
 
 int main(int argc, char** argv) {
   using namespace bd::core;
@@ -32,7 +40,29 @@ int main(int argc, char** argv) {
   const std::string kind = argv[1];
   const int n = std::atoi(argv[2]);
   double checksum = 0.0;  // printed, so that no evaluation is optimised away
-  if (kind == "driven") {
+  if (kind == "planar:driven") {
+    const planar::Model model(planar::linkage_of(samples::paper_fourbar_unloaded(), 0.0));
+    const planar::DrivenScene scene{{0.0}, {6.283185307179586}, 1, 0, 360};
+    for (int i = 0; i < n; ++i) {
+      const planar::Trajectory t = planar::simulate_driven(model, scene);
+      checksum += t.table.values.back();
+    }
+  } else if (kind == "planar:forward" || kind == "planar:inverse") {
+    const planar::Model model(planar::linkage_of(samples::paper_fourbar(), 1.0));
+    planar::Workspace ws(model);
+    std::vector<bd::Vec2> guess = ws.instant.x;
+    std::vector<double> z{1.0};
+    const std::vector<double> rate{2.0}, acceleration{0.5}, effort{0.0};
+    for (int i = 0; i < n; ++i) {
+      bool ok = static_cast<bool>(planar::solve_position(model, ws, guess, z));
+      ok = ok && (kind == "planar:inverse"
+                      ? static_cast<bool>(planar::inverse_dynamics(model, ws, 0.0, rate, acceleration))
+                      : static_cast<bool>(planar::forward_dynamics(model, ws, 0.0, rate, effort)));
+      if (ok) checksum += ws.instant.ground_reaction[0].x();
+      guess = ws.instant.x;
+      z[0] += 1e-3;
+    }
+  } else if (kind == "driven") {
     const FourBar model = samples::paper_fourbar_unloaded();
     const DrivenScene scene{
         .theta1 = 0.0, .omega1 = 6.283185307179586, .revolutions = 1, .samples = 360};
