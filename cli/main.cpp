@@ -589,34 +589,60 @@ std::vector<std::string> with_default_command(int argc, char** argv) {
   return args;
 }
 
+// the program's description, after its name and version
+constexpr const char* kDescription =
+    ": shaking-force and shaking-moment balancing of planar linkages.\n"
+    "Simulates the linkage of a study file (a four-bar or any planar linkage of links, pins and\n"
+    "sliders; free motion or driven inputs) and writes its reaction and joint forces, shaking\n"
+    "force and moment and drive efforts; with a balance section (four-bars) it also synthesises\n"
+    "the balanced design (counterweights, counter-rotations), simulates it in the same scene\n"
+    "and compares the two; with an optimize section (four-bars) it searches for the best design\n"
+    "(NLopt, Ipopt) under constraints and does the same with it.\n\n"
+    "Commands:\n"
+    "  balance-design run STUDY.yaml [--out DIR]   run a study, write its outputs into DIR\n"
+    "  balance-design STUDY.yaml [--out DIR]       the same: run is the default command\n"
+    "  balance-design run STUDY.yaml --resume      continue an interrupted sweep (a study\n"
+    "                                              with a sweep section) where it stopped\n"
+    "  balance-design validate STUDY.yaml          load and check the study only; prints\n"
+    "                                              an ok line (exit 0) or the error (exit 2)\n"
+    "  balance-design report DIR                   rebuild DIR/report.html from the data\n"
+    "                                              files of a run or sweep (and its study\n"
+    "                                              file)\n"
+    "  balance-design bench STUDY.yaml [--out DIR] [--quick] [--repeats N]\n"
+    "                                              run the study, then measure speed\n"
+    "                                              against accuracy (work-precision.csv or\n"
+    "                                              driven-convergence.csv, report.html)\n"
+    "  balance-design run --help                   the options of run\n";
+
+// the bench command and its options
+CLI::App* add_bench_command(CLI::App& app, BenchArgs& bench_args) {
+  CLI::App* bench_cmd = app.add_subcommand(
+      "bench",
+      "run STUDY.yaml as run does, then time every method and integrator against its "
+      "accuracy (free scene: tolerances 1e-3 ... 1e-13, work-precision.csv; driven scene: 4 ... "
+      "720 samples per revolution, driven-convergence.csv) and rewrite report.html");
+  bench_cmd->add_option("STUDY", bench_args.study, "the study file (free or driven scene)")
+      ->required()
+      ->type_name("FILE");
+  bench_cmd
+      ->add_option("-o,--out", bench_args.out,
+                   "output directory, created if needed (default: results/<name>/)")
+      ->type_name("DIR");
+  bench_cmd->add_flag("--quick", bench_args.quick,
+                      "tolerances 1e-4, 1e-7, 1e-10 only, one repeat (a few seconds)");
+  bench_cmd
+      ->add_option("--repeats", bench_args.repeats,
+                   "timed runs per point, the median reported (default 5; 1 with --quick)")
+      ->check(CLI::Range(1, 1000))
+      ->type_name("N");
+  return bench_cmd;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   try {
-    CLI::App app{
-        "balance-design " BD_VERSION
-        ": shaking-force and shaking-moment balancing of planar four-bar linkages.\n"
-        "Simulates the linkage of a study file (free motion or a driven crank) and writes its\n"
-        "reaction forces, shaking force and moment and drive torque; with a balance section it\n"
-        "also synthesises the balanced design (counterweights, counter-rotations), simulates\n"
-        "it in the same scene and compares the two; with an optimize section it searches for\n"
-        "the best design (NLopt, Ipopt) under constraints and does the same with it.\n\n"
-        "Commands:\n"
-        "  balance-design run STUDY.yaml [--out DIR]   run a study, write its outputs into DIR\n"
-        "  balance-design STUDY.yaml [--out DIR]       the same: run is the default command\n"
-        "  balance-design run STUDY.yaml --resume      continue an interrupted sweep (a study\n"
-        "                                              with a sweep section) where it stopped\n"
-        "  balance-design validate STUDY.yaml          load and check the study only; prints\n"
-        "                                              an ok line (exit 0) or the error (exit 2)\n"
-        "  balance-design report DIR                   rebuild DIR/report.html from the data\n"
-        "                                              files of a run or sweep (and its study\n"
-        "                                              file)\n"
-        "  balance-design bench STUDY.yaml [--out DIR] [--quick] [--repeats N]\n"
-        "                                              run the study, then measure speed\n"
-        "                                              against accuracy (work-precision.csv or\n"
-        "                                              driven-convergence.csv, report.html)\n"
-        "  balance-design run --help                   the options of run\n",
-        "balance-design"};
+    CLI::App app{std::string("balance-design ") + BD_VERSION + kDescription, "balance-design"};
     app.footer(kFooter);
     app.set_version_flag("--version", std::string("balance-design ") + BD_VERSION);
     app.require_subcommand(1);
@@ -641,25 +667,7 @@ int main(int argc, char** argv) {
         ->type_name("DIR");
 
     BenchArgs bench_args;
-    CLI::App* bench_cmd = app.add_subcommand(
-        "bench",
-        "run STUDY.yaml as run does, then time every formulation and integrator against its "
-        "accuracy (free scene: tolerances 1e-3 ... 1e-13, work-precision.csv; driven scene: 4 ... "
-        "720 samples per revolution, driven-convergence.csv) and rewrite report.html");
-    bench_cmd->add_option("STUDY", bench_args.study, "the study file (free or driven scene)")
-        ->required()
-        ->type_name("FILE");
-    bench_cmd
-        ->add_option("-o,--out", bench_args.out,
-                     "output directory, created if needed (default: results/<name>/)")
-        ->type_name("DIR");
-    bench_cmd->add_flag("--quick", bench_args.quick,
-                        "tolerances 1e-4, 1e-7, 1e-10 only, one repeat (a few seconds)");
-    bench_cmd
-        ->add_option("--repeats", bench_args.repeats,
-                     "timed runs per point, the median reported (default 5; 1 with --quick)")
-        ->check(CLI::Range(1, 1000))
-        ->type_name("N");
+    CLI::App* bench_cmd = add_bench_command(app, bench_args);
 
     std::vector<std::string> argv_rest = with_default_command(argc, argv);
     if (argv_rest.empty()) {

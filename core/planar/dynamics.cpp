@@ -457,15 +457,14 @@ void link_kinematics(const Model& model, Instant& in) {
   }
 }
 
-// every force output from the multipliers of the structural rows (ws.lambda) and the efforts
-void forces(const Model& model, Workspace& ws) {
+// per link and node: the force on the link from the joint there (f = inertia - load - the
+// link's own constraint forces), from the multipliers of the structural rows (ws.lambda);
+// stored densely in ws.on_link, links x nodes
+void link_node_forces(const Model& model, Workspace& ws) {
   const System& s = model.system();
   const Linkage& l = s.linkage;
-  Instant& in = ws.instant;
+  const Instant& in = ws.instant;
   const std::size_t nodes = l.nodes.size();
-
-  // per link and node: the force on the link from the joint there (f = inertia - load - the
-  // link's own constraint forces); stored densely, links x nodes
   std::vector<Vec2>& on_link = ws.on_link;
   std::fill(on_link.begin(), on_link.end(), Vec2(0, 0));
   auto f = [&](int link, int node) -> Vec2& {
@@ -490,8 +489,18 @@ void forces(const Model& model, Workspace& ws) {
         f(entries[j].link, entries[j].node) -= ws.lambda[row] * entries[j].grad;
     }
   }
+}
 
-  // the frame: ground pins, guides, slide drives on frame guides, springs anchored to it
+// the forces on the frame: ground pins, guides, slide drives on frame guides, springs anchored
+// to it; the shaking force and moment; the joint forces
+void frame_forces(const Model& model, Workspace& ws) {
+  const System& s = model.system();
+  const Linkage& l = s.linkage;
+  Instant& in = ws.instant;
+  const std::size_t nodes = l.nodes.size();
+  auto f = [&](int link, int node) -> const Vec2& {
+    return ws.on_link[static_cast<std::size_t>(link) * nodes + static_cast<std::size_t>(node)];
+  };
   in.Fsh = Vec2(0, 0);
   in.Msh = 0.0;
   auto on_frame = [&](const Vec2& force, const Vec2& at) {
@@ -532,8 +541,12 @@ void forces(const Model& model, Workspace& ws) {
   for (std::size_t j = 0; j < model.joints().size(); ++j) {
     in.joint_force[j] = f(model.joints()[j].link, model.joints()[j].node);
   }
+}
 
-  // the inertial part: -Σ m a and -dH/dt about the origin
+// the inertial part of the shaking force and moment: -Σ m a and -dH/dt about the origin
+void inertial_parts(const Model& model, Instant& in) {
+  const System& s = model.system();
+  const Linkage& l = s.linkage;
   in.Fsh_inertial = Vec2(0, 0);
   in.Msh_inertial = 0.0;
   for (std::size_t k = 0; k < l.links.size(); ++k) {
@@ -551,6 +564,13 @@ void forces(const Model& model, Workspace& ws) {
     in.Fsh_inertial -= pm.mass * in.a[n];
     in.Msh_inertial -= cross(in.x[n], pm.mass * in.a[n]);
   }
+}
+
+// every force output from the multipliers of the structural rows (ws.lambda) and the efforts
+void forces(const Model& model, Workspace& ws) {
+  link_node_forces(model, ws);
+  frame_forces(model, ws);
+  inertial_parts(model, ws.instant);
 }
 
 // after the accelerations q̈: the multipliers from Gᵀ λ = M q̈ - F (efforts of the inputs

@@ -149,35 +149,59 @@ void append_row(const Model& model, const Instant& in, Series& table) {
 // ---------------------------------------------------------------------------------------------
 // driven
 
-Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
-  const int dof = model.inputs();
-  check_count(scene.speeds, dof, "scene.speeds", "speeds");
+namespace {
+
+// A driven scene's sample times: turns of the first angle input that moves, or the duration.
+struct DrivenTimes {
+  bool by_duration{};
+  double period{};  // of one turn [s]
+  double duration{};
+  int samples{};    // per turn, or in all
+  long long rows{};
+  double at(long long i) const {
+    return by_duration ? duration * static_cast<double>(i) / static_cast<double>(rows - 1)
+                       : period * static_cast<double>(i) / samples;
+  }
+};
+
+DrivenTimes driven_times(const Model& model, const DrivenScene& scene) {
+  check_count(scene.speeds, model.inputs(), "scene.speeds", "speeds");
   if (scene.samples < 1) {
     throw InputError(
         FieldError{"scene.samples", -1, "must be >= 1, got " + std::to_string(scene.samples)});
   }
-  // the time span: turns of the first angle input, or the duration
-  double period = 0;
+  DrivenTimes d;
   for (std::size_t k = 0; k < model.linkage().inputs.size(); ++k) {
     if (model.linkage().inputs[k].kind == Input::Kind::kAngle && scene.speeds[k] != 0) {
-      period = kTwoPi / std::abs(scene.speeds[k]);
+      d.period = kTwoPi / std::abs(scene.speeds[k]);
       break;
     }
   }
-  const bool by_duration = scene.duration > 0;
-  if (!by_duration && !(period > 0)) {
+  d.by_duration = scene.duration > 0;
+  d.duration = scene.duration;
+  d.samples = scene.samples;
+  if (!d.by_duration && !(d.period > 0)) {
     throw InputError(FieldError{"scene.duration", -1,
                                 ": the scene needs a duration (no angle input turns, so there are "
                                 "no revolutions to count)"});
   }
-  if (!by_duration && scene.revolutions < 1) {
+  if (!d.by_duration && scene.revolutions < 1) {
     throw InputError(FieldError{"scene.revolutions", -1, "must be >= 1"});
   }
-  const long long rows =
-      by_duration ? scene.samples : static_cast<long long>(scene.samples) * scene.revolutions;
-  if (rows > kMaxSamples || (by_duration && rows < 2)) {
+  d.rows = d.by_duration ? scene.samples
+                         : static_cast<long long>(scene.samples) * scene.revolutions;
+  if (d.rows > kMaxSamples || (d.by_duration && d.rows < 2)) {
     throw InputError(FieldError{"scene.samples", -1, "must be between 2 and 1e8 in all"});
   }
+  return d;
+}
+
+}  // namespace
+
+Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
+  const int dof = model.inputs();
+  const DrivenTimes times = driven_times(model, scene);
+  const long long rows = times.rows;
   Workspace ws(model);
   const std::vector<double> start = start_of(model, ws, scene.start, "scene");
 
@@ -195,9 +219,7 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
   const int drawn_branch = branch();
   double t_prev = 0;
   for (long long i = 0; i < rows; ++i) {
-    const double t = by_duration
-                         ? scene.duration * static_cast<double>(i) / static_cast<double>(rows - 1)
-                         : period * static_cast<double>(i) / scene.samples;
+    const double t = times.at(i);
     for (std::size_t k = 0; k < z.size(); ++k) z[k] = start[k] + scene.speeds[k] * t;
     // the previous sample carried forward to third order (the jerk from the last two samples'
     // accelerations): the chord method then needs a few steps

@@ -42,15 +42,12 @@ double angle_from(double target, const Vec2& d) {
 
 }  // namespace
 
-System::System(const Linkage& l) : linkage(l) {
-  coord.assign(l.nodes.size(), -1);
-  for (std::size_t i = 0; i < l.nodes.size(); ++i) {
-    if (!l.nodes[i].ground) {
-      coord[i] = n;
-      n += 2;
-    }
-  }
-  // element rows, one per link
+namespace {
+
+// one row per link (its element's length), then two per further node of a link (held on the
+// element as a material point); returns the next free row
+int add_link_rows(System& s) {
+  const Linkage& l = s.linkage;
   int row = static_cast<int>(l.links.size());
   std::vector<int> pending_rigid;  // rigid entries in row order, after the element rows
   for (std::size_t k = 0; k < l.links.size(); ++k) {
@@ -58,31 +55,37 @@ System::System(const Linkage& l) : linkage(l) {
     const int p = link.nodes[0], q = link.nodes[1];
     const Vec2 d = l.nodes[static_cast<std::size_t>(q)].position -
                    l.nodes[static_cast<std::size_t>(p)].position;
-    elements.push_back({p, q, d.norm(), d.squaredNorm()});
-    row_ref.push_back({RowRef::Kind::kElement, static_cast<int>(k)});
+    s.elements.push_back({p, q, d.norm(), d.squaredNorm()});
+    s.row_ref.push_back({System::RowRef::Kind::kElement, static_cast<int>(k)});
     ElementMass em{d.norm(), link.mass, link.e, link.f, link.inertia};
-    element_mass.push_back(em);
-    element_M.push_back(element_mass_matrix(em));
-    com_weights.push_back(point_weights(link.e / em.length, link.f / em.length));
+    s.element_mass.push_back(em);
+    s.element_M.push_back(element_mass_matrix(em));
+    s.com_weights.push_back(point_weights(link.e / em.length, link.f / em.length));
     for (std::size_t j = 2; j < link.nodes.size(); ++j) {
       const int r = link.nodes[j];
       const Vec2 c = link_coordinates(l.nodes[static_cast<std::size_t>(p)].position,
                                       l.nodes[static_cast<std::size_t>(q)].position,
                                       l.nodes[static_cast<std::size_t>(r)].position);
-      const int index = static_cast<int>(rigid.size());
-      rigid.push_back({row, static_cast<int>(k), r, p, q, point_weights(c.x(), c.y())});
+      const int index = static_cast<int>(s.rigid.size());
+      s.rigid.push_back({row, static_cast<int>(k), r, p, q, point_weights(c.x(), c.y())});
       row += 2;
       pending_rigid.push_back(index);
     }
   }
   for (int index : pending_rigid) {
-    row_ref.push_back({RowRef::Kind::kRigid, index});
-    row_ref.push_back({RowRef::Kind::kRigid, index});
+    s.row_ref.push_back({System::RowRef::Kind::kRigid, index});
+    s.row_ref.push_back({System::RowRef::Kind::kRigid, index});
   }
+  return row;
+}
+
+// one row per slider (the node on its guide); returns the next free row
+int add_slider_rows(System& s, int row) {
+  const Linkage& l = s.linkage;
   for (std::size_t k = 0; k < l.sliders.size(); ++k) {
     const Slider& sl = l.sliders[k];
-    row_ref.push_back({RowRef::Kind::kSlider, static_cast<int>(k)});
-    SliderRow r;
+    s.row_ref.push_back({System::RowRef::Kind::kSlider, static_cast<int>(k)});
+    System::SliderRow r;
     r.row = row++;
     r.slider = static_cast<int>(k);
     r.node = sl.node;
@@ -98,55 +101,80 @@ System::System(const Linkage& l) : linkage(l) {
       r.unit = (sl.to - sl.from).normalized();
       r.normal = perp(r.unit);
     }
-    sliders.push_back(r);
+    s.sliders.push_back(r);
   }
-  structural_rows = row;
+  return row;
+}
+
+// one row per input (a link's angle or a slider's position); returns the next free row
+int add_input_rows(System& s, int row) {
+  const Linkage& l = s.linkage;
   for (std::size_t k = 0; k < l.inputs.size(); ++k) {
     const Input& in = l.inputs[k];
-    row_ref.push_back({RowRef::Kind::kInput, static_cast<int>(k)});
-    InputRow r;
+    s.row_ref.push_back({System::RowRef::Kind::kInput, static_cast<int>(k)});
+    System::InputRow r;
     r.row = row++;
     r.input = static_cast<int>(k);
     r.angle = in.kind == Input::Kind::kAngle;
     if (r.angle) {
       r.p = l.links[static_cast<std::size_t>(in.link)].nodes[0];
       r.q = l.links[static_cast<std::size_t>(in.link)].nodes[1];
-      r.length = elements[static_cast<std::size_t>(in.link)].length;
+      r.length = s.elements[static_cast<std::size_t>(in.link)].length;
     } else {
       r.slider = in.slider;
     }
-    inputs.push_back(r);
+    s.inputs.push_back(r);
   }
-  rows = row;
+  return row;
+}
 
-  // the constant mass matrix: the elements' blocks at their moving nodes, point masses
-  M = MatrixXd::Zero(n, n);
+// the constant mass matrix (the elements' blocks at their moving nodes, point masses) and the
+// links' constant loads (weights and applied forces at the centres of mass, moments)
+void add_masses_and_loads(System& s) {
+  const Linkage& l = s.linkage;
+  s.M = MatrixXd::Zero(s.n, s.n);
   for (std::size_t k = 0; k < l.links.size(); ++k) {
-    const int nodes[2] = {elements[k].p, elements[k].q};
+    const int nodes[2] = {s.elements[k].p, s.elements[k].q};
     for (int a = 0; a < 2; ++a) {
-      const int ca = coord[static_cast<std::size_t>(nodes[a])];
+      const int ca = s.coord[static_cast<std::size_t>(nodes[a])];
       if (ca < 0) continue;
       for (int b = 0; b < 2; ++b) {
-        const int cb = coord[static_cast<std::size_t>(nodes[b])];
+        const int cb = s.coord[static_cast<std::size_t>(nodes[b])];
         if (cb < 0) continue;
-        M.block<2, 2>(ca, cb) += element_M[k].block<2, 2>(2 * a, 2 * b);
+        s.M.block<2, 2>(ca, cb) += s.element_M[k].block<2, 2>(2 * a, 2 * b);
       }
     }
   }
-  link_force.assign(l.links.size(), Vec2(0, 0));
-  link_moment.assign(l.links.size(), 0.0);
-  for (std::size_t k = 0; k < l.links.size(); ++k) link_force[k] = l.links[k].mass * l.loads.gravity;
-  for (const LinkLoad& ld : l.loads.link_loads) {
-    link_force[static_cast<std::size_t>(ld.link)] += ld.force;
-    link_moment[static_cast<std::size_t>(ld.link)] += ld.moment;
-  }
-  node_mass.assign(l.nodes.size(), 0.0);
+  s.node_mass.assign(l.nodes.size(), 0.0);
   for (const PointMass& pm : l.point_masses) {
-    node_mass[static_cast<std::size_t>(pm.node)] += pm.mass;
-    const int c = coord[static_cast<std::size_t>(pm.node)];
-    M(c, c) += pm.mass;
-    M(c + 1, c + 1) += pm.mass;
+    s.node_mass[static_cast<std::size_t>(pm.node)] += pm.mass;
+    const int c = s.coord[static_cast<std::size_t>(pm.node)];
+    s.M(c, c) += pm.mass;
+    s.M(c + 1, c + 1) += pm.mass;
   }
+  s.link_force.assign(l.links.size(), Vec2(0, 0));
+  s.link_moment.assign(l.links.size(), 0.0);
+  for (std::size_t k = 0; k < l.links.size(); ++k)
+    s.link_force[k] = l.links[k].mass * l.loads.gravity;
+  for (const LinkLoad& ld : l.loads.link_loads) {
+    s.link_force[static_cast<std::size_t>(ld.link)] += ld.force;
+    s.link_moment[static_cast<std::size_t>(ld.link)] += ld.moment;
+  }
+}
+
+}  // namespace
+
+System::System(const Linkage& l) : linkage(l) {
+  coord.assign(l.nodes.size(), -1);
+  for (std::size_t i = 0; i < l.nodes.size(); ++i) {
+    if (!l.nodes[i].ground) {
+      coord[i] = n;
+      n += 2;
+    }
+  }
+  structural_rows = add_slider_rows(*this, add_link_rows(*this));
+  rows = add_input_rows(*this, structural_rows);
+  add_masses_and_loads(*this);
 }
 
 void nodes_from_q(const System& s, const VectorXd& q, NodeVectors& x) {

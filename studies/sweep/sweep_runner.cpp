@@ -18,6 +18,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -348,92 +349,84 @@ std::vector<std::string> sweep_columns(const Study& study) {
   return columns;
 }
 
-SweepResult write_sweep(const Study& study, const fs::path& out_dir, const SweepOptions& options) {
-  if (!study.sweep)
-    throw InputError("write_sweep: study '" + study.name + "' has no sweep section");
-  const Clock::time_point start = Clock::now();
-  const std::vector<std::vector<double>> points = sweep_points(*study.sweep);
+namespace {
+
+// What the folder holds already, checked against this sweep: the rows a resumed sweep keeps.
+struct Existing {
+  std::string csv_text;  // sweep.csv as found ("" for none)
+  CsvRows csv;           // its lines
+  int kept{}, kept_failed{};
+};
+
+Existing existing_rows(const Study& study, const fs::path& out_dir, const SweepResult& result,
+                       const SweepOptions& options, const std::vector<std::vector<double>>& points,
+                       const std::string& header, std::size_t columns) {
   const int n = static_cast<int>(points.size());
-  const std::size_t columns = sweep_columns(study).size();
-  const std::size_t cells = columns - 3 - study.sweep->parameters.size();  // metric cells
-  const std::string header = header_line(study);
-
-  SweepResult result;
-  result.points = n;
-  result.csv = out_dir / "sweep.csv";
-  result.summary = out_dir / "sweep.json";
-
-  // what the folder holds already
-  const std::string old_csv = read_or_empty(result.csv);
+  Existing e;
+  e.csv_text = read_or_empty(result.csv);
+  e.csv = split_rows(e.csv_text);
   const std::string old_json = read_or_empty(result.summary);
-  const CsvRows old = split_rows(old_csv);
   std::optional<Json> old_summary;
   if (!old_json.empty()) {
     // unreadable: a sweep.csv beside it cannot be checked (below)
     Json j = Json::parse(old_json, nullptr, false);
     if (!j.is_discarded() && j.is_object()) old_summary = std::move(j);
   }
-
-  int kept = 0, kept_failed = 0;
-  if (!old_csv.empty() && !options.resume) {
+  if (e.csv_text.empty()) return e;
+  if (!options.resume) {
     // a finished sweep is replaced; an unfinished one only on request
     int folder_points = n;
     if (old_summary && (*old_summary)["points"].is_number_integer()) {
       folder_points = (*old_summary)["points"].get<int>();
     }
-    if (static_cast<int>(old.rows.size()) < folder_points) {
+    if (static_cast<int>(e.csv.rows.size()) < folder_points) {
       throw InputError(out_dir.string() + " holds an unfinished sweep (" +
-                       std::to_string(old.rows.size()) + " of " + std::to_string(folder_points) +
+                       std::to_string(e.csv.rows.size()) + " of " +
+                       std::to_string(folder_points) +
                        " points): pass --resume to continue it, or remove the folder to start "
                        "over");
     }
-  } else if (!old_csv.empty() && old.has_header) {
-    // resume: the rows must be this sweep's, point by point
-    if (!old_summary) refuse(out_dir, "its sweep.json is missing or unreadable");
-    if (const std::string why = identity_difference(*old_summary, study, n); !why.empty()) {
-      refuse(out_dir, why);
-    }
-    if (old.header != header) refuse(out_dir, "the sweep.csv header differs");
-    if (static_cast<int>(old.rows.size()) > n) {
-      refuse(out_dir, "sweep.csv has " + std::to_string(old.rows.size()) + " rows for " +
-                          std::to_string(n) + " points");
-    }
-    for (std::size_t i = 0; i < old.rows.size(); ++i) {
-      if (const std::string why = row_problem(old.rows[i], i, columns, points[i]); !why.empty()) {
-        throw InputError(result.csv.string() + ": row " + std::to_string(i + 1) + " is not point " +
-                         std::to_string(i) + " of this design (" + why +
-                         "); remove the folder to start over");
-      }
-      const std::vector<std::string> f = csv_fields(old.rows[i]);
-      if (f[columns - 2] != "ok") ++kept_failed;
-    }
-    kept = static_cast<int>(old.rows.size());
+    return e;
   }
+  if (!e.csv.has_header) return e;
+  // resume: the rows must be this sweep's, point by point
+  if (!old_summary) refuse(out_dir, "its sweep.json is missing or unreadable");
+  if (const std::string why = identity_difference(*old_summary, study, n); !why.empty()) {
+    refuse(out_dir, why);
+  }
+  if (e.csv.header != header) refuse(out_dir, "the sweep.csv header differs");
+  if (static_cast<int>(e.csv.rows.size()) > n) {
+    refuse(out_dir, "sweep.csv has " + std::to_string(e.csv.rows.size()) + " rows for " +
+                        std::to_string(n) + " points");
+  }
+  for (std::size_t i = 0; i < e.csv.rows.size(); ++i) {
+    if (const std::string why = row_problem(e.csv.rows[i], i, columns, points[i]); !why.empty()) {
+      throw InputError(result.csv.string() + ": row " + std::to_string(i + 1) + " is not point " +
+                       std::to_string(i) + " of this design (" + why +
+                       "); remove the folder to start over");
+    }
+    const std::vector<std::string> f = csv_fields(e.csv.rows[i]);
+    if (f[columns - 2] != "ok") ++e.kept_failed;
+  }
+  e.kept = static_cast<int>(e.csv.rows.size());
+  return e;
+}
 
-  const int remaining = n - kept;
-  const int wanted = options.threads > 0 ? options.threads
-                     : study.sweep->threads > 0
-                         ? study.sweep->threads
-                         : static_cast<int>(std::thread::hardware_concurrency());
-  const int threads = std::min(std::max(wanted, 1), remaining);
-  Counts counts;
-  counts.done = kept;
-  counts.resumed = kept;
-  counts.failed = kept_failed;
-  counts.threads = threads;
-
-  // the folder, sweep.json (first: a sweep.csv is never left without the sweep.json that
-  // identifies it), and sweep.csv: the kept rows (a last line cut short dropped) or a new header
+// The folder, sweep.json (first: a sweep.csv is never left without the sweep.json that
+// identifies it), and sweep.csv: the kept rows (a last line cut short dropped) or a new header.
+void start_files(const Study& study, const fs::path& out_dir, const SweepResult& result,
+                 const SweepOptions& options, const Existing& existing, const std::string& header,
+                 const Counts& counts) {
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec) {
     throw std::runtime_error("cannot create the output directory " + out_dir.string() + ": " +
                              ec.message());
   }
-  write_text_file(sweep_json(study, n, counts), result.summary);
-  if (options.resume && old.has_header) {  // checked above: this sweep's header and rows
-    if (old.complete_size != old_csv.size()) {
-      fs::resize_file(result.csv, old.complete_size, ec);
+  write_text_file(sweep_json(study, result.points, counts), result.summary);
+  if (options.resume && existing.csv.has_header) {  // checked: this sweep's header and rows
+    if (existing.csv.complete_size != existing.csv_text.size()) {
+      fs::resize_file(result.csv, existing.csv.complete_size, ec);
       if (ec) {
         throw std::runtime_error("cannot truncate " + result.csv.string() + ": " + ec.message());
       }
@@ -441,24 +434,26 @@ SweepResult write_sweep(const Study& study, const fs::path& out_dir, const Sweep
   } else {
     write_text_file(header + "\n", result.csv);
   }
+}
 
-  // the workers take points in order from a shared counter and hand finished rows to this
-  // thread, the only writer, which appends them in point order
+// Computes points `first`..n-1 on `threads` workers, which take points in order from a shared
+// counter and hand finished rows to this thread, the only writer, which appends them to
+// sweep.csv in point order. Returns the number of rows sweep.csv holds at the end (fewer than n
+// when stopped); counts.failed counts the failed rows.
+int compute_points(const Study& study, const std::vector<std::vector<double>>& points,
+                   std::size_t cells, int first, int threads, const SweepOptions& options,
+                   const fs::path& csv_file, Counts& counts,
+                   const std::function<void(int, bool)>& report_progress) {
+  const int n = static_cast<int>(points.size());
   std::mutex mutex;
   std::condition_variable changed;
   std::map<int, PointRow> finished;  // rows not written yet (a later point may finish first)
   int workers_done = 0;
-  std::atomic<int> next_point{kept};
+  std::atomic<int> next_point{first};
   std::atomic<bool> halt{false};  // the writer failed: the workers stop too
   auto stopping = [&] { return halt.load() || (options.stop != nullptr && options.stop->load()); };
-
-  auto report_progress = [&](int done, bool last_call) {
-    if (!options.progress) return;
-    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    options.progress(SweepProgress{done, n, kept, elapsed, last_call});
-  };
-  int written = kept;
-  RowFile csv(result.csv);
+  int written = first;
+  RowFile csv(csv_file);
   {
     std::vector<std::jthread> workers;
     try {
@@ -515,6 +510,46 @@ SweepResult write_sweep(const Study& study, const fs::path& out_dir, const Sweep
     }
   }  // the workers join here
   csv.close();
+  return written;
+}
+
+}  // namespace
+
+SweepResult write_sweep(const Study& study, const fs::path& out_dir, const SweepOptions& options) {
+  if (!study.sweep)
+    throw InputError("write_sweep: study '" + study.name + "' has no sweep section");
+  const Clock::time_point start = Clock::now();
+  const std::vector<std::vector<double>> points = sweep_points(*study.sweep);
+  const int n = static_cast<int>(points.size());
+  const std::size_t columns = sweep_columns(study).size();
+  const std::size_t cells = columns - 3 - study.sweep->parameters.size();  // metric cells
+  const std::string header = header_line(study);
+
+  SweepResult result;
+  result.points = n;
+  result.csv = out_dir / "sweep.csv";
+  result.summary = out_dir / "sweep.json";
+  const Existing existing = existing_rows(study, out_dir, result, options, points, header, columns);
+  const int kept = existing.kept;
+
+  const int wanted = options.threads > 0 ? options.threads
+                     : study.sweep->threads > 0
+                         ? study.sweep->threads
+                         : static_cast<int>(std::thread::hardware_concurrency());
+  Counts counts;
+  counts.done = kept;
+  counts.resumed = kept;
+  counts.failed = existing.kept_failed;
+  counts.threads = std::min(std::max(wanted, 1), n - kept);
+  start_files(study, out_dir, result, options, existing, header, counts);
+
+  auto report_progress = [&](int done, bool last_call) {
+    if (!options.progress) return;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    options.progress(SweepProgress{done, n, kept, elapsed, last_call});
+  };
+  const int written = compute_points(study, points, cells, kept, counts.threads, options,
+                                     result.csv, counts, report_progress);
 
   counts.done = written;
   counts.status = written == n ? "complete" : "interrupted";
@@ -526,7 +561,6 @@ SweepResult write_sweep(const Study& study, const fs::path& out_dir, const Sweep
   result.resumed = kept;
   result.failed = counts.failed;
   result.interrupted = written < n;
-
   return result;
 }
 
