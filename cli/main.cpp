@@ -123,6 +123,16 @@ void print_sweep_design(const st::SweepRequest& sweep) {
   }
 }
 
+// the study in `file`, or nothing after its mistake was said on stderr (one line)
+std::optional<st::Study> load_or_say(const std::string& file) {
+  try {
+    return st::load_study(file);
+  } catch (const bd::InputError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return std::nullopt;
+  }
+}
+
 // `validate STUDY.yaml`: load and check only, write nothing
 int validate(const std::string& file) {
   try {
@@ -447,13 +457,9 @@ int run_sweep_study(const st::Study& study, const RunArgs& args, const fs::path&
 
 int run(const RunArgs& args) {
   // load and validate: any mistake is one line on stderr, and nothing is written
-  st::Study study;
-  try {
-    study = st::load_study(args.study);
-  } catch (const bd::InputError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return kExitBadInput;
-  }
+  std::optional<st::Study> loaded = load_or_say(args.study);
+  if (!loaded) return kExitBadInput;
+  const st::Study& study = *loaded;
 
   const fs::path out = args.out.empty() ? fs::path("results") / study.name : fs::path(args.out);
   if (study.sweep) return run_sweep_study(study, args, out);
@@ -534,13 +540,9 @@ struct BenchArgs {
 // (studies/work_precision.hpp): work-precision.csv or driven-convergence.csv, and report.html
 // with its section "Speed against accuracy". Progress on stderr, one line per method.
 int bench(const BenchArgs& args) {
-  st::Study study;
-  try {
-    study = st::load_study(args.study);
-  } catch (const bd::InputError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return kExitBadInput;
-  }
+  std::optional<st::Study> loaded = load_or_say(args.study);
+  if (!loaded) return kExitBadInput;
+  const st::Study& study = *loaded;
   if (study.sweep) {
     std::fprintf(stderr, "%s: bench measures one scene, and this study has a sweep section\n",
                  args.study.c_str());

@@ -504,23 +504,77 @@ bool advance_ok(Trajectory& out, const Motion& m, integrators::Integration& inte
   return false;
 }
 
+// the integration of y' = rhs(t, y) from y0 over [0, t_end] as the options ask
+integrators::Problem free_problem(const SimulateOptions& options, const std::vector<double>& y0,
+                                  double t_end, Motion& m, integrators::RhsFn rhs) {
+  integrators::Problem problem;
+  problem.integrator = options.integrator;
+  problem.y0 = y0;
+  problem.absolute_tolerance.assign(y0.size(), options.absolute_tolerance);
+  problem.tolerance = options.tolerance;
+  problem.t_end = t_end;
+  problem.max_steps = options.max_steps;
+  problem.user_data = &m;
+  problem.rhs = rhs;
+  return problem;
+}
+
+// a trajectory with the model's columns and room for the scene's samples
+Trajectory empty_table(const Model& model, const FreeScene& scene) {
+  Trajectory out;
+  out.table.columns = columns(model);
+  out.table.values.reserve(static_cast<std::size_t>(scene.samples) * out.table.width());
+  return out;
+}
+
+// what the integrator's callbacks share, for a route
+Motion motion(const Model& model, Workspace& ws, Route route, const SimulateOptions& options) {
+  Motion m;
+  m.model = &model;
+  m.ws = &ws;
+  m.dof = model.inputs();
+  m.route = route;
+  m.baumgarte = options.baumgarte;
+  return m;
+}
+
 double output_time(const FreeScene& scene, std::size_t j) {
   const std::size_t last = static_cast<std::size_t>(scene.samples - 1);
   return j == last ? scene.duration
                    : scene.duration * static_cast<double>(j) / static_cast<double>(last);
 }
 
+// The samples after the first: the integration advanced to each output time, the instant there
+// evaluated by `evaluate()` and appended to the table, until the end or a failure (every sample
+// before it kept). `where()` names a limit position reached.
+template <class Where, class Evaluate>
+void sample_run(const Model& model, Motion& m, integrators::Integration& integration,
+                const FreeScene& scene, const SimulateOptions& options, Trajectory& out,
+                Where where, Evaluate evaluate) {
+  out.status = SimulationStatus::kCompleted;
+  out.message = "completed";
+  for (std::size_t j = 1; j < static_cast<std::size_t>(scene.samples); ++j) {
+    m.failed = false;
+    const auto outcome = integration.advance(output_time(scene, j));
+    if (!advance_ok(out, m, integration, outcome, options, where)) break;
+    ++m.evaluations;
+    const auto ok = evaluate();
+    if (!ok) {
+      fail(out, ok.error(), integration.t());
+      break;
+    }
+    append_row(model, m.ws->instant, out.table);
+  }
+  out.steps = integration.steps();
+  out.rhs_evaluations = m.evaluations;
+}
+
 Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scene,
                         const std::vector<double>& start, const std::vector<double>& rates,
                         const SimulateOptions& options) {
   const int dof = model.inputs();
-  Trajectory out;
-  out.table.columns = columns(model);
-  out.table.values.reserve(static_cast<std::size_t>(scene.samples) * out.table.width());
-  Motion m;
-  m.model = &model;
-  m.ws = &ws;
-  m.dof = dof;
+  Trajectory out = empty_table(model, scene);
+  Motion m = motion(model, ws, Route::kReduced, options);
   m.cache = ws.instant.x;
   std::vector<double> y0 = start;
   y0.insert(y0.end(), rates.begin(), rates.end());
@@ -538,37 +592,15 @@ Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scen
   m.root_sign = normalised_determinant(ws) > 0 ? 1.0 : -1.0;
   append_row(model, ws.instant, out.table);
 
-  integrators::Problem problem;
-  problem.integrator = options.integrator;
-  problem.y0 = y0;
-  problem.absolute_tolerance.assign(y0.size(), options.absolute_tolerance);
-  problem.tolerance = options.tolerance;
-  problem.t_end = scene.duration;
-  problem.max_steps = options.max_steps;
-  problem.user_data = &m;
-  problem.rhs = reduced_rhs;
+  integrators::Problem problem = free_problem(options, y0, scene.duration, m, reduced_rhs);
   problem.root = reduced_root;
   integrators::Integration integration(problem);
-  out.status = SimulationStatus::kCompleted;
-  out.message = "completed";
-  for (std::size_t j = 1; j < static_cast<std::size_t>(scene.samples); ++j) {
-    m.failed = false;
-    const auto outcome = integration.advance(output_time(scene, j));
-    const auto where = [&] {
-      return state_text(model, integration.t(),
-                        std::vector<double>(integration.y(), integration.y() + dof));
-    };
-    if (!advance_ok(out, m, integration, outcome, options, where)) break;
-    ++m.evaluations;
-    const auto ok = reduced_state(m, integration.t(), integration.y());
-    if (!ok) {
-      fail(out, ok.error(), integration.t());
-      break;
-    }
-    append_row(model, ws.instant, out.table);
-  }
-  out.steps = integration.steps();
-  out.rhs_evaluations = m.evaluations;
+  const auto where = [&] {
+    return state_text(model, integration.t(),
+                      std::vector<double>(integration.y(), integration.y() + dof));
+  };
+  sample_run(model, m, integration, scene, options, out, where,
+             [&] { return reduced_state(m, integration.t(), integration.y()); });
   return out;
 }
 
@@ -576,15 +608,8 @@ Trajectory free_dae(const Model& model, Workspace& ws, const FreeScene& scene,
                     const std::vector<double>& start, const std::vector<double>& rates,
                     const SimulateOptions& options) {
   const System& s = model.system();
-  Trajectory out;
-  out.table.columns = columns(model);
-  out.table.values.reserve(static_cast<std::size_t>(scene.samples) * out.table.width());
-  Motion m;
-  m.model = &model;
-  m.ws = &ws;
-  m.dof = model.inputs();
-  m.route = Route::kDae;
-  m.baumgarte = options.baumgarte;
+  Trajectory out = empty_table(model, scene);
+  Motion m = motion(model, ws, Route::kDae, options);
   // the start: positions assembled, velocities from the inputs' rates
   if (auto ok = inverse_dynamics(model, ws, 0.0, rates, std::vector<double>(rates.size(), 0.0));
       !ok) {
@@ -605,35 +630,15 @@ Trajectory free_dae(const Model& model, Workspace& ws, const FreeScene& scene,
   }
   append_row(model, ws.instant, out.table);
 
-  integrators::Problem problem;
-  problem.integrator = options.integrator;
-  problem.y0 = y0;
-  problem.absolute_tolerance.assign(y0.size(), options.absolute_tolerance);
-  problem.tolerance = options.tolerance;
-  problem.t_end = scene.duration;
-  problem.max_steps = options.max_steps;
-  problem.user_data = &m;
-  problem.rhs = dae_rhs;
+  const integrators::Problem problem = free_problem(options, y0, scene.duration, m, dae_rhs);
   integrators::Integration integration(problem);
-  out.status = SimulationStatus::kCompleted;
-  out.message = "completed";
   std::vector<double> y(y0.size());
-  for (std::size_t j = 1; j < static_cast<std::size_t>(scene.samples); ++j) {
-    m.failed = false;
-    const auto outcome = integration.advance(output_time(scene, j));
-    const auto where = [&] { return "t = " + text::digits(integration.t(), 10) + " s"; };
-    if (!advance_ok(out, m, integration, outcome, options, where)) break;
+  const auto where = [&] { return "t = " + text::digits(integration.t(), 10) + " s"; };
+  sample_run(model, m, integration, scene, options, out, where, [&] {
     y.assign(integration.y(), integration.y() + y0.size());
     project(model, ws, y.data());
-    ++m.evaluations;
-    if (auto ok = dae_instant(m, integration.t(), y.data()); !ok) {
-      fail(out, ok.error(), integration.t());
-      break;
-    }
-    append_row(model, ws.instant, out.table);
-  }
-  out.steps = integration.steps();
-  out.rhs_evaluations = m.evaluations;
+    return dae_instant(m, integration.t(), y.data());
+  });
   return out;
 }
 

@@ -105,12 +105,7 @@ class BalanceReader {
     if (const MapReader::Entry* shape = m.find("shape")) spec.shape = read_shape(*shape, path);
     const bool disc = spec.shape == balance::CounterweightShape::kDisc;
     auto positive = [&](const MapReader::Entry& x, const char* unit) {
-      const double v = read_number(r_, x, path + "." + x.key, unit);
-      if (!(v > 0)) {
-        r_.fail(mark_of(x.value, x.key_mark),
-                path + "." + x.key + " must be > 0 " + unit + ", got " + text::exact(v));
-      }
-      return v;
+      return read_positive(r_, x, path + "." + x.key, unit);
     };
     // a disc's size: only for shape: disc
     for (const char* key : {"radius", "thickness", "density"}) {

@@ -283,12 +283,7 @@ class OptimizeReader {
       }
     }
     auto positive = [&](const MapReader::Entry& x, const char* unit) {
-      const double v = read_number(r_, x, path + "." + x.key, unit);
-      if (!(v > 0)) {
-        r_.fail(mark_of(x.value, x.key_mark),
-                path + "." + x.key + " must be > 0 " + unit + ", got " + text::exact(v));
-      }
-      return v;
+      return read_positive(r_, x, path + "." + x.key, unit);
     };
     if (const MapReader::Entry* x = m.find("mass_max")) cw.mass_max = positive(*x, "kg");
     if (const MapReader::Entry* x = m.find("distance_max")) cw.distance_max = positive(*x, "m");

@@ -155,6 +155,17 @@ inline double read_number(const Reporter& r, const MapReader::Entry& e, const st
   return read_number(r, e.value, e.key_mark, path, unit);
 }
 
+// a finite number > 0
+inline double read_positive(const Reporter& r, const MapReader::Entry& e, const std::string& path,
+                            const std::string& unit) {
+  const double v = read_number(r, e, path, unit);
+  if (!(v > 0)) {
+    r.fail(mark_of(e.value, e.key_mark),
+           path + " must be > 0" + (unit.empty() ? "" : " " + unit) + ", got " + text::exact(v));
+  }
+  return v;
+}
+
 // a whole number in [lo, hi]
 inline int read_count(const Reporter& r, const MapReader::Entry& e, const std::string& path,
                       double lo, double hi) {
