@@ -23,34 +23,6 @@ Problem positive(const char* field, const char* unit, double v) {
   return FieldError{field, -1, std::string("must be > 0 ") + unit + ", got " + text::exact(v)};
 }
 
-// A counterweight of mass mc at `position` (link axes, from its pivot) whose mass moment is
-// `moment` = mc·position [kg m], realised as the spec asks.
-Counterweight realise(const CounterweightSpec& spec, Complex moment, double link_length) {
-  const double needed = std::abs(moment);  // mc·distance [kg m]
-  const Complex direction = moment / needed;
-  const bool disc = spec.shape == CounterweightShape::kDisc;
-  const double area_density = spec.density * std::numbers::pi * spec.thickness;  // m / r² [kg/m²]
-  Counterweight cw;
-  if (spec.mass) {
-    cw.mass = *spec.mass;
-    cw.distance = needed / cw.mass;
-  } else if (spec.radius) {
-    cw.mass = area_density * *spec.radius * *spec.radius;
-    cw.distance = needed / cw.mass;
-  } else {
-    cw.distance = spec.distance ? *spec.distance : link_length;
-    cw.mass = needed / cw.distance;
-  }
-  const Complex position = cw.distance * direction;
-  cw.position = Vec2(position.real(), position.imag());
-  if (disc) {
-    cw.radius = spec.radius ? *spec.radius : std::sqrt(cw.mass / area_density);
-    cw.thickness = spec.thickness;
-    cw.inertia = 0.5 * cw.mass * cw.radius * cw.radius;
-  }
-  return cw;
-}
-
 }  // namespace
 
 Problem CounterweightSpec::validate() const {
@@ -85,6 +57,34 @@ Problem CounterweightSpec::validate() const {
     if (Problem p = positive("density", "kg/m^3", density)) return p;
   }
   return std::nullopt;
+}
+
+Counterweight realise(const CounterweightSpec& spec, const Vec2& mass_moment,
+                      double default_distance) {
+  const Complex moment(mass_moment.x(), mass_moment.y());
+  const double needed = std::abs(moment);  // mc·distance [kg m]
+  const Complex direction = moment / needed;
+  const bool disc = spec.shape == CounterweightShape::kDisc;
+  const double area_density = spec.density * std::numbers::pi * spec.thickness;  // m / r² [kg/m²]
+  Counterweight cw;
+  if (spec.mass) {
+    cw.mass = *spec.mass;
+    cw.distance = needed / cw.mass;
+  } else if (spec.radius) {
+    cw.mass = area_density * *spec.radius * *spec.radius;
+    cw.distance = needed / cw.mass;
+  } else {
+    cw.distance = spec.distance ? *spec.distance : default_distance;
+    cw.mass = needed / cw.distance;
+  }
+  const Complex position = cw.distance * direction;
+  cw.position = Vec2(position.real(), position.imag());
+  if (disc) {
+    cw.radius = spec.radius ? *spec.radius : std::sqrt(cw.mass / area_density);
+    cw.thickness = spec.thickness;
+    cw.inertia = 0.5 * cw.mass * cw.radius * cw.radius;
+  }
+  return cw;
 }
 
 core::Link merged(const core::Link& link, const Counterweight& counterweight,
@@ -126,7 +126,8 @@ ForceBalancedDesign force_balance(const core::FourBar& model, const Counterweigh
   // crank, about A0: m1' s̄1' = m1 s̄1 + mc p must equal -m2 (1 - s̄2/l2) l1 (eq. 57, first)
   if (!before.force[0].holds) {
     const Complex target = -l2.mass * (1.0 - s2 / l2.length) * l1.length;
-    const Counterweight cw = realise(crank, target - l1.mass * s1, l1.length);
+    const Complex moment = target - l1.mass * s1;
+    const Counterweight cw = realise(crank, Vec2(moment.real(), moment.imag()), l1.length);
     out.model.crank = merged(l1, cw, false);
     out.crank = cw;
   }
@@ -134,7 +135,8 @@ ForceBalancedDesign force_balance(const core::FourBar& model, const Counterweigh
   // (eq. 57, second, times l3)
   if (!before.force[1].holds) {
     const Complex target = l2.mass * s2 * l3.length / l2.length;
-    const Counterweight cw = realise(rocker, target - l3.mass * (s3 - l3.length), l3.length);
+    const Complex moment = target - l3.mass * (s3 - l3.length);
+    const Counterweight cw = realise(rocker, Vec2(moment.real(), moment.imag()), l3.length);
     out.model.rocker = merged(l3, cw, true);
     out.rocker = cw;
   }

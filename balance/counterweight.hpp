@@ -41,6 +41,13 @@ struct Counterweight {
   double inertia{};     // about its own centre [kg m^2]: m r²/2 for a disc, 0 for a point
 };
 
+/// A counterweight whose mass moment about its pivot is `mass_moment` = mass·position [kg m]
+/// (link axes), realised as `spec` asks: the given mass at the distance that gives the moment, or
+/// at the given distance (`default_distance` when the spec gives neither) the mass that does, or
+/// a disc of the given radius. `mass_moment` must not be zero.
+Counterweight realise(const CounterweightSpec& spec, const Vec2& mass_moment,
+                      double default_distance);
+
 /// The design after force balancing, and what was added.
 struct ForceBalancedDesign {
   core::FourBar model;                 // links with their counterweights merged in

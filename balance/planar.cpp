@@ -1,0 +1,408 @@
+#include "balance/planar.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <set>
+
+#include "core/input_error.hpp"
+#include "core/number_text.hpp"
+#include "core/planar/model.hpp"
+
+namespace bd::balance::planar {
+
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+// a link's nodes, element length and drawn direction
+struct LinkFrame {
+  int p{}, q{};
+  double length{};
+  double angle{};  // of the first-to-second node line as drawn [rad]
+};
+LinkFrame frame_of(const cp::Linkage& l, int k) {
+  const cp::Link& link = l.links[static_cast<std::size_t>(k)];
+  LinkFrame f;
+  f.p = link.nodes[0];
+  f.q = link.nodes[1];
+  const Vec2 d = l.nodes[static_cast<std::size_t>(f.q)].position -
+                 l.nodes[static_cast<std::size_t>(f.p)].position;
+  f.length = d.norm();
+  f.angle = std::atan2(d.y(), d.x());
+  return f;
+}
+
+// a drawn point in link k's axes, from its first node
+Vec2 in_link_axes(const cp::Linkage& l, int k, const Vec2& point) {
+  const LinkFrame f = frame_of(l, k);
+  const Vec2 d = point - l.nodes[static_cast<std::size_t>(f.p)].position;
+  const double c = std::cos(f.angle), s = std::sin(f.angle);
+  return {c * d.x() + s * d.y(), -s * d.x() + c * d.y()};
+}
+
+double rms_of_pairs(const VectorXd& v) {  // v = (x0, y0, x1, y1, ...): RMS of the magnitudes
+  const Eigen::Index n = v.size() / 2;
+  return n > 0 ? std::sqrt(v.squaredNorm() / static_cast<double>(n)) : 0.0;
+}
+
+}  // namespace
+
+Eigen::VectorXd Parameters::of(const cp::Linkage& l) {
+  VectorXd theta = VectorXd::Zero(count(l));
+  for (std::size_t k = 0; k < l.links.size(); ++k) {
+    const cp::Link& link = l.links[k];
+    const int i = static_cast<int>(k);
+    theta[link_mass(i)] = link.mass;
+    theta[link_me(i)] = link.mass * link.e;
+    theta[link_mf(i)] = link.mass * link.f;
+    theta[link_J(i)] = link.inertia + link.mass * (link.e * link.e + link.f * link.f);
+  }
+  for (std::size_t j = 0; j < l.point_masses.size(); ++j)
+    theta[point_mass(l, static_cast<int>(j))] = l.point_masses[j].mass;
+  return theta;
+}
+
+std::vector<ComplexMass> equivalent_masses(const cp::Linkage& l) {
+  std::vector<ComplexMass> mu(l.nodes.size(), ComplexMass(0, 0));
+  for (std::size_t k = 0; k < l.links.size(); ++k) {
+    const cp::Link& link = l.links[k];
+    const LinkFrame f = frame_of(l, static_cast<int>(k));
+    const ComplexMass s_over_l = ComplexMass(link.e, link.f) / f.length;
+    mu[static_cast<std::size_t>(f.p)] += link.mass * (1.0 - s_over_l);
+    mu[static_cast<std::size_t>(f.q)] += link.mass * s_over_l;
+  }
+  for (const cp::PointMass& pm : l.point_masses) mu[static_cast<std::size_t>(pm.node)] += pm.mass;
+  return mu;
+}
+
+Expected<Kinematics, cp::PlanarError> kinematics(
+    const cp::Model& model, const std::vector<std::vector<double>>& values,
+    const std::vector<std::vector<double>>& rates,
+    const std::vector<std::vector<double>>& accelerations) {
+  const cp::Linkage& l = model.linkage();
+  const std::size_t dof = l.inputs.size();
+  cp::Workspace ws(model);
+  std::vector<Vec2> guess = ws.instant.x;
+  std::vector<double> unit(dof, 0.0), zero(dof, 0.0);
+  Kinematics out;
+  out.samples.reserve(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    auto ok = cp::solve_position(model, ws, guess, values[i]);
+    if (!ok) return Unexpected<cp::PlanarError>(ok.error());
+    guess = ws.instant.x;
+    Kinematics::Sample s;
+    // the node velocities at unit rate of each input (the factorisation at the solved position
+    // serves each: no new position solve)
+    for (std::size_t d = 0; d < dof; ++d) {
+      std::fill(unit.begin(), unit.end(), 0.0);
+      unit[d] = 1.0;
+      ok = cp::inverse_dynamics(model, ws, 0.0, unit, zero);
+      if (!ok) return Unexpected<cp::PlanarError>(ok.error());
+      s.unit_rate_velocity.push_back(ws.instant.v);
+    }
+    ok = cp::inverse_dynamics(model, ws, 0.0, rates[i], accelerations[i]);
+    if (!ok) return Unexpected<cp::PlanarError>(ok.error());
+    s.x = ws.instant.x;
+    s.a = ws.instant.a;
+    s.angle = ws.instant.angle;
+    s.omega = ws.instant.omega;
+    s.alpha = ws.instant.alpha;
+    out.samples.push_back(std::move(s));
+  }
+  return out;
+}
+
+InputSeries input_series(const cp::Model& model, const core::Series& table) {
+  const cp::Linkage& l = model.linkage();
+  InputSeries out;
+  std::vector<std::array<int, 3>> columns;  // per input: value, rate, acceleration
+  for (const cp::Input& in : l.inputs) {
+    const std::string name = in.kind == cp::Input::Kind::kAngle
+                                 ? l.links[static_cast<std::size_t>(in.link)].name
+                                 : l.sliders[static_cast<std::size_t>(in.slider)].name;
+    const bool angle = in.kind == cp::Input::Kind::kAngle;
+    columns.push_back({table.column((angle ? "theta_" : "s_") + name),
+                       table.column((angle ? "omega_" : "v_") + name),
+                       table.column((angle ? "alpha_" : "a_") + name)});
+  }
+  for (std::size_t r = 0; r < table.rows(); ++r) {
+    std::vector<double> v, w, a;
+    for (const auto& c : columns) {
+      v.push_back(table.at(r, static_cast<std::size_t>(c[0])));
+      w.push_back(table.at(r, static_cast<std::size_t>(c[1])));
+      a.push_back(table.at(r, static_cast<std::size_t>(c[2])));
+    }
+    out.values.push_back(std::move(v));
+    out.rates.push_back(std::move(w));
+    out.accelerations.push_back(std::move(a));
+  }
+  return out;
+}
+
+Eigen::MatrixXd momentum_regressor(const cp::Linkage& l, const Kinematics& k) {
+  const std::size_t dof = l.inputs.size();
+  MatrixXd Z = MatrixXd::Zero(static_cast<Eigen::Index>(2 * dof * k.samples.size()),
+                              Parameters::count(l));
+  Eigen::Index row = 0;
+  for (const Kinematics::Sample& s : k.samples) {
+    for (std::size_t d = 0; d < dof; ++d, row += 2) {
+      const std::vector<Vec2>& v = s.unit_rate_velocity[d];
+      for (std::size_t j = 0; j < l.links.size(); ++j) {
+        const int i = static_cast<int>(j);
+        const LinkFrame f = frame_of(l, i);
+        const Vec2 vp = v[static_cast<std::size_t>(f.p)];
+        const Vec2 dv = (v[static_cast<std::size_t>(f.q)] - vp) / f.length;
+        Z.block<2, 1>(row, Parameters::link_mass(i)) = vp;
+        Z.block<2, 1>(row, Parameters::link_me(i)) = dv;
+        Z.block<2, 1>(row, Parameters::link_mf(i)) = perp(dv);
+      }
+      for (std::size_t j = 0; j < l.point_masses.size(); ++j) {
+        Z.block<2, 1>(row, Parameters::point_mass(l, static_cast<int>(j))) =
+            v[static_cast<std::size_t>(l.point_masses[j].node)];
+      }
+    }
+  }
+  return Z;
+}
+
+Eigen::MatrixXd shaking_force_regressor(const cp::Linkage& l, const Kinematics& k) {
+  MatrixXd Y = MatrixXd::Zero(static_cast<Eigen::Index>(2 * k.samples.size()),
+                              Parameters::count(l));
+  Eigen::Index row = 0;
+  for (const Kinematics::Sample& s : k.samples) {
+    for (std::size_t j = 0; j < l.links.size(); ++j) {
+      const int i = static_cast<int>(j);
+      const LinkFrame f = frame_of(l, i);
+      const Vec2 ap = s.a[static_cast<std::size_t>(f.p)];
+      const Vec2 da = (s.a[static_cast<std::size_t>(f.q)] - ap) / f.length;
+      Y.block<2, 1>(row, Parameters::link_mass(i)) = -ap;
+      Y.block<2, 1>(row, Parameters::link_me(i)) = -da;
+      Y.block<2, 1>(row, Parameters::link_mf(i)) = -perp(da);
+    }
+    for (std::size_t j = 0; j < l.point_masses.size(); ++j) {
+      Y.block<2, 1>(row, Parameters::point_mass(l, static_cast<int>(j))) =
+          -s.a[static_cast<std::size_t>(l.point_masses[j].node)];
+    }
+    row += 2;
+  }
+  return Y;
+}
+
+Eigen::MatrixXd shaking_moment_regressor(const cp::Linkage& l, const Kinematics& k) {
+  MatrixXd Y = MatrixXd::Zero(static_cast<Eigen::Index>(k.samples.size()), Parameters::count(l));
+  Eigen::Index row = 0;
+  for (const Kinematics::Sample& s : k.samples) {
+    for (std::size_t j = 0; j < l.links.size(); ++j) {
+      const int i = static_cast<int>(j);
+      const LinkFrame f = frame_of(l, i);
+      const Vec2 xp = s.x[static_cast<std::size_t>(f.p)], ap = s.a[static_cast<std::size_t>(f.p)];
+      const double w = s.omega[j], al = s.alpha[j];
+      const Vec2 u = unit(s.angle[j]), n = perp(u);
+      // dH/dt of a link about the origin, with r = c - p = (m e u + m f n)/m rotating with it:
+      //   cross(p, m a_p) + cross(p, α perp(m r) - ω² m r) + cross(m r, a_p) + J α
+      auto first_moment_term = [&](const Vec2& dir) {
+        return cross(xp, al * perp(dir) - w * w * dir) + cross(dir, ap);
+      };
+      Y(row, Parameters::link_mass(i)) = -cross(xp, ap);
+      Y(row, Parameters::link_me(i)) = -first_moment_term(u);
+      Y(row, Parameters::link_mf(i)) = -first_moment_term(n);
+      Y(row, Parameters::link_J(i)) = -al;
+    }
+    for (std::size_t j = 0; j < l.point_masses.size(); ++j) {
+      const std::size_t n = static_cast<std::size_t>(l.point_masses[j].node);
+      Y(row, Parameters::point_mass(l, static_cast<int>(j))) = -cross(s.x[n], s.a[n]);
+    }
+    ++row;
+  }
+  return Y;
+}
+
+cp::Link merged(const cp::Link& link, const Counterweight& cw, const Vec2& from_first) {
+  const double m = link.mass, mc = cw.mass, M = m + mc;
+  const Vec2 s(link.e, link.f);
+  const Vec2 c = (m * s + mc * from_first) / M;
+  cp::Link out = link;
+  out.mass = M;
+  out.e = c.x();
+  out.f = c.y();
+  out.inertia = link.inertia + m * (s - c).squaredNorm() + cw.inertia +
+                mc * (from_first - c).squaredNorm();
+  return out;
+}
+
+namespace {
+
+// one counterweight to place: its link, pivot, the pivot in link axes, and what is known
+struct Placement {
+  LinkCounterweightSpec ask;
+  int pivot{};
+  bool grounded{};
+  Vec2 pivot_in_link{0, 0};  // from the link's first node [m]
+  double scale{};            // the unknowns' weight: the distance a counterweight sits at [m]
+  double fixed_mass{};       // a floating link's given mass [kg] (0 for a grounded link)
+};
+
+std::vector<Placement> placements(const cp::Linkage& l,
+                                  const std::vector<LinkCounterweightSpec>& asks) {
+  std::vector<Placement> out;
+  std::set<int> seen;
+  for (const LinkCounterweightSpec& ask : asks) {
+    const cp::Link& link = l.links.at(static_cast<std::size_t>(ask.link));
+    const std::string field = "counterweights." + link.name;
+    if (const Problem p = ask.spec.validate()) {
+      // the spec's own field under the link's: counterweights.crank.mass
+      throw InputError(FieldError{p->field.empty() ? field : field + "." + p->field, -1,
+                                  p->field.empty() ? ": " + p->message : p->message});
+    }
+    if (!seen.insert(ask.link).second)
+      throw InputError(FieldError{field, -1, ": one counterweight per link"});
+    Placement pl;
+    pl.ask = ask;
+    std::vector<int> grounds;
+    for (int n : link.nodes)
+      if (l.nodes[static_cast<std::size_t>(n)].ground) grounds.push_back(n);
+    if (grounds.size() > 1)
+      throw InputError(FieldError{field, -1, ": the link is fixed to the frame at two nodes"});
+    pl.grounded = grounds.size() == 1;
+    pl.pivot = pl.grounded ? grounds[0] : link.nodes[0];
+    pl.pivot_in_link = in_link_axes(l, ask.link, l.nodes[static_cast<std::size_t>(pl.pivot)].position);
+    const double length = frame_of(l, ask.link).length;
+    const CounterweightSpec& spec = ask.spec;
+    if (!pl.grounded) {
+      if (spec.mass) {
+        pl.fixed_mass = *spec.mass;
+      } else if (spec.radius) {
+        pl.fixed_mass = spec.density * std::numbers::pi * spec.thickness * *spec.radius *
+                        *spec.radius;
+      } else {
+        throw InputError(FieldError{field, -1,
+                                    ": the link does not turn about the frame, so its "
+                                    "counterweight's mass moves the node masses too: give its "
+                                    "mass (or a disc's radius) and its position is solved"});
+      }
+    }
+    pl.scale = spec.distance ? *spec.distance : length;
+    out.push_back(pl);
+  }
+  return out;
+}
+
+// the parameter change a counterweight of mass `mass` with first moment `w` about its pivot
+// (link axes) makes
+void add_counterweight(VectorXd& theta, const Placement& pl, double mass, const Vec2& w) {
+  const int k = pl.ask.link;
+  theta[Parameters::link_mass(k)] += mass;
+  theta[Parameters::link_me(k)] += mass * pl.pivot_in_link.x() + w.x();
+  theta[Parameters::link_mf(k)] += mass * pl.pivot_in_link.y() + w.y();
+}
+
+// min-norm least squares of A x = b with x's pairs weighted by the placements' scales
+VectorXd solve_moments(const MatrixXd& R, const VectorXd& theta0,
+                       const std::vector<Placement>& pls) {
+  MatrixXd A(R.rows(), static_cast<Eigen::Index>(2 * pls.size()));
+  for (std::size_t i = 0; i < pls.size(); ++i) {
+    const int k = pls[i].ask.link;
+    A.col(static_cast<Eigen::Index>(2 * i)) = pls[i].scale * R.col(Parameters::link_me(k));
+    A.col(static_cast<Eigen::Index>(2 * i + 1)) = pls[i].scale * R.col(Parameters::link_mf(k));
+  }
+  const VectorXd b = -(R * theta0);
+  Eigen::CompleteOrthogonalDecomposition<MatrixXd> cod(A);
+  VectorXd x = cod.solve(b);
+  for (std::size_t i = 0; i < pls.size(); ++i) x.segment<2>(static_cast<Eigen::Index>(2 * i)) *= pls[i].scale;
+  return x;
+}
+
+// the rank of the momentum conditions, columns scaled to one unit (m by the length scale)
+int condition_rank(const MatrixXd& Z, const cp::Linkage& l, double length) {
+  MatrixXd S = Z;
+  for (std::size_t k = 0; k < l.links.size(); ++k) {
+    S.col(Parameters::link_me(static_cast<int>(k))) *= length;
+    S.col(Parameters::link_mf(static_cast<int>(k))) *= length;
+  }
+  Eigen::CompleteOrthogonalDecomposition<MatrixXd> cod(S);
+  cod.setThreshold(1e-10);
+  return static_cast<int>(cod.rank());
+}
+
+}  // namespace
+
+ForceBalance force_balance(const cp::Linkage& linkage, const Kinematics& k,
+                           const std::vector<LinkCounterweightSpec>& counterweights) {
+  const cp::Linkage& l = linkage;
+  const std::vector<Placement> pls = placements(l, counterweights);
+  double length = 0, total_mass = 0;
+  for (std::size_t j = 0; j < l.links.size(); ++j) {
+    length = std::max(length, frame_of(l, static_cast<int>(j)).length);
+    total_mass += l.links[j].mass;
+  }
+  for (const cp::PointMass& pm : l.point_masses) total_mass += pm.mass;
+
+  const VectorXd theta0 = Parameters::of(l);
+  VectorXd theta_fixed = theta0;  // with the floating counterweights' given masses at their pivots
+  for (const Placement& pl : pls)
+    if (!pl.grounded) add_counterweight(theta_fixed, pl, pl.fixed_mass, Vec2(0, 0));
+  const MatrixXd Z = momentum_regressor(l, k), Y = shaking_force_regressor(l, k);
+
+  ForceBalance out;
+  out.conditions = condition_rank(Z, l, length);
+  const double before = (Z * theta0).norm();
+  VectorXd x = solve_moments(Z, theta_fixed, pls);
+  VectorXd theta = theta_fixed;
+  for (std::size_t i = 0; i < pls.size(); ++i)
+    add_counterweight(theta, pls[i], 0.0, x.segment<2>(static_cast<Eigen::Index>(2 * i)));
+  // what cancels to round-off: the momentum left against the sum of its terms' sizes
+  const double terms = (Z.cwiseAbs() * theta.cwiseAbs()).norm();
+  out.full = (Z * theta).norm() <= 1e-10 * std::max(terms, 1e-300);
+  if (!out.full) {
+    // the least RMS inertial shaking force over the motion instead
+    x = solve_moments(Y, theta_fixed, pls);
+    theta = theta_fixed;
+    for (std::size_t i = 0; i < pls.size(); ++i)
+      add_counterweight(theta, pls[i], 0.0, x.segment<2>(static_cast<Eigen::Index>(2 * i)));
+  }
+  out.momentum_left = before > 0 ? (Z * theta).norm() / before : 0.0;
+  out.Fsh_rms_before = rms_of_pairs(Y * theta0);
+  out.Fsh_rms_after = rms_of_pairs(Y * theta);
+
+  // realise each counterweight and merge it into its link
+  out.linkage = l;
+  for (std::size_t i = 0; i < pls.size(); ++i) {
+    const Placement& pl = pls[i];
+    const Vec2 w = x.segment<2>(static_cast<Eigen::Index>(2 * i));
+    if (w.norm() <= 1e-13 * total_mass * length && pl.grounded) continue;  // balanced already
+    const Counterweight cw = realise(pl.ask.spec, w, pl.scale);
+    LinkCounterweight added{pl.ask.link, pl.pivot, cw};
+    cp::Link& link = out.linkage.links[static_cast<std::size_t>(pl.ask.link)];
+    link = merged(link, cw, pl.pivot_in_link + cw.position);
+    out.added_mass += cw.mass;
+    out.added_inertia += cw.inertia + cw.mass * cw.distance * cw.distance;
+    out.added.push_back(added);
+  }
+  if (!out.full) {
+    // name the node whose momentum is the largest part of what is left
+    const std::vector<ComplexMass> mu = equivalent_masses(out.linkage);
+    std::vector<double> share(l.nodes.size(), 0.0);
+    for (const Kinematics::Sample& s : k.samples)
+      for (const std::vector<Vec2>& v : s.unit_rate_velocity)
+        for (std::size_t n = 0; n < l.nodes.size(); ++n)
+          share[n] += std::norm(mu[n]) * v[n].squaredNorm();
+    const std::size_t worst =
+        static_cast<std::size_t>(std::max_element(share.begin(), share.end()) - share.begin());
+    std::string links;
+    for (const Placement& pl : pls)
+      links += (links.empty() ? "" : ", ") + l.links[static_cast<std::size_t>(pl.ask.link)].name;
+    out.message = "full force balance cannot be reached with counterweights on " +
+                  (links.empty() ? std::string("no link") : links) + ": the largest part of the " +
+                  "linear momentum left is node " + l.nodes[worst].name + "'s (equivalent mass " +
+                  text::digits(std::abs(mu[worst]), 4) + " kg); the least-squares design leaves " +
+                  "the RMS inertial shaking force at " +
+                  text::digits(out.Fsh_rms_before > 0 ? 100 * out.Fsh_rms_after / out.Fsh_rms_before : 0.0, 3) +
+                  " % of the original";
+  }
+  return out;
+}
+
+}  // namespace bd::balance::planar

@@ -1,0 +1,136 @@
+#pragma once
+/// Shaking-force balance of any planar linkage (paper §4.1, §5.2, generalised): the linkage's
+/// linear momentum is carried by its nodes, each link putting the complex equivalent mass
+/// m(1 - s̄/l) at its first node and m s̄/l at its second (s̄ = e + i f), so that
+///   L = Σ_n μ̄_n v̄_n  over the moving nodes, μ̄_n the node's total equivalent mass.
+/// Everything here is linear in the mass parameters of the links (m, m e, m f and the inertia J
+/// about the first node) and the point masses: the linear momentum, the inertial shaking force
+/// and moment are regressors times the parameter vector. Full force balance is L ≡ 0 for every
+/// motion: the momentum per unit rate of each input vanishes at every configuration. Where loops
+/// make node velocities dependent (a ternary link's nodes, a node on a frame guide), these
+/// conditions are fewer than "every node's equivalent mass zero"; they are taken exactly from the
+/// linkage's kinematics at the configurations given (a driven revolution covers all of a crank's).
+///
+/// For a four-bar they are eq. 57 (tests/balance/planar_balance_test.cpp checks it).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "balance/counterweight.hpp"
+#include "core/expected.hpp"
+#include "core/planar/dynamics.hpp"
+#include "core/series.hpp"
+#include "core/types.hpp"
+
+namespace bd::balance::planar {
+
+namespace cp = core::planar;
+
+/// The layout of the mass-parameter vector: per link k, columns 4k + 0..3 are m [kg], m e,
+/// m f [kg m] (its first moment about its first node, in link axes) and J [kg m^2] (inertia
+/// about its first node: I + m (e² + f²)); then one column per point mass [kg].
+struct Parameters {
+  static int link_mass(int k) { return 4 * k; }
+  static int link_me(int k) { return 4 * k + 1; }
+  static int link_mf(int k) { return 4 * k + 2; }
+  static int link_J(int k) { return 4 * k + 3; }
+  static int point_mass(const cp::Linkage& l, int j) {
+    return 4 * static_cast<int>(l.links.size()) + j;
+  }
+  static int count(const cp::Linkage& l) {
+    return 4 * static_cast<int>(l.links.size()) + static_cast<int>(l.point_masses.size());
+  }
+  /// The linkage's values.
+  static Eigen::VectorXd of(const cp::Linkage& l);
+};
+
+/// The complex equivalent mass at every node [kg] (ground nodes included; their velocity is 0).
+std::vector<ComplexMass> equivalent_masses(const cp::Linkage& linkage);
+
+/// The kinematics of a motion at its samples: node positions and accelerations, link angles,
+/// rates and accelerations, and per input the node velocities at unit rate of that input (the
+/// others held). Independent of the mass parameters (the motion is given).
+struct Kinematics {
+  struct Sample {
+    std::vector<Vec2> x, a;                 // per node
+    std::vector<double> angle, omega, alpha;  // per link
+    std::vector<std::vector<Vec2>> unit_rate_velocity;  // per input, per node [m/rad or m/m]
+  };
+  std::vector<Sample> samples;
+};
+
+/// The kinematics at the given samples: per sample the inputs' values, rates and accelerations.
+/// Positions are solved from the previous sample's (the first from the drawn configuration), so
+/// the samples must follow a motion closely enough to stay on its assembly branch (a simulated
+/// run's samples do).
+/// @return the kinematics, or the first sample that cannot be evaluated (its error).
+Expected<Kinematics, cp::PlanarError> kinematics(const cp::Model& model,
+                                                 const std::vector<std::vector<double>>& values,
+                                                 const std::vector<std::vector<double>>& rates,
+                                                 const std::vector<std::vector<double>>& accelerations);
+
+/// The inputs' values, rates and accelerations at every row of a simulated run's table
+/// (core/planar/simulate.hpp, columns()).
+struct InputSeries {
+  std::vector<std::vector<double>> values, rates, accelerations;
+};
+InputSeries input_series(const cp::Model& model, const core::Series& table);
+
+/// Regressors: matrices with one column per mass parameter (Parameters).
+/// The linear momentum per unit input rate: rows (sample, input, x | y); L = Z θ ż.
+Eigen::MatrixXd momentum_regressor(const cp::Linkage& linkage, const Kinematics& k);
+/// The inertial shaking force -Σ m a: rows (sample, x | y) [N].
+Eigen::MatrixXd shaking_force_regressor(const cp::Linkage& linkage, const Kinematics& k);
+/// The inertial shaking moment -dH/dt about the origin: one row per sample [N m].
+Eigen::MatrixXd shaking_moment_regressor(const cp::Linkage& linkage, const Kinematics& k);
+
+/// A counterweight asked for on a link, realised as balance::CounterweightSpec says. Its position
+/// is measured in link axes (along and to the left of the link's first-to-second node line) from
+/// the link's pivot: its ground node, or its first node for a link that does not turn about the
+/// frame (a floating link, whose counterweight needs its mass given: its position is solved).
+struct LinkCounterweightSpec {
+  int link{};
+  CounterweightSpec spec;
+};
+
+/// A realised counterweight on a link.
+struct LinkCounterweight {
+  int link{};
+  int pivot{};             // the node its position is measured from
+  Counterweight counterweight;
+};
+
+/// The result of force balancing.
+struct ForceBalance {
+  cp::Linkage linkage;                    // the links with their counterweights merged in
+  std::vector<LinkCounterweight> added;   // links already balanced get none
+  bool full{};                            // full force balance reached (L ≡ 0 to round-off)
+  int conditions{};                       // independent conditions of full force balance
+  /// Empty when full; else one line naming what cannot be balanced with the counterweights
+  /// allowed, and what the least-squares design leaves.
+  std::string message;
+  /// |Z θ| over |Z θ0| at the design: the linear momentum left, relative to the original's.
+  double momentum_left{};
+  /// RMS of the inertial shaking force over the samples, original and design [N].
+  double Fsh_rms_before{}, Fsh_rms_after{};
+  double added_mass{}, added_inertia{};  // Σ masses [kg]; Σ inertias about the pivots [kg m^2]
+};
+
+/// Counterweights on the given links that make the linkage fully force balanced over the
+/// motion `k` describes (its configurations); where that cannot be reached with these links,
+/// the design that minimises the RMS of the inertial shaking force over k's samples instead,
+/// with `full` false and the message saying why. Among several designs that balance, the one
+/// whose counterweight masses have the least sum of squares (a unique design when the
+/// counterweights are as many as the conditions need).
+/// @throws bd::InputError for an invalid spec (field "counterweights.<link>"), two on one link,
+///         a link through two ground nodes, or a floating link's counterweight without a mass.
+ForceBalance force_balance(const cp::Linkage& linkage, const Kinematics& k,
+                           const std::vector<LinkCounterweightSpec>& counterweights);
+
+/// A link with a counterweight merged in (parallel axes), its position given in link axes from
+/// the link's first node [m].
+cp::Link merged(const cp::Link& link, const Counterweight& counterweight, const Vec2& from_first);
+
+}  // namespace bd::balance::planar
