@@ -476,9 +476,9 @@ int run(const RunArgs& args) {
   std::fflush(stdout);
   if (result.stopped_early()) {
     // one line per run that stopped
-    if (!result.trajectory.ok()) {
+    if (const st::RunStatus status = result.status(); !status.ok()) {
       std::fprintf(stderr, "%s: simulation stopped early: %s\n", args.study.c_str(),
-                   result.trajectory.message.c_str());
+                   status.message.c_str());
     }
     if (result.balanced && !result.balanced->trajectory.ok()) {
       std::fprintf(stderr, "%s: simulation of the balanced design stopped early: %s\n",
@@ -568,9 +568,9 @@ int bench(const BenchArgs& args) {
   std::printf("  bench    %zu rows (%s, %d repeat%s): %s\n", rows, args.quick ? "quick" : "full",
               options.repeats, options.repeats == 1 ? "" : "s", result.csv.string().c_str());
   std::fflush(stdout);
-  if (!result.run.trajectory.ok()) {
+  if (const st::RunStatus status = result.run.status(); !status.ok()) {
     std::fprintf(stderr, "%s: simulation stopped early: %s\n", args.study.c_str(),
-                 result.run.trajectory.message.c_str());
+                 status.message.c_str());
     return kExitStoppedEarly;
   }
   return kExitOk;

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "tests/support/csv.hpp"
+#include "tests/support/studies.hpp"
 #include "tests/support/text.hpp"
 
 namespace {
@@ -135,6 +136,19 @@ TEST_F(CliTest, SimulationStoppedEarlyExitsThreeAndKeepsResults) {
   EXPECT_NE(err_.find("theta1"), std::string::npos) << err_;
   EXPECT_TRUE(fs::exists(dir_ / "res" / "timeseries.csv"));
   EXPECT_NE(read(dir_ / "res" / "summary.json").find("\"ok\": false"), std::string::npos);
+}
+
+TEST_F(CliTest, PlanarSimulationStoppedEarlyNamesWhereItStopped) {
+  write("piston.yaml", bd::testing::piston_driven_slider_crank(1.5, 151));
+  EXPECT_EQ(run("piston.yaml --out res"), 3) << err_;
+  // the planar run's own message (not the empty four-bar trajectory's)
+  EXPECT_EQ(err_.rfind("piston.yaml: simulation stopped early: the linkage cannot be assembled "
+                       "at piston = 0.18",
+                       0),
+            0u)
+      << err_;
+  EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
+  EXPECT_TRUE(fs::exists(dir_ / "res" / "timeseries.csv"));
 }
 
 TEST_F(CliTest, BalanceStudyPrintsTheComparisonAndWritesItsFiles) {
