@@ -567,6 +567,12 @@ int bench(const BenchArgs& args) {
       result.free_rows.empty() ? result.driven_rows.size() : result.free_rows.size();
   std::printf("  bench    %zu rows (%s, %d repeat%s): %s\n", rows, args.quick ? "quick" : "full",
               options.repeats, options.repeats == 1 ? "" : "s", result.csv.string().c_str());
+  if (const std::size_t stopped = result.stopped_early(); stopped > 0) {
+    std::printf(
+        "  bench    %zu of %zu runs stopped before the end of the scene (their rows keep "
+        "what they computed, with the status and message)\n",
+        stopped, rows);
+  }
   std::fflush(stdout);
   if (const st::RunStatus status = result.run.status(); !status.ok()) {
     std::fprintf(stderr, "%s: simulation stopped early: %s\n", args.study.c_str(),
@@ -643,9 +649,10 @@ int main(int argc, char** argv) {
     BenchArgs bench_args;
     CLI::App* bench_cmd = app.add_subcommand(
         "bench",
-        "run STUDY.yaml as run does, then time every formulation and integrator against its "
-        "accuracy (free scene: tolerances 1e-3 ... 1e-13, work-precision.csv; driven scene: 4 ... "
-        "720 samples per revolution, driven-convergence.csv) and rewrite report.html");
+        "run STUDY.yaml as run does, then time every method (a four-bar's formulations, the "
+        "general engine's truss and truss-dae) and integrator against its accuracy (free scene: "
+        "tolerances 1e-3 ... 1e-13, work-precision.csv; driven scene: 4 ... 720 samples per "
+        "revolution, driven-convergence.csv) and rewrite report.html");
     bench_cmd->add_option("STUDY", bench_args.study, "the study file (free or driven scene)")
         ->required()
         ->type_name("FILE");

@@ -149,6 +149,17 @@ TEST_F(CliTest, PlanarSimulationStoppedEarlyNamesWhereItStopped) {
       << err_;
   EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
   EXPECT_TRUE(fs::exists(dir_ / "res" / "timeseries.csv"));
+
+  // its bench keeps every row and says how many runs stopped; the exit code is the run's
+  EXPECT_EQ(run("bench piston.yaml --quick --out bench"), 3) << err_;
+  EXPECT_NE(out_.find("  bench    14 rows (quick, 1 repeat): "), std::string::npos) << out_;
+  EXPECT_NE(out_.find("  bench    14 of 14 runs stopped before the end of the scene"),
+            std::string::npos)
+      << out_;
+  EXPECT_NE(err_.find("piston.yaml: simulation stopped early: the linkage cannot be assembled"),
+            std::string::npos)
+      << err_;
+  EXPECT_EQ(bd::testing::read(dir_ / "bench" / "driven-convergence.csv").substr(0, 7), "method,");
 }
 
 TEST_F(CliTest, BalanceStudyPrintsTheComparisonAndWritesItsFiles) {
