@@ -73,13 +73,18 @@ std::string integrator_style(const std::string& integrator) {
   return line_style(i);
 }
 
+// a method's: the closed forms in warm and green colours, the general engine in red (truss) and
+// blue (truss-dae), so that the two stand apart in the charts that compare them
 std::string method_style(const std::string& method) {
-  std::size_t i = 0;
-  for (Method m : kMethods) {
-    if (method == to_string(m)) break;
-    ++i;
+  static const std::pair<Method, std::size_t> styles[] = {{Method::kOpenedLoop, 1},
+                                                          {Method::kComplexMasses, 2},
+                                                          {Method::kMassMatrix, 3},
+                                                          {Method::kTrussDae, 5},
+                                                          {Method::kTruss, 6}};
+  for (const auto& [m, i] : styles) {
+    if (method == to_string(m)) return line_style(i);
   }
-  return line_style(i);
+  return line_style(0);
 }
 
 using Row = const std::vector<std::string>*;
