@@ -482,9 +482,9 @@ int run(const RunArgs& args) {
   std::fflush(stdout);
   if (result.stopped_early()) {
     // one line per run that stopped
-    if (!result.trajectory.ok()) {
+    if (const st::RunStatus status = result.status(); !status.ok()) {
       std::fprintf(stderr, "%s: simulation stopped early: %s\n", args.study.c_str(),
-                   result.trajectory.message.c_str());
+                   status.message.c_str());
     }
     if (result.balanced && !result.balanced->trajectory.ok()) {
       std::fprintf(stderr, "%s: simulation of the balanced design stopped early: %s\n",
@@ -569,10 +569,16 @@ int bench(const BenchArgs& args) {
       result.free_rows.empty() ? result.driven_rows.size() : result.free_rows.size();
   std::printf("  bench    %zu rows (%s, %d repeat%s): %s\n", rows, args.quick ? "quick" : "full",
               options.repeats, options.repeats == 1 ? "" : "s", result.csv.string().c_str());
+  if (const std::size_t stopped = result.stopped_early(); stopped > 0) {
+    std::printf(
+        "  bench    %zu of %zu runs stopped before the end of the scene (their rows keep "
+        "what they computed, with the status and message)\n",
+        stopped, rows);
+  }
   std::fflush(stdout);
-  if (!result.run.trajectory.ok()) {
+  if (const st::RunStatus status = result.run.status(); !status.ok()) {
     std::fprintf(stderr, "%s: simulation stopped early: %s\n", args.study.c_str(),
-                 result.run.trajectory.message.c_str());
+                 status.message.c_str());
     return kExitStoppedEarly;
   }
   return kExitOk;
@@ -620,9 +626,10 @@ constexpr const char* kDescription =
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& bench_args) {
   CLI::App* bench_cmd = app.add_subcommand(
       "bench",
-      "run STUDY.yaml as run does, then time every method and integrator against its "
-      "accuracy (free scene: tolerances 1e-3 ... 1e-13, work-precision.csv; driven scene: 4 ... "
-      "720 samples per revolution, driven-convergence.csv) and rewrite report.html");
+      "run STUDY.yaml as run does, then time every method (a four-bar's formulations, the "
+      "general engine's truss and truss-dae) and integrator against its accuracy (free scene: "
+      "tolerances 1e-3 ... 1e-13, work-precision.csv; driven scene: 4 ... 720 samples per "
+      "revolution, driven-convergence.csv) and rewrite report.html");
   bench_cmd->add_option("STUDY", bench_args.study, "the study file (free or driven scene)")
       ->required()
       ->type_name("FILE");

@@ -1,13 +1,25 @@
 #pragma once
 /// Speed against accuracy (`balance-design bench STUDY.yaml`, docs/performance.md).
 ///
-/// Free scene: every formulation x every integrator it supports (core::SimulateOptions::validate)
-/// x tolerances 1e-3 ... 1e-13, each run timed (median CPU time of repeats) and compared with a
-/// reference computed by a different formulation: work-precision.csv.
-/// Driven scene: every formulation x samples per revolution 4 ... 720, each revolution timed and
-/// its RMS shaking force and moment compared with those of a 4096-sample revolution computed by
-/// a different formulation: driven-convergence.csv. Periodic sampling is the trapezoidal rule
-/// of a smooth periodic function, so the RMS converges faster than any power of the samples.
+/// Every method of the study's linkage type is measured, named as the study file's `method:`:
+/// a four-bar's formulations (mass-matrix, opened-loop, complex-masses) and the general planar
+/// engine on it (truss, truss-dae), or a planar linkage's routes (truss, truss-dae). Each run is
+/// what the runner computes for that method (studies::simulate, studies/run/simulation.hpp).
+///
+/// Free scene: every method x every integrator it supports x tolerances 1e-3 ... 1e-13, each run
+/// timed (median CPU time of repeats) and compared with a reference computed by a different
+/// method: work-precision.csv.
+/// Driven scene: every method (the general engine as truss: a driven scene has no route) x
+/// samples per revolution 4 ... 720, each revolution timed and its RMS shaking force and moment
+/// compared with those of a 4096-sample revolution: driven-convergence.csv. Periodic sampling
+/// is the trapezoidal rule of a smooth periodic function, so the RMS converges faster than any
+/// power of the samples. A planar scene given by a duration instead of revolutions is sampled
+/// over its duration (both ends included: not periodic, so no spectral convergence).
+///
+/// The error of a free run is measured on the linkage's positions, on one scale for any
+/// linkage: its link angles [rad], and its slider positions and moving node coordinates divided
+/// by the linkage's length scale (core::planar::Model::length_scale(), its longest element; for
+/// a four-bar the longest of crank, coupler and rocker, with A1 and A2 its moving nodes).
 ///
 /// The report's section "Speed against accuracy" (work_precision_section() in
 /// studies/report/report.hpp) charts either file found in the run's folder.
@@ -16,8 +28,7 @@
 #include <string>
 #include <vector>
 
-#include "core/fourbar/dynamics.hpp"
-#include "core/fourbar/simulate.hpp"
+#include "core/simulation.hpp"
 #include "studies/run/runner.hpp"
 #include "studies/study/study.hpp"
 
@@ -34,6 +45,12 @@ struct BenchOptions {
   /// against CVODE Adams on another formulation at the same tolerance (4e-13 relative at the
   /// final time, 1.3e-13 rad at the samples) and the opened loop's order-5 pair at 1e-13 (2e-13,
   /// 4e-14 rad): errors below ~2e-13 are beyond what it resolves.
+  /// On the general engine kErk8 at 1e-14 completes on both routes, so it is the reference
+  /// there too: on studies/examples/engine-slider-crank-free.yaml (5 turns in 0.1 s, 1001
+  /// samples) the truss and truss-dae references agree to 1.2e-13 at every sample (rad; lengths
+  /// divided by the length scale), and CVODE Adams, erk5 and erk6 at 1e-14 lie within 5e-11 of
+  /// them; on the paper example both routes by kErk8 agree with mass-matrix to 2.5e-15. Digits
+  /// above ~12.9 on a planar linkage are beyond what the references resolve.
   double reference_tolerance = 1e-14;
   /// Driven scenes: samples per revolution, and the reference's.
   std::vector<int> samples = {4, 6, 8, 12, 16, 24, 32, 48, 64, 96, 128, 180, 360, 720};
@@ -54,12 +71,12 @@ struct BenchOptions {
   std::string validate() const;
 };
 
-/// One row of work-precision.csv: one formulation, integrator and tolerance.
+/// One row of work-precision.csv: one method, integrator and tolerance.
 struct WorkPrecisionRow {
-  core::Formulation formulation{};
+  Method method{};  // never kAuto
   core::Integrator integrator{};
   double tolerance{};  // relative (absolute 1e-2 of it)
-  core::Formulation reference_formulation{};
+  Method reference_method{};
   core::Integrator reference_integrator{};
   double reference_tolerance{};
   core::SimulationStatus status = core::SimulationStatus::kNotRun;
@@ -68,22 +85,24 @@ struct WorkPrecisionRow {
   int repeats{};                    // timed runs behind the median
   long steps{}, rhs_evaluations{};  // of one run (core::Trajectory)
   std::size_t samples{};            // samples the run computed
-  /// Largest relative error of theta1..theta3 at the final time, and -log10 of it: significant
-  /// correct digits (16 when the error is 0). NaN when the run or the reference stopped early.
+  /// The largest difference from the reference at the final time over the link angles [rad],
+  /// slider positions and moving node coordinates divided by the length scale [-] (the file's
+  /// header comment), and -log10 of it: correct digits (16 when the error is 0). NaN when the run
+  /// or the reference stopped early.
   double final_error{}, digits{};
-  /// Largest |theta_k - theta_k,ref| over k = 1..3 and all samples both runs computed [rad].
+  /// The same difference, largest over all samples both runs computed (NaN when none).
   double max_error{};
 };
 
-/// One row of driven-convergence.csv: one formulation and number of samples per revolution.
+/// One row of driven-convergence.csv: one method and number of samples per revolution.
 struct DrivenConvergenceRow {
-  core::Formulation formulation{};
-  int samples{};  // per revolution
-  core::Formulation reference_formulation{};
+  Method method{};  // never kAuto or kTrussDae
+  int samples{};    // per revolution (over the duration of a planar scene given by one)
+  Method reference_method{};
   int reference_samples{};
   core::SimulationStatus status = core::SimulationStatus::kNotRun;
   std::string message;
-  double cpu_time{};  // median CPU time of one revolution [s]
+  double cpu_time{};  // median CPU time of one revolution (or duration) with its metrics [s]
   int repeats{};
   double Fsh_rms{}, Msh_rms{};  // [N], [N m]
   /// |rms - rms_ref| / rms_ref; NaN when the reference's RMS is 0 or a run failed.
@@ -92,24 +111,43 @@ struct DrivenConvergenceRow {
 
 /// The header lines of the two files (without the newline).
 inline constexpr const char* kWorkPrecisionHeader =
-    "formulation,integrator,tolerance,reference_formulation,reference_integrator,"
+    "method,integrator,tolerance,reference_method,reference_integrator,"
     "reference_tolerance,status,cpu_time,repeats,steps,rhs_evaluations,samples,final_error,"
     "digits,max_error,message";
 inline constexpr const char* kDrivenConvergenceHeader =
-    "formulation,samples,reference_formulation,reference_samples,status,cpu_time,repeats,"
+    "method,samples,reference_method,reference_samples,status,cpu_time,repeats,"
     "Fsh_rms,Msh_rms,Fsh_rms_error,Msh_rms_error,message";
 
-/// The work-precision study of the study's free scene and model (the original design; its
-/// method and tolerance are not used). The reference of formulation F is the first run that
-/// completes of: complex-masses (F = mass-matrix) or mass-matrix (otherwise), and for the
-/// opened loop, when neither reduced formulation can follow the motion (a crank reaching its
-/// limits), the opened loop itself. Rows in the order formulation, integrator, tolerance.
+/// The methods a bench measures on the study (free: is_free(study.scene)), in the files' order:
+/// a four-bar's formulations in core::kFormulations' order, then the general engine (truss,
+/// and truss-dae in a free scene; none when the four-bar has counter-rotating inertias, which
+/// the general engine does not model); a planar linkage's truss, and truss-dae in a free scene.
+std::vector<Method> bench_methods(const Study& study);
+
+/// The methods whose runs may serve as the reference of `method` on the study's linkage, in
+/// order of preference: the first whose reference run completes is used, else the last. Free
+/// scenes (reference runs by kErk8 at options.reference_tolerance):
+/// - mass-matrix: complex-masses; complex-masses: mass-matrix (the same equation set up
+///   otherwise: they agree to round-off);
+/// - opened-loop, and the general engine on a four-bar: mass-matrix, complex-masses, then the
+///   opened loop (the one formulation through limit positions);
+/// - a planar linkage's truss: truss-dae, then truss; truss-dae: truss, then truss-dae (the
+///   other route; the same route only where the other cannot follow the motion).
+/// Driven scenes (reference runs of options.reference_samples): mass-matrix: complex-masses;
+/// the other four-bar methods: mass-matrix; a planar linkage's truss: truss (the one method).
+std::vector<Method> reference_methods(const Study& study, Method method);
+
+/// The work-precision study of the study's free scene and linkage (the original design; its
+/// method and tolerance are not used): bench_methods() x every integrator each supports x
+/// options.tolerances, each against its reference (reference_methods()). Rows in the order
+/// method, integrator, tolerance.
 /// @throws bd::InputError if the study's scene is not free or the options are invalid.
 std::vector<WorkPrecisionRow> work_precision(const Study& study, const BenchOptions& options);
 
-/// The sample convergence of the study's driven scene (one revolution from its theta1 at its
-/// omega1). The reference of formulation F is computed by complex-masses (F = mass-matrix) or
-/// mass-matrix (otherwise) with options.reference_samples samples.
+/// The sample convergence of the study's driven scene: one revolution (a four-bar's from its
+/// theta1 at its omega1; a planar linkage's of its first angle input), or a planar scene's
+/// duration, per method and sample count, against its reference (reference_methods()) with
+/// options.reference_samples samples.
 /// @throws bd::InputError if the study's scene is not driven or the options are invalid.
 std::vector<DrivenConvergenceRow> driven_convergence(const Study& study,
                                                      const BenchOptions& options);
@@ -126,6 +164,9 @@ struct BenchResult {
   std::vector<DrivenConvergenceRow> driven_rows;  // driven scenes
   std::filesystem::path csv;                      // work-precision.csv or driven-convergence.csv
   std::filesystem::path report;                   // report.html (empty when it was not written)
+  /// The rows whose run stopped early (status other than completed): each keeps what its run
+  /// computed up to the stop, with the status and message.
+  std::size_t stopped_early() const;
 };
 
 /// Measures the study's scene (work_precision() or driven_convergence()) and writes

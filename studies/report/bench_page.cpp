@@ -2,9 +2,13 @@
 // work-precision.csv or driven-convergence.csv (written by write_bench(), studies/bench/).
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <map>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <variant>
 #include <vector>
 
 #include "core/number_text.hpp"
@@ -52,102 +56,215 @@ std::string figure(const Chart& chart, const std::string& svg) {
          "\">\n" + svg + "\n<figcaption>" + esc(chart.caption) + "</figcaption>\n</figure>\n";
 }
 
-// the line colour and point type of an integrator, the same in every chart
-std::string line_style(const std::string& integrator) {
+// the line colour and point type of item `i` of a list (integrators, methods), the same in
+// every chart
+std::string line_style(std::size_t i) {
   static const char* const colours[] = {"#9400d3", "#009e73", "#56b4e9", "#e69f00", "#c8b400",
                                         "#0072b2", "#e51e10", "#000000", "#a0522d"};
+  return " lc rgb '" + std::string(colours[i % 9]) + "' pt " + std::to_string(i + 1);
+}
+
+std::string integrator_style(const std::string& integrator) {
   std::size_t i = 0;
   for (core::Integrator k : core::kIntegrators) {
     if (integrator == core::to_string(k)) break;
     ++i;
   }
-  return " lc rgb '" + std::string(colours[i % 9]) + "' pt " + std::to_string(i + 1);
+  return line_style(i);
+}
+
+// a method's: the closed forms in warm and green colours, the general engine in red (truss) and
+// blue (truss-dae), so that the two stand apart in the charts that compare them
+std::string method_style(const std::string& method) {
+  static const std::pair<Method, std::size_t> styles[] = {{Method::kOpenedLoop, 1},
+                                                          {Method::kComplexMasses, 2},
+                                                          {Method::kMassMatrix, 3},
+                                                          {Method::kTrussDae, 5},
+                                                          {Method::kTruss, 6}};
+  for (const auto& [m, i] : styles) {
+    if (method == to_string(m)) return line_style(i);
+  }
+  return line_style(0);
+}
+
+using Row = const std::vector<std::string>*;
+
+// the names in column c of the rows, in file order, each once
+std::vector<std::string> distinct(const Csv& csv, std::size_t c) {
+  std::vector<std::string> names;
+  for (const auto& row : csv.rows) {
+    if (row.size() < csv.header.size()) continue;
+    if (std::find(names.begin(), names.end(), row[c]) == names.end()) names.push_back(row[c]);
+  }
+  return names;
+}
+
+// "the reference of A is B, of C is D" from a method column and its reference column
+std::string references_text(const Csv& csv, std::size_t c_method, std::size_t c_reference) {
+  std::vector<std::pair<std::string, std::string>> pairs;
+  for (const auto& row : csv.rows) {
+    if (row.size() < csv.header.size()) continue;
+    const auto pair = std::pair{row[c_method], row[c_reference]};
+    if (std::find(pairs.begin(), pairs.end(), pair) == pairs.end()) pairs.push_back(pair);
+  }
+  std::string s;
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    s += std::string(i == 0 ? "the reference of " : ", of ") + esc(pairs[i].first) + " is " +
+         esc(pairs[i].second);
+  }
+  return s;
+}
+
+// a notice naming the runs that stopped before the end of the scene (empty when none)
+std::string stopped_notice(
+    const Csv& csv, std::size_t c_status, std::size_t c_message,
+    const std::function<std::string(const std::vector<std::string>&)>& what) {
+  std::size_t stopped = 0, all = 0;
+  Row first = nullptr;
+  for (const auto& row : csv.rows) {
+    if (row.size() < csv.header.size()) continue;
+    ++all;
+    if (row[c_status] == "completed") continue;
+    ++stopped;
+    if (first == nullptr) first = &row;
+  }
+  if (stopped == 0) return "";
+  return "<p class=\"notice bad\">" + std::to_string(stopped) + " of " + std::to_string(all) +
+         " runs stopped before the end of the scene; their rows keep what they computed, with the "
+         "status and message (the first: " +
+         esc(what(*first)) + ", " + esc((*first)[c_status]) + ": " + esc((*first)[c_message]) +
+         ").</p>\n";
 }
 
 std::string free_section(const fs::path& file, const std::string& gnuplot) {
   const Csv csv = report_support::read_csv(file);
-  const std::size_t c_f = column(csv, "formulation", file), c_i = column(csv, "integrator", file),
+  const std::size_t c_f = column(csv, "method", file), c_i = column(csv, "integrator", file),
                     c_tol = column(csv, "tolerance", file), c_st = column(csv, "status", file),
                     c_t = column(csv, "cpu_time", file), c_e = column(csv, "final_error", file),
                     c_d = column(csv, "digits", file), c_m = column(csv, "max_error", file),
                     c_steps = column(csv, "steps", file),
-                    c_rf = column(csv, "reference_formulation", file),
+                    c_rf = column(csv, "reference_method", file),
                     c_ri = column(csv, "reference_integrator", file),
-                    c_rt = column(csv, "reference_tolerance", file);
+                    c_rt = column(csv, "reference_tolerance", file),
+                    c_msg = column(csv, "message", file);
 
-  // methods in file order, each with its rows
-  std::vector<std::pair<std::string, std::string>> methods;
-  std::map<std::pair<std::string, std::string>, std::vector<const std::vector<std::string>*>> of;
+  // (method, integrator) pairs in file order, each with its rows
+  std::vector<std::pair<std::string, std::string>> pairs;
+  std::map<std::pair<std::string, std::string>, std::vector<Row>> of;
   for (const auto& row : csv.rows) {
     if (row.size() < csv.header.size()) continue;
     const auto key = std::pair{row[c_f], row[c_i]};
-    if (of.find(key) == of.end()) methods.push_back(key);
+    if (of.find(key) == of.end()) pairs.push_back(key);
     of[key].push_back(&row);
   }
-  std::vector<std::string> formulations;
-  for (const auto& m : methods) {
-    if (std::find(formulations.begin(), formulations.end(), m.first) == formulations.end()) {
-      formulations.push_back(m.first);
-    }
-  }
+  const std::vector<std::string> methods = distinct(csv, c_f);
 
   std::string h =
       "<p>From <a href=\"work-precision.csv\">work-precision.csv</a> (<code>balance-design "
-      "bench</code>): every formulation with every integrator it supports, at each tolerance "
-      "(absolute tolerance 1e-2 of it), the median CPU time of one run of the study's free "
-      "scene against its error. The error is that of &theta;1..&theta;3 against a reference "
-      "computed by a different formulation";
+      "bench</code>): every method (as the study file names them: a four-bar's formulations, "
+      "and the general planar engine as truss, reduced to the inputs, and truss-dae, the "
+      "stabilised DAE in every node coordinate) with every integrator it supports, at each "
+      "tolerance (absolute tolerance 1e-2 of it), the median CPU time of one run of the study's "
+      "free scene against its error. The error is that of the linkage's positions (its link "
+      "angles in rad, its slider positions and moving node coordinates divided by its length "
+      "scale, the longest link) against a reference computed by a different method";
   if (!csv.rows.empty() && csv.rows.front().size() > c_rt) {
     const auto& r = csv.rows.front();
-    h += " (" + esc(r[c_ri]) + " at tolerance " + esc(fmt(number_at(r, c_rt), "%.0e")) +
-         "; the reference of " + esc(r[c_f]) + " is " + esc(r[c_rf]) + ")";
+    h += " (" + esc(r[c_ri]) + " at tolerance " + esc(fmt(number_at(r, c_rt), "%.0e")) + "; " +
+         references_text(csv, c_f, c_rf) + ")";
   }
-  h += ": the largest relative error at the final time (its -log10 is the number of correct "
-       "digits) and the largest error over all samples.</p>\n";
+  h += ": the largest difference at the final time (its -log10 is the number of correct "
+       "digits) and the largest over all samples.</p>\n";
+  h += stopped_notice(csv, c_st, c_msg, [&](const std::vector<std::string>& r) {
+    return r[c_f] + " / " + r[c_i] + " at " + fmt(number_at(r, c_tol), "%.0e");
+  });
 
-  // the charts: one per formulation, a line per integrator
+  const auto point = [&](Row row) {
+    return fmt(number_at(*row, c_e), "%.6g") + "," + fmt(1e3 * number_at(*row, c_t), "%.6g") + "\n";
+  };
+  const auto plotted = [&](Row row) {
+    return (*row)[c_st] == "completed" && number_at(*row, c_e) > 0 && number_at(*row, c_t) > 0;
+  };
+  const std::string axes =
+      "set logscale xy\nset format x '1e%L'\nset xrange [*:*] reverse\n"
+      "set xlabel 'error at the final time (rad; lengths / length scale)'\n"
+      "set ylabel 'CPU time per run [ms]'\nplot ";
   std::string datablocks;
   std::vector<Chart> charts;
-  for (std::size_t fi = 0; fi < formulations.size(); ++fi) {
+
+  // the methods compared: each method's front, the runs no other run of it beats in both
+  // CPU time and error
+  if (methods.size() > 1) {
     std::string plot;
-    int lines = 0;
-    for (std::size_t mi = 0; mi < methods.size(); ++mi) {
-      if (methods[mi].first != formulations[fi]) continue;
-      const std::string block = "$wp_" + std::to_string(mi);
-      std::string data;
-      for (const auto* row : of[methods[mi]]) {
-        const double e = number_at(*row, c_e), t = number_at(*row, c_t);
-        if ((*row)[c_st] != "completed" || !(e > 0) || !(t > 0)) continue;
-        data += fmt(e, "%.6g") + "," + fmt(1e3 * t, "%.6g") + "\n";
+    for (std::size_t fi = 0; fi < methods.size(); ++fi) {
+      std::vector<Row> runs;
+      for (const auto& [key, rows] : of) {
+        if (key.first != methods[fi]) continue;
+        for (Row row : rows) {
+          if (plotted(row)) runs.push_back(row);
+        }
       }
-      if (data.empty()) continue;
-      datablocks += block + " << EOD\n" + data + "EOD\n";
-      ++lines;
-      plot += std::string(lines > 1 ? ", " : "") + block + " using 1:2 with linespoints lw 2" +
-              line_style(methods[mi].second) + " title " + gp_string(methods[mi].second);
+      // by CPU time; a run is on the front when it is more accurate than every cheaper one
+      std::sort(runs.begin(), runs.end(),
+                [&](Row a, Row b) { return number_at(*a, c_t) < number_at(*b, c_t); });
+      std::vector<Row> front;
+      for (Row row : runs) {
+        if (front.empty() || number_at(*row, c_e) < number_at(*front.back(), c_e)) {
+          front.push_back(row);
+        }
+      }
+      if (front.empty()) continue;
+      const std::string block = "$wpf_" + std::to_string(fi);
+      datablocks += block + " << EOD\n";
+      for (Row row : front) datablocks += point(row);
+      datablocks += "EOD\n";
+      plot += std::string(plot.empty() ? "" : ", ") + block + " using 1:2 with linespoints lw 2" +
+              method_style(methods[fi]) + " title " + gp_string(methods[fi]);
     }
-    if (lines == 0) continue;
-    charts.push_back(
-        {"work-precision-" + formulations[fi], "Work-precision: " + formulations[fi],
-         "CPU time of one run against the largest relative error of theta1..theta3 at the "
-         "final time, one line per integrator, one point per tolerance (more accurate to the "
-         "right); runs that stopped early are left out. From work-precision.csv.",
-         "set logscale xy\nset format x '1e%L'\nset xrange [*:*] reverse\n"
-         "set xlabel 'relative error at the final time'\nset ylabel 'CPU time per run [ms]'\n"
-         "plot " +
-             plot});
+    if (!plot.empty()) {
+      charts.push_back(
+          {"work-precision-methods", "Work-precision: the methods compared",
+           "Per method, the cheapest runs for their accuracy: of all its integrators and "
+           "tolerances, the runs that no other run of the method beats in both CPU time and "
+           "error (more accurate to the right). From work-precision.csv.",
+           axes + plot});
+    }
   }
 
-  // the compact table: per method, the run at tolerance 1e-10 and the cheapest run with
-  // 10 correct digits
-  h += "<table><tr><th>formulation</th><th>integrator</th><th>at tolerance 1e-10: CPU time "
-       "[ms]</th><th>digits</th><th>max error [rad]</th><th>steps</th><th>cheapest run with "
+  // one chart per method, a line per integrator
+  for (const std::string& method : methods) {
+    std::string plot;
+    for (std::size_t mi = 0; mi < pairs.size(); ++mi) {
+      if (pairs[mi].first != method) continue;
+      std::string data;
+      for (Row row : of[pairs[mi]]) {
+        if (plotted(row)) data += point(row);
+      }
+      if (data.empty()) continue;
+      const std::string block = "$wp_" + std::to_string(mi);
+      datablocks += block + " << EOD\n" + data + "EOD\n";
+      plot += std::string(plot.empty() ? "" : ", ") + block + " using 1:2 with linespoints lw 2" +
+              integrator_style(pairs[mi].second) + " title " + gp_string(pairs[mi].second);
+    }
+    if (plot.empty()) continue;
+    charts.push_back({"work-precision-" + method, "Work-precision: " + method,
+                      "CPU time of one run against the largest error of the positions at the "
+                      "final time, one line per integrator, one point per tolerance (more "
+                      "accurate to the right); runs that stopped early are left out. From "
+                      "work-precision.csv.",
+                      axes + plot});
+  }
+
+  // the compact table: per method and integrator, the run at tolerance 1e-10 and the cheapest
+  // run with 10 correct digits
+  h += "<table><tr><th>method</th><th>integrator</th><th>at tolerance 1e-10: CPU time "
+       "[ms]</th><th>digits</th><th>max error</th><th>steps</th><th>cheapest run with "
        "&ge; 10 digits: tolerance</th><th>CPU time [ms]</th><th>failed runs</th></tr>";
-  for (const auto& m : methods) {
-    const std::vector<std::string>* at = nullptr;
-    const std::vector<std::string>* best = nullptr;
+  for (const auto& m : pairs) {
+    Row at = nullptr;
+    Row best = nullptr;
     int failed = 0;
-    for (const auto* row : of[m]) {
+    for (Row row : of[m]) {
       if ((*row)[c_st] != "completed") ++failed;
       if (std::abs(number_at(*row, c_tol) / 1e-10 - 1) < 1e-6) at = row;
       if ((*row)[c_st] == "completed" && number_at(*row, c_d) >= 10 &&
@@ -182,40 +299,48 @@ std::string free_section(const fs::path& file, const std::string& gnuplot) {
   return h;
 }
 
-std::string driven_section(const fs::path& file, const std::string& gnuplot) {
+std::string driven_section(const fs::path& file, const std::string& gnuplot, bool over_duration) {
   const Csv csv = report_support::read_csv(file);
-  const std::size_t c_f = column(csv, "formulation", file), c_n = column(csv, "samples", file),
+  const std::size_t c_f = column(csv, "method", file), c_n = column(csv, "samples", file),
                     c_st = column(csv, "status", file), c_t = column(csv, "cpu_time", file),
                     c_ef = column(csv, "Fsh_rms_error", file),
                     c_em = column(csv, "Msh_rms_error", file),
-                    c_rf = column(csv, "reference_formulation", file),
-                    c_rn = column(csv, "reference_samples", file);
-  std::vector<std::string> formulations;
-  std::map<std::string, std::vector<const std::vector<std::string>*>> of;
+                    c_rf = column(csv, "reference_method", file),
+                    c_rn = column(csv, "reference_samples", file),
+                    c_msg = column(csv, "message", file);
+  const std::vector<std::string> methods = distinct(csv, c_f);
+  std::map<std::string, std::vector<Row>> of;
   for (const auto& row : csv.rows) {
-    if (row.size() < csv.header.size()) continue;
-    if (of.find(row[c_f]) == of.end()) formulations.push_back(row[c_f]);
-    of[row[c_f]].push_back(&row);
+    if (row.size() >= csv.header.size()) of[row[c_f]].push_back(&row);
   }
+  const std::string per = over_duration ? "over the duration" : "per revolution";
 
   std::string h =
       "<p>From <a href=\"driven-convergence.csv\">driven-convergence.csv</a> "
-      "(<code>balance-design bench</code>): one revolution of the study's driven scene per "
-      "formulation and number of samples per revolution, its median CPU time, and the relative "
-      "error of its RMS shaking force and moment against a revolution of ";
+      "(<code>balance-design bench</code>): " +
+      std::string(over_duration ? "the study's driven scene over its duration"
+                                : "one revolution of the study's driven scene") +
+      " per method and number of samples " + per +
+      ", its median CPU time (the run and its metrics), and the relative error of its RMS "
+      "shaking force and moment against a run of ";
   if (!csv.rows.empty()) {
-    h += esc(csv.rows.front()[c_rn]) + " samples computed by a different formulation (that of " +
-         esc(csv.rows.front()[c_f]) + " is " + esc(csv.rows.front()[c_rf]) + ")";
+    h += esc(csv.rows.front()[c_rn]) + " samples (" + references_text(csv, c_f, c_rf) + ")";
   }
-  h += ". Evenly spaced samples of a periodic motion make the RMS a trapezoidal rule of a "
-       "smooth periodic function, which converges faster than any power of the samples "
-       "(spectrally) down to round-off.</p>\n";
+  h += over_duration
+           ? ". The samples include both ends of the duration, so the RMS is not the "
+             "trapezoidal rule of a periodic function and converges like a power of the "
+             "samples.</p>\n"
+           : ". Evenly spaced samples of a periodic motion make the RMS a trapezoidal rule of a "
+             "smooth periodic function, which converges faster than any power of the samples "
+             "(spectrally) down to round-off.</p>\n";
+  h += stopped_notice(csv, c_st, c_msg, [&](const std::vector<std::string>& r) {
+    return r[c_f] + " with " + r[c_n] + " samples";
+  });
 
   std::string datablocks, errors, times;
-  int lines = 0;
-  for (std::size_t fi = 0; fi < formulations.size(); ++fi) {
+  for (std::size_t fi = 0; fi < methods.size(); ++fi) {
     std::string ef, em, t;
-    for (const auto* row : of[formulations[fi]]) {
+    for (Row row : of[methods[fi]]) {
       if ((*row)[c_st] != "completed") continue;
       const double n = number_at(*row, c_n);
       const double e1 = number_at(*row, c_ef), e2 = number_at(*row, c_em);
@@ -225,15 +350,14 @@ std::string driven_section(const fs::path& file, const std::string& gnuplot) {
       if (ct > 0) t += fmt(n, "%.0f") + "," + fmt(1e6 * ct, "%.6g") + "\n";
     }
     const std::string id = std::to_string(fi);
-    const std::string name = formulations[fi];
+    const std::string& name = methods[fi];
     const auto add = [&](const std::string& block, const std::string& data, std::string& plot,
                          const std::string& title, int dash) {
       if (data.empty()) return;
       datablocks += block + " << EOD\n" + data + "EOD\n";
       plot += std::string(plot.empty() ? "" : ", ") + block +
-              " using 1:2 with linespoints lw 2 lc " + std::to_string(fi + 1) + " dt " +
-              std::to_string(dash) + " pt " + std::to_string(fi + 5) + " title " + gp_string(title);
-      ++lines;
+              " using 1:2 with linespoints lw 2 dt " + std::to_string(dash) + method_style(name) +
+              " title " + gp_string(title);
     };
     add("$dc_f" + id, ef, errors, name + ": Fsh_rms", 1);
     add("$dc_m" + id, em, errors, name + ": Msh_rms", 2);
@@ -241,30 +365,28 @@ std::string driven_section(const fs::path& file, const std::string& gnuplot) {
   }
   std::vector<Chart> charts;
   if (!errors.empty()) {
-    charts.push_back({"driven-convergence-error", "RMS error against samples per revolution",
-                      "Relative error of the RMS shaking force and moment of one revolution "
-                      "against the reference, per formulation; errors of exactly 0 are left "
-                      "out. From driven-convergence.csv.",
-                      "set logscale xy\nset format y '1e%L'\nset xlabel 'samples per "
-                      "revolution'\nset ylabel 'relative error of the RMS'\nplot " +
-                          errors});
+    charts.push_back({"driven-convergence-error", "RMS error against samples " + per,
+                      "Relative error of the RMS shaking force and moment against the "
+                      "reference, per method; errors of exactly 0 are left out. From "
+                      "driven-convergence.csv.",
+                      "set logscale xy\nset format y '1e%L'\nset xlabel 'samples " + per +
+                          "'\nset ylabel 'relative error of the RMS'\nplot " + errors});
   }
   if (!times.empty()) {
-    charts.push_back({"driven-convergence-time", "CPU time against samples per revolution",
-                      "Median CPU time of one revolution (core::simulate_driven and "
-                      "core::metrics), per formulation. From driven-convergence.csv.",
-                      "set logscale xy\nset xlabel 'samples per revolution'\nset ylabel 'CPU "
-                      "time per revolution [us]'\nplot " +
-                          times});
+    charts.push_back({"driven-convergence-time", "CPU time against samples " + per,
+                      "Median CPU time of one run with its metrics, per method. From "
+                      "driven-convergence.csv.",
+                      "set logscale xy\nset xlabel 'samples " + per +
+                          "'\nset ylabel 'CPU time per run [us]'\nplot " + times});
   }
 
-  h += "<table><tr><th>formulation</th><th>samples for both errors &lt; 1e-12</th><th>CPU time "
+  h += "<table><tr><th>method</th><th>samples for both errors &lt; 1e-12</th><th>CPU time "
        "[&micro;s]</th><th>at 360 samples: CPU time [&micro;s]</th><th>Fsh_rms error</th>"
        "<th>Msh_rms error</th></tr>";
-  for (const std::string& f : formulations) {
-    const std::vector<std::string>* enough = nullptr;
-    const std::vector<std::string>* at = nullptr;
-    for (const auto* row : of[f]) {
+  for (const std::string& f : methods) {
+    Row enough = nullptr;
+    Row at = nullptr;
+    for (Row row : of[f]) {
       const double e1 = number_at(*row, c_ef), e2 = number_at(*row, c_em);
       const bool small = (std::isnan(e1) || e1 < 1e-12) && (std::isnan(e2) || e2 < 1e-12) &&
                          !(std::isnan(e1) && std::isnan(e2));
@@ -291,14 +413,17 @@ std::string driven_section(const fs::path& file, const std::string& gnuplot) {
 
 }  // namespace
 
-std::string work_precision_section(const fs::path& dir, const std::string& gnuplot) {
+std::string work_precision_section(const Study& study, const fs::path& dir,
+                                   const std::string& gnuplot) {
   std::string h;
   std::error_code ec;
   if (fs::is_regular_file(dir / "work-precision.csv", ec)) {
     h += free_section(dir / "work-precision.csv", gnuplot);
   }
   if (fs::is_regular_file(dir / "driven-convergence.csv", ec)) {
-    h += driven_section(dir / "driven-convergence.csv", gnuplot);
+    const auto* planar = std::get_if<core::planar::DrivenScene>(&study.scene);
+    h += driven_section(dir / "driven-convergence.csv", gnuplot,
+                        planar != nullptr && planar->duration > 0);
   }
   return h.empty() ? h : "<h2 id=\"speed-against-accuracy\">Speed against accuracy</h2>\n" + h;
 }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "studies/report/pages.hpp"
+#include "studies/report/report.hpp"
 #include "studies/report/study_parts.hpp"
 #include "studies/run/files.hpp"
 
@@ -266,7 +267,10 @@ std::string planar_report_html(const Study& study, const fs::path& dir, const st
   std::string datablocks;
   const std::vector<Chart> charts = planar_charts(study, dir, ts, datablocks);
   h += charts_section(gnuplot, datablocks, charts);
-  return h + data_files_html(dir, {"timeseries.csv", "summary.json"});
+  // the measurements of `balance-design bench` when the folder has them (work_precision.hpp)
+  h += work_precision_section(study, dir, gnuplot);
+  return h + data_files_html(dir, {"timeseries.csv", "summary.json", "work-precision.csv",
+                                   "driven-convergence.csv"});
 }
 
 }  // namespace bd::studies::report_support

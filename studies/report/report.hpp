@@ -46,12 +46,15 @@ std::string sweep_report_html(const Study& study, const std::filesystem::path& d
 /// renamed into place, and returns its path.
 std::filesystem::path write_sweep_report(const Study& study, const std::filesystem::path& dir);
 
-/// The report's "Speed against accuracy" section (HTML, starting with an <h2>) built from
-/// dir/work-precision.csv or dir/driven-convergence.csv: log-log charts drawn by `gnuplot`
-/// (free: CPU time against the final-time error, one chart per formulation with a line per
-/// integrator; driven: RMS error and CPU time against samples per revolution) and a compact
-/// table. Without gnuplot, the table and a notice. Empty when neither file exists.
+/// The report's "Speed against accuracy" section (HTML, starting with an <h2>) of the study's
+/// bench, built from dir/work-precision.csv or dir/driven-convergence.csv: log-log charts drawn
+/// by `gnuplot` (free: CPU time against the final-time error, the methods compared by their
+/// fronts, then one chart per method with a line per integrator; driven: RMS error and CPU time
+/// against samples per revolution, or over the duration of a planar scene given by one), a
+/// compact table, and a notice of the runs that stopped early. Without gnuplot, the tables and
+/// a notice. Empty when neither file exists.
 /// @throws std::runtime_error if a file cannot be read or gnuplot fails.
-std::string work_precision_section(const std::filesystem::path& dir, const std::string& gnuplot);
+std::string work_precision_section(const Study& study, const std::filesystem::path& dir,
+                                   const std::string& gnuplot);
 
 }  // namespace bd::studies

@@ -9,11 +9,13 @@ namespace bd::studies {
 
 namespace {
 
-core::Trajectory closed_form(const Study& study, const MethodChoice& method) {
+core::Trajectory closed_form(const Study& study, const MethodChoice& method,
+                             const Tolerances& tolerances) {
   core::SimulateOptions options;
   options.formulation = method.formulation;
   options.integrator = method.integrator;
-  options.tolerance = study.tolerance;
+  options.tolerance = tolerances.relative;
+  options.absolute_tolerance = tolerances.absolute;
   if (const auto* free = std::get_if<core::FreeScene>(&study.scene)) {
     return core::simulate_free(study.fourbar(), *free, options);
   }
@@ -21,14 +23,15 @@ core::Trajectory closed_form(const Study& study, const MethodChoice& method) {
 }
 
 core::planar::Trajectory general_engine(const core::planar::Model& model, const Scene& scene,
-                                        const MethodChoice& method, double tolerance) {
+                                        const MethodChoice& method, const Tolerances& tolerances) {
   if (const auto* driven = std::get_if<core::planar::DrivenScene>(&scene)) {
     return core::planar::simulate_driven(model, *driven);
   }
   core::planar::SimulateOptions options;
   options.route = method.route();
   options.integrator = method.integrator;
-  options.tolerance = tolerance;
+  options.tolerance = tolerances.relative;
+  options.absolute_tolerance = tolerances.absolute;
   return core::planar::simulate_free(model, std::get<core::planar::FreeScene>(scene), options);
 }
 
@@ -55,23 +58,27 @@ RunStatus Simulation::status() const {
 Simulation simulate(const Study& study) { return simulate(study, choose_method(study)); }
 
 Simulation simulate(const Study& study, const MethodChoice& method) {
+  return simulate(study, method, Tolerances{study.tolerance, Tolerances{}.absolute});
+}
+
+Simulation simulate(const Study& study, const MethodChoice& method, const Tolerances& tolerances) {
   Simulation s;
   s.method = method;
   if (study.is_fourbar()) {
     if (!method.general_engine()) {
-      s.fourbar = closed_form(study, method);
+      s.fourbar = closed_form(study, method, tolerances);
       return s;
     }
     const core::FourBar& fb = study.fourbar();
     const core::planar::Model model(
         core::planar::linkage_of(fb, crank_angle_at_start(study.scene)));
     s.fourbar = core::planar::fourbar_trajectory(
-        general_engine(model, planar_scene(study.scene), method, study.tolerance));
+        general_engine(model, planar_scene(study.scene), method, tolerances));
     return s;
   }
   s.is_planar = true;
   const core::planar::Model model(study.planar());
-  s.planar = general_engine(model, study.scene, method, study.tolerance);
+  s.planar = general_engine(model, study.scene, method, tolerances);
   // auto, free: a limit position stops the reduced equations; the DAE passes through it
   if (study.method == Method::kAuto && is_free(study.scene) &&
       s.planar.status == core::SimulationStatus::kSingular && method.method == Method::kTruss) {
@@ -82,7 +89,7 @@ Simulation simulate(const Study& study, const MethodChoice& method) {
         "coordinate: the equations reduced to the inputs stopped at a limit position (" +
         s.planar.message + "), which the DAE passes through; integrated by CVODE Adams";
     s.method = dae;
-    s.planar = general_engine(model, study.scene, dae, study.tolerance);
+    s.planar = general_engine(model, study.scene, dae, tolerances);
   }
   return s;
 }

@@ -39,6 +39,9 @@ struct Simulation {
   bool is_planar{};
 
   RunStatus status() const;
+  bool ok() const {
+    return (is_planar ? planar.status : fourbar.status) == core::SimulationStatus::kCompleted;
+  }
 };
 
 /// Simulates the study's scene with the method choose_method() gives it. A planar linkage's free
@@ -48,6 +51,15 @@ struct Simulation {
 Simulation simulate(const Study& study);
 /// The same with a given method (the balanced or optimised design's own choice).
 Simulation simulate(const Study& study, const MethodChoice& method);
+
+/// A free run's integration tolerances: relative, and absolute on the coordinates and rates.
+struct Tolerances {
+  double relative = 1e-10;
+  double absolute = 1e-12;
+};
+/// The same with given tolerances (the bench's runs; simulate() above integrates at the study's
+/// tolerance and the integrators' default absolute tolerance, 1e-12). Driven scenes ignore them.
+Simulation simulate(const Study& study, const MethodChoice& method, const Tolerances& tolerances);
 
 /// The run's metrics in its table's order: a four-bar's (core::kMetricTable) or a planar
 /// linkage's (core::planar::metric_table()).

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "tests/support/csv.hpp"
+#include "tests/support/studies.hpp"
 #include "tests/support/text.hpp"
 
 namespace {
@@ -135,6 +136,30 @@ TEST_F(CliTest, SimulationStoppedEarlyExitsThreeAndKeepsResults) {
   EXPECT_NE(err_.find("theta1"), std::string::npos) << err_;
   EXPECT_TRUE(fs::exists(dir_ / "res" / "timeseries.csv"));
   EXPECT_NE(read(dir_ / "res" / "summary.json").find("\"ok\": false"), std::string::npos);
+}
+
+TEST_F(CliTest, PlanarSimulationStoppedEarlyNamesWhereItStopped) {
+  write("piston.yaml", bd::testing::piston_driven_slider_crank(1.5, 151));
+  EXPECT_EQ(run("piston.yaml --out res"), 3) << err_;
+  // the planar run's own message (not the empty four-bar trajectory's)
+  EXPECT_EQ(err_.rfind("piston.yaml: simulation stopped early: the linkage cannot be assembled "
+                       "at piston = 0.18",
+                       0),
+            0u)
+      << err_;
+  EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
+  EXPECT_TRUE(fs::exists(dir_ / "res" / "timeseries.csv"));
+
+  // its bench keeps every row and says how many runs stopped; the exit code is the run's
+  EXPECT_EQ(run("bench piston.yaml --quick --out bench"), 3) << err_;
+  EXPECT_NE(out_.find("  bench    14 rows (quick, 1 repeat): "), std::string::npos) << out_;
+  EXPECT_NE(out_.find("  bench    14 of 14 runs stopped before the end of the scene"),
+            std::string::npos)
+      << out_;
+  EXPECT_NE(err_.find("piston.yaml: simulation stopped early: the linkage cannot be assembled"),
+            std::string::npos)
+      << err_;
+  EXPECT_EQ(bd::testing::read(dir_ / "bench" / "driven-convergence.csv").substr(0, 7), "method,");
 }
 
 TEST_F(CliTest, BalanceStudyPrintsTheComparisonAndWritesItsFiles) {

@@ -1,5 +1,5 @@
 #pragma once
-// Test support: study-file texts the sweep tests share.
+// Test support: study-file texts the tests share.
 #include <string>
 
 namespace bd::testing {
@@ -28,6 +28,30 @@ inline std::string paper_free_lhs_sweep(int points, const std::string& extra) {
          "  parameters:\n"
          "    - {path: linkage.coupler.mass, from: 1.0, to: 5.0}\n"
          "    - {path: scene.omega1, from: -2.0, to: 2.0}\n";
+}
+
+/// A single-cylinder engine's slider-crank (crank 40 mm, rod 140 mm, piston 0.35 kg on a
+/// horizontal axis) driven by its piston at 0.05 m/s from mid-stroke (crank at 90 degrees) over
+/// `duration` seconds with `samples` samples: a planar driven scene given by a duration. The
+/// piston reaches the top dead centre at t = 0.92 s; past it the linkage cannot be assembled.
+inline std::string piston_driven_slider_crank(double duration, int samples) {
+  return "name: piston\n"
+         "linkage:\n"
+         "  type: planar\n"
+         "  nodes:\n"
+         "    O: {at: [0, 0], ground: true}\n"
+         "    A: [0, 0.04]\n"
+         "    B: [0.1341640786499874, 0]\n"
+         "  links:\n"
+         "    crank: {nodes: [O, A], mass: 1.2, e: 0.012, f: 0, inertia: 0.0009}\n"
+         "    rod:   {nodes: [A, B], mass: 0.45, e: 0.035, f: 0, inertia: 0.0012}\n"
+         "  point_masses: {B: 0.35}\n"
+         "  sliders:\n"
+         "    piston: {node: B, guide: [[0, 0], [1, 0]]}\n"
+         "  inputs:\n"
+         "    piston: {slider: piston}\n"
+         "scene: {type: driven, speeds: [0.05], duration: " +
+         std::to_string(duration) + ", samples: " + std::to_string(samples) + "}\n";
 }
 
 }  // namespace bd::testing
