@@ -281,6 +281,7 @@ struct Motion {
   double root_sign = 1;     // the sign of the normalised determinant at the start
   std::vector<Vec2> cache;  // positions of the last successful evaluation (Newton's guess)
   std::vector<double> z, zd, efforts;  // scratch: the inputs, their rates, the drives' efforts
+  std::vector<double> sample_angle;    // reduced route: the link angles of the last sample
   // dae route scratch
   MatrixXd kkt;
   VectorXd kkt_rhs, kkt_solution, rate_residual;
@@ -494,6 +495,13 @@ bool advance_ok(Trajectory& out, const Motion& m, integrators::Integration& inte
     out.message = "limit position reached at " + where() +
                   ": the inputs stop being coordinates of the motion there (the dae route "
                   "goes through it)";
+  } else if (m.failed && m.route == Route::kReduced &&
+             m.error.kind == PlanarError::Kind::kAssembly) {
+    // an explicit Runge-Kutta stage beyond a limit position (it cannot retry a shorter step):
+    // the linkage does not close there
+    out.status = SimulationStatus::kSingular;
+    out.message = "limit position reached after " + at + ": a step beyond it cannot close the " +
+                  "linkage (" + m.error.detail + "); the dae route goes through it";
   } else if (m.failed) {
     out.status = status_of(m.error);
     out.message = m.error.detail + " (a step ahead of " + at + " reached it)";
@@ -599,8 +607,23 @@ Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scen
     return state_text(model, integration.t(),
                       std::vector<double>(integration.y(), integration.y() + dof));
   };
-  sample_run(model, m, integration, scene, options, out, where,
-             [&] { return reduced_state(m, integration.t(), integration.y()); });
+  // a sample's link angles continue the last sample's, not the last evaluation's (a step ahead,
+  // up to a turn or more of a crank at loose tolerance), and an angle input's is the integrated
+  // value itself
+  m.sample_angle = ws.instant.angle;
+  sample_run(model, m, integration, scene, options, out, where, [&] {
+    ws.instant.angle = m.sample_angle;
+    auto ok = reduced_state(m, integration.t(), integration.y());
+    if (ok) {
+      for (std::size_t k = 0; k < model.linkage().inputs.size(); ++k) {
+        const Input& in = model.linkage().inputs[k];
+        if (in.kind == Input::Kind::kAngle)
+          ws.instant.angle[static_cast<std::size_t>(in.link)] = integration.y()[k];
+      }
+      m.sample_angle = ws.instant.angle;
+    }
+    return ok;
+  });
   return out;
 }
 
