@@ -329,6 +329,21 @@ int condition_rank(const MatrixXd& Z, const cp::Linkage& l, double length) {
 
 }  // namespace
 
+std::vector<LinkCounterweightSpec> grounded_links(const cp::Linkage& l) {
+  std::vector<LinkCounterweightSpec> out;
+  for (std::size_t k = 0; k < l.links.size(); ++k) {
+    int grounds = 0;
+    for (int n : l.links[k].nodes) grounds += l.nodes[static_cast<std::size_t>(n)].ground ? 1 : 0;
+    if (grounds == 1) out.push_back({static_cast<int>(k), {}});
+  }
+  return out;
+}
+
+void check_counterweights(const cp::Linkage& linkage,
+                          const std::vector<LinkCounterweightSpec>& counterweights) {
+  (void)placements(linkage, counterweights);
+}
+
 ForceBalance force_balance(const cp::Linkage& linkage, const Kinematics& k,
                            const std::vector<LinkCounterweightSpec>& counterweights) {
   const cp::Linkage& l = linkage;

@@ -95,6 +95,22 @@ struct LinkCounterweightSpec {
   CounterweightSpec spec;
 };
 
+/// The study file's `balance:` section for a planar linkage: full force balance by counterweights
+/// on the links named (default: every link that turns about a ground node).
+struct BalanceRequest {
+  bool force = true;
+  std::vector<LinkCounterweightSpec> counterweights;
+};
+
+/// The links that turn about a ground node (one of their nodes is fixed to the frame), each with
+/// a default counterweight: where counterweights go when the study names none.
+std::vector<LinkCounterweightSpec> grounded_links(const cp::Linkage& linkage);
+
+/// Checks counterweight specs against the linkage without balancing anything.
+/// @throws bd::InputError as force_balance().
+void check_counterweights(const cp::Linkage& linkage,
+                          const std::vector<LinkCounterweightSpec>& counterweights);
+
 /// A realised counterweight on a link.
 struct LinkCounterweight {
   int link{};

@@ -274,6 +274,35 @@ void print_balance(const st::Study& study, const st::RunResult& r) {
   print_comparison(study, r);
 }
 
+// a planar linkage's balanced design: the counterweights, whether full force balance is
+// reached (else why not), and before / after / ratio of every metric
+void print_planar_balance(const st::Study& study, const st::RunResult& r) {
+  const st::BalancedRun& run = *r.balanced;
+  if (!run.design) {
+    std::printf("  balance  force full: %s\n", run.status().message.c_str());
+    return;
+  }
+  const bd::balance::planar::ForceBalance& b = *run.design;
+  const bd::core::planar::Linkage& l = study.planar();
+  std::printf("  balance  force full: the balanced design is %s\n",
+              b.full ? "force balanced" : "not force balanced");
+  if (!b.full) std::printf("           %s\n", b.message.c_str());
+  for (const bd::balance::planar::LinkCounterweight& c : b.added) {
+    const bd::balance::Counterweight& w = c.counterweight;
+    std::printf("  %-7s  counterweight %.6g kg at [%.6g, %.6g] m from %s (%.6g m)",
+                l.links[static_cast<std::size_t>(c.link)].name.c_str(), w.mass, w.position.x(),
+                w.position.y(), l.nodes[static_cast<std::size_t>(c.pivot)].name.c_str(),
+                w.distance);
+    if (w.radius > 0) std::printf(", radius %.6g m", w.radius);
+    std::printf("\n");
+  }
+  const st::RunStatus status = run.status();
+  std::printf("  balanced design: method %s, %zu samples, status %s\n",
+              st::to_string(run.method.method), status.samples,
+              bd::core::to_string(status.status));
+  print_comparison(study, r);
+}
+
 // the optimum: how the solver ended, what it added, and before / after / ratio
 void print_optimize(const st::Study& study, const st::RunResult& r) {
   const st::OptimizeRequest& req = *study.optimize;
@@ -368,12 +397,13 @@ void print_summary(const st::Study& study, const st::RunResult& r) {
   std::printf("\n");
   print_metrics(r.metric_list, !st::is_free(study.scene));
   if (study.balance && r.balanced) print_balance(study, r);
+  if (study.planar_balance && r.balanced) print_planar_balance(study, r);
   if (study.optimize && r.optimized) print_optimize(study, r);
   std::printf("  wrote    %s\n", r.timeseries.string().c_str());
   if (r.balanced) {
     for (const fs::path& p :
          {r.balanced->timeseries, r.balanced->study_file, r.balanced->comparison}) {
-      std::printf("           %s\n", p.string().c_str());
+      if (!p.empty()) std::printf("           %s\n", p.string().c_str());
     }
   }
   if (r.optimized && r.optimized->found()) {
@@ -486,9 +516,11 @@ int run(const RunArgs& args) {
       std::fprintf(stderr, "%s: simulation stopped early: %s\n", args.study.c_str(),
                    status.message.c_str());
     }
-    if (result.balanced && !result.balanced->trajectory.ok()) {
+    const bool balanced_ran =
+        result.balanced && (!result.balanced->is_planar || result.balanced->design);
+    if (balanced_ran && !result.balanced->ok()) {
       std::fprintf(stderr, "%s: simulation of the balanced design stopped early: %s\n",
-                   args.study.c_str(), result.balanced->trajectory.message.c_str());
+                   args.study.c_str(), result.balanced->status().message.c_str());
     }
     if (result.optimized && result.optimized->found() && !result.optimized->trajectory.ok()) {
       std::fprintf(stderr, "%s: simulation of the optimised design stopped early: %s\n",

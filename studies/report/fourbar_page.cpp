@@ -423,25 +423,6 @@ FourBarCharts fourbar_charts(const Study& study, const fs::path& dir, const Seco
   return out;
 }
 
-// the balanced or optimised design's section (or the notice that no optimum was found)
-std::string second_design_section(const Json& summary, const SecondDesign& sd) {
-  std::string h;
-  const std::string second = sd.key, second_label = sd.label;
-  if (sd.present()) {
-    const char* section = second == "balanced" ? "balance" : "optimize";
-    h += std::string("<h2>") + (second == "balanced" ? "Balanced design" : "Optimised design") +
-         "</h2>\n";
-    if (const Json* s = member(summary, section)) h += json_table(*s);
-    if (const Json* run = member(summary, second + "_run")) {
-      h += "<h3>Its simulation (same scene)</h3>" + run_table(*run, second_label + " design's");
-    }
-  } else if (const Json* s = member(summary, "optimize")) {
-    h +=
-        "<h2>Optimisation</h2>\n<p class=\"notice bad\">No optimum was found.</p>" + json_table(*s);
-  }
-  return h;
-}
-
 }  // namespace
 
 std::string fourbar_report_html(const Study& study, const fs::path& dir, const std::string& gnuplot,

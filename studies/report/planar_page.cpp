@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -10,6 +12,7 @@
 #include "studies/report/report.hpp"
 #include "studies/report/study_parts.hpp"
 #include "studies/run/files.hpp"
+#include "studies/study/load_study.hpp"
 
 namespace bd::studies::report_support {
 
@@ -60,9 +63,35 @@ std::string magnitude(const Csv& ts, const std::string& name) {
   return "(sqrt($" + std::to_string(cx) + "**2+$" + std::to_string(cy) + "**2))";
 }
 
+// a counterweight drawn on its link: where it sits in the link's axes from its pivot node
+struct CounterweightPart {
+  int link{}, pivot{};
+  Vec2 position{0, 0};
+};
+
+// the counterweights of a balanced design, from summary.json's balance section
+std::vector<CounterweightPart> counterweight_parts(const Linkage& l, const Json& summary) {
+  std::vector<CounterweightPart> parts;
+  const Json* b = member(summary, "balance");
+  const Json* cws = b ? member(*b, "counterweights") : nullptr;
+  if (!cws || !cws->is_array()) return parts;
+  for (const Json& c : *cws) {
+    const int link = core::planar::link_index(l, text(c, "link"));
+    const int pivot = core::planar::node_index(l, text(c, "from_node"));
+    const Json* at = member(c, "position");
+    if (link < 0 || pivot < 0 || !at || !at->is_array() || at->size() != 2) continue;
+    if (!(*at)[0].is_number() || !(*at)[1].is_number()) continue;
+    parts.push_back({link, pivot, Vec2((*at)[0].get<double>(), (*at)[1].get<double>())});
+  }
+  return parts;
+}
+
 // the linkage at four samples evenly spread over the run: links through their nodes, the ground
-// nodes, the frame guides
-Chart linkage_chart(const Linkage& l, const Csv& ts, std::string& datablocks) {
+// nodes, the frame guides, and the counterweights `parts` (a balanced design's); `tag` names the
+// chart's data blocks apart from another linkage's on the page
+Chart linkage_chart(const Linkage& l, const Csv& ts, std::string& datablocks,
+                    const std::string& what = "linkage", const std::string& tag = "p",
+                    const std::vector<CounterweightPart>& parts = {}) {
   const std::size_t n = ts.rows.size();
   std::vector<std::size_t> picks;
   for (std::size_t k = 0; k < 4 && k < n; ++k) picks.push_back(k * n / std::min<std::size_t>(4, n));
@@ -72,7 +101,14 @@ Chart linkage_chart(const Linkage& l, const Csv& ts, std::string& datablocks) {
     return Vec2(row[static_cast<std::size_t>(gp_column(ts, "x_" + node.name) - 1)],
                 row[static_cast<std::size_t>(gp_column(ts, "y_" + node.name) - 1)]);
   };
-  datablocks += "$plinks << EOD\n";
+  // where a counterweight sits at a sample: pivot + R(theta) position
+  auto weight_at = [&](const std::vector<double>& row, const CounterweightPart& part) {
+    const int column = gp_column(ts, "theta_" + l.links[static_cast<std::size_t>(part.link)].name);
+    const double theta = column ? row[static_cast<std::size_t>(column - 1)] : 0.0;
+    const Vec2 u(std::cos(theta), std::sin(theta)), v(-u.y(), u.x());
+    return Vec2(node_at(row, part.pivot) + part.position.x() * u + part.position.y() * v);
+  };
+  datablocks += "$" + tag + "links << EOD\n";
   std::string entries;
   for (std::size_t k = 0; k < picks.size(); ++k) {
     const std::vector<double> row = numbers(ts.rows[picks[k]]);
@@ -81,16 +117,27 @@ Chart linkage_chart(const Linkage& l, const Csv& ts, std::string& datablocks) {
       if (link.nodes.size() > 2) datablocks += xy(node_at(row, link.nodes[0])) + "\n";
       datablocks += "\n";
     }
+    for (const CounterweightPart& part : parts) {  // its arm from the pivot
+      datablocks += xy(node_at(row, part.pivot)) + "\n" + xy(weight_at(row, part)) + "\n\n";
+    }
     datablocks += "\n";  // a new data set per sample (index k)
-    entries += std::string(k ? ", " : "") + "$plinks index " + std::to_string(k) +
+    entries += std::string(k ? ", " : "") + "$" + tag + "links index " + std::to_string(k) +
                " using 1:2 with linespoints lw 2 pt 7 ps 0.6 lt " + std::to_string(k + 1) +
                " title " + gp_string("t = " + fmt(row[0], "%.3g") + " s");
   }
-  datablocks += "EOD\n$pground << EOD\n";
+  // each counterweight where its link carries it, in its sample's colour
+  datablocks += "EOD\n$" + tag + "weights << EOD\n";
+  for (std::size_t k = 0; k < picks.size(); ++k) {
+    const std::vector<double> row = numbers(ts.rows[picks[k]]);
+    for (const CounterweightPart& part : parts) {
+      datablocks += xy(weight_at(row, part)) + "," + std::to_string(k + 1) + "\n";
+    }
+  }
+  datablocks += "EOD\n$" + tag + "ground << EOD\n";
   for (const core::planar::Node& node : l.nodes) {
     if (node.ground) datablocks += xy(node.position) + "\n";
   }
-  datablocks += "EOD\n$pguides << EOD\n";
+  datablocks += "EOD\n$" + tag + "guides << EOD\n";
   // a frame guide over the stretch its node travels, and a little more (the line the study
   // gives may be far longer: a cylinder axis given as [0, 0] to [1, 0])
   for (const core::planar::Slider& s : l.sliders) {
@@ -107,8 +154,9 @@ Chart linkage_chart(const Linkage& l, const Csv& ts, std::string& datablocks) {
     datablocks += xy(s.from + (lo - margin) * u) + "\n" + xy(s.from + (hi + margin) * u) + "\n\n";
   }
   datablocks += "EOD\n";
-  std::string cmd = "set title 'The linkage at " + std::to_string(picks.size()) +
-                    " samples'\nset size ratio -1\nset xlabel 'x [m]'\nset ylabel 'y [m]'\n"
+  std::string cmd = "set title " +
+                    gp_string("The " + what + " at " + std::to_string(picks.size()) + " samples") +
+                    "\nset size ratio -1\nset xlabel 'x [m]'\nset ylabel 'y [m]'\n"
                     "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n"
                     "set key outside right top vertical Left reverse\n";
   for (const core::planar::Node& node : l.nodes) {
@@ -116,11 +164,17 @@ Chart linkage_chart(const Linkage& l, const Csv& ts, std::string& datablocks) {
       cmd +=
           "set label " + gp_string(node.name) + " at " + xy(node.position) + " offset 0.6,-0.8\n";
   }
-  cmd += "plot " + entries +
-         ", $pground using 1:2 with points pt 9 ps 1.8 lc 'gray30' title 'ground nodes'";
+  cmd += "plot " + entries + ", $" + tag +
+         "ground using 1:2 with points pt 9 ps 1.8 lc 'gray30' title 'ground nodes'";
   const bool guides = std::any_of(l.sliders.begin(), l.sliders.end(),
                                   [](const core::planar::Slider& s) { return s.link < 0; });
-  if (guides) cmd += ", $pguides using 1:2 with lines lw 1 dt 2 lc 'gray30' title 'frame guides'";
+  if (guides) {
+    cmd += ", $" + tag + "guides using 1:2 with lines lw 1 dt 2 lc 'gray30' title 'frame guides'";
+  }
+  if (!parts.empty()) {
+    cmd += ", $" + tag +
+           "weights using 1:2:3 with points pt 7 ps 2.2 lc variable title 'counterweights'";
+  }
   Chart c;
   c.id = "linkage";
   c.heading = "The linkage";
@@ -133,8 +187,29 @@ Chart linkage_chart(const Linkage& l, const Csv& ts, std::string& datablocks) {
   return c;
 }
 
+// the balanced design beside the original: its samples' file, its linkage and counterweights
+struct Second {
+  SecondDesign design;
+  std::string file;  // its samples as a gnuplot string
+  std::optional<Linkage> linkage;
+  std::vector<CounterweightPart> parts;
+  Csv ts;
+};
+
+// one line of the original over t, and the second design's (dashed) when there is one
+std::string with_second(const std::string& file, const Second& second, const std::string& name,
+                        const std::string& expr) {
+  std::string plot = file + " skip 1 using 1:" + expr + " with lines lw 2 title " +
+                     gp_string(second.file.empty() ? name : name + ", original");
+  if (!second.file.empty()) {
+    plot += ", " + second.file + " skip 1 using 1:" + expr + " with lines lw 2 dt 2 title " +
+            gp_string(name + ", " + second.design.label);
+  }
+  return plot;
+}
+
 std::vector<Chart> planar_charts(const Study& study, const fs::path& dir, const Csv& ts,
-                                 std::string& datablocks) {
+                                 const Second& second, std::string& datablocks) {
   const Linkage& l = study.planar();
   const std::string file = gp_string((fs::absolute(dir) / "timeseries.csv").string());
   const std::string taxis = "\nset xlabel " + gp_string(time_axis(study.scene)) + "\n";
@@ -155,6 +230,21 @@ std::vector<Chart> planar_charts(const Study& study, const fs::path& dir, const 
     }
     if (c.rfind("tau", 0) == 0) drives.push_back({c, std::to_string(gp_column(ts, c))});
   }
+  std::string drive_plot;
+  for (const auto& [name, expr] : drives) {
+    drive_plot += (drive_plot.empty() ? "" : ", ") + with_second(file, second, name, expr);
+  }
+  std::string hodograph = file + " skip 1 using " + std::to_string(gp_column(ts, "Fshx")) + ":" +
+                          std::to_string(gp_column(ts, "Fshy")) +
+                          " with lines lw 2 title 'shaking force'";
+  if (!second.file.empty()) {
+    hodograph = file + " skip 1 using " + std::to_string(gp_column(ts, "Fshx")) + ":" +
+                std::to_string(gp_column(ts, "Fshy")) +
+                " with lines lw 2 title 'original', " + second.file + " skip 1 using " +
+                std::to_string(gp_column(second.ts, "Fshx")) + ":" +
+                std::to_string(gp_column(second.ts, "Fshy")) +
+                " with linespoints lw 2 pt 7 ps 0.5 pi 10 title " + gp_string(second.design.label);
+  }
   charts.push_back({"angles", "Link angles",
                     "Every link's angle (its first-to-second node direction) over the run.",
                     "set title 'Link angles'" + taxis + "set ylabel 'angle [rad]'\nplot " +
@@ -170,24 +260,34 @@ std::vector<Chart> planar_charts(const Study& study, const fs::path& dir, const 
        "The tip of the shaking force over the run, equal axes.",
        "set title 'Shaking-force hodograph'\nset size ratio -1\nset xlabel 'Fshx [N]'\n"
        "set ylabel 'Fshy [N]'\nplot " +
-           file + " skip 1 using " + std::to_string(gp_column(ts, "Fshx")) + ":" +
-           std::to_string(gp_column(ts, "Fshy")) + " with lines lw 2 title 'shaking force'",
+           hodograph,
        true});
   charts.push_back(
       {"shaking-moment", "Shaking moment", "Shaking moment on the frame about the origin.",
        "set title 'Shaking moment about the origin'" + taxis + "set ylabel 'Msh [N m]'\nplot " +
-           lines_over_t(file, {{"Msh", std::to_string(gp_column(ts, "Msh"))}})});
+           with_second(file, second, "Msh", std::to_string(gp_column(ts, "Msh")))});
   charts.push_back({"drive", "Drive efforts",
                     "The drives' torques [N m] or forces [N] on their inputs, from the frame.",
                     "set title 'Drive efforts'" + taxis +
-                        "set ylabel 'torque [N m] or force [N]'\nplot " +
-                        lines_over_t(file, drives)});
+                        "set ylabel 'torque [N m] or force [N]'\nplot " + drive_plot});
   if (!joints.empty()) {
     charts.push_back({"joints", "Joint forces", "Magnitudes of the joint forces on their links.",
                       "set title 'Joint forces'" + taxis + "set ylabel 'joint force [N]'\nplot " +
                           lines_over_t(file, joints)});
   }
   charts.push_back(linkage_chart(l, ts, datablocks));
+  if (second.linkage && !second.ts.rows.empty()) {
+    Chart c = linkage_chart(*second.linkage, second.ts, datablocks,
+                            second.design.label + " linkage", "b", second.parts);
+    c.id = "linkage-" + second.design.key;
+    c.heading = "The " + second.design.label + " linkage";
+    c.caption =
+        "The " + second.design.label + " design drawn as the original above, from " +
+        second.design.file +
+        ", with each counterweight as a filled circle on an arm from its link's pivot, in its "
+        "sample's colour; the links' masses include them.";
+    charts.push_back(c);
+  }
   return charts;
 }
 
@@ -256,20 +356,36 @@ std::string planar_linkage_tables(const Linkage& l) {
 std::string planar_report_html(const Study& study, const fs::path& dir, const std::string& gnuplot,
                                const Json& summary) {
   const Csv ts = read_csv(dir / "timeseries.csv");
+  Second second;
+  second.design = second_design(summary, dir);
+  if (second.design.present()) {
+    second.file = gp_string((fs::absolute(dir) / second.design.file).string());
+    second.ts = read_csv(dir / second.design.file);
+    second.parts = counterweight_parts(study.planar(), summary);
+    try {
+      second.linkage = load_study((dir / (second.design.key + ".yaml")).string()).planar();
+    } catch (const std::exception& e) {
+      throw std::runtime_error("cannot draw the " + second.design.label +
+                               " design: " + std::string(e.what()));
+    }
+  }
   std::string h = page_start(study, summary) + simulation_section(summary);
   h += "<h2>Linkage</h2>\n" + planar_linkage_tables(study.planar());
   h +=
-      metrics_section(summary, {},
+      metrics_section(summary, second.design,
                       "Fsh, Msh: shaking force [N] and moment about the origin [N m] on the frame; "
                       "tau: drive torques [N m] or forces [N]; R&lt;name&gt;: forces on the frame "
                       "at a ground node or guide [N]; F&lt;joint&gt;: joint forces on their links "
                       "[N]. RMS over the samples, max of magnitudes.");
+  h += comparison_section(dir, second.design);
   std::string datablocks;
-  const std::vector<Chart> charts = planar_charts(study, dir, ts, datablocks);
+  const std::vector<Chart> charts = planar_charts(study, dir, ts, second, datablocks);
   h += charts_section(gnuplot, datablocks, charts);
+  h += second_design_section(summary, second.design);
   // the measurements of `balance-design bench` when the folder has them (work_precision.hpp)
   h += work_precision_section(study, dir, gnuplot);
-  return h + data_files_html(dir, {"timeseries.csv", "summary.json", "work-precision.csv",
+  return h + data_files_html(dir, {"timeseries.csv", "summary.json", "balanced-timeseries.csv",
+                                   "balanced.yaml", "comparison.csv", "work-precision.csv",
                                    "driven-convergence.csv"});
 }
 

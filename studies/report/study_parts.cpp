@@ -126,4 +126,26 @@ std::string time_axis(const Scene& scene) {
   return "t [s]";
 }
 
+std::string second_design_section(const Json& summary, const SecondDesign& sd) {
+  std::string h;
+  const std::string second = sd.key, second_label = sd.label;
+  if (sd.present()) {
+    const char* section = second == "balanced" ? "balance" : "optimize";
+    h += std::string("<h2>") + (second == "balanced" ? "Balanced design" : "Optimised design") +
+         "</h2>\n";
+    if (const Json* s = member(summary, section)) h += json_table(*s);
+    if (const Json* run = member(summary, second + "_run")) {
+      h += "<h3>Its simulation (same scene)</h3>" + run_table(*run, second_label + " design's");
+    }
+  } else if (const Json* s = member(summary, "optimize")) {
+    h +=
+        "<h2>Optimisation</h2>\n<p class=\"notice bad\">No optimum was found.</p>" + json_table(*s);
+  } else if (const Json* b = member(summary, "balance")) {
+    h += "<h2>Balanced design</h2>\n<p class=\"notice bad\">The balanced design was not "
+         "simulated.</p>" +
+         json_table(*b);
+  }
+  return h;
+}
+
 }  // namespace bd::studies::report_support

@@ -30,6 +30,9 @@ std::string metrics_section(const Json& summary, const SecondDesign& second,
                             const std::string& notes);
 /// "Comparison" (comparison.csv), when the folder has it.
 std::string comparison_section(const std::filesystem::path& dir, const SecondDesign& second);
+/// The balanced or optimised design's section: its summary.json section and its run (or the
+/// notice that no optimum was found).
+std::string second_design_section(const Json& summary, const SecondDesign& second);
 /// "Charts": each chart drawn by gnuplot with its heading and caption, or the notice that the
 /// charts need gnuplot.
 std::string charts_section(const std::string& gnuplot, const std::string& datablocks,

@@ -14,6 +14,8 @@
 #include <utility>
 #include <variant>
 
+#include <fmt/format.h>
+
 #include "core/number_text.hpp"
 #include "optimize/nlp.hpp"
 #include "studies/run/files.hpp"
@@ -103,29 +105,28 @@ void write_timeseries(const core::Trajectory& trajectory, const fs::path& file) 
 }
 
 std::vector<ComparisonRow> comparison(const Study& study, const RunResult& result) {
-  assert((study.balance && result.balanced) || (result.optimized && result.optimized->found()));
-  std::vector<ComparisonRow> rows;
-  const core::Metrics& a = result.metrics;
-  const bool balanced = study.balance && result.balanced;
-  const core::Metrics& b = balanced ? result.balanced->metrics : result.optimized->metrics;
+  assert((result.balanced && (study.balance || result.balanced->design)) ||
+         (result.optimized && result.optimized->found()));
+  const MetricList& a = result.metric_list;
+  MetricList b;
   double mass = 0, inertia = 0;
-  if (balanced) {
-    mass = study.balance->added_mass;
-    inertia = study.balance->added_inertia;
+  if (const std::optional<BalancedRun>& run = result.balanced) {
+    b = run->metric_list;
+    mass = run->design ? run->design->added_mass : study.balance->added_mass;
+    inertia = run->design ? run->design->added_inertia : study.balance->added_inertia;
   } else {
+    b = metric_list(result.optimized->metrics);
     mass = added_mass(study.fourbar(), result.optimized->result.design);
     inertia = added_inertia(study.fourbar(), result.optimized->result.design);
   }
-  std::vector<std::pair<std::string, std::pair<double, double>>> items;
-  for (const core::MetricInfo& info : core::kMetricTable) {
-    items.push_back({info.name, {a.*info.field, b.*info.field}});
+  std::vector<ComparisonRow> rows;
+  for (std::size_t k = 0; k < a.size() && k < b.size(); ++k) {
+    rows.push_back({a[k].name, a[k].value, b[k].value, std::nullopt});
   }
-  items.push_back({"added_mass", {0.0, mass}});
-  items.push_back({"added_inertia", {0.0, inertia}});
-  for (const auto& [name, values] : items) {
-    ComparisonRow row{name, values.first, values.second, std::nullopt};
+  rows.push_back({"added_mass", 0.0, mass, std::nullopt});
+  rows.push_back({"added_inertia", 0.0, inertia, std::nullopt});
+  for (ComparisonRow& row : rows) {
     if (row.before != 0) row.ratio = row.after / row.before;
-    rows.push_back(row);
   }
   return rows;
 }
@@ -170,6 +171,25 @@ std::string balanced_yaml(const Study& study) {
       "Links are in the polar form {s, sigma} with every digit (%.17g; e, f as comments).\n"
       "Run it with\n  balance-design balanced.yaml";
   return study_yaml(balanced_study(study), header);
+}
+
+std::string balanced_yaml(const Study& study, const balance::planar::ForceBalance& design) {
+  const core::planar::Linkage& l = study.planar();
+  std::string header = "The balanced design of study '" + study.name + "', synthesised by\n";
+  header += "balance-design from its balance section (force: full)";
+  header += study.source.empty() ? std::string(".\n") : " in\n  " + study.source + "\n";
+  header += design.full ? "It is fully force balanced over the motion.\n"
+                        : "Full force balance is not reached: " + design.message + "\n";
+  for (const balance::planar::LinkCounterweight& c : design.added) {
+    const balance::Counterweight& w = c.counterweight;
+    header += fmt::format(
+        "Link {} carries a counterweight of {:.6g} kg at ({:.6g}, {:.6g}) m from node {} in the "
+        "link's axes (merged into the link below).\n",
+        l.links[static_cast<std::size_t>(c.link)].name, w.mass, w.position.x(), w.position.y(),
+        l.nodes[static_cast<std::size_t>(c.pivot)].name);
+  }
+  header += "Run it with\n  balance-design balanced.yaml";
+  return study_yaml(planar_balanced_study(study, design.linkage), header);
 }
 
 std::string optimized_yaml(const Study& study, const OptimizedRun& run) {
@@ -233,13 +253,53 @@ std::string pareto_csv(const Study& study, const OptimizedRun& run) {
   return text;
 }
 
-RunStatus simulation_status(const RunResult& r) {
-  if (!r.planar.table.columns.empty()) {
-    return {r.planar.status, r.planar.message, r.planar.table.rows(), r.planar.steps,
-            r.planar.rhs_evaluations};
+namespace {
+
+RunStatus status_of(const core::planar::Trajectory& t) {
+  return {t.status, t.message, t.table.rows(), t.steps, t.rhs_evaluations};
+}
+RunStatus status_of(const core::Trajectory& t) {
+  return {t.status, t.message, t.samples.size(), t.steps, t.rhs_evaluations};
+}
+
+// a planar study's balanced design: synthesised from the original's motion (its configurations
+// give the balance conditions), then simulated in the same scene; not run when the original
+// stopped early
+BalancedRun planar_balanced_run(const Study& study, const RunResult& original) {
+  namespace bp = balance::planar;
+  BalancedRun b;
+  b.is_planar = true;
+  if (!original.status().ok()) {
+    b.planar.message = "not run: the original design's simulation stopped early (" +
+                       original.status().message + ")";
+    return b;
   }
-  return {r.trajectory.status, r.trajectory.message, r.trajectory.samples.size(),
-          r.trajectory.steps, r.trajectory.rhs_evaluations};
+  const core::planar::Model model(study.planar());
+  const bp::InputSeries in = bp::input_series(model, original.planar.table);
+  const auto k = bp::kinematics(model, in.values, in.rates, in.accelerations);
+  if (!k) {
+    b.planar.message = "not run: the original's motion cannot be evaluated for balancing (" +
+                       k.error().detail + ")";
+    return b;
+  }
+  b.design = bp::force_balance(study.planar(), *k, study.planar_balance->counterweights);
+  const Study balanced = planar_balanced_study(study, b.design->linkage);
+  Simulation sim = simulate(balanced);
+  b.method = sim.method;
+  b.metric_list = metric_list(balanced, sim);
+  b.planar = std::move(sim.planar);
+  return b;
+}
+
+}  // namespace
+
+RunStatus BalancedRun::status() const {
+  return is_planar ? status_of(planar) : status_of(trajectory);
+}
+
+RunStatus simulation_status(const RunResult& r) {
+  if (!r.planar.table.columns.empty()) return status_of(r.planar);
+  return status_of(r.trajectory);
 }
 
 RunResult compute_study(const Study& study) {
@@ -256,8 +316,10 @@ RunResult compute_study(const Study& study) {
     b.method = balanced.method;
     b.trajectory = balanced.fourbar;
     b.metrics = core::metrics(b.trajectory);
+    b.metric_list = metric_list(b.metrics);
     result.balanced = std::move(b);
   }
+  if (study.planar_balance) result.balanced = planar_balanced_run(study, result);
   if (study.optimize) result.optimized = optimize_study(study, result);
   return result;
 }
@@ -277,13 +339,18 @@ void write_run(const Study& study, RunResult& result, const fs::path& out_dir) {
   } else {
     write_table(result.planar.table, result.timeseries);
   }
-  if (result.balanced) {
+  if (result.balanced && (!result.balanced->is_planar || result.balanced->design)) {
     BalancedRun& b = *result.balanced;
     b.timeseries = out_dir / "balanced-timeseries.csv";
     b.study_file = out_dir / "balanced.yaml";
     b.comparison = out_dir / "comparison.csv";
-    write_timeseries(b.trajectory, b.timeseries);
-    write_text_file(balanced_yaml(study), b.study_file);
+    if (b.is_planar) {
+      write_table(b.planar.table, b.timeseries);
+      write_text_file(balanced_yaml(study, *b.design), b.study_file);
+    } else {
+      write_timeseries(b.trajectory, b.timeseries);
+      write_text_file(balanced_yaml(study), b.study_file);
+    }
     write_text_file(comparison_csv(study, result), b.comparison);
   }
   if (result.optimized && result.optimized->found()) {

@@ -29,11 +29,20 @@ inline constexpr const char* kComparisonHeader = "metric,before,after,ratio";
 /// The balanced design's run in a balance study (same scene, method chosen for it alike).
 struct BalancedRun {
   MethodChoice method;               // formulation used for the balanced design, and why
-  core::Trajectory trajectory;       // its samples and status
-  core::Metrics metrics;             // over its samples
+  core::Trajectory trajectory;       // a four-bar study: its samples and status
+  core::Metrics metrics;             // a four-bar study: over its samples
+  core::planar::Trajectory planar;   // a planar study: its samples' table and status
+  /// A planar study: the design, synthesised from the original's motion; empty when the original
+  /// stopped early (then `planar` is not run and its message says why).
+  std::optional<balance::planar::ForceBalance> design;
+  bool is_planar{};
+  MetricList metric_list;            // its metrics in its table's order (either type)
   std::filesystem::path timeseries;  // out_dir/balanced-timeseries.csv
   std::filesystem::path study_file;  // out_dir/balanced.yaml
   std::filesystem::path comparison;  // out_dir/comparison.csv
+  /// How its simulation ended (either linkage type).
+  RunStatus status() const;
+  bool ok() const { return status().ok(); }
 };
 
 /// The optimisation in an optimize study, and the optimum's run (same scene, method chosen for it
@@ -83,13 +92,13 @@ struct RunResult {
   /// How the original design's simulation ended (either linkage type).
   RunStatus status() const { return simulation_status(*this); }
   bool ok() const {
-    return status().ok() && (!balanced || balanced->trajectory.ok()) &&
+    return status().ok() && (!balanced || balanced->ok()) &&
            (!optimized || (optimized->found() && optimized->trajectory.ok()));
   }
   /// True when a simulation stopped early (the original's, the balanced design's or the
   /// optimum's): exit code 3.
   bool stopped_early() const {
-    return !status().ok() || (balanced && !balanced->trajectory.ok()) ||
+    return !status().ok() || (balanced && !balanced->ok()) ||
            (optimized && optimized->found() && !optimized->trajectory.ok());
   }
 };
@@ -101,12 +110,13 @@ struct ComparisonRow {
   double before{}, after{};
   std::optional<double> ratio;
 };
-/// The rows of comparison.csv, in order: Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max,
-/// RA0_rms, RA0_max, RA3_rms, RA3_max, added_mass, added_inertia.
+/// The rows of comparison.csv, in order: the metrics in their table's order (a four-bar's
+/// Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max, RA0_rms, RA0_max, RA3_rms, RA3_max; a
+/// planar linkage's from core::planar::metric_table()), then added_mass, added_inertia.
 /// In an optimize study added_mass and added_inertia are those of studies::added_mass() and
 /// added_inertia() (negative when the optimum takes mass away).
-/// Precondition: study.balance and result.balanced are set, or result.optimized has found its
-/// optimum.
+/// Precondition: result.balanced is set (with its design, for a planar linkage), or
+/// result.optimized has found its optimum.
 std::vector<ComparisonRow> comparison(const Study& study, const RunResult& result);
 
 /// What run_study() (studies/studies.hpp) computes, without writing anything: simulates the study's
@@ -151,9 +161,12 @@ std::string summary_json(const Study& study, const RunResult& result);
 /// per comparison() entry, numbers "%.17g", ratio empty when before is 0.
 std::string comparison_csv(const Study& study, const RunResult& result);
 
-/// The balanced.yaml text of a balance study: study_yaml(balanced_study(study)) with a header
-/// comment saying where it came from.
+/// The balanced.yaml text of a four-bar's balance study: study_yaml(balanced_study(study)) with a
+/// header comment saying where it came from.
 std::string balanced_yaml(const Study& study);
+/// The balanced.yaml text of a planar linkage's balance study: the design's study with a header
+/// comment saying where it came from and which counterweights it carries.
+std::string balanced_yaml(const Study& study, const balance::planar::ForceBalance& design);
 
 /// The optimized.yaml text of an optimize study whose optimum was found:
 /// study_yaml(optimized_study(study, design)) with a header comment saying how it was found.

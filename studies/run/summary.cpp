@@ -21,14 +21,13 @@ Json metrics_json(const MetricList& metrics) {
   for (const MetricValue& m : metrics) j[m.name] = m.value;
   return j;
 }
-Json metrics_json(const core::Metrics& m) { return metrics_json(metric_list(m)); }
 
 // after / before per metric; null where before is 0
-Json reduction_json(const core::Metrics& before, const core::Metrics& after) {
+Json reduction_json(const MetricList& before, const MetricList& after) {
   Json j = Json::object();
-  for (const core::MetricInfo& info : core::kMetricTable) {
-    const double b = before.*info.field;
-    j[info.name] = b != 0 ? Json(after.*info.field / b) : Json(nullptr);
+  for (std::size_t k = 0; k < before.size() && k < after.size(); ++k) {
+    const double b = before[k].value;
+    j[before[k].name] = b != 0 ? Json(after[k].value / b) : Json(nullptr);
   }
   return j;
 }
@@ -85,10 +84,6 @@ void add_run_fields(Json& j, const RunStatus& r) {
   j["steps"] = r.steps;
   j["rhs_evaluations"] = r.rhs_evaluations;
 }
-void add_run_fields(Json& j, const core::Trajectory& tr) {
-  add_run_fields(j,
-                 RunStatus{tr.status, tr.message, tr.samples.size(), tr.steps, tr.rhs_evaluations});
-}
 
 Json counterweight_json(const char* link, balance::CounterweightShape shape,
                         const balance::Counterweight& c) {
@@ -139,6 +134,34 @@ Json balance_json(const balance::BalancedDesign& b) {
     }
   }
   j["conditions"] = conditions;
+  return j;
+}
+
+// a planar linkage's balance section: the counterweights added, whether full force balance is
+// reached (else why not), and the inertial shaking force before and after
+Json planar_balance_json(const Study& study, const balance::planar::ForceBalance& b) {
+  const core::planar::Linkage& l = study.planar();
+  Json j = {{"force", "full"}, {"moment", "none"}};
+  Json cws = Json::array();
+  for (const balance::planar::LinkCounterweight& c : b.added) {
+    balance::CounterweightShape shape = balance::CounterweightShape::kPoint;
+    for (const balance::planar::LinkCounterweightSpec& ask : study.planar_balance->counterweights) {
+      if (ask.link == c.link) shape = ask.spec.shape;
+    }
+    Json cw = counterweight_json(l.links[static_cast<std::size_t>(c.link)].name.c_str(), shape,
+                                 c.counterweight);
+    cw["from_node"] = l.nodes[static_cast<std::size_t>(c.pivot)].name;
+    cws.push_back(std::move(cw));
+  }
+  j["counterweights"] = cws;
+  j["added_mass"] = b.added_mass;
+  j["added_inertia"] = b.added_inertia;
+  j["force_balanced"] = b.full;
+  j["conditions"] = b.conditions;
+  j["message"] = b.message;
+  j["momentum_left"] = b.momentum_left;
+  j["Fsh_inertial_rms_before"] = b.Fsh_rms_before;
+  j["Fsh_inertial_rms_after"] = b.Fsh_rms_after;
   return j;
 }
 
@@ -218,10 +241,10 @@ Json optimize_json(const Study& study, const RunResult& result) {
 // the keys of a second design's run (the balanced or the optimised one): `<what>_run`,
 // `<what>_metrics`, and `reduction` (second / original per metric)
 void add_second_run(Json& j, const Study& study, const std::string& what,
-                    const MethodChoice& method, const core::Trajectory& trajectory,
-                    const core::Metrics& original, const core::Metrics& second) {
+                    const MethodChoice& method, const RunStatus& status,
+                    const MetricList& original, const MetricList& second) {
   Json run = {{"study", study.name + "-" + what}, {"method", method_json(study, method)}};
-  add_run_fields(run, trajectory);
+  add_run_fields(run, status);
   j[what + "_run"] = run;
   j[what + "_metrics"] = metrics_json(second);
   j["reduction"] = reduction_json(original, second);
@@ -241,13 +264,27 @@ std::string summary_json(const Study& study, const RunResult& result) {
   if (study.balance && result.balanced) {
     const BalancedRun& b = *result.balanced;
     j["balance"] = balance_json(*study.balance);
-    add_second_run(j, study, "balanced", b.method, b.trajectory, result.metrics, b.metrics);
+    add_second_run(j, study, "balanced", b.method, b.status(), result.metric_list, b.metric_list);
+  }
+  if (study.planar_balance && result.balanced) {
+    const BalancedRun& b = *result.balanced;
+    if (b.design) {
+      j["balance"] = planar_balance_json(study, *b.design);
+      add_second_run(j, study, "balanced", b.method, b.status(), result.metric_list,
+                     b.metric_list);
+    } else {
+      j["balance"] = {{"force", "full"}, {"moment", "none"}, {"message", b.status().message}};
+    }
   }
   if (study.optimize && result.optimized) {
     const OptimizedRun& o = *result.optimized;
     j["optimize"] = optimize_json(study, result);
     if (o.found()) {
-      add_second_run(j, study, "optimized", o.method, o.trajectory, result.metrics, o.metrics);
+      const RunStatus status{o.trajectory.status, o.trajectory.message,
+                             o.trajectory.samples.size(), o.trajectory.steps,
+                             o.trajectory.rhs_evaluations};
+      add_second_run(j, study, "optimized", o.method, status, result.metric_list,
+                     metric_list(o.metrics));
     }
   }
   // invalid UTF-8 in a message (a key copied from a study file) is replaced, never a failure

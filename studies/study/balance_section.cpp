@@ -1,9 +1,13 @@
-// The balance section of a four-bar study: what to balance and with what, synthesised at load
-// time (balance/synthesis.hpp); a synthesis that is not possible is reported at the key asking.
+// The balance section: a four-bar's says what to balance and with what, synthesised at load time
+// (balance/synthesis.hpp; a synthesis that is not possible is reported at the key asking); a
+// planar linkage's names the links to carry counterweights, checked here and synthesised by the
+// runner from the motion (balance/planar.hpp).
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -167,7 +171,81 @@ class BalanceReader {
   const Reporter& r_;
 };
 
+// balance: {force, counterweights} of a planar linkage: which links carry counterweights, checked
+// against the linkage; the synthesis waits for the run (its conditions come from the motion)
+balance::planar::BalanceRequest read_planar(const Reporter& r_, const MapReader::Entry& e,
+                                            const core::planar::Linkage& linkage) {
+  namespace bp = balance::planar;
+  BalanceReader reader(r_);
+  bp::BalanceRequest request;
+  std::optional<MapReader::Entry> cw;  // a copy: the section's reader ends with its block
+  if (!e.value.IsNull()) {
+    const MapReader b(r_, e.value, "balance", e.key_mark, "(force, counterweights)");
+    b.check_keys({"force", "moment", "counterweights", "counter_rotations"});
+    if (const MapReader::Entry* f = b.find("force")) {
+      if (!reader.read_full_or_none(*f, "balance.force")) {
+        r_.fail(mark_of(f->value, f->key_mark),
+                "balance.force: none leaves nothing to balance: a planar linkage is force "
+                "balanced by counterweights (moment balance is available for a four-bar)");
+      }
+    }
+    for (const char* key : {"moment", "counter_rotations"}) {
+      if (const MapReader::Entry* m = b.find(key)) {
+        r_.fail(m->key_mark, std::string("balance.") + key +
+                                 " is available for a four-bar (linkage.type: fourbar); a planar "
+                                 "linkage is force balanced by counterweights");
+      }
+    }
+    if (const MapReader::Entry* x = b.find("counterweights")) cw = *x;
+  }
+  std::map<int, YAML::Mark> marks;  // link -> where its counterweight is asked for
+  if (cw && !cw->value.IsNull()) {
+    std::string names;
+    for (const core::planar::Link& l : linkage.links) names += (names.empty() ? "" : ", ") + l.name;
+    const MapReader m(r_, cw->value, "balance.counterweights", cw->key_mark,
+                      "(a link's name and its counterweight: {} or shape, mass, distance, radius, "
+                      "thickness, density)");
+    for (const MapReader::Entry& x : m.entries()) {
+      const int link = core::planar::link_index(linkage, x.key);
+      if (link < 0) {
+        r_.fail(x.key_mark, "balance.counterweights." + x.key + ": no link of that name (links: " +
+                                names + ")");
+      }
+      request.counterweights.push_back(
+          {link, reader.read_counterweight(x, "balance.counterweights." + x.key)});
+      marks[link] = x.key_mark;
+    }
+  } else {
+    request.counterweights = bp::grounded_links(linkage);
+    if (request.counterweights.empty()) {
+      r_.fail(cw ? cw->key_mark : e.key_mark,
+              "balance: no link turns about a ground node to carry a counterweight by default; "
+              "name the links to carry them in balance.counterweights (a floating link's "
+              "counterweight needs its mass)");
+    }
+  }
+  try {
+    bp::check_counterweights(linkage, request.counterweights);
+  } catch (const InputError& err) {
+    // the field is counterweights.<link>[.<spec field>]: reported at the link's key
+    for (const auto& [link, mark] : marks) {
+      const std::string field =
+          "counterweights." + linkage.links[static_cast<std::size_t>(link)].name;
+      if (err.field() && err.field()->field.rfind(field, 0) == 0) {
+        r_.fail(mark, err.field()->joined("balance." + err.field()->field));
+      }
+    }
+    r_.fail(cw ? cw->key_mark : e.key_mark, std::string("balance: ") + err.what());
+  }
+  return request;
+}
+
 }  // namespace
+
+balance::planar::BalanceRequest read_planar_balance(const Reporter& r, const MapReader::Entry& e,
+                                                    const core::planar::Linkage& linkage) {
+  return read_planar(r, e, linkage);
+}
 
 balance::BalancedDesign read_balance(const Reporter& r, const MapReader::Entry& e,
                                      const core::FourBar& model) {

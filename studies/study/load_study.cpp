@@ -92,16 +92,14 @@ class StudyParser {
     }
   }
 
-  // balance or optimize: the four-bar's design sections
+  // balance or optimize: the design sections (optimize: a four-bar's)
   void read_design_sections(const MapReader& top, const MapReader::Entry& name, Study& study) {
     const MapReader::Entry* balance = top.find("balance");
     const MapReader::Entry* opt = top.find("optimize");
-    for (const MapReader::Entry* section : {balance, opt}) {
-      if (section && !study.is_fourbar()) {
-        r_.fail(section->key_mark, section->key +
-                                       " is available for a four-bar (linkage.type: fourbar); a "
-                                       "planar linkage is simulated as it is");
-      }
+    if (opt && !study.is_fourbar()) {
+      r_.fail(opt->key_mark,
+              "optimize is available for a four-bar (linkage.type: fourbar); a planar linkage is "
+              "balanced by its balance section");
     }
     if (balance && opt) {
       // one or the other: a balanced design and an optimised one would compete for the outputs
@@ -116,7 +114,11 @@ class StudyParser {
     }
     if (balance) {
       check_name_room(name, study, kBalancedSuffix, "a balance section", "balanced.yaml");
-      study.balance = read_balance(r_, *balance, study.fourbar());
+      if (study.is_fourbar()) {
+        study.balance = read_balance(r_, *balance, study.fourbar());
+      } else {
+        study.planar_balance = read_planar_balance(r_, *balance, study.planar());
+      }
     }
     if (opt) {
       check_name_room(name, study, kOptimizedSuffix, "an optimize section", "optimized.yaml");

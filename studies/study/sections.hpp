@@ -3,7 +3,8 @@
 /// (yaml_reader.hpp). load_study.cpp reads the top level and hands each section to its reader:
 /// - fourbar_section.cpp: linkage (type: fourbar), loads and scene of a four-bar;
 /// - planar_section.cpp: linkage (type: planar), loads and scene of a general planar linkage;
-/// - balance_section.cpp, optimize_section.cpp: a four-bar's balance and optimize sections;
+/// - balance_section.cpp: the balance section (a four-bar's or a planar linkage's);
+/// - optimize_section.cpp: a four-bar's optimize section;
 /// - sweep_section.cpp: the sweep section, its paths checked against the file's tree.
 #include <memory>
 
@@ -60,6 +61,10 @@ balance::CounterweightShape read_shape(const Reporter& r, const MapReader::Entry
 /// that asked for it).
 balance::BalancedDesign read_balance(const Reporter& r, const MapReader::Entry& e,
                                      const core::FourBar& model);
+/// A planar linkage's balance section: the links to carry counterweights (default: those that
+/// turn about a ground node), checked against the linkage.
+balance::planar::BalanceRequest read_planar_balance(const Reporter& r, const MapReader::Entry& e,
+                                                    const core::planar::Linkage& linkage);
 /// The optimize section, checked by the optimize layer.
 OptimizeRequest read_optimize(const Reporter& r, const MapReader::Entry& e, const Study& study);
 /// The sweep section; each path is checked against `root`, the study file's tree.

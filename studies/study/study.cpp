@@ -61,7 +61,7 @@ std::optional<core::Formulation> formulation_of(Method method) {
 namespace {
 
 // the study of another design of the same linkage type: its name, scene, method and tolerance
-Study derived(const Study& study, const std::string& suffix, const core::FourBar& model) {
+Study derived(const Study& study, const std::string& suffix, const Linkage& model) {
   Study d;
   d.name = study.name + suffix;
   d.linkage = model;
@@ -76,6 +76,10 @@ Study derived(const Study& study, const std::string& suffix, const core::FourBar
 Study balanced_study(const Study& study) {
   assert(study.balance.has_value());
   return derived(study, "-balanced", study.balance->model);
+}
+
+Study planar_balanced_study(const Study& study, const core::planar::Linkage& balanced) {
+  return derived(study, "-balanced", core::planar::make_linkage(balanced));
 }
 
 Study optimized_study(const Study& study, const core::FourBar& design) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <variant>
 
+#include "balance/planar.hpp"
 #include "balance/synthesis.hpp"
 #include "core/fourbar/dynamics.hpp"
 #include "core/fourbar/model.hpp"
@@ -58,8 +59,11 @@ struct Study {
   Method method = Method::kAuto;  // auto: the runner picks, and says why
   double tolerance = 1e-10;       // integrator relative tolerance (free scenes) [-]
   std::string source;             // the study file as named by the user ("" when built in code)
-  /// The study file's `balance:` section, synthesised at load time; empty when absent.
+  /// A four-bar study's `balance:` section, synthesised at load time; empty when absent.
   std::optional<balance::BalancedDesign> balance;
+  /// A planar study's `balance:` section, checked at load time; the runner synthesises the design
+  /// from the original's run (the balance conditions come from its motion). Empty when absent.
+  std::optional<balance::planar::BalanceRequest> planar_balance;
   /// The study file's `optimize:` section, checked at load time and solved by the runner; empty
   /// when absent. A study has a balance section or an optimize section, never both.
   std::optional<OptimizeRequest> optimize;
@@ -81,6 +85,10 @@ struct Study {
 /// The study of the balanced design: name `<name>-balanced`, the balanced model, the same scene,
 /// method and tolerance, no balance section, no source. Precondition: study.balance is set.
 Study balanced_study(const Study& study);
+
+/// The study of a planar linkage's balanced design: name `<name>-balanced`, the linkage
+/// `balanced`, the same scene, method and tolerance, no balance section, no source.
+Study planar_balanced_study(const Study& study, const core::planar::Linkage& balanced);
 
 /// The study of an optimised design: name `<name>-optimized`, model `design`, the same scene,
 /// method and tolerance, no balance or optimize section, no source.

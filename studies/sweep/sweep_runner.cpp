@@ -43,9 +43,6 @@ using Json = nlohmann::ordered_json;
 
 namespace {
 
-// a second design's metrics in the four-bar's table: the sweep.csv columns after its prefix
-constexpr std::size_t kMetrics = core::kMetricCount;
-
 // the statuses a row may have (sweep.hpp, sweep_columns())
 constexpr const char* kStatuses[] = {"ok", "stopped-early", "no-optimum", "bad-input", "error"};
 
@@ -77,13 +74,14 @@ struct PointRow {
 
 // appends the cells of a second design (balanced or optimised): its metrics, added mass and
 // inertia, or as many empty cells
-void second_design_cells(std::string& row, const core::Metrics* metrics, double added_mass,
-                         double added_inertia) {
+// (`count`: how many metrics the study's linkage has)
+void second_design_cells(std::string& row, const MetricList* metrics, std::size_t count,
+                         double added_mass, double added_inertia) {
   if (!metrics) {
-    row.append(kMetrics + 2, ',');
+    row.append(count + 2, ',');
     return;
   }
-  for (const MetricValue& m : metric_list(*metrics)) row += "," + text::exact(m.value);
+  for (const MetricValue& m : *metrics) row += "," + text::exact(m.value);
   row += "," + text::exact(added_mass) + "," + text::exact(added_inertia);
 }
 
@@ -109,22 +107,24 @@ PointRow point_row(const Study& base, int index, std::span<const double> values,
     const Study study = point_study(base, values);
     const RunResult r = compute_study(study);
     for (const MetricValue& m : r.metric_list) body += "," + text::exact(m.value);
-    if (base.balance) {
-      const bool have = study.balance && r.balanced;
+    const std::size_t count = r.metric_list.size();
+    if (base.balance || base.planar_balance) {
+      const bool have = r.balanced && (study.balance || r.balanced->design);
       const auto [mass, inertia] = have ? added(study, r) : std::pair<double, double>{};
-      second_design_cells(body, have ? &r.balanced->metrics : nullptr, mass, inertia);
+      second_design_cells(body, have ? &r.balanced->metric_list : nullptr, count, mass, inertia);
     }
     if (base.optimize) {
       const bool have = r.optimized && r.optimized->found();
       const auto [mass, inertia] = have ? added(study, r) : std::pair<double, double>{};
-      second_design_cells(body, have ? &r.optimized->metrics : nullptr, mass, inertia);
+      const MetricList list = have ? metric_list(r.optimized->metrics) : MetricList{};
+      second_design_cells(body, have ? &list : nullptr, count, mass, inertia);
     }
     if (r.stopped_early()) {
       status = "stopped-early";
-      if (!r.trajectory.ok()) {
-        message = r.trajectory.message;
-      } else if (r.balanced && !r.balanced->trajectory.ok()) {
-        message = "balanced design: " + r.balanced->trajectory.message;
+      if (!r.status().ok()) {
+        message = r.status().message;
+      } else if (r.balanced && !r.balanced->ok()) {
+        message = "balanced design: " + r.balanced->status().message;
       } else {
         message = "optimised design: " + r.optimized->trajectory.message;
       }
@@ -338,9 +338,9 @@ std::vector<std::string> sweep_columns(const Study& study) {
   }
   for (const std::string& m : metric_names(study)) columns.push_back(m);
   for (const char* prefix : {"balanced_", "optimized_"}) {
-    if (prefix[0] == 'b' ? !study.balance : !study.optimize) continue;
-    for (const core::MetricInfo& m : core::kMetricTable)
-      columns.push_back(std::string(prefix) + m.name);
+    const bool balance = study.balance || study.planar_balance;
+    if (prefix[0] == 'b' ? !balance : !study.optimize) continue;
+    for (const std::string& m : metric_names(study)) columns.push_back(prefix + m);
     columns.push_back("added_mass");
     columns.push_back("added_inertia");
   }

@@ -116,8 +116,8 @@ TEST(PlanarStudy, MistakesAreOneLineAtTheirPlace) {
                "method mass-matrix is one of the four-bar's formulations");
   expect_error(edit("  type: planar\n", "  type: sixbar\n"), 3, 9,
                "linkage.type 'sixbar' is not supported; expected fourbar or planar");
-  expect_error(kEngine + "balance: {force: full}\n", 20, 1,
-               "balance is available for a four-bar (linkage.type: fourbar)");
+  expect_error(kEngine + "optimize: {}\n", 20, 1,
+               "optimize is available for a four-bar (linkage.type: fourbar)");
   // a start the linkage cannot reach: a slider-crank driven from the piston past its stroke;
   // the message names where, on the way from the drawn position, it stopped closing
   const std::string from_piston =
