@@ -1,0 +1,242 @@
+// A planar linkage's balance section, from the study file to the files a run writes: the loader
+// places every mistake at its file:line:column; the runner synthesises the counterweights from
+// the original's motion, simulates the balanced design and writes it as a study that runs by
+// itself. The balanced six-bars are checked by the independent referee (tests/reference/planar,
+// Newton-Euler per body, sharing no code with the engine or the balance layer), the engine's
+// least-squares design by the engine's own simulation of it (regressors against kinetostatics).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "studies/run/runner.hpp"
+#include "studies/studies.hpp"
+#include "studies/study/load_study.hpp"
+#include "core/number_text.hpp"
+#include "tests/support/planar_glue.hpp"
+#include "tests/support/studies.hpp"
+#include "tests/support/study_errors.hpp"
+#include "tests/support/text.hpp"
+
+namespace bd::studies {
+namespace {
+
+namespace fs = std::filesystem;
+namespace bp = balance::planar;
+
+// a slider-crank driven by its crank at 3000 rpm, no gravity; line numbers below refer to it
+const std::string kEngine =
+    "name: e\n"                                                                 // 1
+    "linkage:\n"                                                                // 2
+    "  type: planar\n"                                                          // 3
+    "  nodes:\n"                                                                // 4
+    "    O: {at: [0, 0], ground: true}\n"                                       // 5
+    "    A: [0.04, 0]\n"                                                        // 6
+    "    B: [0.18, 0]\n"                                                        // 7
+    "  links:\n"                                                                // 8
+    "    crank: {nodes: [O, A], mass: 1.2, e: 0.012, f: 0, inertia: 0.0009}\n"  // 9
+    "    rod: {nodes: [A, B], mass: 0.45, e: 0.035, f: 0, inertia: 0.0012}\n"   // 10
+    "  point_masses: {B: 0.35}\n"                                               // 11
+    "  sliders:\n"                                                              // 12
+    "    piston: {node: B, guide: [[0, 0], [1, 0]]}\n"                          // 13
+    "  inputs:\n"                                                               // 14
+    "    crank: {link: crank}\n"                                                // 15
+    "scene:\n"                                                                  // 16
+    "  type: driven\n"                                                          // 17
+    "  speeds: [314.1592653589793]\n"                                           // 18
+    "  samples: 72\n";                                                          // 19
+
+void expect_error(const std::string& text, int line, int column, const std::string& message) {
+  bd::testing::expect_study_error(text, "e.yaml", line, column, message);
+}
+
+std::string example(const std::string& file) {
+  return std::string(BD_SOURCE_DIR) + "/studies/examples/" + file;
+}
+
+// the column `name` of a planar run's table
+std::vector<double> column(const core::planar::Trajectory& t, const std::string& name) {
+  return t.table.column_values(name);
+}
+
+double rms_norm(const std::vector<double>& x, const std::vector<double>& y) {
+  double s = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) s += x[i] * x[i] + y[i] * y[i];
+  return std::sqrt(s / static_cast<double>(x.size()));
+}
+
+TEST(PlanarBalanceStudy, MistakesAreOneLineAtTheirPlace) {
+  expect_error(kEngine + "balance: {moment: full}\n", 20, 11,
+               "balance.moment is available for a four-bar (linkage.type: fourbar)");
+  expect_error(kEngine + "balance: {force: none}\n", 20, 18,
+               "balance.force: none leaves nothing to balance");
+  expect_error(kEngine + "balance:\n  counterweights:\n    piston: {}\n", 22, 5,
+               "balance.counterweights.piston: no link of that name (links: crank, rod)");
+  expect_error(kEngine + "balance:\n  counterweights:\n    crank: {mass: -1}\n", 22, 19,
+               "balance.counterweights.crank.mass must be > 0 kg, got -1");
+  expect_error(kEngine + "balance:\n  counterweights:\n    rod: {distance: 0.05}\n", 22, 5,
+               "balance.counterweights.rod: the link does not turn about the frame");
+  expect_error(kEngine + "balance:\n  counterweights:\n    crank: {colour: red}\n", 22, 13,
+               "colour");
+  expect_error(kEngine + "balance: {counter_rotations: {}}\n", 20, 11,
+               "balance.counter_rotations is available for a four-bar");
+}
+
+TEST(PlanarBalanceStudy, CounterweightsDefaultToTheLinksThatTurnAboutTheFrame) {
+  const Study s = parse_study(kEngine + "balance:\n", "e.yaml");
+  ASSERT_TRUE(s.planar_balance.has_value());
+  ASSERT_EQ(s.planar_balance->counterweights.size(), 1u);
+  EXPECT_EQ(s.planar_balance->counterweights[0].link, 0);  // the crank, not the rod
+
+  const Study w = load_study(example("watt-sixbar-balanced.yaml"));
+  ASSERT_TRUE(w.planar_balance.has_value());
+  std::vector<std::string> links;
+  for (const bp::LinkCounterweightSpec& c : w.planar_balance->counterweights) {
+    links.push_back(w.planar().links[static_cast<std::size_t>(c.link)].name);
+    EXPECT_EQ(c.spec.shape, balance::CounterweightShape::kDisc);
+  }
+  EXPECT_EQ(links, (std::vector<std::string>{"crank", "rocker", "output"}));
+}
+
+// The example six-bar: fully force balanced; the balanced design's own simulation, and the
+// referee's of the design read back from balanced.yaml, find no inertial shaking force left; the
+// files say what was added and the balanced study runs by itself to the same numbers.
+TEST(PlanarBalanceStudy, TheExampleSixBarIsFullyForceBalancedAndItsStudyRunsByItself) {
+  const Study study = load_study(example("watt-sixbar-balanced.yaml"));
+  const fs::path out = fs::path(BD_BINARY_DIR) / "test-output" / "planar-balance" / "watt";
+  fs::remove_all(out);
+  RunResult r = compute_study(study);
+  write_run(study, r, out);
+  ASSERT_TRUE(r.ok());
+  ASSERT_TRUE(r.balanced && r.balanced->design);
+  const bp::ForceBalance& design = *r.balanced->design;
+  EXPECT_TRUE(design.full) << design.message;
+  EXPECT_EQ(design.conditions, 6);
+  ASSERT_EQ(design.added.size(), 3u);
+
+  // the engine's balanced run: the shaking force is inertial (no gravity) and gone
+  const double before = r.metric_list.front().value;  // Fsh_rms
+  ASSERT_EQ(r.metric_list.front().name, "Fsh_rms");
+  ASSERT_GT(before, 1.0);
+  const core::planar::Trajectory& b = r.balanced->planar;
+  const std::vector<double> fx = column(b, "Fshx"), fy = column(b, "Fshy");
+  double worst = 0;
+  for (std::size_t i = 0; i < fx.size(); ++i) worst = std::max(worst, std::hypot(fx[i], fy[i]));
+  EXPECT_LE(worst / before, 1e-13);
+
+  // balanced.yaml is the design to the last digit, and runs by itself to the same samples
+  const Study again = load_study((out / "balanced.yaml").string());
+  ASSERT_FALSE(again.is_fourbar());
+  EXPECT_FALSE(again.planar_balance.has_value());
+  for (std::size_t k = 0; k < design.linkage.links.size(); ++k) {
+    const core::planar::Link& x = again.planar().links[k];
+    const core::planar::Link& y = design.linkage.links[k];
+    EXPECT_EQ(x.mass, y.mass);
+    EXPECT_EQ(x.e, y.e);
+    EXPECT_EQ(x.f, y.f);
+    EXPECT_EQ(x.inertia, y.inertia);
+  }
+  const RunResult rerun = compute_study(again);
+  ASSERT_EQ(rerun.metric_list.size(), r.balanced->metric_list.size());
+  for (std::size_t k = 0; k < rerun.metric_list.size(); ++k) {
+    EXPECT_EQ(rerun.metric_list[k].value, r.balanced->metric_list[k].value)
+        << rerun.metric_list[k].name;
+  }
+
+  // the referee on the design as written: no inertial shaking force at any sample
+  const bd::testing::planar::Glue g = bd::testing::planar::glue_of(again.planar());
+  const auto& scene = std::get<core::planar::DrivenScene>(study.scene);
+  const std::vector<double> times = column(b, "t");
+  double referee_worst = 0;
+  for (const referee::Sample& s : referee::driven(g.mechanism, scene.speeds, 0.0, times)) {
+    referee_worst = std::max(referee_worst, s.inertial_force.norm() / before);
+  }
+  EXPECT_LE(referee_worst, 1e-10);
+
+  // the mass added is the balanced linkage's total mass less the original's
+  const double added = core::planar::total_mass(again.planar()) -
+                       core::planar::total_mass(study.planar());
+  EXPECT_NEAR(design.added_mass, added, 1e-14 * added);
+  const std::string csv = bd::testing::read(out / "comparison.csv");
+  EXPECT_NE(csv.find("\nFsh_rms," + text::exact(before) + ","), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\nFD_max,"), std::string::npos) << csv;  // every metric of the six-bar
+  EXPECT_NE(csv.find("\nadded_mass,0," + text::exact(design.added_mass) + ",\n"),
+            std::string::npos)
+      << csv;
+  const std::string summary = bd::testing::read(out / "summary.json");
+  EXPECT_NE(summary.find("\"force_balanced\": true"), std::string::npos);
+  EXPECT_NE(summary.find("\"balanced_metrics\""), std::string::npos);
+  EXPECT_NE(summary.find("\"from_node\": \"O4\""), std::string::npos);
+}
+
+// A slider-crank's piston cannot be balanced by a counterweight on the crank: the message says
+// so, and the least-squares design's RMS shaking force, computed by the balance layer from its
+// regressor, is what the engine's simulation of the design finds.
+TEST(PlanarBalanceStudy, AnEnginesCrankCounterweightLeavesWhatTheMessageSays) {
+  const Study study = parse_study(kEngine + "balance:\n  counterweights:\n    crank: {}\n", "e.yaml");
+  const RunResult r = compute_study(study);
+  ASSERT_TRUE(r.ok());
+  ASSERT_TRUE(r.balanced && r.balanced->design);
+  const bp::ForceBalance& d = *r.balanced->design;
+  EXPECT_FALSE(d.full);
+  EXPECT_NE(d.message.find("cannot"), std::string::npos) << d.message;
+  const core::planar::Trajectory& b = r.balanced->planar;
+  const double simulated = rms_norm(column(b, "Fshx"), column(b, "Fshy"));
+  EXPECT_NEAR(d.Fsh_rms_after, simulated, 1e-12 * d.Fsh_rms_before);
+  EXPECT_NEAR(d.Fsh_rms_before, r.metric_list.front().value, 1e-12 * d.Fsh_rms_before);
+  EXPECT_LT(d.Fsh_rms_after, d.Fsh_rms_before);
+}
+
+// A free run: the counterweights come from the configurations the original swung through, and
+// the balanced design, released alike, shakes its frame with no inertial force whatever motion
+// the spring and motor give it (its linear momentum is zero in every configuration).
+TEST(PlanarBalanceStudy, AFreeSixBarBalancedFromItsSwingShakesNoMoreInItsOwnSwing) {
+  std::string text = bd::testing::read(example("stephenson-sixbar-free.yaml"));
+  const std::string gravity = "loads:\n  gravity: [0, -9.81]\n";
+  ASSERT_NE(text.find(gravity), std::string::npos);
+  text.replace(text.find(gravity), gravity.size(), "");
+  text.replace(text.find("samples: 3001"), 13, "samples: 301");
+  const Study study = parse_study(text + "balance:\n", "free.yaml");
+  const RunResult r = compute_study(study);
+  ASSERT_TRUE(r.ok()) << r.balanced->status().message;
+  ASSERT_TRUE(r.balanced->design);
+  EXPECT_TRUE(r.balanced->design->full) << r.balanced->design->message;
+  const double before = r.metric_list.front().value;
+  const core::planar::Trajectory& b = r.balanced->planar;
+  const std::vector<double> fx = column(b, "Fshx"), fy = column(b, "Fshy");
+  double worst = 0;
+  for (std::size_t i = 0; i < fx.size(); ++i) worst = std::max(worst, std::hypot(fx[i], fy[i]));
+  EXPECT_LE(worst / before, 1e-10);
+  // the balanced design moves otherwise than the original (heavier links, same loads)
+  EXPECT_NE(column(b, "theta_crank").back(), column(r.planar, "theta_crank").back());
+}
+
+// When the original stops early there is no motion to balance over: nothing is synthesised, the
+// summary says why, no balanced file is written, and the run reports the early stop.
+TEST(PlanarBalanceStudy, NoBalancedDesignWhenTheOriginalStopsEarly) {
+  const Study study =
+      parse_study(bd::testing::piston_driven_slider_crank(1.5, 31) + "balance:\n", "p.yaml");
+  const fs::path out = fs::path(BD_BINARY_DIR) / "test-output" / "planar-balance" / "stopped";
+  fs::remove_all(out);
+  RunResult r = compute_study(study);
+  write_run(study, r, out);
+  EXPECT_TRUE(r.stopped_early());
+  ASSERT_TRUE(r.balanced);
+  EXPECT_FALSE(r.balanced->design);
+  EXPECT_EQ(r.balanced->status().message.rfind("not run: the original design's simulation", 0),
+            0u)
+      << r.balanced->status().message;
+  EXPECT_TRUE(fs::exists(out / "timeseries.csv"));
+  EXPECT_FALSE(fs::exists(out / "balanced.yaml"));
+  EXPECT_FALSE(fs::exists(out / "comparison.csv"));
+  const std::string summary = bd::testing::read(out / "summary.json");
+  EXPECT_NE(summary.find("\"message\": \"not run: the original design's simulation stopped"),
+            std::string::npos)
+      << summary;
+}
+
+}  // namespace
+}  // namespace bd::studies
