@@ -27,27 +27,8 @@ namespace {
 namespace fs = std::filesystem;
 namespace bp = balance::planar;
 
-// a slider-crank driven by its crank at 3000 rpm, no gravity; line numbers below refer to it
-const std::string kEngine =
-    "name: e\n"                                                                 // 1
-    "linkage:\n"                                                                // 2
-    "  type: planar\n"                                                          // 3
-    "  nodes:\n"                                                                // 4
-    "    O: {at: [0, 0], ground: true}\n"                                       // 5
-    "    A: [0.04, 0]\n"                                                        // 6
-    "    B: [0.18, 0]\n"                                                        // 7
-    "  links:\n"                                                                // 8
-    "    crank: {nodes: [O, A], mass: 1.2, e: 0.012, f: 0, inertia: 0.0009}\n"  // 9
-    "    rod: {nodes: [A, B], mass: 0.45, e: 0.035, f: 0, inertia: 0.0012}\n"   // 10
-    "  point_masses: {B: 0.35}\n"                                               // 11
-    "  sliders:\n"                                                              // 12
-    "    piston: {node: B, guide: [[0, 0], [1, 0]]}\n"                          // 13
-    "  inputs:\n"                                                               // 14
-    "    crank: {link: crank}\n"                                                // 15
-    "scene:\n"                                                                  // 16
-    "  type: driven\n"                                                          // 17
-    "  speeds: [314.1592653589793]\n"                                           // 18
-    "  samples: 72\n";                                                          // 19
+// a slider-crank driven by its crank; line numbers below refer to it
+const std::string kEngine = bd::testing::engine_study(72);
 
 void expect_error(const std::string& text, int line, int column, const std::string& message) {
   bd::testing::expect_study_error(text, "e.yaml", line, column, message);

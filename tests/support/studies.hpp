@@ -54,4 +54,30 @@ inline std::string piston_driven_slider_crank(double duration, int samples) {
          std::to_string(duration) + ", samples: " + std::to_string(samples) + "}\n";
 }
 
+/// A single-cylinder engine's slider-crank (crank 40 mm, rod 140 mm, piston 0.35 kg on a
+/// horizontal axis) driven by its crank at 3000 rpm over one revolution with `samples` samples,
+/// no loads. Tests that quote line numbers refer to this text: `samples` is line 19, the last.
+inline std::string engine_study(int samples) {
+  return "name: e\n"                                                                 // 1
+         "linkage:\n"                                                                // 2
+         "  type: planar\n"                                                          // 3
+         "  nodes:\n"                                                                // 4
+         "    O: {at: [0, 0], ground: true}\n"                                       // 5
+         "    A: [0.04, 0]\n"                                                        // 6
+         "    B: [0.18, 0]\n"                                                        // 7
+         "  links:\n"                                                                // 8
+         "    crank: {nodes: [O, A], mass: 1.2, e: 0.012, f: 0, inertia: 0.0009}\n"  // 9
+         "    rod: {nodes: [A, B], mass: 0.45, e: 0.035, f: 0, inertia: 0.0012}\n"   // 10
+         "  point_masses: {B: 0.35}\n"                                               // 11
+         "  sliders:\n"                                                              // 12
+         "    piston: {node: B, guide: [[0, 0], [1, 0]]}\n"                          // 13
+         "  inputs:\n"                                                               // 14
+         "    crank: {link: crank}\n"                                                // 15
+         "scene:\n"                                                                  // 16
+         "  type: driven\n"                                                          // 17
+         "  speeds: [314.1592653589793]\n"                                           // 18
+         "  samples: " +
+         std::to_string(samples) + "\n";  // 19
+}
+
 }  // namespace bd::testing
