@@ -16,6 +16,9 @@ trap 'rm -rf "$tmp"' EXIT
 "$bin" run studies/examples/paper-fourbar-sweep.yaml --out "$tmp/sweep" --progress none >/dev/null
 "$bin" run studies/examples/engine-slider-crank.yaml --out "$tmp/engine" >/dev/null
 "$bin" run studies/examples/watt-sixbar.yaml --out "$tmp/watt" >/dev/null
+"$bin" run studies/examples/watt-sixbar-balanced.yaml --out "$tmp/watt-balanced" >/dev/null
+"$bin" run studies/examples/engine-slider-crank-balanced.yaml --out "$tmp/engine-balanced" \
+  >/dev/null
 
 # extract_chart PAGE ID FILE: the chart `ID` of a report.html, as the page draws it, written as a
 # standalone SVG file (the page inlines it without an XML prolog or a size)
@@ -48,6 +51,12 @@ extract_chart "$tmp/engine/report.html" linkage "$out/engine-slider-crank-linkag
 extract_chart "$tmp/engine/report.html" hodograph "$out/engine-slider-crank-hodograph.svg"
 extract_chart "$tmp/watt/report.html" linkage "$out/watt-sixbar-linkage.svg"
 extract_chart "$tmp/watt/report.html" joints "$out/watt-sixbar-joints.svg"
+# balancing them: the Watt six-bar with its three counterweights, and the engine's shaking force
+# before and after its crank counterweight
+extract_chart "$tmp/watt-balanced/report.html" linkage-balanced \
+  "$out/watt-sixbar-balanced-linkage.svg"
+extract_chart "$tmp/engine-balanced/report.html" hodograph \
+  "$out/engine-slider-crank-balanced-hodograph.svg"
 
 gnuplot <<GP
 set datafile separator ','
