@@ -298,8 +298,7 @@ void print_planar_balance(const st::Study& study, const st::RunResult& r) {
   }
   const st::RunStatus status = run.status();
   std::printf("  balanced design: method %s, %zu samples, status %s\n",
-              st::to_string(run.method.method), status.samples,
-              bd::core::to_string(status.status));
+              st::to_string(run.method.method), status.samples, bd::core::to_string(status.status));
   print_comparison(study, r);
 }
 

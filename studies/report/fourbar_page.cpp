@@ -440,6 +440,7 @@ std::string fourbar_report_html(const Study& study, const fs::path& dir, const s
                       "drive torque [N m]; RA0, RA3: forces on the ground at the bearings [N]. RMS "
                       "over the samples, max of magnitudes.");
   h += comparison_section(dir, second);
+  h += harmonics_section(dir);
   const FourBarCharts c = fourbar_charts(study, dir, second, ts, has_pareto ? &pareto : nullptr);
   h += charts_section(gnuplot, c.datablocks, c.charts);
   if (!c.original.poses.empty()) {
@@ -456,10 +457,10 @@ std::string fourbar_report_html(const Study& study, const fs::path& dir, const s
   }
   // the measurements of `balance-design bench` when the folder has them (work_precision.hpp)
   h += work_precision_section(study, dir, gnuplot);
-  return h + data_files_html(
-                 dir, {"timeseries.csv", "summary.json", "balanced-timeseries.csv", "balanced.yaml",
-                       "optimized-timeseries.csv", "optimized.yaml", "comparison.csv", "pareto.csv",
-                       "work-precision.csv", "driven-convergence.csv"});
+  return h + data_files_html(dir, {"timeseries.csv", "summary.json", "balanced-timeseries.csv",
+                                   "balanced.yaml", "optimized-timeseries.csv", "optimized.yaml",
+                                   "comparison.csv", "harmonics.csv", "pareto.csv",
+                                   "work-precision.csv", "driven-convergence.csv"});
 }
 
 }  // namespace bd::studies::report_support

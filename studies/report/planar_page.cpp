@@ -239,10 +239,9 @@ std::vector<Chart> planar_charts(const Study& study, const fs::path& dir, const 
                           " with lines lw 2 title 'shaking force'";
   if (!second.file.empty()) {
     hodograph = file + " skip 1 using " + std::to_string(gp_column(ts, "Fshx")) + ":" +
-                std::to_string(gp_column(ts, "Fshy")) +
-                " with lines lw 2 title 'original', " + second.file + " skip 1 using " +
-                std::to_string(gp_column(second.ts, "Fshx")) + ":" +
-                std::to_string(gp_column(second.ts, "Fshy")) +
+                std::to_string(gp_column(ts, "Fshy")) + " with lines lw 2 title 'original', " +
+                second.file + " skip 1 using " + std::to_string(gp_column(second.ts, "Fshx")) +
+                ":" + std::to_string(gp_column(second.ts, "Fshy")) +
                 " with linespoints lw 2 pt 7 ps 0.5 pi 10 title " + gp_string(second.design.label);
   }
   charts.push_back({"angles", "Link angles",
@@ -378,6 +377,7 @@ std::string planar_report_html(const Study& study, const fs::path& dir, const st
                       "at a ground node or guide [N]; F&lt;joint&gt;: joint forces on their links "
                       "[N]. RMS over the samples, max of magnitudes.");
   h += comparison_section(dir, second.design);
+  h += harmonics_section(dir);
   std::string datablocks;
   const std::vector<Chart> charts = planar_charts(study, dir, ts, second, datablocks);
   h += charts_section(gnuplot, datablocks, charts);
@@ -385,8 +385,8 @@ std::string planar_report_html(const Study& study, const fs::path& dir, const st
   // the measurements of `balance-design bench` when the folder has them (work_precision.hpp)
   h += work_precision_section(study, dir, gnuplot);
   return h + data_files_html(dir, {"timeseries.csv", "summary.json", "balanced-timeseries.csv",
-                                   "balanced.yaml", "comparison.csv", "work-precision.csv",
-                                   "driven-convergence.csv"});
+                                   "balanced.yaml", "comparison.csv", "harmonics.csv",
+                                   "work-precision.csv", "driven-convergence.csv"});
 }
 
 }  // namespace bd::studies::report_support

@@ -1,5 +1,6 @@
 #include "studies/report/study_parts.hpp"
 
+#include <algorithm>
 #include <variant>
 
 namespace bd::studies::report_support {
@@ -96,6 +97,36 @@ std::string comparison_section(const fs::path& dir, const SecondDesign& second) 
          "(before) and the " +
          second.label + " design (after), ratio after/before.</p>" +
          csv_table(read_csv(dir / "comparison.csv"));
+}
+
+std::string harmonics_section(const fs::path& dir) {
+  if (!fs::exists(dir / "harmonics.csv")) return "";
+  const Csv csv = read_csv(dir / "harmonics.csv");
+  // the amplitudes, one row per design and order; the phases are in the file
+  const char* columns[] = {"design",      "order",        "Fshx_amplitude", "Fshy_amplitude",
+                           "Fsh_forward", "Fsh_backward", "Msh_amplitude"};
+  std::vector<std::size_t> at;
+  for (const char* c : columns) {
+    const auto it = std::find(csv.header.begin(), csv.header.end(), c);
+    if (it == csv.header.end()) return "";
+    at.push_back(static_cast<std::size_t>(it - csv.header.begin()));
+  }
+  std::string h =
+      "<h2>Harmonic orders</h2>\n<p>From <a href=\"harmonics.csv\">harmonics.csv</a>: the shaking "
+      "force and moment over the first revolution of the driven input, by the discrete Fourier "
+      "transform of the exact samples; order k repeats k times per revolution. Amplitudes of Fshx, "
+      "Fshy [N] and Msh [N m]; the force's parts turning with the input (forward: a counterweight "
+      "on the input's link cancels order 1) and against it (backward) [N]. Phases are in the "
+      "file.</p><table><tr><th>design</th><th>order</th><th>Fshx</th><th>Fshy</th>"
+      "<th>forward</th><th>backward</th><th>Msh</th></tr>";
+  for (const std::vector<std::string>& row : csv.rows) {
+    if (row.size() < csv.header.size() || row[at[1]] == "0") continue;  // the mean: in the file
+    h += "<tr><td>" + esc(row[at[0]]) + "</td><td class=\"n\">" + esc(row[at[1]]) + "</td>";
+    for (std::size_t k = 2; k < at.size(); ++k)
+      h += "<td class=\"n\">" + num_cell(row[at[k]]) + "</td>";
+    h += "</tr>";
+  }
+  return h + "</table>\n";
 }
 
 std::string charts_section(const std::string& gnuplot, const std::string& datablocks,

@@ -1,5 +1,6 @@
 #include "studies/run/runner.hpp"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,8 +14,6 @@
 #include <system_error>
 #include <utility>
 #include <variant>
-
-#include <fmt/format.h>
 
 #include "core/number_text.hpp"
 #include "optimize/nlp.hpp"
@@ -288,6 +287,7 @@ BalancedRun planar_balanced_run(const Study& study, const RunResult& original) {
   b.method = sim.method;
   b.metric_list = metric_list(balanced, sim);
   b.planar = std::move(sim.planar);
+  b.harmonics = harmonics(balanced, b.trajectory, b.planar);
   return b;
 }
 
@@ -310,13 +310,16 @@ RunResult compute_study(const Study& study) {
   result.trajectory = std::move(sim.fourbar);
   result.planar = std::move(sim.planar);
   if (study.is_fourbar()) result.metrics = core::metrics(result.trajectory);
+  result.harmonics = harmonics(study, result.trajectory, result.planar);
   if (study.balance) {
-    const Simulation balanced = simulate(balanced_study(study));
+    const Study design = balanced_study(study);
+    const Simulation balanced = simulate(design);
     BalancedRun b;
     b.method = balanced.method;
     b.trajectory = balanced.fourbar;
     b.metrics = core::metrics(b.trajectory);
     b.metric_list = metric_list(b.metrics);
+    b.harmonics = harmonics(design, b.trajectory, b.planar);
     result.balanced = std::move(b);
   }
   if (study.planar_balance) result.balanced = planar_balanced_run(study, result);
@@ -352,6 +355,15 @@ void write_run(const Study& study, RunResult& result, const fs::path& out_dir) {
       write_text_file(balanced_yaml(study), b.study_file);
     }
     write_text_file(comparison_csv(study, result), b.comparison);
+  }
+  if (result.harmonics) {
+    std::string text =
+        std::string(kHarmonicsHeader) + "\n" + harmonics_rows("original", *result.harmonics);
+    if (result.balanced && result.balanced->harmonics) {
+      text += harmonics_rows("balanced", *result.balanced->harmonics);
+    }
+    result.harmonics_file = out_dir / "harmonics.csv";
+    write_text_file(text, result.harmonics_file);
   }
   if (result.optimized && result.optimized->found()) {
     OptimizedRun& o = *result.optimized;

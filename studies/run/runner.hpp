@@ -13,6 +13,7 @@
 #include "core/fourbar/simulate.hpp"
 #include "optimize/optimize.hpp"
 #include "studies/run/files.hpp"
+#include "studies/run/harmonics.hpp"
 #include "studies/run/simulation.hpp"
 #include "studies/study/study.hpp"
 
@@ -28,18 +29,19 @@ inline constexpr const char* kComparisonHeader = "metric,before,after,ratio";
 
 /// The balanced design's run in a balance study (same scene, method chosen for it alike).
 struct BalancedRun {
-  MethodChoice method;               // formulation used for the balanced design, and why
-  core::Trajectory trajectory;       // a four-bar study: its samples and status
-  core::Metrics metrics;             // a four-bar study: over its samples
-  core::planar::Trajectory planar;   // a planar study: its samples' table and status
+  MethodChoice method;              // formulation used for the balanced design, and why
+  core::Trajectory trajectory;      // a four-bar study: its samples and status
+  core::Metrics metrics;            // a four-bar study: over its samples
+  core::planar::Trajectory planar;  // a planar study: its samples' table and status
   /// A planar study: the design, synthesised from the original's motion; empty when the original
   /// stopped early (then `planar` is not run and its message says why).
   std::optional<balance::planar::ForceBalance> design;
   bool is_planar{};
-  MetricList metric_list;            // its metrics in its table's order (either type)
-  std::filesystem::path timeseries;  // out_dir/balanced-timeseries.csv
-  std::filesystem::path study_file;  // out_dir/balanced.yaml
-  std::filesystem::path comparison;  // out_dir/comparison.csv
+  MetricList metric_list;              // its metrics in its table's order (either type)
+  std::optional<Harmonics> harmonics;  // its harmonic orders (a driven scene)
+  std::filesystem::path timeseries;    // out_dir/balanced-timeseries.csv
+  std::filesystem::path study_file;    // out_dir/balanced.yaml
+  std::filesystem::path comparison;    // out_dir/comparison.csv
   /// How its simulation ended (either linkage type).
   RunStatus status() const;
   bool ok() const { return status().ok(); }
@@ -82,7 +84,9 @@ struct RunResult {
   core::Metrics metrics;                  // a four-bar study: over the samples computed
   core::planar::Trajectory planar;        // a planar study: the samples' table and the status
   MetricList metric_list;                 // every study: its metrics in its table's order
+  std::optional<Harmonics> harmonics;     // a driven scene: the orders of Fsh and Msh
   std::filesystem::path timeseries;       // out_dir/timeseries.csv
+  std::filesystem::path harmonics_file;   // out_dir/harmonics.csv (with harmonics)
   std::filesystem::path summary;          // out_dir/summary.json
   std::optional<BalancedRun> balanced;    // set when the study has a balance section
   std::optional<OptimizedRun> optimized;  // set when the study has an optimize section

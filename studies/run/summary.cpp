@@ -75,6 +75,25 @@ Json scene_json(const Scene& scene) {
   return j;
 }
 
+// the harmonic orders of a driven run: per order Fshx, Fshy, Msh (amplitude, phase) and the
+// force's parts turning with and against the input
+Json harmonics_json(const Harmonics& h) {
+  auto real = [](const core::Harmonic& x) {
+    return Json{{"amplitude", x.amplitude}, {"phase", x.phase}};
+  };
+  Json orders = Json::array();
+  for (const HarmonicOrder& o : h.orders) {
+    orders.push_back(
+        {{"order", o.order},
+         {"Fshx", real(o.Fshx)},
+         {"Fshy", real(o.Fshy)},
+         {"Fsh_forward", {{"amplitude", o.Fsh.forward}, {"phase", o.Fsh.forward_phase}}},
+         {"Fsh_backward", {{"amplitude", o.Fsh.backward}, {"phase", o.Fsh.backward_phase}}},
+         {"Msh", real(o.Msh)}});
+  }
+  return {{"input", h.input}, {"speed", h.speed}, {"samples", h.samples}, {"orders", orders}};
+}
+
 // a run's facts (status, counts), added to `j`
 void add_run_fields(Json& j, const RunStatus& r) {
   j["samples"] = r.samples;
@@ -241,8 +260,8 @@ Json optimize_json(const Study& study, const RunResult& result) {
 // the keys of a second design's run (the balanced or the optimised one): `<what>_run`,
 // `<what>_metrics`, and `reduction` (second / original per metric)
 void add_second_run(Json& j, const Study& study, const std::string& what,
-                    const MethodChoice& method, const RunStatus& status,
-                    const MetricList& original, const MetricList& second) {
+                    const MethodChoice& method, const RunStatus& status, const MetricList& original,
+                    const MetricList& second) {
   Json run = {{"study", study.name + "-" + what}, {"method", method_json(study, method)}};
   add_run_fields(run, status);
   j[what + "_run"] = run;
@@ -261,17 +280,19 @@ std::string summary_json(const Study& study, const RunResult& result) {
             {"tolerance", study.tolerance}};
   add_run_fields(j, result.status());
   j["metrics"] = metrics_json(result.metric_list);
+  if (result.harmonics) j["harmonics"] = harmonics_json(*result.harmonics);
   if (study.balance && result.balanced) {
     const BalancedRun& b = *result.balanced;
     j["balance"] = balance_json(*study.balance);
     add_second_run(j, study, "balanced", b.method, b.status(), result.metric_list, b.metric_list);
+    if (b.harmonics) j["balanced_harmonics"] = harmonics_json(*b.harmonics);
   }
   if (study.planar_balance && result.balanced) {
     const BalancedRun& b = *result.balanced;
     if (b.design) {
       j["balance"] = planar_balance_json(study, *b.design);
-      add_second_run(j, study, "balanced", b.method, b.status(), result.metric_list,
-                     b.metric_list);
+      add_second_run(j, study, "balanced", b.method, b.status(), result.metric_list, b.metric_list);
+      if (b.harmonics) j["balanced_harmonics"] = harmonics_json(*b.harmonics);
     } else {
       j["balance"] = {{"force", "full"}, {"moment", "none"}, {"message", b.status().message}};
     }
@@ -280,9 +301,8 @@ std::string summary_json(const Study& study, const RunResult& result) {
     const OptimizedRun& o = *result.optimized;
     j["optimize"] = optimize_json(study, result);
     if (o.found()) {
-      const RunStatus status{o.trajectory.status, o.trajectory.message,
-                             o.trajectory.samples.size(), o.trajectory.steps,
-                             o.trajectory.rhs_evaluations};
+      const RunStatus status{o.trajectory.status, o.trajectory.message, o.trajectory.samples.size(),
+                             o.trajectory.steps, o.trajectory.rhs_evaluations};
       add_second_run(j, study, "optimized", o.method, status, result.metric_list,
                      metric_list(o.metrics));
     }

@@ -208,8 +208,8 @@ balance::planar::BalanceRequest read_planar(const Reporter& r_, const MapReader:
     for (const MapReader::Entry& x : m.entries()) {
       const int link = core::planar::link_index(linkage, x.key);
       if (link < 0) {
-        r_.fail(x.key_mark, "balance.counterweights." + x.key + ": no link of that name (links: " +
-                                names + ")");
+        r_.fail(x.key_mark, "balance.counterweights." + x.key +
+                                ": no link of that name (links: " + names + ")");
       }
       request.counterweights.push_back(
           {link, reader.read_counterweight(x, "balance.counterweights." + x.key)});

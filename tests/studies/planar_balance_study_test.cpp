@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "core/number_text.hpp"
 #include "studies/run/runner.hpp"
 #include "studies/studies.hpp"
 #include "studies/study/load_study.hpp"
-#include "core/number_text.hpp"
 #include "tests/support/planar_glue.hpp"
 #include "tests/support/studies.hpp"
 #include "tests/support/study_errors.hpp"
@@ -138,14 +138,13 @@ TEST(PlanarBalanceStudy, TheExampleSixBarIsFullyForceBalancedAndItsStudyRunsByIt
   EXPECT_LE(referee_worst, 1e-10);
 
   // the mass added is the balanced linkage's total mass less the original's
-  const double added = core::planar::total_mass(again.planar()) -
-                       core::planar::total_mass(study.planar());
+  const double added =
+      core::planar::total_mass(again.planar()) - core::planar::total_mass(study.planar());
   EXPECT_NEAR(design.added_mass, added, 1e-14 * added);
   const std::string csv = bd::testing::read(out / "comparison.csv");
   EXPECT_NE(csv.find("\nFsh_rms," + text::exact(before) + ","), std::string::npos) << csv;
   EXPECT_NE(csv.find("\nFD_max,"), std::string::npos) << csv;  // every metric of the six-bar
-  EXPECT_NE(csv.find("\nadded_mass,0," + text::exact(design.added_mass) + ",\n"),
-            std::string::npos)
+  EXPECT_NE(csv.find("\nadded_mass,0," + text::exact(design.added_mass) + ",\n"), std::string::npos)
       << csv;
   const std::string summary = bd::testing::read(out / "summary.json");
   EXPECT_NE(summary.find("\"force_balanced\": true"), std::string::npos);
@@ -157,7 +156,8 @@ TEST(PlanarBalanceStudy, TheExampleSixBarIsFullyForceBalancedAndItsStudyRunsByIt
 // so, and the least-squares design's RMS shaking force, computed by the balance layer from its
 // regressor, is what the engine's simulation of the design finds.
 TEST(PlanarBalanceStudy, AnEnginesCrankCounterweightLeavesWhatTheMessageSays) {
-  const Study study = parse_study(kEngine + "balance:\n  counterweights:\n    crank: {}\n", "e.yaml");
+  const Study study =
+      parse_study(kEngine + "balance:\n  counterweights:\n    crank: {}\n", "e.yaml");
   const RunResult r = compute_study(study);
   ASSERT_TRUE(r.ok());
   ASSERT_TRUE(r.balanced && r.balanced->design);
@@ -207,8 +207,7 @@ TEST(PlanarBalanceStudy, NoBalancedDesignWhenTheOriginalStopsEarly) {
   EXPECT_TRUE(r.stopped_early());
   ASSERT_TRUE(r.balanced);
   EXPECT_FALSE(r.balanced->design);
-  EXPECT_EQ(r.balanced->status().message.rfind("not run: the original design's simulation", 0),
-            0u)
+  EXPECT_EQ(r.balanced->status().message.rfind("not run: the original design's simulation", 0), 0u)
       << r.balanced->status().message;
   EXPECT_TRUE(fs::exists(out / "timeseries.csv"));
   EXPECT_FALSE(fs::exists(out / "balanced.yaml"));

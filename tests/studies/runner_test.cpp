@@ -159,7 +159,7 @@ TEST_F(RunnerTest, DrivenSceneWritesOneRowPerSampleAndSaysWhyNoIntegrator) {
   EXPECT_NE(json.find("no integrator: kinetostatics per sample"), std::string::npos) << json;
   EXPECT_GT(r.metrics.tau_max, 0.0);
   EXPECT_EQ(names_in(dir_),
-            (std::set<std::string>{"report.html", "summary.json", "timeseries.csv"}));
+            (std::set<std::string>{"harmonics.csv", "report.html", "summary.json", "timeseries.csv"}));
 }
 
 TEST_F(RunnerTest, RunningAgainReplacesTheFiles) {
@@ -169,7 +169,7 @@ TEST_F(RunnerTest, RunningAgainReplacesTheFiles) {
   run_study(study, dir_);
   EXPECT_EQ(read(dir_ / "timeseries.csv"), first);
   EXPECT_EQ(names_in(dir_),
-            (std::set<std::string>{"report.html", "summary.json", "timeseries.csv"}));
+            (std::set<std::string>{"harmonics.csv", "report.html", "summary.json", "timeseries.csv"}));
 }
 
 TEST_F(RunnerTest, SimulationStoppedEarlyKeepsItsSamplesAndSaysWhy) {
@@ -203,9 +203,10 @@ TEST_F(RunnerTest, InvalidSceneCreatesNothing) {
 
 // ---- balance studies ----
 
+// (driven scenes: with the harmonic orders of both designs)
 const std::set<std::string> kBalanceFiles = {
-    "balanced-timeseries.csv", "balanced.yaml", "comparison.csv", "report.html", "summary.json",
-    "timeseries.csv"};
+    "balanced-timeseries.csv", "balanced.yaml", "comparison.csv", "harmonics.csv", "report.html",
+    "summary.json",            "timeseries.csv"};
 
 // the value of `"key": ` in the JSON text after `from` (a number or null)
 std::string json_value(const std::string& json, const std::string& key, std::size_t from = 0) {
@@ -413,7 +414,9 @@ TEST_F(RunnerTest, BalanceStudyStoppedEarlyKeepsEveryFile) {
   ASSERT_TRUE(r.balanced.has_value());
   EXPECT_FALSE(r.balanced->trajectory.ok());
   EXPECT_FALSE(r.balanced->trajectory.samples.empty());
-  EXPECT_EQ(names_in(dir_), kBalanceFiles);
+  std::set<std::string> files = kBalanceFiles;  // no whole revolution: no harmonic orders
+  files.erase("harmonics.csv");
+  EXPECT_EQ(names_in(dir_), files);
   expect_rows_match(lines_of(read(r.balanced->timeseries)), r.balanced->trajectory);
   const std::string json = bd::testing::json_view(read(r.summary));
   const auto run = json.find("\"balanced_run\"");
@@ -425,9 +428,10 @@ TEST_F(RunnerTest, BalanceStudyStoppedEarlyKeepsEveryFile) {
 
 // ---- optimize studies ----
 
-const std::set<std::string> kOptimizeFiles = {"comparison.csv", "optimized-timeseries.csv",
-                                              "optimized.yaml", "report.html",
-                                              "summary.json",   "timeseries.csv"};
+// (driven scenes: with the original's harmonic orders)
+const std::set<std::string> kOptimizeFiles = {
+    "comparison.csv", "harmonics.csv",  "optimized-timeseries.csv", "optimized.yaml",
+    "report.html",    "summary.json",   "timeseries.csv"};
 
 // the driven paper linkage (paper-fourbar-driven.yaml) with an optimize section appended
 Study driven_with(const std::string& optimize_section, const std::string& name) {
@@ -645,7 +649,7 @@ TEST_F(RunnerTest, InfeasibleOptimizationKeepsTheOriginalAndSaysWhy) {
   EXPECT_NE(r.optimized->result.message.find("force balance"), std::string::npos)
       << r.optimized->result.message;
   EXPECT_EQ(names_in(dir_),
-            (std::set<std::string>{"report.html", "summary.json", "timeseries.csv"}));
+            (std::set<std::string>{"harmonics.csv", "report.html", "summary.json", "timeseries.csv"}));
   expect_rows_match(lines_of(read(r.timeseries)), r.trajectory);
   const std::string json = bd::testing::json_view(read(r.summary));
   EXPECT_NE(json.find("\"termination\": \"infeasible\""), std::string::npos) << json;
