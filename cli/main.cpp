@@ -568,7 +568,7 @@ struct BenchArgs {
 };
 
 // `bench STUDY.yaml`: run the study as `run` does, then measure speed against accuracy
-// (studies/work_precision.hpp): work-precision.csv or driven-convergence.csv, and report.html
+// (studies/bench/work_precision.hpp): work-precision.csv or driven-convergence.csv, and report.html
 // with its section "Speed against accuracy". Progress on stderr, one line per method.
 int bench(const BenchArgs& args) {
   std::optional<st::Study> loaded = load_or_say(args.study);

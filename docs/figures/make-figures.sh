@@ -20,26 +20,7 @@ trap 'rm -rf "$tmp"' EXIT
 "$bin" run studies/examples/engine-slider-crank-balanced.yaml --out "$tmp/engine-balanced" \
   >/dev/null
 
-# extract_chart PAGE ID FILE: the chart `ID` of a report.html, as the page draws it, written as a
-# standalone SVG file (the page inlines it without an XML prolog or a size)
-extract_chart() {
-  awk -v id="id=\"chart-$2\"" '
-    index($0, id) { found = 1; next }
-    found && /^<svg/ { inside = 1 }
-    inside { print }
-    inside && /<\/svg>/ { exit }' "$1" >"$tmp/chart.svg"
-  if ! grep -q '</svg>' "$tmp/chart.svg"; then
-    echo "make-figures: $1 has no chart $2" >&2
-    exit 1
-  fi
-  local size
-  size=$(grep -o -m1 'viewBox="0 0 [0-9]* [0-9]*"' "$tmp/chart.svg" | tr -d '"' | cut -d' ' -f3,4)
-  {
-    echo '<?xml version="1.0" encoding="utf-8" standalone="no"?>'
-    sed "1s|^<svg role=\"img\" aria-label=\"[^\"]*\"|<svg width=\"${size% *}\" height=\"${size#* }\"|" \
-      "$tmp/chart.svg"
-  } >"$3"
-}
+source docs/figures/extract-chart.sh
 # the shaking-force hodograph of the driven paper four-bar, original and force balanced, straight
 # from the run's report.html
 extract_chart "$tmp/driven-balanced/report.html" hodograph "$out/report-hodograph.svg"
