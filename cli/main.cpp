@@ -47,8 +47,12 @@ Outputs (in DIR, default results/<name>/ with <name> the study's `name`):
   summary.json    study name, method used and why, scene, samples, status, metrics
                   (Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max, RA0_rms, RA0_max,
                   RA3_rms, RA3_max); with a balance section also balance, balanced_run,
-                  balanced_metrics and reduction (balanced / original)
-  With a `balance:` section, besides (for the balanced design, same scene):
+                  balanced_metrics and reduction (balanced / original); in a driven scene
+                  the harmonic orders of the shaking force and moment (harmonics)
+  harmonics.csv   a driven scene: design,order, amplitude and phase of Fshx, Fshy, Msh, and
+                  the force's parts turning with and against the input, orders 0 to 8
+  A planar linkage's timeseries.csv and metrics name its links, nodes, joints and inputs
+  (docs/study-format.md). With a `balance:` section, besides (for the balanced design, same scene):
   balanced-timeseries.csv  the balanced design's samples, columns as timeseries.csv
   balanced.yaml            a complete study file of the balanced design
   comparison.csv           metric,before,after,ratio for the main metrics, added mass and inertia
@@ -399,6 +403,7 @@ void print_summary(const st::Study& study, const st::RunResult& r) {
   if (study.planar_balance && r.balanced) print_planar_balance(study, r);
   if (study.optimize && r.optimized) print_optimize(study, r);
   std::printf("  wrote    %s\n", r.timeseries.string().c_str());
+  if (!r.harmonics_file.empty()) std::printf("           %s\n", r.harmonics_file.string().c_str());
   if (r.balanced) {
     for (const fs::path& p :
          {r.balanced->timeseries, r.balanced->study_file, r.balanced->comparison}) {
