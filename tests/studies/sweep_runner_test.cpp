@@ -199,6 +199,46 @@ TEST_F(SweepRunner, EachRowIsThePointsStudyRunOnItsOwn) {
   EXPECT_EQ((*params)[1]["to"].get<double>(), 2.5);
 }
 
+// A planar linkage with a balance section sweeps alike: its own metrics, the balanced design's
+// after them under balanced_, and each row the point's study run on its own, bit for bit.
+TEST_F(SweepRunner, APlanarBalanceStudySweepsItsOwnMetrics) {
+  const Study study = parse_study(bd::testing::engine_study(36) +
+                                      "balance:\n"
+                                      "sweep:\n"
+                                      "  parameters:\n"
+                                      "    - {path: linkage.point_masses.B, values: [0.3, 0.5]}\n",
+                                  "e.yaml");
+  const std::vector<std::string> columns = sweep_columns(study);
+  ASSERT_GT(columns.size(), 6u);
+  EXPECT_EQ(columns[2], "Fsh_rms");
+  const auto balanced = std::find(columns.begin(), columns.end(), "balanced_Fsh_rms");
+  ASSERT_NE(balanced, columns.end());
+  EXPECT_NE(std::find(columns.begin(), columns.end(), "balanced_Rpiston_max"), columns.end());
+  const SweepResult r = run_sweep(study, dir_, quiet(1));
+  EXPECT_EQ(r.done, 2);
+  EXPECT_EQ(r.failed, 0);
+  const std::vector<std::string> rows = lines(read(r.csv));
+  ASSERT_EQ(rows.size(), 3u);
+  const auto points = sweep_points(*study.sweep);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const std::vector<std::string> f = csv_fields(rows[i + 1]);
+    ASSERT_EQ(f.size(), columns.size());
+    const RunResult one = compute_study(point_study(study, points[i]));
+    ASSERT_TRUE(one.balanced && one.balanced->design);
+    std::vector<double> expected;
+    for (const MetricList* list : {&one.metric_list, &one.balanced->metric_list}) {
+      for (const MetricValue& m : *list) expected.push_back(m.value);
+    }
+    expected.push_back(one.balanced->design->added_mass);
+    expected.push_back(one.balanced->design->added_inertia);
+    ASSERT_EQ(expected.size() + 4, columns.size());
+    for (std::size_t k = 0; k < expected.size(); ++k) {
+      EXPECT_EQ(f[2 + k], number(expected[k])) << columns[2 + k];
+    }
+    EXPECT_EQ(f[columns.size() - 2], "ok");
+  }
+}
+
 TEST_F(SweepRunner, OneThreadAndTwoThreadsWriteTheSameFile) {
   const Study grid = parse_study(kDriven + "balance: {force: full}\n" + kGrid3x3, "s.yaml");
   run_sweep(grid, dir_ / "grid-1", quiet(1));
