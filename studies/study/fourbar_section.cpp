@@ -111,63 +111,28 @@ class FourBarSection::Impl {
     const double length = number(m.require("length", "l in m"), "m");
     const double mass = number(m.require("mass", "in kg"), "kg");
 
-    // centre of mass: exactly one complete pair, {s, sigma} or {e, f}
-    const MapReader::Entry* s = m.find("s");
-    const MapReader::Entry* sigma = m.find("sigma");
-    const MapReader::Entry* ce = m.find("e");
-    const MapReader::Entry* cf = m.find("f");
-    const MapReader::Entry* polar_first = first_of(s, sigma);
-    const MapReader::Entry* cart_first = first_of(ce, cf);
-    if (polar_first && cart_first) {
-      const MapReader::Entry* later =
-          polar_first->key_mark.pos > cart_first->key_mark.pos ? polar_first : cart_first;
-      r_.fail(later->key_mark, path +
-                                   " gives its centre of mass both as {s, sigma} and as "
-                                   "{e, f}; give one pair only");
-    }
-    if (!polar_first && !cart_first) {
-      r_.fail(e.key_mark, path +
-                              ": missing the centre of mass; give s [m] and sigma [rad], "
-                              "or e [m] and f [m]");
-    }
-    auto pair_check = [&](const MapReader::Entry* a, const MapReader::Entry* b, const char* an,
-                          const char* bn) {
-      if (a && !b) {
-        r_.fail(a->key_mark,
-                path + "." + an + " is given without " + bn + "; give both " + an + " and " + bn);
-      }
-    };
-    pair_check(s, sigma, "s", "sigma");
-    pair_check(sigma, s, "sigma", "s");
-    pair_check(ce, cf, "e", "f");
-    pair_check(cf, ce, "f", "e");
-
+    const CentreOfMassKeys com =
+        centre_of_mass_keys(r_, m, e, path, "give s [m] and sigma [rad], or e [m] and f [m]");
     const double inertia =
         number(m.require("inertia", "I about the centre of mass in kg m^2"), "kg m^2");
-    if (s) {
-      const double sv = number(*s, "m");
+    if (com.polar()) {
+      const double sv = number(*com.s, "m");
       if (sv < 0) {
-        r_.fail(mark_of(s->value, s->key_mark), path +
-                                                    ".s must be >= 0 m (sigma gives the "
-                                                    "direction), got " +
-                                                    text::exact(sv));
+        r_.fail(mark_of(com.s->value, com.s->key_mark), path +
+                                                            ".s must be >= 0 m (sigma gives the "
+                                                            "direction), got " +
+                                                            text::exact(sv));
       }
-      const double sg = number(*sigma, "rad");
+      const double sg = number(*com.sigma, "rad");
       return core::link_from_polar(length, mass, sv, sg, inertia);
     }
     core::Link link;
     link.length = length;
     link.mass = mass;
-    link.e = number(*ce, "m");
-    link.f = number(*cf, "m");
+    link.e = number(*com.e, "m");
+    link.f = number(*com.f, "m");
     link.inertia = inertia;
     return link;
-  }
-
-  static const MapReader::Entry* first_of(const MapReader::Entry* a, const MapReader::Entry* b) {
-    if (!a) return b;
-    if (!b) return a;
-    return a->key_mark.pos <= b->key_mark.pos ? a : b;
   }
 
   core::Loads read_loads(const MapReader::Entry& e) {

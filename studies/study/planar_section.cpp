@@ -216,37 +216,16 @@ class PlanarSection::Impl {
   // exactly one pair: {e, f} or {s, sigma}
   void read_centre_of_mass(const MapReader& lm, const MapReader::Entry& x, const std::string& path,
                            core::planar::Link& link) {
-    const MapReader::Entry *e = lm.find("e"), *f = lm.find("f"), *s = lm.find("s"),
-                           *sigma = lm.find("sigma");
-    const bool cart = e || f, polar = s || sigma;
-    if (cart && polar) {
-      r_.fail(
-          (e ? e : f)->key_mark,
-          path + " gives its centre of mass both as {s, sigma} and as {e, f}; give one pair only");
-    }
-    if (!cart && !polar) {
-      r_.fail(x.key_mark, path +
-                              ": missing the centre of mass; give e [m] and f [m] (along and to "
-                              "the left of the line from its first node to its second), or s [m] "
-                              "and sigma [rad]");
-    }
-    auto need = [&](const MapReader::Entry* a, const MapReader::Entry* b, const char* an,
-                    const char* bn) {
-      if (a && !b) {
-        r_.fail(a->key_mark,
-                path + "." + an + " is given without " + bn + "; give both " + an + " and " + bn);
-      }
-    };
-    need(e, f, "e", "f");
-    need(f, e, "f", "e");
-    need(s, sigma, "s", "sigma");
-    need(sigma, s, "sigma", "s");
-    if (cart) {
-      link.e = read_number(r_, *e, path + ".e", "m");
-      link.f = read_number(r_, *f, path + ".f", "m");
+    const CentreOfMassKeys com = centre_of_mass_keys(
+        r_, lm, x, path,
+        "give e [m] and f [m] (along and to the left of the line from its first node to its "
+        "second), or s [m] and sigma [rad]");
+    if (!com.polar()) {
+      link.e = read_number(r_, *com.e, path + ".e", "m");
+      link.f = read_number(r_, *com.f, path + ".f", "m");
     } else {
-      const double sv = non_negative(*s, path + ".s", "m");
-      const double sg = read_number(r_, *sigma, path + ".sigma", "rad");
+      const double sv = non_negative(*com.s, path + ".s", "m");
+      const double sg = read_number(r_, *com.sigma, path + ".sigma", "rad");
       link.e = sv * std::cos(sg);
       link.f = sv * std::sin(sg);
     }

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/number_text.hpp"
@@ -202,6 +203,44 @@ inline Vec2 read_vec2(const Reporter& r, const MapReader::Entry& e, const std::s
         read_number(r, item, m, path + "[" + std::to_string(i) + "]", unit);
   }
   return v;
+}
+
+// A link's centre of mass in a study file: exactly one complete pair, {s, sigma} or {e, f}.
+struct CentreOfMassKeys {
+  const MapReader::Entry *s, *sigma, *e, *f;
+  bool polar() const { return s != nullptr; }
+};
+// The pair `m` (the link at `path`, its entry `link`) gives; a mistake is reported at its key:
+// both pairs given (at the later pair), half a pair (at the half), none (at the link, with
+// `missing`, what to give).
+inline CentreOfMassKeys centre_of_mass_keys(const Reporter& r, const MapReader& m,
+                                            const MapReader::Entry& link, const std::string& path,
+                                            const std::string& missing) {
+  const CentreOfMassKeys k{m.find("s"), m.find("sigma"), m.find("e"), m.find("f")};
+  auto first_of = [](const MapReader::Entry* a, const MapReader::Entry* b) {
+    if (!a || !b) return a ? a : b;
+    return a->key_mark.pos <= b->key_mark.pos ? a : b;
+  };
+  const MapReader::Entry* polar = first_of(k.s, k.sigma);
+  const MapReader::Entry* cart = first_of(k.e, k.f);
+  if (polar && cart) {
+    r.fail((polar->key_mark.pos > cart->key_mark.pos ? polar : cart)->key_mark,
+           path + " gives its centre of mass both as {s, sigma} and as {e, f}; give one pair only");
+  }
+  if (!polar && !cart) r.fail(link.key_mark, path + ": missing the centre of mass; " + missing);
+  const std::pair<const MapReader::Entry*, const char*> halves[][2] = {
+      {{k.s, "s"}, {k.sigma, "sigma"}}, {{k.e, "e"}, {k.f, "f"}}};
+  for (const auto& pair : halves) {
+    for (int i = 0; i < 2; ++i) {
+      const auto& [given, name] = pair[i];
+      const char* other = pair[1 - i].second;
+      if (given && !pair[1 - i].first) {
+        r.fail(given->key_mark, path + "." + name + " is given without " + other + "; give both " +
+                                    name + " and " + other);
+      }
+    }
+  }
+  return k;
 }
 
 }  // namespace bd::studies::detail

@@ -98,6 +98,13 @@ TEST(PlanarStudy, MistakesAreOneLineAtTheirPlace) {
                "method mass-matrix is one of the four-bar's formulations");
   expect_error(edit("  type: planar\n", "  type: sixbar\n"), 3, 9,
                "linkage.type 'sixbar' is not supported; expected fourbar or planar");
+  // the centre of mass: one complete pair, {e, f} or {s, sigma} (the four-bar's reader's check)
+  const std::string crank = "e: 0.012, f: 0, inertia";
+  expect_error(edit(crank, "e: 0.012, inertia"), 9, 39,
+               "linkage.links.crank.e is given without f; give both e and f");
+  expect_error(edit(crank, "e: 0.012, f: 0, s: 0.1, inertia"), 9, 55,
+               "linkage.links.crank gives its centre of mass both as {s, sigma} and as {e, f}");
+  expect_error(edit(crank, "inertia"), 9, 5, "linkage.links.crank: missing the centre of mass");
   expect_error(kEngine + "optimize: {}\n", 20, 1,
                "optimize is available for a four-bar (linkage.type: fourbar)");
   // a start the linkage cannot reach: a slider-crank driven from the piston past its stroke;
