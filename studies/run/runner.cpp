@@ -254,13 +254,6 @@ std::string pareto_csv(const Study& study, const OptimizedRun& run) {
 
 namespace {
 
-RunStatus status_of(const core::planar::Trajectory& t) {
-  return {t.status, t.message, t.table.rows(), t.steps, t.rhs_evaluations};
-}
-RunStatus status_of(const core::Trajectory& t) {
-  return {t.status, t.message, t.samples.size(), t.steps, t.rhs_evaluations};
-}
-
 // a planar study's balanced design: synthesised from the original's motion (its configurations
 // give the balance conditions), then simulated in the same scene; not run when the original
 // stopped early
@@ -294,12 +287,12 @@ BalancedRun planar_balanced_run(const Study& study, const RunResult& original) {
 }  // namespace
 
 RunStatus BalancedRun::status() const {
-  return is_planar ? status_of(planar) : status_of(trajectory);
+  return is_planar ? run_status(planar) : run_status(trajectory);
 }
 
 RunStatus simulation_status(const RunResult& r) {
-  if (!r.planar.table.columns.empty()) return status_of(r.planar);
-  return status_of(r.trajectory);
+  if (!r.planar.table.columns.empty()) return run_status(r.planar);
+  return run_status(r.trajectory);
 }
 
 RunResult compute_study(const Study& study) {

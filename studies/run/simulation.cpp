@@ -46,13 +46,16 @@ Scene planar_scene(const Scene& scene) {
 
 }  // namespace
 
+RunStatus run_status(const core::Trajectory& t) {
+  return {t.status, t.message, t.samples.size(), t.steps, t.rhs_evaluations};
+}
+
+RunStatus run_status(const core::planar::Trajectory& t) {
+  return {t.status, t.message, t.table.rows(), t.steps, t.rhs_evaluations};
+}
+
 RunStatus Simulation::status() const {
-  if (is_planar) {
-    return {planar.status, planar.message, planar.table.rows(), planar.steps,
-            planar.rhs_evaluations};
-  }
-  return {fourbar.status, fourbar.message, fourbar.samples.size(), fourbar.steps,
-          fourbar.rhs_evaluations};
+  return is_planar ? run_status(planar) : run_status(fourbar);
 }
 
 Simulation simulate(const Study& study) { return simulate(study, choose_method(study)); }

@@ -30,6 +30,10 @@ struct RunStatus {
   bool ok() const { return status == core::SimulationStatus::kCompleted; }
 };
 
+/// How a four-bar's or a planar linkage's run ended.
+RunStatus run_status(const core::Trajectory& trajectory);
+RunStatus run_status(const core::planar::Trajectory& trajectory);
+
 /// A simulation of a study: a four-bar's trajectory (`fourbar`) or a planar linkage's table
 /// (`planar`), the other left empty.
 struct Simulation {

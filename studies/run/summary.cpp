@@ -301,9 +301,7 @@ std::string summary_json(const Study& study, const RunResult& result) {
     const OptimizedRun& o = *result.optimized;
     j["optimize"] = optimize_json(study, result);
     if (o.found()) {
-      const RunStatus status{o.trajectory.status, o.trajectory.message, o.trajectory.samples.size(),
-                             o.trajectory.steps, o.trajectory.rhs_evaluations};
-      add_second_run(j, study, "optimized", o.method, status, result.metric_list,
+      add_second_run(j, study, "optimized", o.method, run_status(o.trajectory), result.metric_list,
                      metric_list(o.metrics));
     }
   }

@@ -109,6 +109,35 @@ TEST(HarmonicsStudy, AnOffsetEngineShowsOddOrders) {
   }
 }
 
+// At constant speed the forces depend on the position and ω² only, so the engine turned the
+// other way has the same orders as functions of the crank angle: amplitudes and phases alike
+// (its samples are taken with the angle decreasing, and read back in the angle's order).
+TEST(HarmonicsStudy, TurningTheOtherWayGivesTheSameOrdersOfTheCrankAngle) {
+  std::string offset = engine(0.012);
+  const RunResult ahead = compute_study(parse_study(offset, "e.yaml"));
+  const RunResult back = compute_study(
+      parse_study(replaced(offset, "speeds: [314.1592653589793]", "speeds: [-314.1592653589793]"),
+                  "e.yaml"));
+  ASSERT_TRUE(ahead.harmonics && back.harmonics);
+  EXPECT_EQ(back.harmonics->speed, -kOmega);
+  const double scale = ahead.harmonics->orders[1].Fshx.amplitude;
+  const double mscale = ahead.harmonics->orders[1].Msh.amplitude;
+  ASSERT_GT(mscale, 0.1);
+  for (std::size_t k = 1; k < ahead.harmonics->orders.size(); ++k) {
+    const HarmonicOrder &a = ahead.harmonics->orders[k], &b = back.harmonics->orders[k];
+    EXPECT_NEAR(b.Fshx.amplitude, a.Fshx.amplitude, 1e-12 * scale) << k;
+    EXPECT_NEAR(b.Fsh.forward, a.Fsh.forward, 1e-12 * scale) << k;
+    EXPECT_NEAR(b.Fsh.backward, a.Fsh.backward, 1e-12 * scale) << k;
+    EXPECT_NEAR(b.Msh.amplitude, a.Msh.amplitude, 1e-12 * mscale) << k;
+    if (a.Fshx.amplitude > 1e-6 * scale) {
+      // phases on the circle: ±π are one angle
+      EXPECT_NEAR(std::remainder(b.Fshx.phase - a.Fshx.phase, 2 * kPi), 0.0, 1e-9) << k;
+      EXPECT_NEAR(std::remainder(b.Fsh.forward_phase - a.Fsh.forward_phase, 2 * kPi), 0.0, 1e-9)
+          << k;
+    }
+  }
+}
+
 // A four-bar driven by its crank has orders too; its force-balanced design has none.
 TEST(HarmonicsStudy, AForceBalancedFourBarHasNoShakingForceOrders) {
   const Study study = load_study(std::string(BD_SOURCE_DIR) +
