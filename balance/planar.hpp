@@ -95,10 +95,10 @@ struct LinkCounterweightSpec {
   CounterweightSpec spec;
 };
 
-/// The study file's `balance:` section for a planar linkage: full force balance by counterweights
-/// on the links named (default: every link that turns about a ground node).
+/// The study file's `balance:` section for a planar linkage: full force balance (the only
+/// balance a planar linkage takes so far) by counterweights on the links named (default: every
+/// link that turns about a ground node).
 struct BalanceRequest {
-  bool force = true;
   std::vector<LinkCounterweightSpec> counterweights;
 };
 

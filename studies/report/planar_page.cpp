@@ -234,15 +234,14 @@ std::vector<Chart> planar_charts(const Study& study, const fs::path& dir, const 
   for (const auto& [name, expr] : drives) {
     drive_plot += (drive_plot.empty() ? "" : ", ") + with_second(file, second, name, expr);
   }
-  std::string hodograph = file + " skip 1 using " + std::to_string(gp_column(ts, "Fshx")) + ":" +
-                          std::to_string(gp_column(ts, "Fshy")) +
-                          " with lines lw 2 title 'shaking force'";
+  // the second design has the original's columns (the same links, nodes and joints)
+  const std::string fsh = " skip 1 using " + std::to_string(gp_column(ts, "Fshx")) + ":" +
+                          std::to_string(gp_column(ts, "Fshy"));
+  std::string hodograph = file + fsh + " with lines lw 2 title " +
+                          gp_string(second.file.empty() ? "shaking force" : "original");
   if (!second.file.empty()) {
-    hodograph = file + " skip 1 using " + std::to_string(gp_column(ts, "Fshx")) + ":" +
-                std::to_string(gp_column(ts, "Fshy")) + " with lines lw 2 title 'original', " +
-                second.file + " skip 1 using " + std::to_string(gp_column(second.ts, "Fshx")) +
-                ":" + std::to_string(gp_column(second.ts, "Fshy")) +
-                " with linespoints lw 2 pt 7 ps 0.5 pi 10 title " + gp_string(second.design.label);
+    hodograph += ", " + second.file + fsh + " with linespoints lw 2 pt 7 ps 0.5 pi 10 title " +
+                 gp_string(second.design.label);
   }
   charts.push_back({"angles", "Link angles",
                     "Every link's angle (its first-to-second node direction) over the run.",

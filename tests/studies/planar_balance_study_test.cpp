@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -126,6 +127,33 @@ TEST(PlanarBalanceStudy, TheExampleSixBarIsFullyForceBalancedAndItsStudyRunsByIt
     EXPECT_EQ(rerun.metric_list[k].value, r.balanced->metric_list[k].value)
         << rerun.metric_list[k].name;
   }
+
+  // each counterweight as reported (mass, position from its pivot, disc of the radius given) is
+  // what the link in balanced.yaml carries: the merged link rebuilt here by the parallel-axis
+  // sum from the original link and the reported counterweight (every pivot here is the link's
+  // first node, so link axes and pivot axes share their origin)
+  double inertia_added = 0;
+  for (const bp::LinkCounterweight& c : design.added) {
+    const core::planar::Link& before_link = study.planar().links[static_cast<std::size_t>(c.link)];
+    const core::planar::Link& after_link = again.planar().links[static_cast<std::size_t>(c.link)];
+    ASSERT_EQ(c.pivot, before_link.nodes[0]);
+    const balance::Counterweight& w = c.counterweight;
+    EXPECT_NEAR(w.distance, w.position.norm(), 1e-15 * w.distance);
+    EXPECT_NEAR(w.inertia, 0.5 * w.mass * w.radius * w.radius, 1e-15 * w.inertia);  // a disc
+    EXPECT_NEAR(w.mass, 0.02 * 7850 * std::numbers::pi * w.radius * w.radius, 1e-13 * w.mass);
+    const double m = before_link.mass + w.mass;
+    const Vec2 g0(before_link.e, before_link.f),
+        g = (before_link.mass * g0 + w.mass * w.position) / m;
+    const double inertia = before_link.inertia + before_link.mass * (g0 - g).squaredNorm() +
+                           w.inertia + w.mass * (w.position - g).squaredNorm();
+    EXPECT_NEAR(after_link.mass, m, 1e-15 * m) << after_link.name;
+    EXPECT_NEAR(after_link.e, g.x(), 1e-15 * g.norm()) << after_link.name;
+    EXPECT_NEAR(after_link.f, g.y(), 1e-15 * g.norm()) << after_link.name;
+    EXPECT_NEAR(after_link.inertia, inertia, 1e-14 * inertia) << after_link.name;
+    inertia_added += w.inertia + w.mass * w.position.squaredNorm();  // about the pivot
+  }
+  EXPECT_NEAR(design.added_inertia, inertia_added, 1e-14 * inertia_added);
+  EXPECT_LE(design.momentum_left, 1e-12);
 
   // the referee on the design as written: no inertial shaking force at any sample
   const bd::testing::planar::Glue g = bd::testing::planar::glue_of(again.planar());
