@@ -109,6 +109,7 @@ void resize(Instant& in, const Model& m) {
   in.ground_reaction.assign(m.ground_nodes().size(), Vec2(0, 0));
   in.guide_reaction.assign(m.frame_guides().size(), Vec2(0, 0));
   in.joint_force.assign(m.joints().size(), Vec2(0, 0));
+  in.shaft_reaction.assign(l.shafts.size(), Vec2(0, 0));
 }
 
 bool finite(const VectorXd& v) { return v.allFinite(); }
@@ -194,7 +195,6 @@ Workspace::Workspace(const Model& model) {
   zdd.setZero(model.inputs());
   trial = instant.x;
   on_link.assign(model.linkage().links.size() * model.linkage().nodes.size(), Vec2(0, 0));
-
 }
 
 std::vector<double> drawn_inputs(const Model& model) {
@@ -475,7 +475,9 @@ void link_node_forces(const Model& model, Workspace& ws) {
     Vec4 acc;
     acc << in.a[static_cast<std::size_t>(e.p)], in.a[static_cast<std::size_t>(e.q)];
     const Vec4 inertia = s.element_M[k] * acc;
-    const Vec4 applied = element_nodal_forces(s.com_weights[k], s.link_force[k], s.link_moment[k],
+    const double moment =
+        s.shafts.empty() ? s.link_moment[k] : detail::link_moment_at(s, static_cast<int>(k), in.x);
+    const Vec4 applied = element_nodal_forces(s.com_weights[k], s.link_force[k], moment,
                                               in.x[static_cast<std::size_t>(e.p)],
                                               in.x[static_cast<std::size_t>(e.q)]);
     f(static_cast<int>(k), e.p) += inertia.segment<2>(0) - applied.segment<2>(0);
@@ -488,6 +490,35 @@ void link_node_forces(const Model& model, Workspace& ws) {
       if (entries[j].link >= 0)
         f(entries[j].link, entries[j].node) -= ws.lambda[row] * entries[j].grad;
     }
+  }
+}
+
+// the balance shafts' forces on the frame: each shaft's bearing carries its weight and inertia
+// and the reaction of its tooth force, whose action on the link goes to the frame through the
+// link's pivot (its moment about the pivot is the drive's torque on the link, already in the
+// multipliers); a drive without a pitch point reacts on the frame with (ratio - 1) τ instead
+template <class OnFrame>
+void shaft_forces(const Model& model, Instant& in, OnFrame& on_frame) {
+  const System& s = model.system();
+  const Linkage& l = s.linkage;
+  for (std::size_t k = 0; k < l.shafts.size(); ++k) {
+    const BalanceShaft& b = l.shafts[k];
+    const System::ShaftRef& r = s.shafts[k];
+    const std::size_t link = static_cast<std::size_t>(b.link);
+    const detail::ShaftMotion m =
+        detail::shaft_motion(s, static_cast<int>(k), in.x, in.omega[link], in.alpha[link]);
+    Vec2 reaction = b.mass * (l.loads.gravity - m.a);
+    if (r.mesh) {
+      const Vec2 tooth = r.per_torque * m.torque * r.normal;  // on the link
+      const auto g = std::find(model.ground_nodes().begin(), model.ground_nodes().end(), r.pivot);
+      in.ground_reaction[static_cast<std::size_t>(g - model.ground_nodes().begin())] += tooth;
+      on_frame(tooth, l.nodes[static_cast<std::size_t>(r.pivot)].position);
+      reaction -= tooth;
+    } else {
+      in.Msh += (b.ratio - 1) * m.torque;
+    }
+    in.shaft_reaction[k] = reaction;
+    on_frame(reaction, b.at);
   }
 }
 
@@ -541,6 +572,7 @@ void frame_forces(const Model& model, Workspace& ws) {
   for (std::size_t j = 0; j < model.joints().size(); ++j) {
     in.joint_force[j] = f(model.joints()[j].link, model.joints()[j].node);
   }
+  shaft_forces(model, in, on_frame);
 }
 
 // the inertial part of the shaking force and moment: -Σ m a and -dH/dt about the origin
@@ -563,6 +595,14 @@ void inertial_parts(const Model& model, Instant& in) {
     const std::size_t n = static_cast<std::size_t>(pm.node);
     in.Fsh_inertial -= pm.mass * in.a[n];
     in.Msh_inertial -= cross(in.x[n], pm.mass * in.a[n]);
+  }
+  for (std::size_t k = 0; k < l.shafts.size(); ++k) {
+    const BalanceShaft& b = l.shafts[k];
+    const std::size_t link = static_cast<std::size_t>(b.link);
+    const detail::ShaftMotion m =
+        detail::shaft_motion(s, static_cast<int>(k), in.x, in.omega[link], in.alpha[link]);
+    in.Fsh_inertial -= b.mass * m.a;
+    in.Msh_inertial -= b.inertia * m.alpha + cross(b.at + m.r, b.mass * m.a);
   }
 }
 

@@ -80,6 +80,10 @@ struct Instant {
   std::vector<Vec2> ground_reaction;  // per ground node: force of the mechanism ON the frame [N]
   std::vector<Vec2> guide_reaction;   // per frame guide: force ON the frame at the node [N]
   std::vector<Vec2> joint_force;      // per joint: force on the link at the node [N]
+  /// Per balance shaft: the force ON the frame at its bearing [N] (its weight and inertia, and
+  /// the reaction of its tooth force; the tooth force's action on the link reaches the frame
+  /// through the link's pivot, in that ground node's reaction).
+  std::vector<Vec2> shaft_reaction;
   Vec2 Fsh{0, 0};           // shaking force: every force of the mechanism ON the frame [N]
   double Msh{};             // shaking moment about the origin, drives' reactions included [N m]
   Vec2 Fsh_inertial{0, 0};  // -Σ m a [N]

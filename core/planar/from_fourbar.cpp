@@ -6,11 +6,6 @@
 namespace bd::core::planar {
 
 Linkage linkage_of(const FourBar& m, double theta1) {
-  if (has_counter_rotations(m)) {
-    throw InputError(
-        "counter_rotations: the general engine does not model the four-bar's counter-rotating "
-        "inertias; use one of the four-bar's own methods");
-  }
   const auto pose = solve_position(m, theta1);
   if (!pose) throw InputError(pose.error().what());
   const Joints j = joint_positions(m, *pose);
@@ -27,6 +22,14 @@ Linkage linkage_of(const FourBar& m, double theta1) {
     if (!load.force.isZero(0.0) || load.moment != 0.0) l.loads.link_loads.push_back(load);
   }
   l.loads.gravity = m.loads.gravity;
+  // the counter-rotating discs: balance shafts geared to the crank and the rocker with ratio -1
+  // (equal pitch radii, as the four-bar's), named so that their reactions are RC1 and RC3
+  const CounterRotation* discs[] = {&m.counter_rotations.crank, &m.counter_rotations.rocker};
+  for (int side = 0; side < 2; ++side) {
+    if (!(discs[side]->inertia > 0)) continue;
+    l.shafts.push_back({side == 0 ? std::string("C1") : std::string("C3"), side == 0 ? 0 : 2, -1,
+                        discs[side]->at, 0.0, Vec2(0, 0), discs[side]->inertia});
+  }
   Input crank;
   crank.kind = Input::Kind::kAngle;
   crank.name = "crank";
@@ -55,6 +58,12 @@ core::Trajectory fourbar_trajectory(const Trajectory& planar) {
     d.Fsh = Vec2(t.at(i, f), t.at(i, f + 1));
     d.Msh = t.at(i, m);
     d.tau = t.at(i, tau);
+    if (t.column("RC1x") >= 0) {
+      d.RC1 = Vec2(t.at(i, col("RC1x")), t.at(i, col("RC1y")));
+    }
+    if (t.column("RC3x") >= 0) {
+      d.RC3 = Vec2(t.at(i, col("RC3x")), t.at(i, col("RC3y")));
+    }
     out.t.push_back(t.at(i, c_t));
     out.samples.push_back(d);
   }

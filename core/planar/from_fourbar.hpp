@@ -12,8 +12,9 @@
 namespace bd::core::planar {
 
 /// The linkage drawn at crank angle theta1 on the four-bar's branch.
-/// @throws bd::InputError if the loop cannot close at theta1, or the four-bar has counter-rotating
-///         inertias (the general engine models them from the balancing layer's gears).
+/// Counter-rotating discs become balance shafts C1 (on the crank) and C3 (on the rocker) with
+/// ratio -1, so that their reactions are the four-bar's RC1 and RC3.
+/// @throws bd::InputError if the loop cannot close at theta1.
 Linkage linkage_of(const FourBar& fourbar, double theta1);
 
 /// The general engine's samples of that linkage as the four-bar's (its crank, coupler and rocker

@@ -37,6 +37,11 @@ std::vector<ColumnMetric> metric_table(const Model& model) {
          "the guide force |" + name + "| of slider " + l.sliders[static_cast<std::size_t>(s)].name,
          {name + "x", name + "y"});
   }
+  for (const BalanceShaft& b : l.shafts) {
+    const std::string name = "R" + b.name;
+    both(name, "N", "the bearing force |" + name + "| of balance shaft " + b.name,
+         {name + "x", name + "y"});
+  }
   for (const JointForce& j : model.joints()) {
     const std::string name = "F" + j.name;
     t.push_back({name + "_max",

@@ -187,6 +187,33 @@ void check_others(const Linkage& l) {
   }
 }
 
+void check_shafts(const Linkage& l) {
+  std::set<std::string> names;
+  for (const Node& n : l.nodes) names.insert(n.name);
+  for (const Slider& s : l.sliders) names.insert(s.name);
+  for (std::size_t k = 0; k < l.shafts.size(); ++k) {
+    const BalanceShaft& b = l.shafts[k];
+    if (b.name.empty()) fail("shafts", k, ": a name is needed");
+    if (!names.insert(b.name).second) {
+      fail("shafts", k,
+           ": the name '" + b.name +
+               "' is a node's, a slider's or another shaft's (its reaction is R" + b.name + ")");
+    }
+    if (b.link < 0 || b.link >= static_cast<int>(l.links.size())) fail("shafts", k, ": not a link");
+    if (pivot_of(l, b.link) < 0) {
+      fail("shafts", k,
+           ": link " + l.links[static_cast<std::size_t>(b.link)].name +
+               " does not turn about one ground node; a balance shaft is geared to a link "
+               "pivoted on the frame");
+    }
+    if (b.ratio == 0) fail("shafts", k, ".ratio must be a non-zero integer, got 0");
+    if (!finite(b.at)) fail("shafts", k, ".at must be finite");
+    if (!finite(b.eccentricity)) fail("shafts", k, ".eccentricity must be finite");
+    check_value("shafts", k, "mass", b.mass, b.mass >= 0, ">= 0", "kg");
+    check_value("shafts", k, "inertia", b.inertia, b.inertia >= 0, ">= 0", "kg m^2");
+  }
+}
+
 }  // namespace
 
 double TimeFunction::operator()(double t) const {
@@ -220,6 +247,7 @@ Linkage make_linkage(const Linkage& candidate) {
   check_sliders(l);
   check_inputs(l);
   check_others(l);
+  check_shafts(l);
   return candidate;
 }
 
@@ -244,10 +272,21 @@ double element_length(const Linkage& l, int k) {
       .norm();
 }
 
+int pivot_of(const Linkage& l, int link) {
+  int pivot = -1;
+  for (int n : l.links[static_cast<std::size_t>(link)].nodes) {
+    if (!l.nodes[static_cast<std::size_t>(n)].ground) continue;
+    if (pivot >= 0) return -1;
+    pivot = n;
+  }
+  return pivot;
+}
+
 double total_mass(const Linkage& l) {
   double m = 0;
   for (const Link& link : l.links) m += link.mass;
   for (const PointMass& pm : l.point_masses) m += pm.mass;
+  for (const BalanceShaft& b : l.shafts) m += b.mass;
   return m;
 }
 

@@ -69,6 +69,25 @@ struct Spring {
   double damping{};      // c [N s/m], >= 0
 };
 
+/// A balance shaft: a rigid body on a shaft fixed in the frame at `at`, geared to a link that
+/// turns about a ground node so that it turns at `ratio` times the link's rate (-1: Berkof's
+/// counter-rotation; ±1, ±2: a Lanchester balancer's shafts). It carries `mass` with its centre
+/// of mass at `eccentricity` from the shaft (global axes, in the drawn configuration) and
+/// `inertia` about that centre of mass. Its motion is the link's, so it adds no degree of
+/// freedom; the drive between them is an ideal gear pair whose tooth force is normal to the line
+/// of centres at the pitch point (the pair's relative instant centre, (pivot - ratio at) /
+/// (1 - ratio)), or a pure torque where there is none (ratio 1, or a shaft on the link's pivot:
+/// a chain, a belt or a coaxial train, housed in the frame).
+struct BalanceShaft {
+  std::string name;
+  int link = -1;
+  int ratio = -1;           // the shaft's rate over the link's; an integer, not 0
+  Vec2 at{0, 0};            // [m]
+  double mass{};            // [kg], >= 0
+  Vec2 eccentricity{0, 0};  // [m]
+  double inertia{};         // about its centre of mass [kg m^2], >= 0
+};
+
 /// A value over time: a constant, a piecewise-linear table (held at its ends), or a harmonic
 /// mean + amplitude sin(2π frequency t + phase).
 struct TimeFunction {
@@ -119,12 +138,15 @@ struct Linkage {
   std::vector<Spring> springs;
   std::vector<Input> inputs;
   Loads loads;
+  std::vector<BalanceShaft> shafts;
 };
 
 /// Checks and returns the linkage: names unique and not empty, node indices valid, a link
 /// through >= 2 distinct nodes whose first two are apart, masses and inertias >= 0 and finite,
 /// every number finite, a slider's guide of non-zero length, a guide on a link through two of
-/// that link's nodes, an angle input on a link with a ground node, loads on moving parts.
+/// that link's nodes, an angle input on a link with a ground node, loads on moving parts, a
+/// balance shaft geared to a link with exactly one ground node, its name not a node's or a
+/// slider's (its reaction is R<name>).
 /// (Whether the drawn positions close every constraint, and whether the inputs match the
 /// mobility, is checked by the kinematics: assemble().)
 /// @throws bd::InputError with a FieldError whose field names the item, e.g. {"links", 2,
@@ -138,7 +160,11 @@ int link_index(const Linkage& linkage, const std::string& name);
 /// The element length of link k: |nodes[1] - nodes[0]| as drawn [m].
 double element_length(const Linkage& linkage, int k);
 
-/// Σ of the link masses and point masses [kg].
+/// The ground node a link turns about: its only ground node, or -1 (none, or two: a link fixed to
+/// the frame).
+int pivot_of(const Linkage& linkage, int link);
+
+/// Σ of the link masses, point masses and balance shafts' masses [kg].
 double total_mass(const Linkage& linkage);
 
 }  // namespace bd::core::planar

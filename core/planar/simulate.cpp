@@ -115,6 +115,7 @@ std::vector<std::string> columns(const Model& model) {
   };
   for (int g : model.ground_nodes()) pair("R" + l.nodes[static_cast<std::size_t>(g)].name);
   for (int s : model.frame_guides()) pair("R" + l.sliders[static_cast<std::size_t>(s)].name);
+  for (const BalanceShaft& b : l.shafts) pair("R" + b.name);
   for (const JointForce& j : model.joints()) pair("F" + j.name);
   c.insert(c.end(), {"Fshx", "Fshy", "Msh"});
   if (l.inputs.size() == 1) {
@@ -140,6 +141,7 @@ void append_row(const Model& model, const Instant& in, Series& table) {
   }
   for (const Vec2& r : in.ground_reaction) v.insert(v.end(), {r.x(), r.y()});
   for (const Vec2& r : in.guide_reaction) v.insert(v.end(), {r.x(), r.y()});
+  for (const Vec2& r : in.shaft_reaction) v.insert(v.end(), {r.x(), r.y()});
   for (const Vec2& f : in.joint_force) v.insert(v.end(), {f.x(), f.y()});
   v.insert(v.end(), {in.Fsh.x(), in.Fsh.y(), in.Msh});
   v.insert(v.end(), in.effort.begin(), in.effort.end());
@@ -156,7 +158,7 @@ struct DrivenTimes {
   bool by_duration{};
   double period{};  // of one turn [s]
   double duration{};
-  int samples{};    // per turn, or in all
+  int samples{};  // per turn, or in all
   long long rows{};
   double at(long long i) const {
     return by_duration ? duration * static_cast<double>(i) / static_cast<double>(rows - 1)
@@ -188,8 +190,8 @@ DrivenTimes driven_times(const Model& model, const DrivenScene& scene) {
   if (!d.by_duration && scene.revolutions < 1) {
     throw InputError(FieldError{"scene.revolutions", -1, "must be >= 1"});
   }
-  d.rows = d.by_duration ? scene.samples
-                         : static_cast<long long>(scene.samples) * scene.revolutions;
+  d.rows =
+      d.by_duration ? scene.samples : static_cast<long long>(scene.samples) * scene.revolutions;
   if (d.rows > kMaxSamples || (d.by_duration && d.rows < 2)) {
     throw InputError(FieldError{"scene.samples", -1, "must be between 2 and 1e8 in all"});
   }
@@ -228,8 +230,8 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
       previous = ws.instant.x;
       for (std::size_t n = 0; n < guess.size(); ++n) {
         const Vec2 jerk = i > 1 ? Vec2((ws.instant.a[n] - a_previous[n]) / h_previous) : Vec2(0, 0);
-        guess[n] = ws.instant.x[n] +
-                   h * (ws.instant.v[n] + h / 2 * (ws.instant.a[n] + h / 3 * jerk));
+        guess[n] =
+            ws.instant.x[n] + h * (ws.instant.v[n] + h / 2 * (ws.instant.a[n] + h / 3 * jerk));
       }
       h_previous = h;
     }

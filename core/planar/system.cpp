@@ -1,5 +1,6 @@
 #include "core/planar/system.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace bd::core::planar::detail {
@@ -57,7 +58,13 @@ int add_link_rows(System& s) {
                    l.nodes[static_cast<std::size_t>(p)].position;
     s.elements.push_back({p, q, d.norm(), d.squaredNorm()});
     s.row_ref.push_back({System::RowRef::Kind::kElement, static_cast<int>(k)});
-    ElementMass em{d.norm(), link.mass, link.e, link.f, link.inertia};
+    double geared = 0;  // the balance shafts' inertia, as the link sees it
+    for (const BalanceShaft& b : l.shafts) {
+      if (b.link == static_cast<int>(k)) {
+        geared += b.ratio * b.ratio * (b.inertia + b.mass * b.eccentricity.squaredNorm());
+      }
+    }
+    ElementMass em{d.norm(), link.mass, link.e, link.f, link.inertia + geared};
     s.element_mass.push_back(em);
     s.element_M.push_back(element_mass_matrix(em));
     s.com_weights.push_back(point_weights(link.e / em.length, link.f / em.length));
@@ -162,7 +169,64 @@ void add_masses_and_loads(System& s) {
   }
 }
 
+// the balance shafts' references: their link's direction, the gear pair's geometry
+void add_shafts(System& s) {
+  const Linkage& l = s.linkage;
+  for (const BalanceShaft& b : l.shafts) {
+    System::ShaftRef r;
+    r.link = b.link;
+    r.pivot = pivot_of(l, b.link);
+    r.ratio = b.ratio;
+    r.p = s.elements[static_cast<std::size_t>(b.link)].p;
+    r.q = s.elements[static_cast<std::size_t>(b.link)].q;
+    r.drawn = (l.nodes[static_cast<std::size_t>(r.q)].position -
+               l.nodes[static_cast<std::size_t>(r.p)].position)
+                  .normalized();
+    r.J = b.inertia + b.mass * b.eccentricity.squaredNorm();
+    const Vec2 d = b.at - l.nodes[static_cast<std::size_t>(r.pivot)].position;
+    // a shaft within 1e-12 of the linkage's size of its link's pivot is coaxial with it
+    double size = 0;
+    for (const System::ElementRow& e : s.elements) size = std::max(size, e.length);
+    r.mesh = b.ratio != 1 && d.norm() > 1e-12 * size;
+    if (r.mesh) {
+      r.normal = perp(d / d.norm());
+      r.per_torque = (1.0 - b.ratio) / d.norm();
+    }
+    s.shafts.push_back(r);
+  }
+}
+
 }  // namespace
+
+ShaftMotion shaft_motion(const System& s, int k, const NodeVectors& x, double omega_link,
+                         double alpha_link) {
+  const System::ShaftRef& r = s.shafts[static_cast<std::size_t>(k)];
+  const BalanceShaft& b = s.linkage.shafts[static_cast<std::size_t>(k)];
+  const Vec2 d = at(x, r.q) - at(x, r.p);
+  const double turned = r.ratio * std::atan2(cross(r.drawn, d), r.drawn.dot(d));
+  const double c = std::cos(turned), sn = std::sin(turned);
+  ShaftMotion m;
+  m.r = Vec2(c * b.eccentricity.x() - sn * b.eccentricity.y(),
+             sn * b.eccentricity.x() + c * b.eccentricity.y());
+  m.omega = r.ratio * omega_link;
+  m.alpha = r.ratio * alpha_link;
+  m.a = m.alpha * perp(m.r) - m.omega * m.omega * m.r;
+  m.torque = r.J * m.alpha - cross(m.r, b.mass * s.linkage.loads.gravity);
+  return m;
+}
+
+double link_moment_at(const System& s, int k, const NodeVectors& x) {
+  double moment = s.link_moment[static_cast<std::size_t>(k)];
+  const Vec2& g = s.linkage.loads.gravity;
+  if (g.isZero(0.0)) return moment;
+  for (std::size_t j = 0; j < s.shafts.size(); ++j) {
+    const BalanceShaft& b = s.linkage.shafts[j];
+    if (b.link != k || b.mass == 0.0) continue;
+    const ShaftMotion m = shaft_motion(s, static_cast<int>(j), x, 0.0, 0.0);
+    moment += b.ratio * cross(m.r, b.mass * g);
+  }
+  return moment;
+}
 
 System::System(const Linkage& l) : linkage(l) {
   coord.assign(l.nodes.size(), -1);
@@ -175,6 +239,7 @@ System::System(const Linkage& l) : linkage(l) {
   structural_rows = add_slider_rows(*this, add_link_rows(*this));
   rows = add_input_rows(*this, structural_rows);
   add_masses_and_loads(*this);
+  add_shafts(*this);
 }
 
 void nodes_from_q(const System& s, const VectorXd& q, NodeVectors& x) {
@@ -377,10 +442,12 @@ void applied_forces(const System& s, const NodeVectors& x, const NodeVectors& v,
   const Vec2& g = l.loads.gravity;
   // weights at the centres of mass, and the links' loads (eq. 46)
   for (std::size_t k = 0; k < l.links.size(); ++k) {
-    if (s.link_force[k].isZero(0.0) && s.link_moment[k] == 0.0) continue;
+    const double moment =
+        s.shafts.empty() ? s.link_moment[k] : link_moment_at(s, static_cast<int>(k), x);
+    if (s.link_force[k].isZero(0.0) && moment == 0.0) continue;
     const System::ElementRow& e = s.elements[k];
-    const Vec4 f = element_nodal_forces(s.com_weights[k], s.link_force[k], s.link_moment[k],
-                                        at(x, e.p), at(x, e.q));
+    const Vec4 f =
+        element_nodal_forces(s.com_weights[k], s.link_force[k], moment, at(x, e.p), at(x, e.q));
     add_force(s, F, e.p, f.segment<2>(0));
     add_force(s, F, e.q, f.segment<2>(2));
   }

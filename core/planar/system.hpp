@@ -82,8 +82,22 @@ struct System {
   std::vector<PointWeights> com_weights;  // per link: its centre of mass on the element
   std::vector<Vec2> link_force;           // per link: its weight and load at its centre of mass [N]
   std::vector<double> link_moment;        // per link: its load's moment [N m]
-  MatrixXd M;                             // n x n, constant
-  std::vector<double> node_mass;          // per node: point masses there [kg]
+  /// A balance shaft (model.hpp BalanceShaft). Its kinetic energy ½ J ratio² ω² is carried by its
+  /// link as extra rotary inertia (element_M includes it), so that M stays constant and the
+  /// multipliers are the joint forces of the link loaded by the drive's torque -ratio τ; the
+  /// shaft's own forces are added to the outputs (core/planar/dynamics.cpp).
+  struct ShaftRef {
+    int link{}, pivot{}, ratio{};
+    int p{}, q{};         // the link's element nodes (its direction)
+    Vec2 drawn{0, 0};     // the element's unit direction as drawn
+    double J{};           // inertia about the shaft [kg m^2]
+    bool mesh{};          // a gear pair with a pitch point; else a pure torque
+    Vec2 normal{0, 0};    // the tooth force's direction: normal to the line of centres
+    double per_torque{};  // tooth force per unit shaft torque, (1 - ratio) / |at - pivot|
+  };
+  std::vector<ShaftRef> shafts;
+  MatrixXd M;                     // n x n, constant
+  std::vector<double> node_mass;  // per node: point masses there [kg]
 
   explicit System(const Linkage& linkage);
 };
@@ -129,6 +143,19 @@ void constraint_bias(const System& s, const NodeVectors& x, const NodeVectors& v
 /// and point-mass weights, the spring-dampers; with `efforts`, the inputs' drive efforts too.
 void applied_forces(const System& s, const NodeVectors& x, const NodeVectors& v,
                     const std::vector<double>* efforts, VectorXd& F);
+
+/// A balance shaft's motion: its centre of mass from the shaft and that point's acceleration,
+/// its rate and acceleration, and the torque τ its drive applies to it (J α - r × m g) [N m].
+struct ShaftMotion {
+  Vec2 r{0, 0}, a{0, 0};
+  double omega{}, alpha{}, torque{};
+};
+/// Shaft k's motion for node positions x and its link's rate and acceleration.
+ShaftMotion shaft_motion(const System& s, int k, const NodeVectors& x, double omega_link,
+                         double alpha_link);
+/// The moment on link k at x: its load's and the gravity torque its balance shafts pass back
+/// through their drives (ratio × r × m g) [N m].
+double link_moment_at(const System& s, int k, const NodeVectors& x);
 
 /// The tension of spring k [N] (positive pulls its nodes together), its length and its unit
 /// vector from a to b.

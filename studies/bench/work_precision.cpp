@@ -213,15 +213,6 @@ void check(const BenchOptions& options) {
   }
 }
 
-// says which methods a four-bar with counter-rotating inertias leaves out
-void note_left_out(const Study& study, const BenchOptions& options) {
-  if (options.progress && study.is_fourbar() && core::has_counter_rotations(study.fourbar())) {
-    options.progress(
-        "bench: truss and truss-dae not measured: the general engine does not model the "
-        "four-bar's counter-rotating inertias");
-  }
-}
-
 }  // namespace
 
 BenchOptions BenchOptions::quick() {
@@ -260,7 +251,6 @@ std::vector<Method> bench_methods(const Study& study) {
   std::vector<Method> methods;
   if (study.is_fourbar()) {
     for (core::Formulation f : core::kFormulations) methods.push_back(method_of(f));
-    if (core::has_counter_rotations(study.fourbar())) return methods;
   }
   methods.push_back(Method::kTruss);
   if (is_free(study.scene)) methods.push_back(Method::kTrussDae);
@@ -283,7 +273,6 @@ std::vector<Method> reference_methods(const Study& study, Method method) {
 std::vector<WorkPrecisionRow> work_precision(const Study& study, const BenchOptions& options) {
   check(options);
   if (!is_free(study.scene)) throw InputError("bench: work_precision needs a free scene");
-  note_left_out(study, options);
   const double scale = length_scale(study);
 
   // the reference runs, computed once per method that serves as one
@@ -419,7 +408,6 @@ std::vector<DrivenConvergenceRow> driven_convergence(const Study& study,
                                                      const BenchOptions& options) {
   check(options);
   if (is_free(study.scene)) throw InputError("bench: driven_convergence needs a driven scene");
-  note_left_out(study, options);
   const DrivenRunner run(study);
   // the driven scene has no integrator: the choice's is not used
   const auto method = [](Method m) { return choice(m, core::Integrator::kCvodeAdams); };

@@ -1,5 +1,5 @@
 // A general planar linkage's sections of a study file (linkage type: planar):
-//   linkage: {type: planar, nodes, links, point_masses, sliders, springs, inputs}
+//   linkage: {type: planar, nodes, links, point_masses, sliders, springs, balance_shafts, inputs}
 //   loads:   {gravity, links: {<link>: {force, moment}}, nodes: {<node>: {force}}}
 //   scene:   {type: driven, speeds, revolutions | duration, samples, start}
 //            {type: free, rates, duration, samples, start}
@@ -31,8 +31,10 @@ class PlanarSection::Impl {
 
   core::planar::Linkage read(const MapReader::Entry& e, const MapReader::Entry* loads) {
     const MapReader lk(r_, e.value, "linkage", e.key_mark,
-                       "(type, nodes, links, point_masses, sliders, springs, inputs)");
-    lk.check_keys({"type", "nodes", "links", "point_masses", "sliders", "springs", "inputs"});
+                       "(type, nodes, links, point_masses, sliders, springs, balance_shafts, "
+                       "inputs)");
+    lk.check_keys({"type", "nodes", "links", "point_masses", "sliders", "springs", "balance_shafts",
+                   "inputs"});
     linkage_mark_ = e.key_mark;
     core::planar::Linkage l;
     read_nodes(lk.require("nodes", "the joint points, each [x, y] in m or {at, ground}"), l);
@@ -40,6 +42,7 @@ class PlanarSection::Impl {
     if (const MapReader::Entry* x = lk.find("point_masses")) read_point_masses(*x, l);
     if (const MapReader::Entry* x = lk.find("sliders")) read_sliders(*x, l);
     if (const MapReader::Entry* x = lk.find("springs")) read_springs(*x, l);
+    if (const MapReader::Entry* x = lk.find("balance_shafts")) read_shafts(*x, l);
     const MapReader::Entry& inputs =
         lk.require("inputs", "the degrees of freedom: link angles or slider positions");
     read_inputs(inputs, l);
@@ -314,6 +317,44 @@ class PlanarSection::Impl {
         s.damping = non_negative(*k, path + ".damping", "N s/m");
       places_["springs[" + std::to_string(l.springs.size()) + "]"] = {path, x.key_mark};
       l.springs.push_back(s);
+    }
+  }
+
+  // balance_shafts: {S1: {link, ratio, at: [x, y], mass, eccentricity: [x, y], inertia}}
+  void read_shafts(const MapReader::Entry& e, core::planar::Linkage& l) {
+    if (e.value.IsNull()) return;
+    const MapReader m(r_, e.value, "linkage.balance_shafts", e.key_mark,
+                      "of name: {link, ratio, at, mass, eccentricity, inertia}");
+    for (const MapReader::Entry& x : m.entries()) {
+      const std::string path = "linkage.balance_shafts." + x.key;
+      const MapReader sm(r_, x.value, path, x.key_mark,
+                         "(link, ratio, at, mass, eccentricity, inertia)");
+      sm.check_keys({"link", "ratio", "at", "mass", "eccentricity", "inertia"});
+      core::planar::BalanceShaft b;
+      b.name = x.key;
+      const MapReader::Entry& k = sm.require("link", "the link it is geared to");
+      b.link = link_named(k.value, k.key_mark, path + ".link", l);
+      const MapReader::Entry& ratio = sm.require(
+          "ratio", "its rate over the link's: -1 counter-rotates, 2 turns twice as fast");
+      const double q = read_number(r_, ratio, path + ".ratio", "");
+      if (q != std::round(q) || q == 0 || std::abs(q) > 1000) {
+        r_.fail(mark_of(ratio.value, ratio.key_mark),
+                path + ".ratio must be a whole number other than 0 (the shaft turns a whole " +
+                    "number of times per turn of its link), got " + text::shortest(q));
+      }
+      b.ratio = static_cast<int>(q);
+      YAML::Mark marks[2];
+      b.at = read_vec2(r_, sm.require("at", "the shaft's position [x, y] in m"), path + ".at", "m",
+                       marks);
+      if (const MapReader::Entry* v = sm.find("mass"))
+        b.mass = non_negative(*v, path + ".mass", "kg");
+      if (const MapReader::Entry* v = sm.find("eccentricity")) {
+        b.eccentricity = read_vec2(r_, *v, path + ".eccentricity", "m", marks);
+      }
+      if (const MapReader::Entry* v = sm.find("inertia"))
+        b.inertia = non_negative(*v, path + ".inertia", "kg m^2");
+      places_["shafts[" + std::to_string(l.shafts.size()) + "]"] = {path, x.key_mark};
+      l.shafts.push_back(b);
     }
   }
 

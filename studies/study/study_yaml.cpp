@@ -88,6 +88,15 @@ std::string planar_linkage_yaml(const core::planar::Linkage& l) {
            ", damping: " + text::exact(sp.damping) + "}\n";
     }
   }
+  if (!l.shafts.empty()) {
+    y += "  balance_shafts:\n";
+    for (const core::planar::BalanceShaft& b : l.shafts) {
+      y += "    " + b.name + ": {link: " + l.links[static_cast<std::size_t>(b.link)].name +
+           ", ratio: " + std::to_string(b.ratio) + ", at: " + vec(b.at) +
+           ", mass: " + text::exact(b.mass) + ", eccentricity: " + vec(b.eccentricity) +
+           ", inertia: " + text::exact(b.inertia) + "}\n";
+    }
+  }
   y += "  inputs:\n";
   for (const core::planar::Input& in : l.inputs) {
     if (in.kind == core::planar::Input::Kind::kAngle) {

@@ -87,6 +87,46 @@ TEST(FourBarOnTruss, ForwardDynamicsEqualsTheClosedFormOnRandomLinkages) {
   EXPECT_GT(compared, 190);
 }
 
+// Counter-rotating discs (Berkof's moment balance) on random four-bars under gravity: the
+// general engine's balance shafts with ratio -1 against the four-bar's own discs (a mesh force
+// at the midpoint, core/fourbar/counter_rotation.cpp), reaction by reaction, shafts included,
+// in inverse and forward dynamics. The two share no code: the four-bar adds each disc's inertia
+// to its link and loads the bare linkage with the mesh force; the general engine carries the
+// disc on the link's element and adds the tooth force at the pair's pitch point.
+TEST(FourBarOnTruss, CounterRotationsEqualTheFourBarsDiscsReactionByReaction) {
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> angle(-M_PI, M_PI), rate(-20, 20), acc(-200, 200),
+      inertia(0.001, 0.05), place(-0.3, 0.3);
+  int compared = 0;
+  for (int i = 0; i < 100; ++i) {
+    FourBar fb = samples::random_crank_rocker(rng);
+    fb.loads.gravity = Vec2(0.3, -9.81);
+    fb.counter_rotations.crank = {inertia(rng), Vec2(place(rng), place(rng) + 0.5)};
+    if (i % 3)
+      fb.counter_rotations.rocker = {inertia(rng), Vec2(fb.frame_length + place(rng), -0.4)};
+    const double theta1 = angle(rng), omega1 = rate(rng), alpha1 = acc(rng);
+    const auto d =
+        i % 2 ? inverse_dynamics(fb, theta1, omega1, alpha1) : forward_dynamics(fb, theta1, omega1);
+    if (!d) continue;
+    const Model model(linkage_of(fb, theta1));
+    ASSERT_EQ(model.linkage().shafts.size(), i % 3 ? 2u : 1u);
+    Workspace ws(model);
+    ASSERT_TRUE(solve_position(model, ws, ws.instant.x, {theta1}));
+    const auto r = i % 2 ? inverse_dynamics(model, ws, 0.0, {omega1}, {alpha1})
+                         : forward_dynamics(model, ws, 0.0, {omega1}, {0.0});
+    ASSERT_TRUE(r) << r.error().detail;
+    const std::string what = "linkage " + std::to_string(i);
+    expect_same(*d, ws.instant, fb, what);
+    const double force = bd::testing::force_scale(*d);
+    EXPECT_LT((ws.instant.shaft_reaction[0] - d->RC1).norm(), kTol * force) << what;
+    if (i % 3) {
+      EXPECT_LT((ws.instant.shaft_reaction[1] - d->RC3).norm(), kTol * force) << what;
+    }
+    ++compared;
+  }
+  EXPECT_GT(compared, 90);
+}
+
 TEST(FourBarOnTruss, AssemblyFollowsTheDrawnBranchToAnyCrankAngle) {
   const FourBar fb = samples::paper_fourbar();
   for (Branch b : {Branch::kPlus, Branch::kMinus}) {
@@ -117,7 +157,8 @@ double column_gap(const Trajectory& p, const char* column, const core::Trajector
                   double (*get)(const DynamicsSample&)) {
   const std::vector<double> col = p.table.column_values(column);
   double scale = 0, gap = 0;
-  for (std::size_t i = 0; i < f.samples.size(); ++i) scale = std::max(scale, std::abs(get(f.samples[i])));
+  for (std::size_t i = 0; i < f.samples.size(); ++i)
+    scale = std::max(scale, std::abs(get(f.samples[i])));
   for (std::size_t i = 0; i < f.samples.size() && i < col.size(); ++i) {
     gap = std::max(gap, std::abs(col[i] - get(f.samples[i])));
   }
@@ -144,9 +185,15 @@ TEST(FourBarOnTruss, FreeMotionAgreesWithTheClosedFormToTheToleranceAskedFor) {
     ASSERT_TRUE(p.ok()) << to_string(route) << ": " << p.message;
     ASSERT_EQ(p.table.rows(), f.samples.size());
     SCOPED_TRACE(to_string(route));
-    EXPECT_LT(column_gap(p, "theta_crank", f, [](const DynamicsSample& d) { return d.state.theta1; }), 1e-10);
-    EXPECT_LT(column_gap(p, "omega_crank", f, [](const DynamicsSample& d) { return d.state.omega1; }), 1e-10);
-    EXPECT_LT(column_gap(p, "alpha_rocker", f, [](const DynamicsSample& d) { return d.state.alpha3; }), 1e-10);
+    EXPECT_LT(
+        column_gap(p, "theta_crank", f, [](const DynamicsSample& d) { return d.state.theta1; }),
+        1e-10);
+    EXPECT_LT(
+        column_gap(p, "omega_crank", f, [](const DynamicsSample& d) { return d.state.omega1; }),
+        1e-10);
+    EXPECT_LT(
+        column_gap(p, "alpha_rocker", f, [](const DynamicsSample& d) { return d.state.alpha3; }),
+        1e-10);
     EXPECT_LT(column_gap(p, "RA0x", f, [](const DynamicsSample& d) { return d.RA0.x(); }), 1e-10);
     EXPECT_LT(column_gap(p, "RA3y", f, [](const DynamicsSample& d) { return d.RA3.y(); }), 1e-10);
     EXPECT_LT(column_gap(p, "Msh", f, [](const DynamicsSample& d) { return d.Msh; }), 1e-10);
