@@ -144,8 +144,8 @@ InputSeries input_series(const cp::Model& model, const core::Series& table) {
 
 Eigen::MatrixXd momentum_regressor(const cp::Linkage& l, const Kinematics& k) {
   const std::size_t dof = l.inputs.size();
-  MatrixXd Z = MatrixXd::Zero(static_cast<Eigen::Index>(2 * dof * k.samples.size()),
-                              Parameters::count(l));
+  MatrixXd Z =
+      MatrixXd::Zero(static_cast<Eigen::Index>(2 * dof * k.samples.size()), Parameters::count(l));
   Eigen::Index row = 0;
   for (const Kinematics::Sample& s : k.samples) {
     for (std::size_t d = 0; d < dof; ++d, row += 2) {
@@ -169,8 +169,8 @@ Eigen::MatrixXd momentum_regressor(const cp::Linkage& l, const Kinematics& k) {
 }
 
 Eigen::MatrixXd shaking_force_regressor(const cp::Linkage& l, const Kinematics& k) {
-  MatrixXd Y = MatrixXd::Zero(static_cast<Eigen::Index>(2 * k.samples.size()),
-                              Parameters::count(l));
+  MatrixXd Y =
+      MatrixXd::Zero(static_cast<Eigen::Index>(2 * k.samples.size()), Parameters::count(l));
   Eigen::Index row = 0;
   for (const Kinematics::Sample& s : k.samples) {
     for (std::size_t j = 0; j < l.links.size(); ++j) {
@@ -220,6 +220,38 @@ Eigen::MatrixXd shaking_moment_regressor(const cp::Linkage& l, const Kinematics&
   return Y;
 }
 
+ShaftSeries shaft_series(const cp::Linkage& l, const Kinematics& k) {
+  const std::size_t dof = l.inputs.size(), n = k.samples.size();
+  ShaftSeries out{VectorXd::Zero(static_cast<Eigen::Index>(2 * dof * n)),
+                  VectorXd::Zero(static_cast<Eigen::Index>(2 * n)),
+                  VectorXd::Zero(static_cast<Eigen::Index>(n))};
+  for (const cp::BalanceShaft& b : l.shafts) {
+    const LinkFrame f = frame_of(l, b.link);
+    const std::size_t L = static_cast<std::size_t>(b.link);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Kinematics::Sample& s = k.samples[i];
+      const double turned = b.ratio * (s.angle[L] - f.angle);
+      const double c = std::cos(turned), sn = std::sin(turned);
+      const Vec2 r(c * b.eccentricity.x() - sn * b.eccentricity.y(),
+                   sn * b.eccentricity.x() + c * b.eccentricity.y());
+      const double w = b.ratio * s.omega[L], al = b.ratio * s.alpha[L];
+      const Vec2 a = al * perp(r) - w * w * r;
+      const Vec2 d = s.x[static_cast<std::size_t>(f.q)] - s.x[static_cast<std::size_t>(f.p)];
+      for (std::size_t j = 0; j < dof; ++j) {
+        const std::vector<Vec2>& v = s.unit_rate_velocity[j];
+        const double rate =
+            cross(d, v[static_cast<std::size_t>(f.q)] - v[static_cast<std::size_t>(f.p)]) /
+            d.squaredNorm();
+        out.momentum.segment<2>(static_cast<Eigen::Index>(2 * (i * dof + j))) +=
+            b.mass * b.ratio * rate * perp(r);
+      }
+      out.force.segment<2>(static_cast<Eigen::Index>(2 * i)) -= b.mass * a;
+      out.moment[static_cast<Eigen::Index>(i)] -= b.inertia * al + cross(b.at + r, b.mass * a);
+    }
+  }
+  return out;
+}
+
 cp::Link merged(const cp::Link& link, const Counterweight& cw, const Vec2& from_first) {
   const double m = link.mass, mc = cw.mass, M = m + mc;
   const Vec2 s(link.e, link.f);
@@ -228,8 +260,8 @@ cp::Link merged(const cp::Link& link, const Counterweight& cw, const Vec2& from_
   out.mass = M;
   out.e = c.x();
   out.f = c.y();
-  out.inertia = link.inertia + m * (s - c).squaredNorm() + cw.inertia +
-                mc * (from_first - c).squaredNorm();
+  out.inertia =
+      link.inertia + m * (s - c).squaredNorm() + cw.inertia + mc * (from_first - c).squaredNorm();
   return out;
 }
 
@@ -268,15 +300,16 @@ std::vector<Placement> placements(const cp::Linkage& l,
       throw InputError(FieldError{field, -1, ": the link is fixed to the frame at two nodes"});
     pl.grounded = grounds.size() == 1;
     pl.pivot = pl.grounded ? grounds[0] : link.nodes[0];
-    pl.pivot_in_link = in_link_axes(l, ask.link, l.nodes[static_cast<std::size_t>(pl.pivot)].position);
+    pl.pivot_in_link =
+        in_link_axes(l, ask.link, l.nodes[static_cast<std::size_t>(pl.pivot)].position);
     const double length = frame_of(l, ask.link).length;
     const CounterweightSpec& spec = ask.spec;
     if (!pl.grounded) {
       if (spec.mass) {
         pl.fixed_mass = *spec.mass;
       } else if (spec.radius) {
-        pl.fixed_mass = spec.density * std::numbers::pi * spec.thickness * *spec.radius *
-                        *spec.radius;
+        pl.fixed_mass =
+            spec.density * std::numbers::pi * spec.thickness * *spec.radius * *spec.radius;
       } else {
         throw InputError(FieldError{field, -1,
                                     ": the link does not turn about the frame, so its "
@@ -300,18 +333,20 @@ void add_counterweight(VectorXd& theta, const Placement& pl, double mass, const 
 }
 
 // min-norm least squares of A x = b with x's pairs weighted by the placements' scales
-VectorXd solve_moments(const MatrixXd& R, const VectorXd& theta0,
+VectorXd solve_moments(const MatrixXd& R, const VectorXd& theta0, const VectorXd& fixed,
                        const std::vector<Placement>& pls) {
+  if (pls.empty()) return VectorXd();
   MatrixXd A(R.rows(), static_cast<Eigen::Index>(2 * pls.size()));
   for (std::size_t i = 0; i < pls.size(); ++i) {
     const int k = pls[i].ask.link;
     A.col(static_cast<Eigen::Index>(2 * i)) = pls[i].scale * R.col(Parameters::link_me(k));
     A.col(static_cast<Eigen::Index>(2 * i + 1)) = pls[i].scale * R.col(Parameters::link_mf(k));
   }
-  const VectorXd b = -(R * theta0);
+  const VectorXd b = -(R * theta0 + fixed);
   Eigen::CompleteOrthogonalDecomposition<MatrixXd> cod(A);
   VectorXd x = cod.solve(b);
-  for (std::size_t i = 0; i < pls.size(); ++i) x.segment<2>(static_cast<Eigen::Index>(2 * i)) *= pls[i].scale;
+  for (std::size_t i = 0; i < pls.size(); ++i)
+    x.segment<2>(static_cast<Eigen::Index>(2 * i)) *= pls[i].scale;
   return x;
 }
 
@@ -344,43 +379,129 @@ void check_counterweights(const cp::Linkage& linkage,
   (void)placements(linkage, counterweights);
 }
 
+namespace {
+
+// the crank counterweight's first moment about its pivot, in the crank's link axes, by an
+// engine's balancing factor β: μ_A + p/|OA| = -β μ_B (force_balance's comment)
+Vec2 by_balancing_factor(const cp::Linkage& l, const std::vector<Placement>& pls, double beta,
+                         std::string& what) {
+  auto refuse = [](const std::string& why) {
+    throw InputError(FieldError{"balancing_factor", -1, ": " + why});
+  };
+  if (!std::isfinite(beta) || beta < 0) refuse("must be a number >= 0");
+  if (pls.size() != 1 || !pls[0].grounded ||
+      l.links[static_cast<std::size_t>(pls[0].ask.link)].nodes.size() != 2) {
+    refuse(
+        "applies to one counterweight, on a crank: a binary link that turns about a ground node");
+  }
+  const int crank = pls[0].ask.link, O = pls[0].pivot;
+  const auto& cn = l.links[static_cast<std::size_t>(crank)].nodes;
+  const int A = cn[0] == O ? cn[1] : cn[0];
+  int B = -1;  // the piston: across a binary rod from A, on a frame guide
+  for (std::size_t r = 0; r < l.links.size(); ++r) {
+    const auto& nodes = l.links[r].nodes;
+    if (static_cast<int>(r) == crank || nodes.size() != 2) continue;
+    if (nodes[0] != A && nodes[1] != A) continue;
+    const int other = nodes[0] == A ? nodes[1] : nodes[0];
+    for (const cp::Slider& sl : l.sliders) {
+      if (sl.link < 0 && sl.node == other) {
+        if (B >= 0) refuse("the crank drives more than one piston; balance it with counterweights");
+        B = other;
+      }
+    }
+  }
+  const std::string crank_name = l.links[static_cast<std::size_t>(crank)].name;
+  if (B < 0) refuse("crank " + crank_name + " drives no piston through a connecting rod");
+  const std::vector<ComplexMass> mu = equivalent_masses(l);
+  const Vec2 OA =
+      l.nodes[static_cast<std::size_t>(A)].position - l.nodes[static_cast<std::size_t>(O)].position;
+  const ComplexMass p =
+      -OA.norm() * (mu[static_cast<std::size_t>(A)] + beta * mu[static_cast<std::size_t>(B)]);
+  // from the axes O->A to the link's axes (first to second node)
+  const double turn = std::atan2(OA.y(), OA.x()) - frame_of(l, crank).angle;
+  const ComplexMass w = p * std::polar(1.0, turn);
+  what = "balancing factor " + text::digits(beta, 4) + ": the counterweight on " + crank_name +
+         " balances the rotating mass at " + l.nodes[static_cast<std::size_t>(A)].name + " and " +
+         text::digits(100 * beta, 4) + " % of the reciprocating mass at " +
+         l.nodes[static_cast<std::size_t>(B)].name;
+  return {w.real(), w.imag()};
+}
+
+// one line naming the node whose momentum is the largest part of what is left
+std::string unbalanced_message(const cp::Linkage& l, const ForceBalance& out, const Kinematics& k,
+                               const std::vector<Placement>& pls) {
+  const std::vector<ComplexMass> mu = equivalent_masses(out.linkage);
+  std::vector<double> share(l.nodes.size(), 0.0);
+  for (const Kinematics::Sample& s : k.samples)
+    for (const std::vector<Vec2>& v : s.unit_rate_velocity)
+      for (std::size_t n = 0; n < l.nodes.size(); ++n)
+        share[n] += std::norm(mu[n]) * v[n].squaredNorm();
+  const std::size_t worst =
+      static_cast<std::size_t>(std::max_element(share.begin(), share.end()) - share.begin());
+  std::string links;
+  for (const Placement& pl : pls)
+    links += (links.empty() ? "" : ", ") + l.links[static_cast<std::size_t>(pl.ask.link)].name;
+  return "full force balance cannot be reached with counterweights on " +
+         (links.empty() ? std::string("no link") : links) + ": the largest part of the " +
+         "linear momentum left is node " + l.nodes[worst].name + "'s (equivalent mass " +
+         text::digits(std::abs(mu[worst]), 4) + " kg); the least-squares design leaves " +
+         "the RMS inertial shaking force at " +
+         text::digits(out.Fsh_rms_before > 0 ? 100 * out.Fsh_rms_after / out.Fsh_rms_before : 0.0,
+                      3) +
+         " % of the original";
+}
+
+}  // namespace
+
+void check_balancing_factor(const cp::Linkage& linkage,
+                            const std::vector<LinkCounterweightSpec>& counterweights, double beta) {
+  std::string rule;
+  (void)by_balancing_factor(linkage, placements(linkage, counterweights), beta, rule);
+}
+
 ForceBalance force_balance(const cp::Linkage& linkage, const Kinematics& k,
-                           const std::vector<LinkCounterweightSpec>& counterweights) {
+                           const std::vector<LinkCounterweightSpec>& counterweights,
+                           std::optional<double> balancing_factor) {
   const cp::Linkage& l = linkage;
   const std::vector<Placement> pls = placements(l, counterweights);
-  double length = 0, total_mass = 0;
-  for (std::size_t j = 0; j < l.links.size(); ++j) {
+  double length = 0;
+  for (std::size_t j = 0; j < l.links.size(); ++j)
     length = std::max(length, frame_of(l, static_cast<int>(j)).length);
-    total_mass += l.links[j].mass;
-  }
-  for (const cp::PointMass& pm : l.point_masses) total_mass += pm.mass;
+  const double total_mass = cp::total_mass(l);
 
   const VectorXd theta0 = Parameters::of(l);
   VectorXd theta_fixed = theta0;  // with the floating counterweights' given masses at their pivots
   for (const Placement& pl : pls)
     if (!pl.grounded) add_counterweight(theta_fixed, pl, pl.fixed_mass, Vec2(0, 0));
   const MatrixXd Z = momentum_regressor(l, k), Y = shaking_force_regressor(l, k);
+  const ShaftSeries shafts = shaft_series(l, k);
 
   ForceBalance out;
+  out.balancing_factor = balancing_factor;
   out.conditions = condition_rank(Z, l, length);
-  const double before = (Z * theta0).norm();
-  VectorXd x = solve_moments(Z, theta_fixed, pls);
-  VectorXd theta = theta_fixed;
-  for (std::size_t i = 0; i < pls.size(); ++i)
-    add_counterweight(theta, pls[i], 0.0, x.segment<2>(static_cast<Eigen::Index>(2 * i)));
-  // what cancels to round-off: the momentum left against the sum of its terms' sizes
-  const double terms = (Z.cwiseAbs() * theta.cwiseAbs()).norm();
-  out.full = (Z * theta).norm() <= 1e-10 * std::max(terms, 1e-300);
-  if (!out.full) {
-    // the least RMS inertial shaking force over the motion instead
-    x = solve_moments(Y, theta_fixed, pls);
-    theta = theta_fixed;
+  const double before = (Z * theta0 + shafts.momentum).norm();
+  std::string rule;
+  VectorXd x = balancing_factor ? VectorXd(by_balancing_factor(l, pls, *balancing_factor, rule))
+                                : solve_moments(Z, theta_fixed, shafts.momentum, pls);
+  auto design = [&](const VectorXd& moments) {
+    VectorXd theta = theta_fixed;
     for (std::size_t i = 0; i < pls.size(); ++i)
-      add_counterweight(theta, pls[i], 0.0, x.segment<2>(static_cast<Eigen::Index>(2 * i)));
+      add_counterweight(theta, pls[i], 0.0, moments.segment<2>(static_cast<Eigen::Index>(2 * i)));
+    return theta;
+  };
+  VectorXd theta = design(x);
+  // what cancels to round-off: the momentum left against the sum of its terms' sizes
+  const double terms = (Z.cwiseAbs() * theta.cwiseAbs()).norm() + shafts.momentum.norm();
+  out.full =
+      !balancing_factor && (Z * theta + shafts.momentum).norm() <= 1e-10 * std::max(terms, 1e-300);
+  if (!out.full && !balancing_factor) {
+    // the least RMS inertial shaking force over the motion instead
+    x = solve_moments(Y, theta_fixed, shafts.force, pls);
+    theta = design(x);
   }
-  out.momentum_left = before > 0 ? (Z * theta).norm() / before : 0.0;
-  out.Fsh_rms_before = rms_of_pairs(Y * theta0);
-  out.Fsh_rms_after = rms_of_pairs(Y * theta);
+  out.momentum_left = before > 0 ? (Z * theta + shafts.momentum).norm() / before : 0.0;
+  out.Fsh_rms_before = rms_of_pairs(Y * theta0 + shafts.force);
+  out.Fsh_rms_after = rms_of_pairs(Y * theta + shafts.force);
 
   // realise each counterweight and merge it into its link
   out.linkage = l;
@@ -396,26 +517,14 @@ ForceBalance force_balance(const cp::Linkage& linkage, const Kinematics& k,
     out.added_inertia += cw.inertia + cw.mass * cw.distance * cw.distance;
     out.added.push_back(added);
   }
-  if (!out.full) {
-    // name the node whose momentum is the largest part of what is left
-    const std::vector<ComplexMass> mu = equivalent_masses(out.linkage);
-    std::vector<double> share(l.nodes.size(), 0.0);
-    for (const Kinematics::Sample& s : k.samples)
-      for (const std::vector<Vec2>& v : s.unit_rate_velocity)
-        for (std::size_t n = 0; n < l.nodes.size(); ++n)
-          share[n] += std::norm(mu[n]) * v[n].squaredNorm();
-    const std::size_t worst =
-        static_cast<std::size_t>(std::max_element(share.begin(), share.end()) - share.begin());
-    std::string links;
-    for (const Placement& pl : pls)
-      links += (links.empty() ? "" : ", ") + l.links[static_cast<std::size_t>(pl.ask.link)].name;
-    out.message = "full force balance cannot be reached with counterweights on " +
-                  (links.empty() ? std::string("no link") : links) + ": the largest part of the " +
-                  "linear momentum left is node " + l.nodes[worst].name + "'s (equivalent mass " +
-                  text::digits(std::abs(mu[worst]), 4) + " kg); the least-squares design leaves " +
-                  "the RMS inertial shaking force at " +
-                  text::digits(out.Fsh_rms_before > 0 ? 100 * out.Fsh_rms_after / out.Fsh_rms_before : 0.0, 3) +
-                  " % of the original";
+  if (balancing_factor) {
+    out.message =
+        rule + "; the RMS inertial shaking force is " +
+        text::digits(out.Fsh_rms_before > 0 ? 100 * out.Fsh_rms_after / out.Fsh_rms_before : 0.0,
+                     3) +
+        " % of the original";
+  } else if (!out.full) {
+    out.message = unbalanced_message(l, out, k, pls);
   }
   return out;
 }

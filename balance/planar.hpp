@@ -12,11 +12,10 @@
 /// linkage's kinematics at the configurations given (a driven revolution covers all of a crank's).
 ///
 /// For a four-bar they are eq. 57 (tests/balance/planar_balance_test.cpp checks it).
+#include <Eigen/Dense>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Dense>
 
 #include "balance/counterweight.hpp"
 #include "core/expected.hpp"
@@ -54,8 +53,8 @@ std::vector<ComplexMass> equivalent_masses(const cp::Linkage& linkage);
 /// others held). Independent of the mass parameters (the motion is given).
 struct Kinematics {
   struct Sample {
-    std::vector<Vec2> x, a;                 // per node
-    std::vector<double> angle, omega, alpha;  // per link
+    std::vector<Vec2> x, a;                             // per node
+    std::vector<double> angle, omega, alpha;            // per link
     std::vector<std::vector<Vec2>> unit_rate_velocity;  // per input, per node [m/rad or m/m]
   };
   std::vector<Sample> samples;
@@ -66,10 +65,10 @@ struct Kinematics {
 /// the samples must follow a motion closely enough to stay on its assembly branch (a simulated
 /// run's samples do).
 /// @return the kinematics, or the first sample that cannot be evaluated (its error).
-Expected<Kinematics, cp::PlanarError> kinematics(const cp::Model& model,
-                                                 const std::vector<std::vector<double>>& values,
-                                                 const std::vector<std::vector<double>>& rates,
-                                                 const std::vector<std::vector<double>>& accelerations);
+Expected<Kinematics, cp::PlanarError> kinematics(
+    const cp::Model& model, const std::vector<std::vector<double>>& values,
+    const std::vector<std::vector<double>>& rates,
+    const std::vector<std::vector<double>>& accelerations);
 
 /// The inputs' values, rates and accelerations at every row of a simulated run's table
 /// (core/planar/simulate.hpp, columns()).
@@ -86,6 +85,15 @@ Eigen::MatrixXd shaking_force_regressor(const cp::Linkage& linkage, const Kinema
 /// The inertial shaking moment -dH/dt about the origin: one row per sample [N m].
 Eigen::MatrixXd shaking_moment_regressor(const cp::Linkage& linkage, const Kinematics& k);
 
+/// The balance shafts' part of the linkage's momentum and inertial shaking force and moment
+/// (core/planar/model.hpp BalanceShaft; they are not mass parameters): vectors with the rows of
+/// momentum_regressor, shaking_force_regressor and shaking_moment_regressor, to be added to
+/// those regressors' products.
+struct ShaftSeries {
+  Eigen::VectorXd momentum, force, moment;
+};
+ShaftSeries shaft_series(const cp::Linkage& linkage, const Kinematics& k);
+
 /// A counterweight asked for on a link, realised as balance::CounterweightSpec says. Its position
 /// is measured in link axes (along and to the left of the link's first-to-second node line) from
 /// the link's pivot: its ground node, or its first node for a link that does not turn about the
@@ -95,11 +103,24 @@ struct LinkCounterweightSpec {
   CounterweightSpec spec;
 };
 
-/// The study file's `balance:` section for a planar linkage: full force balance (the only
-/// balance a planar linkage takes so far) by counterweights on the links named (default: every
-/// link that turns about a ground node).
+/// Balance shafts asked for (balance/planar_shafts.hpp): a Lanchester balancer.
+struct ShaftRequest {
+  std::vector<int> orders;  // the orders of the shaking force to cancel, each >= 1
+  std::optional<Vec2> at;   // where the shafts sit [m]; default: the crank's pivot
+  std::optional<double>
+      radius;  // their centres of mass from the shaft [m]; default: the crank's length
+};
+
+/// The study file's `balance:` section for a planar linkage: force balance by counterweights on
+/// the links named (default: every link that turns about a ground node), or an engine's crank
+/// counterweight by its balancing factor; then, if asked, balance shafts that cancel orders of
+/// the shaking force.
 struct BalanceRequest {
   std::vector<LinkCounterweightSpec> counterweights;
+  /// An engine's crank counterweight: the fraction of the reciprocating mass it balances on top
+  /// of the rotating mass (force_balance()).
+  std::optional<double> balancing_factor;
+  std::optional<ShaftRequest> shafts;
 };
 
 /// The links that turn about a ground node (one of their nodes is fixed to the frame), each with
@@ -111,19 +132,25 @@ std::vector<LinkCounterweightSpec> grounded_links(const cp::Linkage& linkage);
 void check_counterweights(const cp::Linkage& linkage,
                           const std::vector<LinkCounterweightSpec>& counterweights);
 
+/// Checks a balancing factor's rule against the linkage (force_balance()'s conditions).
+/// @throws bd::InputError as force_balance().
+void check_balancing_factor(const cp::Linkage& linkage,
+                            const std::vector<LinkCounterweightSpec>& counterweights, double beta);
+
 /// A realised counterweight on a link.
 struct LinkCounterweight {
   int link{};
-  int pivot{};             // the node its position is measured from
+  int pivot{};  // the node its position is measured from
   Counterweight counterweight;
 };
 
 /// The result of force balancing.
 struct ForceBalance {
-  cp::Linkage linkage;                    // the links with their counterweights merged in
-  std::vector<LinkCounterweight> added;   // links already balanced get none
-  bool full{};                            // full force balance reached (L ≡ 0 to round-off)
-  int conditions{};                       // independent conditions of full force balance
+  std::optional<double> balancing_factor;  // the engine rule used, if it was
+  cp::Linkage linkage;                     // the links with their counterweights merged in
+  std::vector<LinkCounterweight> added;    // links already balanced get none
+  bool full{};                             // full force balance reached (L ≡ 0 to round-off)
+  int conditions{};                        // independent conditions of full force balance
   /// Empty when full; else one line naming what cannot be balanced with the counterweights
   /// allowed, and what the least-squares design leaves.
   std::string message;
@@ -140,10 +167,20 @@ struct ForceBalance {
 /// with `full` false and the message saying why. Among several designs that balance, the one
 /// whose counterweight masses have the least sum of squares (a unique design when the
 /// counterweights are as many as the conditions need).
+///
+/// With a balancing factor β (an engine's rule): one counterweight, on a crank O-A that drives a
+/// piston B (a node on a frame guide) through a connecting rod A-B; it makes the crank pin's
+/// complex equivalent mass -β times the piston's, μ_A + p/|OA| = -β μ_B (p its first moment
+/// about O in the crank's axes O->A): the rotating mass balanced and the fraction β of the
+/// reciprocating mass, whose primary force it turns into a rotating one. `full` is false and the
+/// message says what the rule leaves.
 /// @throws bd::InputError for an invalid spec (field "counterweights.<link>"), two on one link,
-///         a link through two ground nodes, or a floating link's counterweight without a mass.
+///         a link through two ground nodes, or a floating link's counterweight without a mass;
+///         with a balancing factor, anything but one counterweight on such a crank (field
+///         "balancing_factor").
 ForceBalance force_balance(const cp::Linkage& linkage, const Kinematics& k,
-                           const std::vector<LinkCounterweightSpec>& counterweights);
+                           const std::vector<LinkCounterweightSpec>& counterweights,
+                           std::optional<double> balancing_factor = std::nullopt);
 
 /// A link with a counterweight merged in (parallel axes), its position given in link axes from
 /// the link's first node [m].

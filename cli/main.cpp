@@ -288,9 +288,13 @@ void print_planar_balance(const st::Study& study, const st::RunResult& r) {
   }
   const bd::balance::planar::ForceBalance& b = *run.design;
   const bd::core::planar::Linkage& l = study.planar();
-  std::printf("  balance  force full: the balanced design is %s\n",
-              b.full ? "force balanced" : "not force balanced");
-  if (!b.full) std::printf("           %s\n", b.message.c_str());
+  if (b.balancing_factor) {
+    std::printf("  balance  crank counterweight by the balancing factor %g\n", *b.balancing_factor);
+  } else {
+    std::printf("  balance  force full: the balanced design is %s\n",
+                b.full ? "force balanced" : "not force balanced");
+  }
+  if (!b.message.empty()) std::printf("           %s\n", b.message.c_str());
   for (const bd::balance::planar::LinkCounterweight& c : b.added) {
     const bd::balance::Counterweight& w = c.counterweight;
     std::printf("  %-7s  counterweight %.6g kg at [%.6g, %.6g] m from %s (%.6g m)",
@@ -299,6 +303,17 @@ void print_planar_balance(const st::Study& study, const st::RunResult& r) {
                 w.distance);
     if (w.radius > 0) std::printf(", radius %.6g m", w.radius);
     std::printf("\n");
+  }
+  if (run.shafts) {
+    for (int i : run.shafts->added) {
+      const bd::core::planar::BalanceShaft& s =
+          run.shafts->linkage.shafts[static_cast<std::size_t>(i)];
+      std::printf(
+          "  %-7s  balance shaft at [%.6g, %.6g] m turning %d times the %s: %.6g kg at "
+          "%.6g m\n",
+          s.name.c_str(), s.at.x(), s.at.y(), s.ratio,
+          l.links[static_cast<std::size_t>(s.link)].name.c_str(), s.mass, s.eccentricity.norm());
+    }
   }
   const st::RunStatus status = run.status();
   std::printf("  balanced design: method %s, %zu samples, status %s\n",

@@ -15,6 +15,7 @@
 #include <utility>
 #include <variant>
 
+#include "balance/planar_shafts.hpp"
 #include "core/number_text.hpp"
 #include "optimize/nlp.hpp"
 #include "studies/run/files.hpp"
@@ -119,8 +120,18 @@ std::vector<ComparisonRow> comparison(const Study& study, const RunResult& resul
     inertia = added_inertia(study.fourbar(), result.optimized->result.design);
   }
   std::vector<ComparisonRow> rows;
-  for (std::size_t k = 0; k < a.size() && k < b.size(); ++k) {
-    rows.push_back({a[k].name, a[k].value, b[k].value, std::nullopt});
+  // by name: a balanced design's new parts (a balance shaft's bearing) add metrics, 0 before
+  std::vector<bool> matched(b.size(), false);
+  for (const auto& m : a) {
+    for (std::size_t k = 0; k < b.size(); ++k) {
+      if (matched[k] || b[k].name != m.name) continue;
+      rows.push_back({m.name, m.value, b[k].value, std::nullopt});
+      matched[k] = true;
+      break;
+    }
+  }
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    if (!matched[k]) rows.push_back({b[k].name, 0.0, b[k].value, std::nullopt});
   }
   rows.push_back({"added_mass", 0.0, mass, std::nullopt});
   rows.push_back({"added_inertia", 0.0, inertia, std::nullopt});
@@ -175,10 +186,14 @@ std::string balanced_yaml(const Study& study) {
 std::string balanced_yaml(const Study& study, const balance::planar::ForceBalance& design) {
   const core::planar::Linkage& l = study.planar();
   std::string header = "The balanced design of study '" + study.name + "', synthesised by\n";
-  header += "balance-design from its balance section (force: full)";
+  header += design.balancing_factor
+                ? fmt::format("balance-design from its balance section (balancing factor {:g})",
+                              *design.balancing_factor)
+                : std::string("balance-design from its balance section (force: full)");
   header += study.source.empty() ? std::string(".\n") : " in\n  " + study.source + "\n";
   header += design.full ? "It is fully force balanced over the motion.\n"
-                        : "Full force balance is not reached: " + design.message + "\n";
+                        : (design.balancing_factor ? "" : "Full force balance is not reached: ") +
+                              design.message + "\n";
   for (const balance::planar::LinkCounterweight& c : design.added) {
     const balance::Counterweight& w = c.counterweight;
     header += fmt::format(
@@ -186,6 +201,16 @@ std::string balanced_yaml(const Study& study, const balance::planar::ForceBalanc
         "link's axes (merged into the link below).\n",
         l.links[static_cast<std::size_t>(c.link)].name, w.mass, w.position.x(), w.position.y(),
         l.nodes[static_cast<std::size_t>(c.pivot)].name);
+  }
+  for (const core::planar::BalanceShaft& s : design.linkage.shafts) {
+    bool had = false;
+    for (const core::planar::BalanceShaft& o : l.shafts) had = had || o.name == s.name;
+    if (had) continue;
+    header += fmt::format(
+        "Balance shaft {} at ({:.6g}, {:.6g}) m turns {} times link {}: {:.6g} kg at {:.6g} m "
+        "(balance_shafts below).\n",
+        s.name, s.at.x(), s.at.y(), s.ratio, l.links[static_cast<std::size_t>(s.link)].name, s.mass,
+        s.eccentricity.norm());
   }
   header += "Run it with\n  balance-design balanced.yaml";
   return study_yaml(planar_balanced_study(study, design.linkage), header);
@@ -274,7 +299,12 @@ BalancedRun planar_balanced_run(const Study& study, const RunResult& original) {
                        k.error().detail + ")";
     return b;
   }
-  b.design = bp::force_balance(study.planar(), *k, study.planar_balance->counterweights);
+  const bp::BalanceRequest& ask = *study.planar_balance;
+  b.design = bp::force_balance(study.planar(), *k, ask.counterweights, ask.balancing_factor);
+  if (ask.shafts) {
+    b.shafts = bp::balance_shafts(b.design->linkage, *ask.shafts);
+    bp::add_shafts(*b.design, *b.shafts, *k, study.planar());
+  }
   const Study balanced = planar_balanced_study(study, b.design->linkage);
   Simulation sim = simulate(balanced);
   b.method = sim.method;

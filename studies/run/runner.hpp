@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "balance/planar_shafts.hpp"
 #include "core/fourbar/metrics.hpp"
 #include "core/fourbar/simulate.hpp"
 #include "optimize/optimize.hpp"
@@ -36,6 +37,9 @@ struct BalancedRun {
   /// A planar study: the design, synthesised from the original's motion; empty when the original
   /// stopped early (then `planar` is not run and its message says why).
   std::optional<balance::planar::ForceBalance> design;
+  /// A planar study with balance.shafts: the shafts added to the design (design->linkage has
+  /// them; its added mass, RMS force and message include them).
+  std::optional<balance::planar::ShaftBalance> shafts;
   bool is_planar{};
   MetricList metric_list;              // its metrics in its table's order (either type)
   std::optional<Harmonics> harmonics;  // its harmonic orders (a driven scene)
@@ -116,7 +120,8 @@ struct ComparisonRow {
 };
 /// The rows of comparison.csv, in order: the metrics in their table's order (a four-bar's
 /// Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max, RA0_rms, RA0_max, RA3_rms, RA3_max; a
-/// planar linkage's from core::planar::metric_table()), then added_mass, added_inertia.
+/// planar linkage's from core::planar::metric_table()), then the balanced design's metrics the
+/// original lacks (a balance shaft's bearing force, 0 before), then added_mass, added_inertia.
 /// In an optimize study added_mass and added_inertia are those of studies::added_mass() and
 /// added_inertia() (negative when the optimum takes mass away).
 /// Precondition: result.balanced is set (with its design, for a planar linkage), or

@@ -158,9 +158,11 @@ Json balance_json(const balance::BalancedDesign& b) {
 
 // a planar linkage's balance section: the counterweights added, whether full force balance is
 // reached (else why not), and the inertial shaking force before and after
-Json planar_balance_json(const Study& study, const balance::planar::ForceBalance& b) {
+Json planar_balance_json(const Study& study, const BalancedRun& run) {
+  const balance::planar::ForceBalance& b = *run.design;
   const core::planar::Linkage& l = study.planar();
   Json j = {{"force", "full"}, {"moment", "none"}};
+  if (b.balancing_factor) j["balancing_factor"] = *b.balancing_factor;
   Json cws = Json::array();
   for (const balance::planar::LinkCounterweight& c : b.added) {
     balance::CounterweightShape shape = balance::CounterweightShape::kPoint;
@@ -181,6 +183,28 @@ Json planar_balance_json(const Study& study, const balance::planar::ForceBalance
   j["momentum_left"] = b.momentum_left;
   j["Fsh_inertial_rms_before"] = b.Fsh_rms_before;
   j["Fsh_inertial_rms_after"] = b.Fsh_rms_after;
+  if (run.shafts) {
+    Json shafts = Json::array();
+    for (int i : run.shafts->added) {
+      const core::planar::BalanceShaft& s = run.shafts->linkage.shafts[static_cast<std::size_t>(i)];
+      shafts.push_back({{"name", s.name},
+                        {"link", l.links[static_cast<std::size_t>(s.link)].name},
+                        {"ratio", s.ratio},
+                        {"at", {s.at.x(), s.at.y()}},
+                        {"mass", s.mass},
+                        {"eccentricity", {s.eccentricity.x(), s.eccentricity.y()}},
+                        {"inertia", s.inertia}});
+    }
+    Json orders = Json::array();
+    for (const balance::planar::ShaftBalance::Order& o : run.shafts->orders) {
+      orders.push_back({{"order", o.order},
+                        {"forward_before", o.forward_before},
+                        {"backward_before", o.backward_before},
+                        {"forward_after", o.forward_after},
+                        {"backward_after", o.backward_after}});
+    }
+    j["shafts"] = {{"added", shafts}, {"orders", orders}};
+  }
   return j;
 }
 
@@ -290,7 +314,7 @@ std::string summary_json(const Study& study, const RunResult& result) {
   if (study.planar_balance && result.balanced) {
     const BalancedRun& b = *result.balanced;
     if (b.design) {
-      j["balance"] = planar_balance_json(study, *b.design);
+      j["balance"] = planar_balance_json(study, b);
       add_second_run(j, study, "balanced", b.method, b.status(), result.metric_list, b.metric_list);
       if (b.harmonics) j["balanced_harmonics"] = harmonics_json(*b.harmonics);
     } else {

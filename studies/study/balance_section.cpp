@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "balance/planar_shafts.hpp"
 #include "studies/study/sections.hpp"
 #include "studies/study/yaml_reader.hpp"
 
@@ -173,15 +174,53 @@ class BalanceReader {
 
 // balance: {force, counterweights} of a planar linkage: which links carry counterweights, checked
 // against the linkage; the synthesis waits for the run (its conditions come from the motion)
+// shafts: {orders: [1, 2], at: [x, y], radius: r}
+balance::planar::ShaftRequest read_shafts(const Reporter& r_, const MapReader::Entry& e) {
+  balance::planar::ShaftRequest q;
+  const MapReader m(r_, e.value, "balance.shafts", e.key_mark, "(orders, at, radius)");
+  m.check_keys({"orders", "at", "radius"});
+  const MapReader::Entry& o =
+      m.require("orders", "the orders of the shaking force to cancel, e.g. [1, 2]");
+  const YAML::Mark om = mark_of(o.value, o.key_mark);
+  if (!o.value.IsSequence() || o.value.size() == 0) {
+    r_.fail(om, "balance.shafts.orders must be a list of whole numbers >= 1, e.g. [1, 2], got " +
+                    describe(o.value));
+  }
+  for (std::size_t i = 0; i < o.value.size(); ++i) {
+    const std::string path = "balance.shafts.orders[" + std::to_string(i) + "]";
+    const double n = read_number(r_, o.value[i], om, path, "");
+    if (n != std::round(n) || n < 1 || n > 100) {
+      r_.fail(mark_of(o.value[i], om),
+              path + " must be a whole number from 1 to 100, got " + text::shortest(n));
+    }
+    q.orders.push_back(static_cast<int>(n));
+  }
+  if (const MapReader::Entry* a = m.find("at")) {
+    YAML::Mark marks[2];
+    q.at = read_vec2(r_, *a, "balance.shafts.at", "m", marks);
+  }
+  if (const MapReader::Entry* x = m.find("radius")) {
+    q.radius = read_number(r_, *x, "balance.shafts.radius", "m");
+    if (!(*q.radius > 0)) {
+      r_.fail(mark_of(x->value, x->key_mark),
+              "balance.shafts.radius must be > 0 m, got " + text::shortest(*q.radius));
+    }
+  }
+  return q;
+}
+
 balance::planar::BalanceRequest read_planar(const Reporter& r_, const MapReader::Entry& e,
                                             const core::planar::Linkage& linkage) {
   namespace bp = balance::planar;
   BalanceReader reader(r_);
   bp::BalanceRequest request;
   std::optional<MapReader::Entry> cw;  // a copy: the section's reader ends with its block
+  std::optional<YAML::Mark> factor_mark, shafts_mark;
   if (!e.value.IsNull()) {
-    const MapReader b(r_, e.value, "balance", e.key_mark, "(force, counterweights)");
-    b.check_keys({"force", "moment", "counterweights", "counter_rotations"});
+    const MapReader b(r_, e.value, "balance", e.key_mark,
+                      "(force, counterweights, balancing_factor, shafts)");
+    b.check_keys(
+        {"force", "moment", "counterweights", "counter_rotations", "balancing_factor", "shafts"});
     if (const MapReader::Entry* f = b.find("force")) {
       if (!reader.read_full_or_none(*f, "balance.force")) {
         r_.fail(mark_of(f->value, f->key_mark),
@@ -197,6 +236,20 @@ balance::planar::BalanceRequest read_planar(const Reporter& r_, const MapReader:
       }
     }
     if (const MapReader::Entry* x = b.find("counterweights")) cw = *x;
+    if (const MapReader::Entry* x = b.find("balancing_factor")) {
+      request.balancing_factor = read_number(r_, *x, "balance.balancing_factor", "");
+      factor_mark = mark_of(x->value, x->key_mark);
+      if (!(*request.balancing_factor >= 0)) {
+        r_.fail(*factor_mark,
+                "balance.balancing_factor must be >= 0 (0.5 balances half the "
+                "reciprocating mass), got " +
+                    text::shortest(*request.balancing_factor));
+      }
+    }
+    if (const MapReader::Entry* x = b.find("shafts")) {
+      request.shafts = read_shafts(r_, *x);
+      shafts_mark = x->key_mark;
+    }
   }
   std::map<int, YAML::Mark> marks;  // link -> where its counterweight is asked for
   if (cw && !cw->value.IsNull()) {
@@ -236,6 +289,20 @@ balance::planar::BalanceRequest read_planar(const Reporter& r_, const MapReader:
       }
     }
     r_.fail(cw ? cw->key_mark : e.key_mark, std::string("balance: ") + err.what());
+  }
+  try {
+    if (request.balancing_factor) {
+      bp::check_balancing_factor(linkage, request.counterweights, *request.balancing_factor);
+    }
+  } catch (const InputError& err) {
+    r_.fail(*factor_mark, err.field() ? err.field()->joined("balance.balancing_factor")
+                                      : std::string("balance.balancing_factor: ") + err.what());
+  }
+  try {
+    if (request.shafts) (void)bp::balance_shafts(linkage, *request.shafts);
+  } catch (const InputError& err) {
+    r_.fail(*shafts_mark, err.field() ? err.field()->joined("balance.shafts")
+                                      : std::string("balance.shafts: ") + err.what());
   }
   return request;
 }

@@ -65,6 +65,53 @@ TEST(PlanarBalanceStudy, MistakesAreOneLineAtTheirPlace) {
                "colour");
   expect_error(kEngine + "balance: {counter_rotations: {}}\n", 20, 11,
                "balance.counter_rotations is available for a four-bar");
+  expect_error(kEngine + "balance: {balancing_factor: -1}\n", 20, 29,
+               "balance.balancing_factor must be >= 0");
+  expect_error(kEngine + "balance:\n  counterweights: {rod: {mass: 1}}\n  balancing_factor: 0.5\n",
+               22, 21, "balance.balancing_factor: applies to one counterweight, on a crank");
+  expect_error(kEngine + "balance:\n  shafts: {orders: [1, 0]}\n", 21, 24,
+               "balance.shafts.orders[1] must be a whole number from 1 to 100, got 0");
+  expect_error(kEngine + "balance:\n  shafts: {orders: 2}\n", 21, 20,
+               "balance.shafts.orders must be a list of whole numbers >= 1");
+  expect_error(kEngine + "balance:\n  shafts: {orders: [2], radius: 0}\n", 21, 33,
+               "balance.shafts.radius must be > 0 m, got 0");
+}
+
+// The Lanchester example: the crank counterweight by balancing factor 0.5, then shafts at -1, 2
+// and -2 times crank speed; the balanced run's orders 1 and 2 (harmonics, from its own samples)
+// vanish to round-off, order 4 stays, and its balanced.yaml runs by itself to the same samples.
+TEST(PlanarBalanceStudy, TheLanchesterEngineLosesOrdersOneAndTwoAndItsStudyRunsByItself) {
+  const fs::path dir = fs::path(BD_BINARY_DIR) / "test-output" / "planar-balance" / "lanchester";
+  fs::remove_all(dir);
+  const Study study = load_study(example("engine-lanchester.yaml"));
+  RunResult r = compute_study(study);
+  write_run(study, r, dir);
+  ASSERT_TRUE(r.ok() && r.balanced && r.balanced->ok() && r.balanced->shafts);
+  const bp::ShaftBalance& sh = *r.balanced->shafts;
+  ASSERT_EQ(sh.added.size(), 3u);  // the counterweight took the forward half of order 1
+  ASSERT_TRUE(r.harmonics && r.balanced->harmonics);
+  const Harmonics& before = *r.harmonics;
+  const Harmonics& after = *r.balanced->harmonics;
+  auto x = [](const Harmonics& h, int n) {
+    return h.orders[static_cast<std::size_t>(n)].Fshx.amplitude;
+  };
+  auto y = [](const Harmonics& h, int n) {
+    return h.orders[static_cast<std::size_t>(n)].Fshy.amplitude;
+  };
+  const double size = x(before, 1);
+  for (int n : {1, 2, 3}) {
+    EXPECT_LT(x(after, n), 1e-12 * size) << n;
+    EXPECT_LT(y(after, n), 1e-12 * size) << n;
+  }
+  EXPECT_NEAR(x(after, 4), x(before, 4), 1e-12 * size);
+  EXPECT_GT(x(before, 4), 1e-4 * size);
+  const Study again = load_study((dir / "balanced.yaml").string());
+  ASSERT_EQ(again.planar().shafts.size(), 3u);
+  const RunResult r2 = compute_study(again);
+  ASSERT_TRUE(r2.ok());
+  const std::vector<double> a = column(r.balanced->planar, "Fshx"), b = column(r2.planar, "Fshx");
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], 1e-12 * size);
 }
 
 TEST(PlanarBalanceStudy, CounterweightsDefaultToTheLinksThatTurnAboutTheFrame) {
