@@ -230,10 +230,7 @@ ShaftSeries shaft_series(const cp::Linkage& l, const Kinematics& k) {
     const std::size_t L = static_cast<std::size_t>(b.link);
     for (std::size_t i = 0; i < n; ++i) {
       const Kinematics::Sample& s = k.samples[i];
-      const double turned = b.ratio * (s.angle[L] - f.angle);
-      const double c = std::cos(turned), sn = std::sin(turned);
-      const Vec2 r(c * b.eccentricity.x() - sn * b.eccentricity.y(),
-                   sn * b.eccentricity.x() + c * b.eccentricity.y());
+      const Vec2 r = cp::shaft_centre(b, s.angle[L] - f.angle);
       const double w = b.ratio * s.omega[L], al = b.ratio * s.alpha[L];
       const Vec2 a = al * perp(r) - w * w * r;
       const Vec2 d = s.x[static_cast<std::size_t>(f.q)] - s.x[static_cast<std::size_t>(f.p)];

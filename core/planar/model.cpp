@@ -272,6 +272,12 @@ double element_length(const Linkage& l, int k) {
       .norm();
 }
 
+Vec2 shaft_centre(const BalanceShaft& b, double link_turn) {
+  const double turned = b.ratio * link_turn, c = std::cos(turned), s = std::sin(turned);
+  return {c * b.eccentricity.x() - s * b.eccentricity.y(),
+          s * b.eccentricity.x() + c * b.eccentricity.y()};
+}
+
 int pivot_of(const Linkage& l, int link) {
   int pivot = -1;
   for (int n : l.links[static_cast<std::size_t>(link)].nodes) {

@@ -88,6 +88,10 @@ struct BalanceShaft {
   double inertia{};         // about its centre of mass [kg m^2], >= 0
 };
 
+/// A balance shaft's centre of mass from its shaft when its link has turned `link_turn` [rad]
+/// from the drawn configuration: the eccentricity turned by ratio × link_turn [m].
+Vec2 shaft_centre(const BalanceShaft& shaft, double link_turn);
+
 /// A value over time: a constant, a piecewise-linear table (held at its ends), or a harmonic
 /// mean + amplitude sin(2π frequency t + phase).
 struct TimeFunction {

@@ -203,11 +203,8 @@ ShaftMotion shaft_motion(const System& s, int k, const NodeVectors& x, double om
   const System::ShaftRef& r = s.shafts[static_cast<std::size_t>(k)];
   const BalanceShaft& b = s.linkage.shafts[static_cast<std::size_t>(k)];
   const Vec2 d = at(x, r.q) - at(x, r.p);
-  const double turned = r.ratio * std::atan2(cross(r.drawn, d), r.drawn.dot(d));
-  const double c = std::cos(turned), sn = std::sin(turned);
   ShaftMotion m;
-  m.r = Vec2(c * b.eccentricity.x() - sn * b.eccentricity.y(),
-             sn * b.eccentricity.x() + c * b.eccentricity.y());
+  m.r = shaft_centre(b, std::atan2(cross(r.drawn, d), r.drawn.dot(d)));
   m.omega = r.ratio * omega_link;
   m.alpha = r.ratio * alpha_link;
   m.a = m.alpha * perp(m.r) - m.omega * m.omega * m.r;

@@ -107,6 +107,16 @@ TEST(PlanarBalanceStudy, TheLanchesterEngineLosesOrdersOneAndTwoAndItsStudyRunsB
   EXPECT_GT(x(before, 4), 1e-4 * size);
   const Study again = load_study((dir / "balanced.yaml").string());
   ASSERT_EQ(again.planar().shafts.size(), 3u);
+  // what the design reports, against the design read back and its own simulation (no gravity:
+  // the shaking force is all inertial)
+  const bp::ForceBalance& d = *r.balanced->design;
+  EXPECT_NEAR(d.added_mass,
+              core::planar::total_mass(again.planar()) - core::planar::total_mass(study.planar()),
+              1e-12 * core::planar::total_mass(study.planar()));
+  const core::planar::Trajectory& t = r.balanced->planar;
+  EXPECT_NEAR(d.Fsh_rms_after, rms_norm(column(t, "Fshx"), column(t, "Fshy")),
+              1e-12 * d.Fsh_rms_before);
+  EXPECT_LT(d.Fsh_rms_after, 3e-3 * d.Fsh_rms_before);
   const RunResult r2 = compute_study(again);
   ASSERT_TRUE(r2.ok());
   const std::vector<double> a = column(r.balanced->planar, "Fshx"), b = column(r2.planar, "Fshx");
