@@ -43,6 +43,11 @@ Vec2 in_link_axes(const cp::Linkage& l, int k, const Vec2& point) {
   return {c * d.x() + s * d.y(), -s * d.x() + c * d.y()};
 }
 
+// a residual that cancels to round-off against the sum of its terms' sizes
+bool cancels(const VectorXd& residual, double terms) {
+  return residual.norm() <= 1e-10 * std::max(terms, 1e-300);
+}
+
 double rms_of_pairs(const VectorXd& v) {  // v = (x0, y0, x1, y1, ...): RMS of the magnitudes
   const Eigen::Index n = v.size() / 2;
   return n > 0 ? std::sqrt(v.squaredNorm() / static_cast<double>(n)) : 0.0;
@@ -220,11 +225,43 @@ Eigen::MatrixXd shaking_moment_regressor(const cp::Linkage& l, const Kinematics&
   return Y;
 }
 
+Eigen::MatrixXd angular_momentum_regressor(const cp::Linkage& l, const Kinematics& k) {
+  const std::size_t dof = l.inputs.size();
+  MatrixXd H =
+      MatrixXd::Zero(static_cast<Eigen::Index>(dof * k.samples.size()), Parameters::count(l));
+  Eigen::Index row = 0;
+  for (const Kinematics::Sample& s : k.samples) {
+    for (std::size_t d = 0; d < dof; ++d, ++row) {
+      const std::vector<Vec2>& v = s.unit_rate_velocity[d];
+      for (std::size_t j = 0; j < l.links.size(); ++j) {
+        const int i = static_cast<int>(j);
+        const LinkFrame f = frame_of(l, i);
+        const std::size_t p = static_cast<std::size_t>(f.p), q = static_cast<std::size_t>(f.q);
+        const Vec2 xp = s.x[p], vp = v[p], dx = s.x[q] - xp;
+        const double w = cross(dx, v[q] - vp) / dx.squaredNorm();
+        const Vec2 u = dx / dx.norm(), n = perp(u);
+        // H of a rigid link about the origin, with r = c - p = (m e u + m f n)/m rotating with
+        // it and S = m r: m p × v_p + ω (p · S) + S × v_p + J ω
+        H(row, Parameters::link_mass(i)) = cross(xp, vp);
+        H(row, Parameters::link_me(i)) = w * xp.dot(u) + cross(u, vp);
+        H(row, Parameters::link_mf(i)) = w * xp.dot(n) + cross(n, vp);
+        H(row, Parameters::link_J(i)) = w;
+      }
+      for (std::size_t j = 0; j < l.point_masses.size(); ++j) {
+        const std::size_t n = static_cast<std::size_t>(l.point_masses[j].node);
+        H(row, Parameters::point_mass(l, static_cast<int>(j))) = cross(s.x[n], v[n]);
+      }
+    }
+  }
+  return H;
+}
+
 ShaftSeries shaft_series(const cp::Linkage& l, const Kinematics& k) {
   const std::size_t dof = l.inputs.size(), n = k.samples.size();
   ShaftSeries out{VectorXd::Zero(static_cast<Eigen::Index>(2 * dof * n)),
                   VectorXd::Zero(static_cast<Eigen::Index>(2 * n)),
-                  VectorXd::Zero(static_cast<Eigen::Index>(n))};
+                  VectorXd::Zero(static_cast<Eigen::Index>(n)),
+                  VectorXd::Zero(static_cast<Eigen::Index>(dof * n))};
   for (const cp::BalanceShaft& b : l.shafts) {
     const LinkFrame f = frame_of(l, b.link);
     const std::size_t L = static_cast<std::size_t>(b.link);
@@ -241,12 +278,22 @@ ShaftSeries shaft_series(const cp::Linkage& l, const Kinematics& k) {
             d.squaredNorm();
         out.momentum.segment<2>(static_cast<Eigen::Index>(2 * (i * dof + j))) +=
             b.mass * b.ratio * rate * perp(r);
+        // spin about its centre of mass, and its centre's turn about the shaft seen from O
+        out.angular_momentum[static_cast<Eigen::Index>(i * dof + j)] +=
+            b.ratio * rate * (b.inertia + b.mass * (b.at + r).dot(r));
       }
       out.force.segment<2>(static_cast<Eigen::Index>(2 * i)) -= b.mass * a;
       out.moment[static_cast<Eigen::Index>(i)] -= b.inertia * al + cross(b.at + r, b.mass * a);
     }
   }
   return out;
+}
+
+bool force_balanced(const cp::Linkage& l, const Kinematics& k) {
+  const MatrixXd Z = momentum_regressor(l, k);
+  const VectorXd theta = Parameters::of(l);
+  const VectorXd momentum = shaft_series(l, k).momentum;
+  return cancels(Z * theta + momentum, (Z.cwiseAbs() * theta.cwiseAbs()).norm() + momentum.norm());
 }
 
 cp::Link merged(const cp::Link& link, const Counterweight& cw, const Vec2& from_first) {
@@ -489,8 +536,7 @@ ForceBalance force_balance(const cp::Linkage& linkage, const Kinematics& k,
   VectorXd theta = design(x);
   // what cancels to round-off: the momentum left against the sum of its terms' sizes
   const double terms = (Z.cwiseAbs() * theta.cwiseAbs()).norm() + shafts.momentum.norm();
-  out.full =
-      !balancing_factor && (Z * theta + shafts.momentum).norm() <= 1e-10 * std::max(terms, 1e-300);
+  out.full = !balancing_factor && cancels(Z * theta + shafts.momentum, terms);
   if (!out.full && !balancing_factor) {
     // the least RMS inertial shaking force over the motion instead
     x = solve_moments(Y, theta_fixed, shafts.force, pls);

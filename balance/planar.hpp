@@ -84,15 +84,23 @@ Eigen::MatrixXd momentum_regressor(const cp::Linkage& linkage, const Kinematics&
 Eigen::MatrixXd shaking_force_regressor(const cp::Linkage& linkage, const Kinematics& k);
 /// The inertial shaking moment -dH/dt about the origin: one row per sample [N m].
 Eigen::MatrixXd shaking_moment_regressor(const cp::Linkage& linkage, const Kinematics& k);
+/// The angular momentum about the origin per unit input rate: rows (sample, input); H = Σ_j
+/// (row of input j) θ ż_j [kg m^2 per s per unit rate].
+Eigen::MatrixXd angular_momentum_regressor(const cp::Linkage& linkage, const Kinematics& k);
 
 /// The balance shafts' part of the linkage's momentum and inertial shaking force and moment
 /// (core/planar/model.hpp BalanceShaft; they are not mass parameters): vectors with the rows of
 /// momentum_regressor, shaking_force_regressor and shaking_moment_regressor, to be added to
-/// those regressors' products.
+/// those regressors' products; and their angular momentum about the origin per unit input rate
+/// (the rows of angular_momentum_regressor).
 struct ShaftSeries {
-  Eigen::VectorXd momentum, force, moment;
+  Eigen::VectorXd momentum, force, moment, angular_momentum;
 };
 ShaftSeries shaft_series(const cp::Linkage& linkage, const Kinematics& k);
+
+/// True when the linkage's linear momentum (its shafts' included) vanishes to round-off in every
+/// configuration of `k`: against the sum of its terms' sizes, to 1e-10.
+bool force_balanced(const cp::Linkage& linkage, const Kinematics& k);
 
 /// A counterweight asked for on a link, realised as balance::CounterweightSpec says. Its position
 /// is measured in link axes (along and to the left of the link's first-to-second node line) from

@@ -18,10 +18,10 @@
 
 #include "balance/conditions.hpp"
 #include "balance/counterweight.hpp"
-#include "core/input_error.hpp"
 #include "core/fourbar/metrics.hpp"
 #include "core/fourbar/model.hpp"
 #include "core/fourbar/simulate.hpp"
+#include "core/input_error.hpp"
 
 namespace bd::balance {
 namespace {

@@ -7,8 +7,6 @@
 //    driven and free: no inertial shaking force left;
 //  - a slider-crank, which counterweights on the crank cannot balance: the message, and the
 //    least-squares design against the first Fourier coefficient of the engine's shaking force.
-#include "balance/planar.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -19,34 +17,19 @@
 #include <string>
 
 #include "balance/counterweight.hpp"
+#include "balance/planar.hpp"
 #include "core/fourbar/samples.hpp"
 #include "core/input_error.hpp"
 #include "core/planar/from_fourbar.hpp"
 #include "core/planar/simulate.hpp"
+#include "tests/support/balance_motion.hpp"
 #include "tests/support/planar_glue.hpp"
 #include "tests/support/planar_mechanisms.hpp"
 
 namespace bd::testing::planar {
 namespace {
 
-namespace bp = balance::planar;
-
 // a driven revolution of the first input (and the others at their own speeds) on the engine
-cp::Trajectory revolution(const cp::Linkage& l, const std::vector<double>& speeds, int samples) {
-  cp::DrivenScene scene;
-  scene.speeds = speeds;
-  scene.samples = samples;
-  return cp::simulate_driven(cp::Model(l), scene);
-}
-
-bp::Kinematics kinematics_of(const cp::Linkage& l, const cp::Trajectory& tr) {
-  const cp::Model model(l);
-  const bp::InputSeries in = bp::input_series(model, tr.table);
-  auto k = bp::kinematics(model, in.values, in.rates, in.accelerations);
-  EXPECT_TRUE(k) << (k ? "" : k.error().detail);
-  return k ? *k : bp::Kinematics{};
-}
-
 // RMS of the inertial shaking force's magnitude over a table's rows
 double rms_inertial_force(const core::Series& t) {
   const std::vector<double> a = t.column_values("Fshx_inertial"),
@@ -95,8 +78,8 @@ TEST(PlanarBalance, RegressorsReproduceTheEnginesInertialShakingForceAndMoment) 
       const double df = std::hypot(F[2 * static_cast<Eigen::Index>(r)] - fx[r],
                                    F[2 * static_cast<Eigen::Index>(r) + 1] - fy[r]);
       worst_force = std::max(worst_force, df / f_scale);
-      worst_moment = std::max(worst_moment,
-                              std::abs(M[static_cast<Eigen::Index>(r)] - mz[r]) / m_scale);
+      worst_moment =
+          std::max(worst_moment, std::abs(M[static_cast<Eigen::Index>(r)] - mz[r]) / m_scale);
     }
     // the momentum per unit input rate, body by body: m (v_p + ω × (c - p)) + point masses
     const Eigen::VectorXd Z = bp::momentum_regressor(l, k) * theta;
@@ -128,18 +111,6 @@ TEST(PlanarBalance, RegressorsReproduceTheEnginesInertialShakingForceAndMoment) 
   EXPECT_LE(worst_force, 1e-12);
   EXPECT_LE(worst_moment, 1e-12);
   EXPECT_LE(worst_momentum, 1e-13);
-}
-
-// random mass data on the paper's four-bar geometry
-core::FourBar random_fourbar(Rng& rng) {
-  core::FourBar fb = core::samples::paper_fourbar_unloaded();
-  for (core::Link* link : {&fb.crank, &fb.coupler, &fb.rocker}) {
-    link->mass = uniform(rng, 0.5, 5);
-    link->e = uniform(rng, -0.3, 1.3) * link->length;
-    link->f = uniform(rng, -0.4, 0.4) * link->length;
-    link->inertia = uniform(rng, 0.1, 3);
-  }
-  return fb;
 }
 
 // On a four-bar the general conditions are eq. 57's two complex equations, and the counterweights
@@ -204,9 +175,10 @@ void balanced_family(const char* family, std::uint64_t seed, Make make) {
     for (const rf::Sample& s : rf::free_run(g.mechanism, {speed}, duration, free_times))
       worst_free = std::max(worst_free, s.inertial_force.norm() / original);
   }
-  std::printf("%s balanced: inertial shaking force left (referee) / original RMS: driven %.2e, "
-              "free %.2e\n",
-              family, worst_driven, worst_free);
+  std::printf(
+      "%s balanced: inertial shaking force left (referee) / original RMS: driven %.2e, "
+      "free %.2e\n",
+      family, worst_driven, worst_free);
   EXPECT_LE(worst_driven, 1e-10);
   EXPECT_LE(worst_free, 1e-10);
 }
@@ -243,7 +215,8 @@ TEST(PlanarBalance, SliderCrankCannotBeBalancedOnItsCrankAndSaysWhy) {
     std::complex<double> c1(0, 0);
     double power = 0;
     for (int j = 0; j < n; ++j) {
-      const std::complex<double> F(fx[static_cast<std::size_t>(j)], fy[static_cast<std::size_t>(j)]);
+      const std::complex<double> F(fx[static_cast<std::size_t>(j)],
+                                   fy[static_cast<std::size_t>(j)]);
       c1 += F * std::exp(std::complex<double>(0, -th[static_cast<std::size_t>(j)]));
       power += std::norm(F);
     }
