@@ -119,16 +119,26 @@ struct ShaftRequest {
       radius;  // their centres of mass from the shaft [m]; default: the crank's length
 };
 
+/// A counter-rotation asked for on a link that turns about one ground node, its shaft at `at`
+/// [m] (default: below the link's pivot by the link's length, as a four-bar's);
+/// balance/planar_moment.hpp synthesises it.
+struct CounterRotationRequest {
+  int link{};
+  std::optional<Vec2> at;
+};
+
 /// The study file's `balance:` section for a planar linkage: force balance by counterweights on
 /// the links named (default: every link that turns about a ground node), or an engine's crank
 /// counterweight by its balancing factor; then, if asked, balance shafts that cancel orders of
-/// the shaking force.
+/// the shaking force; then, if asked, counter-rotations that cancel the shaking moment.
 struct BalanceRequest {
   std::vector<LinkCounterweightSpec> counterweights;
   /// An engine's crank counterweight: the fraction of the reciprocating mass it balances on top
   /// of the rotating mass (force_balance()).
   std::optional<double> balancing_factor;
   std::optional<ShaftRequest> shafts;
+  /// Moment balance (after the rest) by counter-rotations on these links, when asked for.
+  std::optional<std::vector<CounterRotationRequest>> counter_rotations;
 };
 
 /// The links that turn about a ground node (one of their nodes is fixed to the frame), each with

@@ -20,13 +20,6 @@
 
 namespace bd::balance::planar {
 
-/// A counter-rotation asked for on a link that turns about one ground node, its shaft at `at`
-/// [m] (default: below the link's pivot by the link's length, as a four-bar's).
-struct CounterRotationRequest {
-  int link{};
-  std::optional<Vec2> at;
-};
-
 /// One on every link that turns about exactly one ground node, shafts at their defaults.
 std::vector<CounterRotationRequest> default_counter_rotations(const cp::Linkage& linkage);
 
@@ -61,9 +54,9 @@ struct MomentBalance {
 /// that cannot be reached, the discs that minimise the RMS of the inertial shaking moment over
 /// k's samples, with `full` false and the message saying why; among several such (a link that
 /// turns at constant speed in k's motion, whose disc changes nothing there), those that leave the
-/// least angular momentum over k's configurations, for the motions whose speed varies. A disc whose coefficient k J comes
-/// out negative counter-rotates (ratio -1, J = -c); one that comes out positive turns with its
-/// link (ratio 1: a flywheel that adds to the link's own angular momentum).
+/// least angular momentum over k's configurations, for the motions whose speed varies. A disc whose
+/// coefficient k J comes out negative counter-rotates (ratio -1, J = -c); one that comes out
+/// positive turns with its link (ratio 1: a flywheel that adds to the link's own angular momentum).
 /// @throws bd::InputError as check_counter_rotations(), or (no field) when `linkage` is not
 ///         force balanced over k to round-off: a moment balance starts from full force balance.
 MomentBalance moment_balance(const cp::Linkage& linkage, const Kinematics& k,

@@ -8,8 +8,8 @@
 #include "balance/conditions.hpp"
 #include "balance/counter_rotation.hpp"
 #include "balance/counterweight.hpp"
-#include "core/input_error.hpp"
 #include "core/fourbar/model.hpp"
+#include "core/input_error.hpp"
 #include "core/types.hpp"
 
 namespace bd::balance {
@@ -21,8 +21,8 @@ struct BalanceRequest {
                         // Berkof coupler)
   CounterweightSpec crank_counterweight;   // default: a point mass at distance l1
   CounterweightSpec rocker_counterweight;  // default: a point mass at distance l3
-  std::optional<Vec2> crank_at;   // crank counter-rotation shaft [m]; default (0, -l1)
-  std::optional<Vec2> rocker_at;  // rocker counter-rotation shaft [m]; default (l4, -l3)
+  std::optional<Vec2> crank_at;            // crank counter-rotation shaft [m]; default (0, -l1)
+  std::optional<Vec2> rocker_at;           // rocker counter-rotation shaft [m]; default (l4, -l3)
 };
 
 /// The shaft positions a request uses [m]: as given, else crank (0, -l1) and rocker (l4, -l3).

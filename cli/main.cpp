@@ -219,13 +219,18 @@ struct RunArgs {
 
 // before / after / ratio of the main metrics, added mass and inertia
 void print_comparison(const st::Study& study, const st::RunResult& r) {
-  std::printf("  %-14s %14s %14s %12s\n", "metric", "before", "after", "ratio");
-  for (const st::ComparisonRow& row : st::comparison(study, r)) {
+  const std::vector<st::ComparisonRow> rows = st::comparison(study, r);
+  int width = 14;  // the metric column, as wide as the longest name (a shaft's bearing force)
+  for (const st::ComparisonRow& row : rows)
+    width = std::max(width, static_cast<int>(row.metric.size()));
+  std::printf("  %-*s %14s %14s %12s\n", width, "metric", "before", "after", "ratio");
+  for (const st::ComparisonRow& row : rows) {
     if (row.ratio) {
-      std::printf("  %-14s %14.6g %14.6g %12.4g\n", row.metric.c_str(), row.before, row.after,
+      std::printf("  %-*s %14.6g %14.6g %12.4g\n", width, row.metric.c_str(), row.before, row.after,
                   *row.ratio);
     } else {
-      std::printf("  %-14s %14.6g %14.6g %12s\n", row.metric.c_str(), row.before, row.after, "-");
+      std::printf("  %-*s %14.6g %14.6g %12s\n", width, row.metric.c_str(), row.before, row.after,
+                  "-");
     }
   }
 }
@@ -314,6 +319,18 @@ void print_planar_balance(const st::Study& study, const st::RunResult& r) {
           s.name.c_str(), s.at.x(), s.at.y(), s.ratio,
           l.links[static_cast<std::size_t>(s.link)].name.c_str(), s.mass, s.eccentricity.norm());
     }
+  }
+  if (run.moment) {
+    for (int i : run.moment->added) {
+      const bd::core::planar::BalanceShaft& s =
+          run.moment->linkage.shafts[static_cast<std::size_t>(i)];
+      std::printf(
+          "  %-7s  counter-rotation J = %.6g kg m^2 on a shaft at [%.6g, %.6g] m, ratio %d\n",
+          l.links[static_cast<std::size_t>(s.link)].name.c_str(), s.inertia, s.at.x(), s.at.y(),
+          s.ratio);
+    }
+    std::printf("  balance  moment full: the balanced design is %s\n",
+                run.moment->full ? "moment balanced" : "not moment balanced");
   }
   const st::RunStatus status = run.status();
   std::printf("  balanced design: method %s, %zu samples, status %s\n",

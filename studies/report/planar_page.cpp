@@ -133,6 +133,33 @@ Chart linkage_chart(const Linkage& l, const Csv& ts, std::string& datablocks,
       datablocks += xy(weight_at(row, part)) + "," + std::to_string(k + 1) + "\n";
     }
   }
+  // balance shafts: each shaft on the frame, its drive from its link's pivot, and its
+  // eccentric mass where it is at each sample, in that sample's colour
+  datablocks += "EOD\n$" + tag + "shafts << EOD\n";
+  for (const core::planar::BalanceShaft& b : l.shafts) datablocks += xy(b.at) + "\n";
+  datablocks += "EOD\n$" + tag + "drives << EOD\n";
+  for (const core::planar::BalanceShaft& b : l.shafts) {
+    datablocks +=
+        xy(l.nodes[static_cast<std::size_t>(core::planar::pivot_of(l, b.link))].position) + "\n" +
+        xy(b.at) + "\n\n";
+  }
+  datablocks += "EOD\n$" + tag + "eccentrics << EOD\n";
+  bool eccentric = false;
+  for (std::size_t k = 0; k < picks.size(); ++k) {
+    const std::vector<double> row = numbers(ts.rows[picks[k]]);
+    for (const core::planar::BalanceShaft& b : l.shafts) {
+      if (b.mass == 0 || b.eccentricity.norm() == 0) continue;
+      const core::planar::Link& link = l.links[static_cast<std::size_t>(b.link)];
+      const Vec2 d = l.nodes[static_cast<std::size_t>(link.nodes[1])].position -
+                     l.nodes[static_cast<std::size_t>(link.nodes[0])].position;
+      const int column = gp_column(ts, "theta_" + link.name);
+      const double turn =
+          column ? row[static_cast<std::size_t>(column - 1)] - std::atan2(d.y(), d.x()) : 0.0;
+      datablocks +=
+          xy(b.at + core::planar::shaft_centre(b, turn)) + "," + std::to_string(k + 1) + "\n";
+      eccentric = true;
+    }
+  }
   datablocks += "EOD\n$" + tag + "ground << EOD\n";
   for (const core::planar::Node& node : l.nodes) {
     if (node.ground) datablocks += xy(node.position) + "\n";
@@ -164,6 +191,19 @@ Chart linkage_chart(const Linkage& l, const Csv& ts, std::string& datablocks,
       cmd +=
           "set label " + gp_string(node.name) + " at " + xy(node.position) + " offset 0.6,-0.8\n";
   }
+  // one label per shaft position (a Lanchester pair may share one)
+  std::vector<std::pair<Vec2, std::string>> shaft_labels;
+  for (const core::planar::BalanceShaft& b : l.shafts) {
+    auto same = std::find_if(shaft_labels.begin(), shaft_labels.end(),
+                             [&](const auto& x) { return x.first == b.at; });
+    if (same == shaft_labels.end()) {
+      shaft_labels.emplace_back(b.at, b.name);
+    } else {
+      same->second += ", " + b.name;
+    }
+  }
+  for (const auto& [at, names] : shaft_labels)
+    cmd += "set label " + gp_string(names) + " at " + xy(at) + " offset 0.8,0.6\n";
   cmd += "plot " + entries + ", $" + tag +
          "ground using 1:2 with points pt 9 ps 1.8 lc 'gray30' title 'ground nodes'";
   const bool guides = std::any_of(l.sliders.begin(), l.sliders.end(),
@@ -175,13 +215,23 @@ Chart linkage_chart(const Linkage& l, const Csv& ts, std::string& datablocks,
     cmd += ", $" + tag +
            "weights using 1:2:3 with points pt 7 ps 2.2 lc variable title 'counterweights'";
   }
+  if (!l.shafts.empty()) {
+    cmd += ", $" + tag + "drives using 1:2 with lines dt 3 lw 1 lc 'gray50' notitle, $" + tag +
+           "shafts using 1:2 with points pt 6 ps 2.4 lw 2 lc 'black' title 'balance shafts'";
+    if (eccentric) {
+      cmd += ", $" + tag +
+             "eccentrics using 1:2:3 with points pt 5 ps 1.2 lc variable title 'shaft masses'";
+    }
+  }
   Chart c;
   c.id = "linkage";
   c.heading = "The linkage";
   c.caption =
       "Links through their nodes (a ternary link as a closed outline) at samples spread "
       "evenly over the run, one colour per sample; ground nodes as triangles, guides fixed "
-      "in the frame dashed. From the node columns of timeseries.csv.";
+      "in the frame dashed; balance shafts as open circles, dotted to the pivot of the link "
+      "that drives them, with their eccentric masses in each sample's colour. From the node "
+      "columns of timeseries.csv.";
   c.commands = cmd;
   c.square = true;
   return c;
@@ -334,6 +384,18 @@ std::string planar_linkage_tables(const Linkage& l) {
            esc(node_name(l, s.a) + ", " + node_name(l, s.b)) + "</td><td class=\"n\">" +
            fmt(s.stiffness) + "</td><td class=\"n\">" + fmt(s.free_length) +
            "</td><td class=\"n\">" + fmt(s.damping) + "</td></tr>";
+    }
+    h += "</table>";
+  }
+  if (!l.shafts.empty()) {
+    h += "<table><tr><th>balance shaft</th><th>geared to</th><th>ratio</th><th>at [m]</th>"
+         "<th>mass [kg]</th><th>eccentricity [m]</th><th>inertia [kg m&sup2;]</th></tr>";
+    for (const core::planar::BalanceShaft& b : l.shafts) {
+      h += "<tr><th>" + esc(b.name) + "</th><td>" +
+           esc(l.links[static_cast<std::size_t>(b.link)].name) + "</td><td class=\"n\">" +
+           std::to_string(b.ratio) + "</td><td>" + vec_text(b.at) + "</td><td class=\"n\">" +
+           fmt(b.mass) + "</td><td>" + vec_text(b.eccentricity) + "</td><td class=\"n\">" +
+           fmt(b.inertia) + "</td></tr>";
     }
     h += "</table>";
   }

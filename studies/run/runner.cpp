@@ -305,6 +305,16 @@ BalancedRun planar_balanced_run(const Study& study, const RunResult& original) {
     b.shafts = bp::balance_shafts(b.design->linkage, *ask.shafts);
     bp::add_shafts(*b.design, *b.shafts, *k, study.planar());
   }
+  if (ask.counter_rotations) {
+    if (b.design->full) {
+      b.moment = bp::moment_balance(b.design->linkage, *k, *ask.counter_rotations);
+      bp::add_counter_rotations(*b.design, *b.moment);
+    } else {
+      b.design->message +=
+          "; no counter-rotations: a moment balance starts from full force "
+          "balance, which is not reached";
+    }
+  }
   const Study balanced = planar_balanced_study(study, b.design->linkage);
   Simulation sim = simulate(balanced);
   b.method = sim.method;

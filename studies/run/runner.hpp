@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "balance/planar_moment.hpp"
 #include "balance/planar_shafts.hpp"
 #include "core/fourbar/metrics.hpp"
 #include "core/fourbar/simulate.hpp"
@@ -40,6 +41,10 @@ struct BalancedRun {
   /// A planar study with balance.shafts: the shafts added to the design (design->linkage has
   /// them; its added mass, RMS force and message include them).
   std::optional<balance::planar::ShaftBalance> shafts;
+  /// A planar study with balance.moment: full, when full force balance was reached: the
+  /// counter-rotations added (design->linkage has them; its added inertia and message include
+  /// them).
+  std::optional<balance::planar::MomentBalance> moment;
   bool is_planar{};
   MetricList metric_list;              // its metrics in its table's order (either type)
   std::optional<Harmonics> harmonics;  // its harmonic orders (a driven scene)

@@ -161,7 +161,8 @@ Json balance_json(const balance::BalancedDesign& b) {
 Json planar_balance_json(const Study& study, const BalancedRun& run) {
   const balance::planar::ForceBalance& b = *run.design;
   const core::planar::Linkage& l = study.planar();
-  Json j = {{"force", "full"}, {"moment", "none"}};
+  Json j = {{"force", "full"},
+            {"moment", study.planar_balance->counter_rotations ? "full" : "none"}};
   if (b.balancing_factor) j["balancing_factor"] = *b.balancing_factor;
   Json cws = Json::array();
   for (const balance::planar::LinkCounterweight& c : b.added) {
@@ -204,6 +205,25 @@ Json planar_balance_json(const Study& study, const BalancedRun& run) {
                         {"backward_after", o.backward_after}});
     }
     j["shafts"] = {{"added", shafts}, {"orders", orders}};
+  }
+  if (study.planar_balance->counter_rotations) {
+    j["moment_balanced"] = run.moment && run.moment->full;
+    if (run.moment) {
+      const balance::planar::MomentBalance& m = *run.moment;
+      Json discs = Json::array();
+      for (int i : m.added) {
+        const core::planar::BalanceShaft& s = m.linkage.shafts[static_cast<std::size_t>(i)];
+        discs.push_back({{"name", s.name},
+                         {"link", l.links[static_cast<std::size_t>(s.link)].name},
+                         {"ratio", s.ratio},
+                         {"at", {s.at.x(), s.at.y()}},
+                         {"inertia", s.inertia}});
+      }
+      j["counter_rotations"] = discs;
+      j["angular_momentum_left"] = m.angular_momentum_left;
+      j["Msh_inertial_rms_before"] = m.Msh_rms_before;
+      j["Msh_inertial_rms_after"] = m.Msh_rms_after;
+    }
   }
   return j;
 }

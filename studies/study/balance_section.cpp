@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "balance/planar_moment.hpp"
 #include "balance/planar_shafts.hpp"
 #include "studies/study/sections.hpp"
 #include "studies/study/yaml_reader.hpp"
@@ -209,6 +210,54 @@ balance::planar::ShaftRequest read_shafts(const Reporter& r_, const MapReader::E
   return q;
 }
 
+// moment: full with counter_rotations: {<link>: {at: [x, y]}} (default: every link that turns
+// about one ground node, shafts at their defaults)
+std::vector<balance::planar::CounterRotationRequest> read_counter_rotations(
+    const Reporter& r_, const MapReader::Entry& moment,
+    const std::optional<MapReader::Entry>& rotations, const core::planar::Linkage& linkage) {
+  namespace bp = balance::planar;
+  std::vector<bp::CounterRotationRequest> out;
+  std::map<int, YAML::Mark> marks;  // link -> where its counter-rotation is asked for
+  if (rotations && !rotations->value.IsNull()) {
+    const MapReader m(r_, rotations->value, "balance.counter_rotations", rotations->key_mark,
+                      "(a link's name and its counter-rotation: {} or {at: [x, y]})");
+    for (const MapReader::Entry& x : m.entries()) {
+      const std::string path = "balance.counter_rotations." + x.key;
+      const int link = core::planar::link_index(linkage, x.key);
+      if (link < 0) r_.fail(x.key_mark, path + ": no link of that name");
+      bp::CounterRotationRequest ask{link, std::nullopt};
+      if (!x.value.IsNull()) {
+        const MapReader at(r_, x.value, path, x.key_mark, "(at)");
+        at.check_keys({"at"});
+        if (const MapReader::Entry* a = at.find("at")) {
+          YAML::Mark xy[2];
+          ask.at = read_vec2(r_, *a, path + ".at", "m", xy);
+        }
+      }
+      out.push_back(ask);
+      marks[link] = x.key_mark;
+    }
+  } else {
+    out = bp::default_counter_rotations(linkage);
+    if (out.empty()) {
+      r_.fail(mark_of(moment.value, moment.key_mark),
+              "balance.moment: no link turns about a ground node to carry a counter-rotation");
+    }
+  }
+  try {
+    bp::check_counter_rotations(linkage, out);
+  } catch (const InputError& err) {
+    for (const auto& [link, mark] : marks) {
+      const std::string field =
+          "counter_rotations." + linkage.links[static_cast<std::size_t>(link)].name;
+      if (err.field() && err.field()->field == field)
+        r_.fail(mark, err.field()->joined("balance." + field));
+    }
+    r_.fail(mark_of(moment.value, moment.key_mark), std::string("balance.moment: ") + err.what());
+  }
+  return out;
+}
+
 balance::planar::BalanceRequest read_planar(const Reporter& r_, const MapReader::Entry& e,
                                             const core::planar::Linkage& linkage) {
   namespace bp = balance::planar;
@@ -216,24 +265,28 @@ balance::planar::BalanceRequest read_planar(const Reporter& r_, const MapReader:
   bp::BalanceRequest request;
   std::optional<MapReader::Entry> cw;  // a copy: the section's reader ends with its block
   std::optional<YAML::Mark> factor_mark, shafts_mark;
+  std::optional<MapReader::Entry> moment, rotations;
   if (!e.value.IsNull()) {
     const MapReader b(r_, e.value, "balance", e.key_mark,
-                      "(force, counterweights, balancing_factor, shafts)");
+                      "(force, counterweights, balancing_factor, shafts, moment, "
+                      "counter_rotations)");
     b.check_keys(
         {"force", "moment", "counterweights", "counter_rotations", "balancing_factor", "shafts"});
     if (const MapReader::Entry* f = b.find("force")) {
       if (!reader.read_full_or_none(*f, "balance.force")) {
         r_.fail(mark_of(f->value, f->key_mark),
-                "balance.force: none leaves nothing to balance: a planar linkage is force "
-                "balanced by counterweights (moment balance is available for a four-bar)");
+                "balance.force: none leaves nothing to balance: a planar linkage is balanced "
+                "from full force balance by counterweights");
       }
     }
-    for (const char* key : {"moment", "counter_rotations"}) {
-      if (const MapReader::Entry* m = b.find(key)) {
-        r_.fail(m->key_mark, std::string("balance.") + key +
-                                 " is available for a four-bar (linkage.type: fourbar); a planar "
-                                 "linkage is force balanced by counterweights");
+    if (const MapReader::Entry* m = b.find("moment")) {
+      if (reader.read_full_or_none(*m, "balance.moment")) moment = *m;
+    }
+    if (const MapReader::Entry* x = b.find("counter_rotations")) {
+      if (!moment) {
+        r_.fail(x->key_mark, "balance.counter_rotations are used only with balance.moment: full");
       }
+      rotations = *x;
     }
     if (const MapReader::Entry* x = b.find("counterweights")) cw = *x;
     if (const MapReader::Entry* x = b.find("balancing_factor")) {
@@ -297,6 +350,12 @@ balance::planar::BalanceRequest read_planar(const Reporter& r_, const MapReader:
   } catch (const InputError& err) {
     r_.fail(*factor_mark, err.field() ? err.field()->joined("balance.balancing_factor")
                                       : std::string("balance.balancing_factor: ") + err.what());
+  }
+  if (moment) request.counter_rotations = read_counter_rotations(r_, *moment, rotations, linkage);
+  if (moment && request.balancing_factor) {
+    r_.fail(mark_of(moment->value, moment->key_mark),
+            "balance.moment: full needs full force balance, which a balancing factor does not "
+            "give (it leaves part of the reciprocating mass)");
   }
   try {
     if (request.shafts) (void)bp::balance_shafts(linkage, *request.shafts);

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -51,8 +52,17 @@ double rms_norm(const std::vector<double>& x, const std::vector<double>& y) {
 }
 
 TEST(PlanarBalanceStudy, MistakesAreOneLineAtTheirPlace) {
-  expect_error(kEngine + "balance: {moment: full}\n", 20, 11,
-               "balance.moment is available for a four-bar (linkage.type: fourbar)");
+  expect_error(kEngine + "balance: {moment: full, balancing_factor: 0.5}\n", 20, 19,
+               "balance.moment: full needs full force balance, which a balancing factor does not "
+               "give");
+  expect_error(kEngine + "balance:\n  moment: full\n  counter_rotations:\n    piston: {}\n", 23, 5,
+               "balance.counter_rotations.piston: no link of that name");
+  expect_error(kEngine + "balance:\n  moment: full\n  counter_rotations:\n    rod: {}\n", 23, 5,
+               "balance.counter_rotations.rod: the link does not turn about one ground node");
+  expect_error(kEngine + "balance:\n  moment: full\n  counter_rotations:\n    crank: {at: [1]}\n",
+               23, 17, "balance.counter_rotations.crank.at");
+  expect_error(kEngine + "balance:\n  moment: full\n  counter_rotations:\n    crank: {on: 1}\n", 23,
+               13, "on");
   expect_error(kEngine + "balance: {force: none}\n", 20, 18,
                "balance.force: none leaves nothing to balance");
   expect_error(kEngine + "balance:\n  counterweights:\n    piston: {}\n", 22, 5,
@@ -64,7 +74,7 @@ TEST(PlanarBalanceStudy, MistakesAreOneLineAtTheirPlace) {
   expect_error(kEngine + "balance:\n  counterweights:\n    crank: {colour: red}\n", 22, 13,
                "colour");
   expect_error(kEngine + "balance: {counter_rotations: {}}\n", 20, 11,
-               "balance.counter_rotations is available for a four-bar");
+               "balance.counter_rotations are used only with balance.moment: full");
   expect_error(kEngine + "balance: {balancing_factor: -1}\n", 20, 29,
                "balance.balancing_factor must be >= 0");
   expect_error(kEngine + "balance:\n  counterweights: {rod: {mass: 1}}\n  balancing_factor: 0.5\n",
@@ -122,6 +132,84 @@ TEST(PlanarBalanceStudy, TheLanchesterEngineLosesOrdersOneAndTwoAndItsStudyRunsB
   const std::vector<double> a = column(r.balanced->planar, "Fshx"), b = column(r2.planar, "Fshx");
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], 1e-12 * size);
+}
+
+// The Berkof inline four-bar of berkof-inline-moment-balanced.yaml written as a planar linkage
+// (crank A0-A1, coupler A1-A2, rocker A2-A3): balance.moment: full finds the four-bar's
+// counter-rotations (Berkof's reduced inertias, from the four-bar's own synthesis of that
+// example), the balanced run has neither shaking force nor shaking moment left, and its
+// balanced.yaml, with the discs as balance shafts, runs by itself to the same samples.
+TEST(PlanarBalanceStudy, ABerkofFourBarOnTrussElementsIsForceAndMomentBalanced) {
+  // A2 where the coupler (3 m from A1 = (1, 0)) meets the rocker (2 m from A3 = (3.2, 0))
+  const double a = (9.0 - 4.0 + 2.2 * 2.2) / (2 * 2.2), h = std::sqrt(9.0 - a * a);
+  const std::string text =
+      "name: berkof-planar\n"
+      "linkage:\n"
+      "  type: planar\n"
+      "  nodes:\n"
+      "    A0: {at: [0, 0], ground: true}\n"
+      "    A3: {at: [3.2, 0], ground: true}\n"
+      "    A1: [1, 0]\n"
+      "    A2: [" +
+      text::exact(1 + a) + ", " + text::exact(h) +
+      "]\n"
+      "  links:\n"
+      "    crank: {nodes: [A0, A1], mass: 2.0, e: 0.5, f: 0, inertia: 0.2}\n"
+      "    coupler: {nodes: [A1, A2], mass: 3.0, e: 1.2, f: 0, inertia: 6.48}\n"
+      "    rocker: {nodes: [A2, A3], mass: 2.2, e: 1.0, f: 0, inertia: 0.8}\n"
+      "  inputs:\n"
+      "    crank: {link: crank}\n"
+      "scene:\n"
+      "  type: driven\n"
+      "  speeds: [6.283185307179586]\n"
+      "  samples: 360\n"
+      "balance:\n"
+      "  moment: full\n"
+      "  counter_rotations:\n"
+      "    crank: {at: [0.0, -1.0]}\n"
+      "    rocker: {at: [3.2, -2.0]}\n";
+  const Study study = parse_study(text, "berkof-planar.yaml");
+  ASSERT_TRUE(study.planar_balance && study.planar_balance->counter_rotations);
+  const fs::path out = fs::path(BD_BINARY_DIR) / "test-output" / "planar-balance" / "berkof";
+  fs::remove_all(out);
+  RunResult r = compute_study(study);
+  write_run(study, r, out);
+  ASSERT_TRUE(r.ok() && r.balanced && r.balanced->ok() && r.balanced->moment);
+  const bp::MomentBalance& m = *r.balanced->moment;
+  EXPECT_TRUE(m.full) << m.message;
+
+  const Study fourbar = load_study(example("berkof-inline-moment-balanced.yaml"));
+  const core::CounterRotations& want = fourbar.balance->model.counter_rotations;
+  ASSERT_EQ(m.added.size(), 2u);
+  const core::planar::BalanceShaft& c = m.linkage.shafts[static_cast<std::size_t>(m.added[0])];
+  const core::planar::BalanceShaft& k = m.linkage.shafts[static_cast<std::size_t>(m.added[1])];
+  EXPECT_NEAR(c.inertia, want.crank.inertia, 1e-12 * want.crank.inertia);
+  EXPECT_NEAR(k.inertia, want.rocker.inertia, 1e-12 * want.rocker.inertia);
+
+  // the balanced run: no inertial shaking force or moment (no gravity) against the original's
+  const core::planar::Trajectory& b = r.balanced->planar;
+  const double force = rms_norm(column(r.planar, "Fshx"), column(r.planar, "Fshy"));
+  const std::vector<double> msh0 = column(r.planar, "Msh"), zero(msh0.size(), 0.0);
+  const double moment = rms_norm(msh0, zero);
+  EXPECT_LE(rms_norm(column(b, "Fshx"), column(b, "Fshy")), 1e-12 * force);
+  EXPECT_LE(rms_norm(column(b, "Msh"), zero), 1e-12 * moment);
+
+  const nlohmann::json j = nlohmann::json::parse(bd::testing::read(out / "summary.json"));
+  EXPECT_EQ(j["balance"]["moment"], "full");
+  EXPECT_EQ(j["balance"]["moment_balanced"], true);
+  EXPECT_EQ(j["balance"]["counter_rotations"].size(), 2u);
+  EXPECT_EQ(j["balance"]["counter_rotations"][1]["name"], "counter_rocker");
+  EXPECT_EQ(j["balance"]["counter_rotations"][1]["ratio"], -1);
+  EXPECT_EQ(j["balance"]["counter_rotations"][1]["inertia"].get<double>(), k.inertia);
+
+  const Study again = load_study((out / "balanced.yaml").string());
+  ASSERT_EQ(again.planar().shafts.size(), 2u);
+  EXPECT_EQ(again.planar().shafts[0].inertia, c.inertia);
+  const RunResult rerun = compute_study(again);
+  ASSERT_TRUE(rerun.ok());
+  const std::vector<double> m1 = column(b, "Msh"), m2 = column(rerun.planar, "Msh");
+  ASSERT_EQ(m1.size(), m2.size());
+  for (std::size_t i = 0; i < m1.size(); ++i) EXPECT_EQ(m1[i], m2[i]);
 }
 
 TEST(PlanarBalanceStudy, CounterweightsDefaultToTheLinksThatTurnAboutTheFrame) {

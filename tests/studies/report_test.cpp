@@ -204,6 +204,33 @@ std::vector<std::vector<std::string>> table_after(const std::string& html,
   return rows;
 }
 
+// A planar balanced design's balance shafts are parts of its drawing: the shafts (one label for
+// the Lanchester shafts that share the crank's pivot), and the eccentric masses of those that
+// have one; the original, which has none, is drawn without them.
+TEST_F(ReportTest, BalanceShaftsAreDrawnAsParts) {
+  for (const char* example : {"engine-lanchester.yaml", "watt-sixbar-moment-balanced.yaml"}) {
+    const Study study = load_study(std::string(BD_SOURCE_DIR "/studies/examples/") + example);
+    const fs::path out = dir_ / example;
+    ASSERT_TRUE(run_study(study, out).ok());
+    const std::string html = read(out / "report.html");
+    if (find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
+    const std::size_t original = html.find("id=\"chart-linkage\""),
+                      balanced = html.find("id=\"chart-linkage-balanced\"");
+    ASSERT_NE(original, std::string::npos);
+    ASSERT_NE(balanced, std::string::npos);
+    const std::string a = html.substr(original, html.find("</svg>", original) - original);
+    const std::string b = html.substr(balanced, html.find("</svg>", balanced) - balanced);
+    EXPECT_EQ(a.find("balance shafts"), std::string::npos) << example;
+    EXPECT_NE(b.find("balance shafts"), std::string::npos) << example;
+    const bool lanchester = std::string(example) == "engine-lanchester.yaml";
+    EXPECT_NE(b.find(lanchester ? "shaft_-1, shaft_2, shaft_-2" : "counter_rocker"),
+              std::string::npos)
+        << example;
+    // only eccentric shafts carry a mass to draw
+    EXPECT_EQ(b.find("shaft masses") != std::string::npos, lanchester) << example;
+  }
+}
+
 TEST_F(ReportTest, BalancedLinkageIsDrawnWithItsCounterweights) {
   const Study study =
       load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven-force-balanced.yaml");
