@@ -165,7 +165,7 @@ class Tnlp : public Ipopt::TNLP {
   }
 
   TrackedNlp& tracked_;
-  const Nlp& nlp_;
+  const Program& nlp_;
   VectorXd x0_;
   int max_evaluations_;
   VectorXd x_, grad_, c_, solution_;
@@ -271,7 +271,8 @@ std::mutex ipopt_mutex;
 
 }  // namespace
 
-DriverOutcome solve_with_ipopt(const Nlp& nlp, const VectorXd& x0, const OptimizeOptions& options) {
+DriverOutcome solve_with_ipopt(const Program& nlp, const VectorXd& x0,
+                               const OptimizeOptions& options) {
   const std::lock_guard<std::mutex> lock(ipopt_mutex);  // outlives the application below
   DriverOutcome out;
   out.x = x0;

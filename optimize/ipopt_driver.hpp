@@ -4,8 +4,8 @@
 #include <Eigen/Core>
 
 #include "optimize/nlopt_driver.hpp"  // DriverOutcome, TrackedNlp
-#include "optimize/nlp.hpp"
 #include "optimize/optimize.hpp"
+#include "optimize/program.hpp"
 
 namespace bd::optimize::detail {
 
@@ -16,7 +16,7 @@ namespace bd::optimize::detail {
 /// once options.max_evaluations objective evaluations are spent. Nothing is printed.
 /// Thread-safe: solves from several threads run one at a time (Debian 12's Ipopt 3.11 calls
 /// MUMPS, which is not thread-safe).
-DriverOutcome solve_with_ipopt(const Nlp& nlp, const Eigen::VectorXd& x0,
+DriverOutcome solve_with_ipopt(const Program& nlp, const Eigen::VectorXd& x0,
                                const OptimizeOptions& options);
 
 }  // namespace bd::optimize::detail

@@ -30,7 +30,7 @@ bool same_point(const VectorXd& a, const VectorXd& b) {
 // ---------------------------------------------------------------------------------------------
 // TrackedNlp
 
-TrackedNlp::TrackedNlp(const Nlp& nlp, double constraint_tolerance)
+TrackedNlp::TrackedNlp(const Program& nlp, double constraint_tolerance)
     : nlp_(nlp), tolerance_(constraint_tolerance) {}
 
 double TrackedNlp::objective(const VectorXd& x, VectorXd* grad) {
@@ -71,7 +71,7 @@ void TrackedNlp::consider() {
   best_x_ = x_f_;
 }
 
-double constraint_violation(const Nlp& nlp, const VectorXd& x, int* worst, double* value) {
+double constraint_violation(const Program& nlp, const VectorXd& x, int* worst, double* value) {
   double largest = 0.0;
   int index = -1;
   double at = 0.0;
@@ -256,7 +256,7 @@ struct Run {
 Run run_nlopt(nlopt_algorithm algorithm, bool mma, TrackedNlp& tracked, const VectorXd& x0,
               const VectorXd& lower, const VectorXd& upper, int max_evaluations,
               const OptimizeOptions& options, bool stop_on_tolerances) {
-  const Nlp& nlp = tracked.nlp();
+  const Program& nlp = tracked.nlp();
   const unsigned n = static_cast<unsigned>(nlp.n());
   Run run;
   Context ctx;
@@ -354,7 +354,7 @@ Run run_slsqp(TrackedNlp& tracked, const VectorXd& x0, const VectorXd& lower, co
 // best feasible point the run visited (when better than NLopt's)
 VectorXd chosen_point(const Run& run, const TrackedNlp& tracked, double tolerance,
                       std::string& note) {
-  const Nlp& nlp = tracked.nlp();
+  const Program& nlp = tracked.nlp();
   const bool feasible = constraint_violation(nlp, run.x) <= tolerance;
   const bool converged = termination_of(run.result) == Termination::kConverged;
   if (feasible && (converged || !tracked.has_best() || run.f <= tracked.best_objective())) {
@@ -403,7 +403,7 @@ double radical_inverse(int i, int b) {
 
 // "mlsl": a multistart of SLSQP runs from x0 and from Halton points (randomly shifted by the
 // seed, a Cranley-Patterson rotation) within the bounds, the best feasible optimum kept
-DriverOutcome multistart(const Nlp& nlp, const VectorXd& x0, const OptimizeOptions& options) {
+DriverOutcome multistart(const Program& nlp, const VectorXd& x0, const OptimizeOptions& options) {
   constexpr int kStarts = 8;
   TrackedNlp tracked(nlp, options.constraint_tolerance);
   VectorXd lower = nlp.lower(), upper = nlp.upper();
@@ -473,7 +473,8 @@ DriverOutcome multistart(const Nlp& nlp, const VectorXd& x0, const OptimizeOptio
 
 }  // namespace
 
-DriverOutcome solve_with_nlopt(const Nlp& nlp, const VectorXd& x0, const OptimizeOptions& options) {
+DriverOutcome solve_with_nlopt(const Program& nlp, const VectorXd& x0,
+                               const OptimizeOptions& options) {
   if (options.algorithm == Algorithm::kMlsl) return multistart(nlp, x0, options);
 
   nlopt_algorithm algorithm = NLOPT_LD_SLSQP;

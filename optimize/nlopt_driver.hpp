@@ -1,13 +1,13 @@
 #pragma once
-/// Internal to bd_optimize (included by optimize.cpp and ipopt_driver.cpp only): what a solver
+/// Internal to bd_optimize (included by its optimize*.cpp and ipopt_driver.cpp only): what a solver
 /// driver returns, the evaluation counter that remembers the best feasible point a solver has
 /// seen, and the NLopt driver. NLopt's own header appears only in nlopt_driver.cpp.
 #include <Eigen/Core>
 #include <limits>
 #include <string>
 
-#include "optimize/nlp.hpp"
 #include "optimize/optimize.hpp"
+#include "optimize/program.hpp"
 
 namespace bd::optimize::detail {
 
@@ -27,9 +27,9 @@ struct DriverOutcome {
 /// the best feasible point it visited rather than its last iterate.
 class TrackedNlp {
  public:
-  TrackedNlp(const Nlp& nlp, double constraint_tolerance);
+  TrackedNlp(const Program& nlp, double constraint_tolerance);
 
-  const Nlp& nlp() const { return nlp_; }
+  const Program& nlp() const { return nlp_; }
   double objective(const Eigen::VectorXd& x, Eigen::VectorXd* grad);
   void equalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac);
   void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac);
@@ -50,7 +50,7 @@ class TrackedNlp {
  private:
   void consider();  // a candidate when f, c_eq and c_in are known at one x
 
-  const Nlp& nlp_;
+  const Program& nlp_;
   double tolerance_;
   int evaluations_{};
   Eigen::VectorXd x_f_, x_eq_, x_in_;  // where each part was last evaluated
@@ -63,7 +63,7 @@ class TrackedNlp {
 /// Largest scaled constraint violation at x: max(|c_eq|, max(c_in, 0)), 0 without constraints.
 /// `worst` (if not null) receives the index into nlp.constraint_names() of the worst one (-1 if
 /// none is violated) and `value` its value.
-double constraint_violation(const Nlp& nlp, const Eigen::VectorXd& x, int* worst = nullptr,
+double constraint_violation(const Program& nlp, const Eigen::VectorXd& x, int* worst = nullptr,
                             double* value = nullptr);
 
 /// Runs the NLopt algorithm of options.algorithm (slsqp, mma, mlsl, isres, cobyla) from x0.
@@ -83,7 +83,22 @@ double constraint_violation(const Nlp& nlp, const Eigen::VectorXd& x, int* worst
 ///   (seeded by options.seed); the best feasible local optimum is kept.
 /// Budget: options.max_evaluations objective evaluations in all; xtol_rel = ftol_rel =
 /// options.relative_tolerance for the local methods, the budget alone for isres.
-DriverOutcome solve_with_nlopt(const Nlp& nlp, const Eigen::VectorXd& x0,
+/// A program solved by options.algorithm from x0, with the feasibility of the point returned
+/// checked whatever the solver said (the message then names the binding constraint). With
+/// options.check_gradients and exact gradients, the analytic derivatives are first compared with
+/// central differences at x0; a disagreement ends it there (kFailed at x0, the worst entry in the
+/// message, gradient_check_failed set).
+struct Solved {
+  Termination termination = Termination::kFailed;
+  std::string message;
+  Eigen::VectorXd x;
+  int iterations{}, evaluations{};
+  double seconds{}, objective{}, constraint_violation{};
+  bool gradient_check_failed{};
+};
+Solved solve(const Program& program, const Eigen::VectorXd& x0, const OptimizeOptions& options);
+
+DriverOutcome solve_with_nlopt(const Program& nlp, const Eigen::VectorXd& x0,
                                const OptimizeOptions& options);
 
 }  // namespace bd::optimize::detail

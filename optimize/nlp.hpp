@@ -70,6 +70,7 @@
 #include "core/fourbar/model.hpp"
 #include "optimize/optimize.hpp"
 #include "optimize/problem.hpp"
+#include "optimize/program.hpp"
 
 namespace bd::optimize {
 
@@ -77,7 +78,7 @@ namespace detail {
 class NlpProgram;
 }
 
-class Nlp {
+class Nlp final : public Program {
  public:
   /// Precomputes what the problem needs (the regressor for a driven scene, the original's
   /// metrics for the normalisation).
@@ -90,15 +91,15 @@ class Nlp {
   /// that of the term or limit, e.g. text() "objective[0]: the original design's Fsh_rms is 0 N,
   /// too small to normalise by (it is already minimal)".
   explicit Nlp(const DesignProblem& problem);
-  ~Nlp();
+  ~Nlp() override;
   Nlp(const Nlp&) = delete;
   Nlp& operator=(const Nlp&) = delete;
 
-  int n() const;       // variables, bound variables included
-  int n_eq() const;    // equality constraints
-  int n_ineq() const;  // inequality constraints (c <= 0)
-  const Eigen::VectorXd& lower() const;
-  const Eigen::VectorXd& upper() const;
+  int n() const override;       // variables, bound variables included
+  int n_eq() const override;    // equality constraints
+  int n_ineq() const override;  // inequality constraints (c <= 0)
+  const Eigen::VectorXd& lower() const override;
+  const Eigen::VectorXd& upper() const override;
   /// The natural start: each link parameter at its value in the original design (clamped to its
   /// bounds); each counterweight, which the original lacks, at half its mass_max and half its
   /// distance_max on the far side of the pivot (crank: (-d/2, 0) from A0; rocker: (d/2, 0) from
@@ -106,16 +107,17 @@ class Nlp {
   Eigen::VectorXd start() const;
   /// Names of the variables and of the constraints, for messages ("crank counterweight mass [kg]",
   /// "force balance, crank side (real part)", "Fsh_rms <= 0.2 x original", ...).
-  const std::vector<std::string>& variable_names() const;
-  const std::vector<std::string>& constraint_names() const;  // equalities first
+  const std::vector<std::string>& variable_names() const override;
+  const std::vector<std::string>& constraint_names() const override;  // equalities first
   /// True when exact gradients are available (driven scenes).
-  bool has_gradients() const;
+  bool has_gradients() const override;
 
   /// The objective and, when `grad` is not null, its gradient.
-  double objective(const Eigen::VectorXd& x, Eigen::VectorXd* grad) const;
+  double objective(const Eigen::VectorXd& x, Eigen::VectorXd* grad) const override;
   /// The equality constraints c_eq(x) (size n_eq) and, when `jac` is not null, their Jacobian
   /// (n_eq x n). Scaled by the original total mass.
-  void equalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac) const;
+  void equalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
+                  Eigen::MatrixXd* jac) const override;
   /// The inequality constraints c_in(x) <= 0 (size n_ineq), Jacobian n_ineq x n, in this order:
   /// the counterweight envelopes (x² + y²)/distance_max² - 1, the limits (problem order), then
   /// the peak-bound constraints per sample for each peak objective term:
@@ -123,7 +125,8 @@ class Nlp {
   /// (squared form).
   /// Gradients (objective, equalities, inequalities) are exact where has_gradients(); asking for
   /// one otherwise throws std::logic_error. A wrong x.size() throws bd::InputError.
-  void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac) const;
+  void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
+                    Eigen::MatrixXd* jac) const override;
 
   /// The design at x (counterweights merged into their links), and its counterweights.
   core::FourBar design(const Eigen::VectorXd& x) const;

@@ -40,7 +40,7 @@ struct Worst {
 
 // the differences of every output of `fun` (objective or constraints) with respect to x_j
 template <class Fun>
-VectorXd difference(const Nlp& nlp, const VectorXd& x, int j, Fun&& fun) {
+VectorXd difference(const Program& nlp, const VectorXd& x, int j, Fun&& fun) {
   const double h = 1e-6 * std::max(1.0, std::abs(x[j]));
   VectorXd xp = x;
   auto at = [&](double step) {
@@ -55,7 +55,8 @@ VectorXd difference(const Nlp& nlp, const VectorXd& x, int j, Fun&& fun) {
 }
 
 void compare(const MatrixXd& analytic, const MatrixXd& numeric,
-             const std::vector<std::string>& rows, int row_offset, const Nlp& nlp, Worst& worst) {
+             const std::vector<std::string>& rows, int row_offset, const Program& nlp,
+             Worst& worst) {
   for (int i = 0; i < analytic.rows(); ++i) {
     for (int j = 0; j < analytic.cols(); ++j) {
       const double a = analytic(i, j), d = numeric(i, j);
@@ -72,7 +73,7 @@ void compare(const MatrixXd& analytic, const MatrixXd& numeric,
 }
 
 // "" when every entry agrees, else the worst entry in words
-std::string check_gradients(const Nlp& nlp, const VectorXd& x) {
+std::string check_gradients(const Program& nlp, const VectorXd& x) {
   const int n = nlp.n();
   Worst worst;
   // objective
@@ -253,27 +254,10 @@ std::string OptimizeResult::brief_report() const {
 
 namespace {
 
-// The result at x0 when the gradient check failed (`message`): not solved, not verified.
-OptimizeResult gradient_check_failed(const Nlp& nlp, const VectorXd& x0,
-                                     const OptimizeOptions& options, std::string message) {
-  OptimizeResult r;
-  r.algorithm = options.algorithm;
-  r.termination = Termination::kFailed;
-  r.message = std::move(message);
-  r.x = x0;
-  r.objective = nlp.objective(x0, nullptr);
-  r.constraint_violation = detail::constraint_violation(nlp, x0);
-  r.design = nlp.design(x0);
-  r.counterweights = nlp.counterweights(x0);
-  r.metrics = nlp.metrics(x0);
-  r.verification_error = std::numeric_limits<double>::quiet_NaN();  // not verified
-  return r;
-}
-
 // The feasibility of the point returned, whatever the solver said: r.constraint_violation, and
 // the termination and message when they disagree with it (`solver` is the solver's message).
-void check_feasibility(const Nlp& nlp, const OptimizeOptions& options, const std::string& solver,
-                       OptimizeResult& r) {
+void check_feasibility(const Program& nlp, const OptimizeOptions& options,
+                       const std::string& solver, detail::Solved& r) {
   int worst = -1;
   double worst_value = 0.0;
   r.constraint_violation = detail::constraint_violation(nlp, r.x, &worst, &worst_value);
@@ -314,27 +298,26 @@ void verify(const DesignProblem& problem, OptimizeResult& r) {
 
 }  // namespace
 
-OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& options) {
-  detail::check_inputs(problem, options);
-  const Nlp nlp(problem);
-  throw_if(check_algorithm(problem, options));
-  const VectorXd x0 = nlp.start();
+detail::Solved detail::solve(const Program& nlp, const VectorXd& x0,
+                             const OptimizeOptions& options) {
+  Solved r;
   if (options.check_gradients && nlp.has_gradients()) {
     // a wrong derivative would mislead every gradient method: stop before solving (Ceres)
     if (std::string e = check_gradients(nlp, x0); !e.empty()) {
-      return gradient_check_failed(nlp, x0, options, std::move(e));
+      r.termination = Termination::kFailed;
+      r.message = std::move(e);
+      r.x = x0;
+      r.objective = nlp.objective(x0, nullptr);
+      r.constraint_violation = constraint_violation(nlp, x0);
+      r.gradient_check_failed = true;
+      return r;
     }
   }
-
-  // the solve
   const auto started = std::chrono::steady_clock::now();
-  detail::DriverOutcome outcome = options.algorithm == Algorithm::kIpopt
-                                      ? detail::solve_with_ipopt(nlp, x0, options)
-                                      : detail::solve_with_nlopt(nlp, x0, options);
+  DriverOutcome outcome = options.algorithm == Algorithm::kIpopt
+                              ? solve_with_ipopt(nlp, x0, options)
+                              : solve_with_nlopt(nlp, x0, options);
   const auto stopped = std::chrono::steady_clock::now();
-
-  OptimizeResult r;
-  r.algorithm = options.algorithm;
   r.termination = outcome.termination;
   r.message = outcome.message;
   r.x = outcome.x;
@@ -343,11 +326,33 @@ OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& opt
   r.seconds = std::chrono::duration<double>(stopped - started).count();
   r.objective = nlp.objective(r.x, nullptr);
   check_feasibility(nlp, options, outcome.message, r);
+  return r;
+}
 
+OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& options) {
+  detail::check_inputs(problem, options);
+  const Nlp nlp(problem);
+  throw_if(check_algorithm(problem, options));
+  const detail::Solved solved = detail::solve(nlp, nlp.start(), options);
+
+  OptimizeResult r;
+  r.algorithm = options.algorithm;
+  r.termination = solved.termination;
+  r.message = solved.message;
+  r.x = solved.x;
+  r.iterations = solved.iterations;
+  r.evaluations = solved.evaluations;
+  r.seconds = solved.seconds;
+  r.objective = solved.objective;
+  r.constraint_violation = solved.constraint_violation;
   // the optimum as a design, as the optimiser evaluated it, then verified
   r.design = nlp.design(r.x);
   r.counterweights = nlp.counterweights(r.x);
   r.metrics = nlp.metrics(r.x);
+  if (solved.gradient_check_failed) {
+    r.verification_error = std::numeric_limits<double>::quiet_NaN();  // not verified
+    return r;
+  }
   verify(problem, r);
   return r;
 }

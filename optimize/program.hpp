@@ -1,0 +1,39 @@
+#pragma once
+/// A smooth nonlinear program as the solver drivers see it:
+///   minimise f(x)  subject to  c_eq(x) = 0,  c_in(x) <= 0,  lower <= x <= upper.
+/// The drivers (NLopt, Ipopt), the gradient check and the feasibility check work on this and
+/// nothing else, so any linkage type's design problem is solved by the same code: the
+/// four-bar's Nlp (optimize/nlp.hpp) and the general planar linkage's PlanarNlp
+/// (optimize/planar.hpp) implement it. Constraints are scaled to be of order one.
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace bd::optimize {
+
+class Program {
+ public:
+  virtual ~Program() = default;
+
+  virtual int n() const = 0;       // variables
+  virtual int n_eq() const = 0;    // equality constraints
+  virtual int n_ineq() const = 0;  // inequality constraints (c <= 0)
+  virtual const Eigen::VectorXd& lower() const = 0;
+  virtual const Eigen::VectorXd& upper() const = 0;
+  /// Names of the variables and of the constraints (equalities first), for messages.
+  virtual const std::vector<std::string>& variable_names() const = 0;
+  virtual const std::vector<std::string>& constraint_names() const = 0;
+  /// True when exact gradients are available; asking for one otherwise throws
+  /// std::logic_error.
+  virtual bool has_gradients() const = 0;
+  /// The objective and, when `grad` is not null, its gradient.
+  virtual double objective(const Eigen::VectorXd& x, Eigen::VectorXd* grad) const = 0;
+  /// c_eq(x) (size n_eq) and, when `jac` is not null, its Jacobian (n_eq x n).
+  virtual void equalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
+                          Eigen::MatrixXd* jac) const = 0;
+  /// c_in(x) (size n_ineq) and, when `jac` is not null, its Jacobian (n_ineq x n).
+  virtual void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
+                            Eigen::MatrixXd* jac) const = 0;
+};
+
+}  // namespace bd::optimize
