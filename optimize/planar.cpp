@@ -1,0 +1,748 @@
+#include "optimize/planar.hpp"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <set>
+
+#include "core/input_error.hpp"
+#include "core/number_text.hpp"
+#include "optimize/nlopt_driver.hpp"
+
+namespace bd::optimize::planar {
+
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+namespace bp = balance::planar;
+using P = bp::Parameters;
+using Param = LinkParameterVariable::Parameter;
+
+Problem field(const std::string& name, int index, const std::string& message) {
+  return FieldError{name, index, message};
+}
+
+// a link's node that turns about the frame, else its first node: where its counterweight's
+// position is measured from
+int pivot(const cp::Linkage& l, int link) {
+  const int g = cp::pivot_of(l, link);
+  return g >= 0 ? g : l.links[static_cast<std::size_t>(link)].nodes[0];
+}
+
+// a drawn point in link k's axes, from its first node
+Vec2 in_link_axes(const cp::Linkage& l, int k, const Vec2& point) {
+  const auto& nodes = l.links[static_cast<std::size_t>(k)].nodes;
+  const Vec2 p = l.nodes[static_cast<std::size_t>(nodes[0])].position;
+  const Vec2 d = l.nodes[static_cast<std::size_t>(nodes[1])].position - p;
+  const double a = std::atan2(d.y(), d.x()), c = std::cos(a), s = std::sin(a);
+  const Vec2 r = point - p;
+  return {c * r.x() + s * r.y(), -s * r.x() + c * r.y()};
+}
+
+double disc_inertia_per_mass2(const CounterweightVariables& c) {  // I = m² / (2 ρ π t)
+  return c.shape == balance::CounterweightShape::kDisc
+             ? 1.0 / (2 * c.density * std::numbers::pi * c.thickness)
+             : 0.0;
+}
+
+const char* parameter_text(Param p) {
+  switch (p) {
+    case Param::kMass:
+      return "mass";
+    case Param::kE:
+      return "e";
+    case Param::kF:
+      return "f";
+    case Param::kInertia:
+      return "inertia";
+  }
+  return "?";
+}
+
+}  // namespace
+
+Problem DesignProblem::validate() const {
+  const cp::Linkage& l = original;
+  const int links = static_cast<int>(l.links.size());
+  const std::vector<cp::ColumnMetric> table = cp::metric_table(cp::Model(l));
+  auto metric = [&](const std::string& name) -> const cp::ColumnMetric* {
+    for (const cp::ColumnMetric& m : table)
+      if (m.name == name) return &m;
+    return nullptr;
+  };
+  std::string names;
+  for (const cp::ColumnMetric& m : table) names += (names.empty() ? "" : ", ") + m.name;
+  if (counterweights.empty() && link_parameters.empty())
+    return field("", -1, "no design variable: give counterweights or link parameters");
+  std::set<int> moved;  // links whose centre of mass the variables move
+  std::set<int> with_cw;
+  for (std::size_t i = 0; i < counterweights.size(); ++i) {
+    const CounterweightVariables& c = counterweights[i];
+    const int k = static_cast<int>(i);
+    if (c.link < 0 || c.link >= links) return field("counterweights", k, ": not a link");
+    if (!with_cw.insert(c.link).second)
+      return field("counterweights", k, ": a second counterweight on the link");
+    if (!(std::isfinite(c.mass_max) && c.mass_max > 0))
+      return field("counterweights", k,
+                   ".mass_max must be > 0 kg, got " + text::shortest(c.mass_max));
+    if (!(std::isfinite(c.distance_max) && c.distance_max > 0))
+      return field("counterweights", k,
+                   ".distance_max must be > 0 m, got " + text::shortest(c.distance_max));
+    if (c.shape == balance::CounterweightShape::kDisc &&
+        !(c.thickness > 0 && c.density > 0 && std::isfinite(c.thickness) &&
+          std::isfinite(c.density)))
+      return field("counterweights", k, ": a disc needs thickness > 0 m and density > 0 kg/m^3");
+    moved.insert(c.link);
+  }
+  std::set<std::pair<int, int>> seen;
+  for (std::size_t i = 0; i < link_parameters.size(); ++i) {
+    const LinkParameterVariable& v = link_parameters[i];
+    const int k = static_cast<int>(i);
+    if (v.link < 0 || v.link >= links) return field("link_parameters", k, ": not a link");
+    const std::string what = "(" + l.links[static_cast<std::size_t>(v.link)].name + "." +
+                             parameter_text(v.parameter) + ")";
+    if (!seen.insert({v.link, static_cast<int>(v.parameter)}).second)
+      return field("link_parameters", k, ": " + what + " is a variable twice");
+    if (!(std::isfinite(v.lower) && std::isfinite(v.upper) && v.lower <= v.upper))
+      return field("link_parameters", k, ": " + what + " needs finite bounds, lower <= upper");
+    if (v.parameter == Param::kMass && !(v.lower > 0))
+      return field("link_parameters", k, ": " + what + ".lower must be > 0 kg");
+    if (v.parameter == Param::kInertia && !(v.lower >= 0))
+      return field("link_parameters", k, ": " + what + ".lower must be >= 0 kg m^2");
+    if (v.parameter != Param::kInertia) moved.insert(v.link);
+  }
+  for (const cp::LinkLoad& load : l.loads.link_loads) {
+    if (moved.count(load.link) > 0 && load.force.norm() > 0) {
+      return field("original", -1,
+                   ": link " + l.links[static_cast<std::size_t>(load.link)].name +
+                       " carries a force at its centre of mass, which the design variables move; "
+                       "apply it at a node to optimise this link");
+    }
+  }
+  if (objective.empty()) return field("objective", -1, ": give at least one term");
+  bool positive = false;
+  for (std::size_t i = 0; i < objective.size(); ++i) {
+    const Term& t = objective[i];
+    const int k = static_cast<int>(i);
+    if (!(std::isfinite(t.weight) && t.weight >= 0))
+      return field("objective", k, ".weight must be >= 0, got " + text::shortest(t.weight));
+    positive = positive || t.weight > 0;
+    if (t.metric == "added_mass") continue;
+    const cp::ColumnMetric* m = metric(t.metric);
+    if (!m)
+      return field("objective", k,
+                   ": no metric " + t.metric + " (metrics: " + names + ", added_mass)");
+    if (m->statistic == core::Statistic::kMax)
+      return field("objective", k,
+                   ": " + t.metric + " is a peak; minimise an RMS and limit the peak");
+  }
+  if (!positive) return field("objective", -1, ": at least one weight must be > 0");
+  for (std::size_t i = 0; i < limits.size(); ++i) {
+    const Limit& lim = limits[i];
+    const int k = static_cast<int>(i);
+    if (!std::isfinite(lim.value))
+      return field("limits", k, ".value must be finite, got " + text::shortest(lim.value));
+    if (lim.metric == "added_mass") continue;
+    if (!metric(lim.metric))
+      return field("limits", k,
+                   ": no metric " + lim.metric + " (metrics: " + names + ", added_mass)");
+    if (!(lim.value > 0))
+      return field(
+          "limits", k,
+          ".value must be > 0 (a fraction of the original), got " + text::shortest(lim.value));
+  }
+  if (!(smoothing > 0 && smoothing <= 0.1))
+    return field("smoothing", -1, "must be in (0, 0.1], got " + text::shortest(smoothing));
+  return std::nullopt;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+struct PlanarNlp::Impl {
+  DesignProblem p;
+  int nq{}, samples{};
+  VectorXd q0;
+  double mass0{}, length{};
+  std::vector<cp::ColumnMetric> table;
+  std::vector<double> original;
+  // per output column used by a metric: y = base + B (q - q0), samples x nq
+  std::map<std::string, std::pair<VectorXd, MatrixXd>> outputs;
+  std::vector<double> times;
+  // variables
+  int n{};
+  VectorXd lower, upper;
+  std::vector<std::string> variable_names, constraint_names;
+  std::vector<int> cw_var, param_var;
+  std::vector<int> cw_pivot;
+  std::vector<Vec2> cw_pivot_in_link, cw_away;
+  // objective weights per metric (table order) and on added_mass
+  std::vector<double> weight;
+  double added_weight{};
+  // constraints
+  MatrixXd balance_rows;  // r x nq: U_rᵀ Z / (M0 L)
+  VectorXd balance_offset;
+  struct Row {
+    enum class Kind { kEnvelope, kRmsLimit, kPeakLimit, kAddedMass } kind{};
+    int index{};   // counterweight, or metric
+    int sample{};  // peak limits
+    double value{};
+  };
+  std::vector<Row> rows;
+
+  void build_regressor();
+  void set_up_variables();
+  void set_up_constraints();
+  void q_of(const VectorXd& x, VectorXd& q, MatrixXd* J) const;
+  const cp::ColumnMetric& metric(int k) const { return table[static_cast<std::size_t>(k)]; }
+  int metric_index(const std::string& name) const {
+    for (std::size_t k = 0; k < table.size(); ++k)
+      if (table[k].name == name) return static_cast<int>(k);
+    return -1;
+  }
+  // the columns' values at q, and their Jacobians B J when J is given
+  struct Columns {
+    std::vector<VectorXd> y;
+    std::vector<MatrixXd> dy;
+  };
+  Columns columns(int k, const VectorXd& q, const MatrixXd* J) const {
+    Columns c;
+    for (const std::string& name : metric(k).columns) {
+      const auto& [base, B] = outputs.at(name);
+      c.y.push_back(base + B * (q - q0));
+      if (J) c.dy.push_back(B * *J);
+    }
+    return c;
+  }
+  double rms2(const Columns& c, VectorXd* grad) const {
+    double s = 0;
+    if (grad) grad->setZero(n);
+    for (std::size_t i = 0; i < c.y.size(); ++i) {
+      s += c.y[i].squaredNorm();
+      if (grad) *grad += 2.0 * c.dy[i].transpose() * c.y[i];
+    }
+    if (grad) *grad /= samples;
+    return s / samples;
+  }
+  double added(const VectorXd& q, const MatrixXd* J, VectorXd* grad) const {
+    double a = 0;
+    if (grad) grad->setZero(n);
+    for (std::size_t k = 0; k < p.original.links.size(); ++k) {
+      const int i = P::link_mass(static_cast<int>(k));
+      a += q[i] - q0[i];
+      if (grad) *grad += J->row(i).transpose();
+    }
+    return a;
+  }
+};
+
+void PlanarNlp::Impl::build_regressor() {
+  const cp::Linkage& l = p.original;
+  std::set<std::string> used;
+  for (const cp::ColumnMetric& m : table)
+    for (const std::string& c : m.columns) used.insert(c);
+  auto run = [&](const VectorXd& q, const char* what) {
+    cp::Linkage d = l;
+    for (std::size_t k = 0; k < l.links.size(); ++k) {
+      const int i = static_cast<int>(k);
+      cp::Link& link = d.links[k];
+      link.mass = q[P::link_mass(i)];
+      link.e = q[P::link_me(i)] / link.mass;
+      link.f = q[P::link_mf(i)] / link.mass;
+      link.inertia = q[P::link_J(i)] - link.mass * (link.e * link.e + link.f * link.f);
+    }
+    for (std::size_t j = 0; j < l.point_masses.size(); ++j)
+      d.point_masses[j].mass = q[P::point_mass(l, static_cast<int>(j))];
+    const cp::Trajectory t = cp::simulate_driven(cp::Model(cp::make_linkage(d)), p.scene);
+    if (!t.ok()) throw InputError(std::string(what) + " cannot run in the scene: " + t.message);
+    return t;
+  };
+  const cp::Trajectory base = run(q0, "the original design");
+  samples = static_cast<int>(base.table.rows());
+  times = base.table.column_values("t");
+  original = cp::metric_values(table, base.table);
+  for (const std::string& c : used) {
+    const std::vector<double> v = base.table.column_values(c);
+    outputs[c] = {Eigen::Map<const VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())),
+                  MatrixXd::Zero(samples, nq)};
+  }
+  // one column per parameter: the outputs are affine in q, so a difference is exact (to
+  // round-off); a link's J is raised with its first moments so that its inertia stays >= 0
+  for (int i = 0; i < nq; ++i) {
+    VectorXd lo = q0, hi = q0;
+    double step = 1.0;
+    const int k = i < 4 * static_cast<int>(l.links.size()) ? i / 4 : -1;
+    if (k >= 0) {
+      const double m = std::max(q0[P::link_mass(k)], 1e-6 * mass0);
+      const double L = cp::element_length(l, k);
+      const int which = i - 4 * k;
+      step = which == 0 ? m : which == 3 ? m * L * L : m * L;
+      if (which == 0 && q0[P::link_mass(k)] <= 0) {
+        throw InputError("link " + l.links[static_cast<std::size_t>(k)].name +
+                         " has no mass: give it one to optimise the linkage");
+      }
+      const double lift = which == 1 || which == 2 ? 4 * m * L * L : 0.0;
+      lo[P::link_J(k)] += lift;
+      hi[P::link_J(k)] += lift;
+    } else {
+      step = std::max(q0[i], 1e-3 * mass0);
+    }
+    hi[i] += step;
+    const cp::Trajectory a = run(lo, "a perturbed design"), b = run(hi, "a perturbed design");
+    for (auto& [name, out] : outputs) {
+      const std::vector<double> ya = a.table.column_values(name), yb = b.table.column_values(name);
+      for (int s = 0; s < samples; ++s)
+        out.second(s, i) =
+            (yb[static_cast<std::size_t>(s)] - ya[static_cast<std::size_t>(s)]) / step;
+    }
+  }
+  // the force-balance conditions: the momentum per unit input rate, in its independent rows
+  if (p.force_balance) {
+    const cp::Model model(l);
+    const bp::InputSeries in = bp::input_series(model, base.table);
+    const auto k = bp::kinematics(model, in.values, in.rates, in.accelerations);
+    if (!k) throw InputError("the original's motion cannot be evaluated: " + k.error().detail);
+    const MatrixXd Z = bp::momentum_regressor(l, *k);
+    const VectorXd z0 = bp::shaft_series(l, *k).momentum;
+    MatrixXd S = Z;  // columns scaled to one unit for the rank
+    for (std::size_t j = 0; j < l.links.size(); ++j) {
+      S.col(P::link_me(static_cast<int>(j))) *= length;
+      S.col(P::link_mf(static_cast<int>(j))) *= length;
+      S.col(P::link_J(static_cast<int>(j))) *= length * length;
+    }
+    Eigen::JacobiSVD<MatrixXd> svd(S, Eigen::ComputeThinU);
+    svd.setThreshold(1e-10);
+    const MatrixXd U = svd.matrixU().leftCols(svd.rank());
+    balance_rows = U.transpose() * Z / (mass0 * length);
+    balance_offset = U.transpose() * z0 / (mass0 * length);
+  }
+}
+
+void PlanarNlp::Impl::set_up_variables() {
+  const cp::Linkage& l = p.original;
+  auto add = [&](double lo, double hi, std::string name) {
+    lower.conservativeResize(n + 1);
+    upper.conservativeResize(n + 1);
+    lower[n] = lo;
+    upper[n] = hi;
+    variable_names.push_back(std::move(name));
+    return n++;
+  };
+  for (const CounterweightVariables& c : p.counterweights) {
+    const std::string name = l.links[static_cast<std::size_t>(c.link)].name;
+    const int pv = pivot(l, c.link);
+    cw_pivot.push_back(pv);
+    cw_pivot_in_link.push_back(
+        in_link_axes(l, c.link, l.nodes[static_cast<std::size_t>(pv)].position));
+    // away from the link's other node (its second, or its first when the pivot is the second)
+    const auto& nodes = l.links[static_cast<std::size_t>(c.link)].nodes;
+    const int other = nodes[0] == pv ? nodes[1] : nodes[0];
+    const Vec2 d = in_link_axes(l, c.link, l.nodes[static_cast<std::size_t>(other)].position) -
+                   cw_pivot_in_link.back();
+    cw_away.push_back(-d.normalized());
+    cw_var.push_back(add(0.0, c.mass_max, name + " counterweight mass [kg]"));
+    add(-c.distance_max, c.distance_max, name + " counterweight x [m]");
+    add(-c.distance_max, c.distance_max, name + " counterweight y [m]");
+  }
+  for (const LinkParameterVariable& v : p.link_parameters) {
+    param_var.push_back(
+        add(v.lower, v.upper,
+            l.links[static_cast<std::size_t>(v.link)].name + "." + parameter_text(v.parameter)));
+  }
+}
+
+void PlanarNlp::Impl::set_up_constraints() {
+  for (Eigen::Index r = 0; r < balance_rows.rows(); ++r)
+    constraint_names.push_back("force balance, condition " + std::to_string(r + 1));
+  for (std::size_t c = 0; c < p.counterweights.size(); ++c) {
+    rows.push_back({Row::Kind::kEnvelope, static_cast<int>(c), 0, 0.0});
+    constraint_names.push_back(
+        p.original.links[static_cast<std::size_t>(p.counterweights[c].link)].name +
+        " counterweight within distance_max = " +
+        text::digits(p.counterweights[c].distance_max, 6) + " m of its pivot");
+  }
+  for (const Limit& lim : p.limits) {
+    const std::string what = lim.metric + " <= " + text::digits(lim.value, 6);
+    if (lim.metric == "added_mass") {
+      rows.push_back({Row::Kind::kAddedMass, -1, 0, lim.value});
+      constraint_names.push_back(what + " kg");
+      continue;
+    }
+    const int k = metric_index(lim.metric);
+    if (metric(k).statistic == core::Statistic::kRms) {
+      rows.push_back({Row::Kind::kRmsLimit, k, 0, lim.value});
+      constraint_names.push_back(what + " x original");
+    } else {
+      for (int s = 0; s < samples; ++s) {
+        rows.push_back({Row::Kind::kPeakLimit, k, s, lim.value});
+        constraint_names.push_back(what + " x original at t = " +
+                                   text::digits(times[static_cast<std::size_t>(s)], 6) + " s");
+      }
+    }
+  }
+}
+
+void PlanarNlp::Impl::q_of(const VectorXd& x, VectorXd& q, MatrixXd* J) const {
+  const cp::Linkage& l = p.original;
+  q = q0;
+  if (J) J->setZero(nq, n);
+  // link parameters: the link's (m, e, f, I) with the variables' values, as π
+  std::map<int, std::array<int, 4>> vars;  // link -> variable of m, e, f, I (or -1)
+  for (std::size_t i = 0; i < p.link_parameters.size(); ++i) {
+    const LinkParameterVariable& v = p.link_parameters[i];
+    auto [it, _] = vars.try_emplace(v.link, std::array<int, 4>{-1, -1, -1, -1});
+    it->second[static_cast<std::size_t>(v.parameter)] = param_var[i];
+  }
+  for (const auto& [k, var] : vars) {
+    const cp::Link& link = l.links[static_cast<std::size_t>(k)];
+    const double m = var[0] >= 0 ? x[var[0]] : link.mass, e = var[1] >= 0 ? x[var[1]] : link.e,
+                 f = var[2] >= 0 ? x[var[2]] : link.f, I = var[3] >= 0 ? x[var[3]] : link.inertia;
+    q[P::link_mass(k)] = m;
+    q[P::link_me(k)] = m * e;
+    q[P::link_mf(k)] = m * f;
+    q[P::link_J(k)] = I + m * (e * e + f * f);
+    if (!J) continue;
+    if (var[0] >= 0) {
+      (*J)(P::link_mass(k), var[0]) = 1;
+      (*J)(P::link_me(k), var[0]) = e;
+      (*J)(P::link_mf(k), var[0]) = f;
+      (*J)(P::link_J(k), var[0]) = e * e + f * f;
+    }
+    if (var[1] >= 0) {
+      (*J)(P::link_me(k), var[1]) = m;
+      (*J)(P::link_J(k), var[1]) = 2 * m * e;
+    }
+    if (var[2] >= 0) {
+      (*J)(P::link_mf(k), var[2]) = m;
+      (*J)(P::link_J(k), var[2]) = 2 * m * f;
+    }
+    if (var[3] >= 0) (*J)(P::link_J(k), var[3]) = 1;
+  }
+  // counterweights: a mass at the pivot + (x, y), and a disc's own inertia
+  for (std::size_t c = 0; c < p.counterweights.size(); ++c) {
+    const int k = p.counterweights[c].link, v = cw_var[c];
+    const double mc = x[v];
+    const Vec2 r = cw_pivot_in_link[c] + Vec2(x[v + 1], x[v + 2]);
+    const double a = disc_inertia_per_mass2(p.counterweights[c]);
+    q[P::link_mass(k)] += mc;
+    q[P::link_me(k)] += mc * r.x();
+    q[P::link_mf(k)] += mc * r.y();
+    q[P::link_J(k)] += mc * r.squaredNorm() + a * mc * mc;
+    if (!J) continue;
+    (*J)(P::link_mass(k), v) += 1;
+    (*J)(P::link_me(k), v) += r.x();
+    (*J)(P::link_mf(k), v) += r.y();
+    (*J)(P::link_J(k), v) += r.squaredNorm() + 2 * a * mc;
+    (*J)(P::link_me(k), v + 1) += mc;
+    (*J)(P::link_J(k), v + 1) += 2 * mc * r.x();
+    (*J)(P::link_mf(k), v + 2) += mc;
+    (*J)(P::link_J(k), v + 2) += 2 * mc * r.y();
+  }
+}
+
+PlanarNlp::PlanarNlp(const DesignProblem& problem) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.p = problem;
+  m.p.original = cp::make_linkage(problem.original);
+  if (const Problem e = m.p.validate()) throw InputError("invalid design problem: " + e->text());
+  const cp::Linkage& l = m.p.original;
+  m.nq = P::count(l);
+  m.q0 = P::of(l);
+  m.mass0 = cp::total_mass(l);
+  for (std::size_t k = 0; k < l.links.size(); ++k)
+    m.length = std::max(m.length, cp::element_length(l, static_cast<int>(k)));
+  m.table = cp::metric_table(cp::Model(l));
+  m.build_regressor();
+  // the normalisers: the original's value of each metric in the objective or a limit
+  m.weight.assign(m.table.size(), 0.0);
+  auto normaliser = [&](const std::string& name, const char* list, int index) {
+    const int k = m.metric_index(name);
+    double scale = 0;
+    for (std::size_t j = 0; j < m.table.size(); ++j)
+      if (m.table[j].unit == m.metric(k).unit) scale = std::max(scale, m.original[j]);
+    if (!(m.original[static_cast<std::size_t>(k)] > 1e-10 * scale)) {
+      throw InputError(FieldError{list, index,
+                                  ": the original design's " + name + " is " +
+                                      text::digits(m.original[static_cast<std::size_t>(k)], 3) +
+                                      " " + m.metric(k).unit +
+                                      ", too small to normalise by (it is already minimal)"});
+    }
+    return k;
+  };
+  for (std::size_t i = 0; i < m.p.objective.size(); ++i) {
+    const Term& t = m.p.objective[i];
+    if (t.metric == "added_mass") {
+      m.added_weight += t.weight;
+    } else if (t.weight > 0) {
+      m.weight[static_cast<std::size_t>(normaliser(t.metric, "objective", static_cast<int>(i)))] +=
+          t.weight;
+    }
+  }
+  for (std::size_t i = 0; i < m.p.limits.size(); ++i)
+    if (m.p.limits[i].metric != "added_mass")
+      normaliser(m.p.limits[i].metric, "limits", static_cast<int>(i));
+  m.set_up_variables();
+  m.set_up_constraints();
+}
+
+PlanarNlp::~PlanarNlp() = default;
+
+int PlanarNlp::n() const { return impl_->n; }
+int PlanarNlp::n_eq() const { return static_cast<int>(impl_->balance_rows.rows()); }
+int PlanarNlp::n_ineq() const { return static_cast<int>(impl_->rows.size()); }
+const VectorXd& PlanarNlp::lower() const { return impl_->lower; }
+const VectorXd& PlanarNlp::upper() const { return impl_->upper; }
+const std::vector<std::string>& PlanarNlp::variable_names() const { return impl_->variable_names; }
+const std::vector<std::string>& PlanarNlp::constraint_names() const {
+  return impl_->constraint_names;
+}
+const std::vector<cp::ColumnMetric>& PlanarNlp::metric_table() const { return impl_->table; }
+const std::vector<double>& PlanarNlp::original_metrics() const { return impl_->original; }
+
+double PlanarNlp::objective(const VectorXd& x, VectorXd* grad) const {
+  const Impl& m = *impl_;
+  VectorXd q;
+  MatrixXd J;
+  m.q_of(x, q, grad ? &J : nullptr);
+  double f = 0;
+  if (grad) grad->setZero(m.n);
+  VectorXd g;
+  for (std::size_t k = 0; k < m.table.size(); ++k) {
+    if (m.weight[k] == 0) continue;
+    const double o = m.original[k];
+    const double r2 =
+        m.rms2(m.columns(static_cast<int>(k), q, grad ? &J : nullptr), grad ? &g : nullptr) /
+        (o * o);
+    const double s = std::sqrt(r2 + m.p.smoothing * m.p.smoothing);
+    f += m.weight[k] * s;
+    if (grad) *grad += m.weight[k] / (2 * s * o * o) * g;
+  }
+  if (m.added_weight > 0) {
+    f += m.added_weight * m.added(q, grad ? &J : nullptr, grad ? &g : nullptr) / m.mass0;
+    if (grad) *grad += m.added_weight / m.mass0 * g;
+  }
+  return f;
+}
+
+void PlanarNlp::equalities(const VectorXd& x, VectorXd& c, MatrixXd* jac) const {
+  const Impl& m = *impl_;
+  VectorXd q;
+  MatrixXd J;
+  m.q_of(x, q, jac ? &J : nullptr);
+  c = m.balance_rows * q + m.balance_offset;
+  if (jac) *jac = m.balance_rows * J;
+}
+
+void PlanarNlp::inequalities(const VectorXd& x, VectorXd& c, MatrixXd* jac) const {
+  const Impl& m = *impl_;
+  VectorXd q;
+  MatrixXd J;
+  m.q_of(x, q, jac ? &J : nullptr);
+  c.resize(static_cast<Eigen::Index>(m.rows.size()));
+  if (jac) jac->setZero(static_cast<Eigen::Index>(m.rows.size()), m.n);
+  std::map<int, Impl::Columns> cache;  // per metric
+  auto columns = [&](int k) -> const Impl::Columns& {
+    auto it = cache.find(k);
+    if (it == cache.end()) it = cache.emplace(k, m.columns(k, q, jac ? &J : nullptr)).first;
+    return it->second;
+  };
+  VectorXd g;
+  for (std::size_t i = 0; i < m.rows.size(); ++i) {
+    const Impl::Row& row = m.rows[i];
+    const Eigen::Index r = static_cast<Eigen::Index>(i);
+    switch (row.kind) {
+      case Impl::Row::Kind::kEnvelope: {
+        const int v = m.cw_var[static_cast<std::size_t>(row.index)];
+        const double d = m.p.counterweights[static_cast<std::size_t>(row.index)].distance_max;
+        c[r] = (x[v + 1] * x[v + 1] + x[v + 2] * x[v + 2]) / (d * d) - 1;
+        if (jac) {
+          (*jac)(r, v + 1) = 2 * x[v + 1] / (d * d);
+          (*jac)(r, v + 2) = 2 * x[v + 2] / (d * d);
+        }
+        break;
+      }
+      case Impl::Row::Kind::kAddedMass:
+        c[r] = (m.added(q, jac ? &J : nullptr, jac ? &g : nullptr) - row.value) / m.mass0;
+        if (jac) jac->row(r) = g.transpose() / m.mass0;
+        break;
+      case Impl::Row::Kind::kRmsLimit: {
+        const double bound = row.value * m.original[static_cast<std::size_t>(row.index)];
+        c[r] = m.rms2(columns(row.index), jac ? &g : nullptr) / (bound * bound) - 1;
+        if (jac) jac->row(r) = g.transpose() / (bound * bound);
+        break;
+      }
+      case Impl::Row::Kind::kPeakLimit: {
+        const double bound = row.value * m.original[static_cast<std::size_t>(row.index)];
+        const Impl::Columns& y = columns(row.index);
+        double s2 = 0;
+        for (std::size_t j = 0; j < y.y.size(); ++j) {
+          const double yi = y.y[j][row.sample];
+          s2 += yi * yi;
+          if (jac) jac->row(r) += 2 * yi * y.dy[j].row(row.sample) / (bound * bound);
+        }
+        c[r] = s2 / (bound * bound) - 1;
+        break;
+      }
+    }
+  }
+}
+
+VectorXd PlanarNlp::start() const {
+  const Impl& m = *impl_;
+  VectorXd x(m.n);
+  for (std::size_t c = 0; c < m.p.counterweights.size(); ++c) {
+    const CounterweightVariables& cw = m.p.counterweights[c];
+    const int v = m.cw_var[c];
+    x[v] = cw.mass_max / 2;
+    x.segment<2>(v + 1) = cw.distance_max / 2 * m.cw_away[c];
+  }
+  for (std::size_t i = 0; i < m.p.link_parameters.size(); ++i) {
+    const LinkParameterVariable& v = m.p.link_parameters[i];
+    const cp::Link& link = m.p.original.links[static_cast<std::size_t>(v.link)];
+    const double value = v.parameter == Param::kMass ? link.mass
+                         : v.parameter == Param::kE  ? link.e
+                         : v.parameter == Param::kF  ? link.f
+                                                     : link.inertia;
+    x[m.param_var[i]] = std::clamp(value, v.lower, v.upper);
+  }
+  return x;
+}
+
+std::vector<bp::LinkCounterweight> PlanarNlp::counterweights(const VectorXd& x) const {
+  const Impl& m = *impl_;
+  std::vector<bp::LinkCounterweight> out;
+  for (std::size_t c = 0; c < m.p.counterweights.size(); ++c) {
+    const CounterweightVariables& cw = m.p.counterweights[c];
+    const int v = m.cw_var[c];
+    balance::Counterweight w;
+    w.mass = x[v];
+    w.position = Vec2(x[v + 1], x[v + 2]);
+    w.distance = w.position.norm();
+    if (cw.shape == balance::CounterweightShape::kDisc) {
+      w.thickness = cw.thickness;
+      w.radius = std::sqrt(w.mass / (cw.density * std::numbers::pi * cw.thickness));
+    }
+    w.inertia = disc_inertia_per_mass2(cw) * w.mass * w.mass;
+    out.push_back({cw.link, m.cw_pivot[c], w});
+  }
+  return out;
+}
+
+cp::Linkage PlanarNlp::design(const VectorXd& x) const {
+  const Impl& m = *impl_;
+  cp::Linkage d = m.p.original;
+  VectorXd q;
+  m.q_of(x, q, nullptr);
+  // the links' own parameters, then each counterweight merged in (parallel axes)
+  for (std::size_t i = 0; i < m.p.link_parameters.size(); ++i) {
+    const LinkParameterVariable& v = m.p.link_parameters[i];
+    cp::Link& link = d.links[static_cast<std::size_t>(v.link)];
+    const double value = x[m.param_var[i]];
+    (v.parameter == Param::kMass ? link.mass
+     : v.parameter == Param::kE  ? link.e
+     : v.parameter == Param::kF  ? link.f
+                                 : link.inertia) = value;
+  }
+  const std::vector<bp::LinkCounterweight> cws = counterweights(x);
+  for (std::size_t c = 0; c < cws.size(); ++c) {
+    if (cws[c].counterweight.mass <= 0) continue;
+    cp::Link& link = d.links[static_cast<std::size_t>(cws[c].link)];
+    link = bp::merged(link, cws[c].counterweight,
+                      m.cw_pivot_in_link[c] + cws[c].counterweight.position);
+  }
+  return cp::make_linkage(d);
+}
+
+std::vector<double> PlanarNlp::metrics(const VectorXd& x) const {
+  const Impl& m = *impl_;
+  VectorXd q;
+  m.q_of(x, q, nullptr);
+  std::vector<double> out;
+  for (std::size_t k = 0; k < m.table.size(); ++k) {
+    const Impl::Columns c = m.columns(static_cast<int>(k), q, nullptr);
+    if (m.metric(static_cast<int>(k)).statistic == core::Statistic::kRms) {
+      out.push_back(std::sqrt(m.rms2(c, nullptr)));
+    } else {
+      double peak = 0;
+      for (int s = 0; s < m.samples; ++s) {
+        double s2 = 0;
+        for (const VectorXd& y : c.y) s2 += y[s] * y[s];
+        peak = std::max(peak, std::sqrt(s2));
+      }
+      out.push_back(peak);
+    }
+  }
+  return out;
+}
+
+double PlanarNlp::added_mass(const VectorXd& x) const {
+  VectorXd q;
+  impl_->q_of(x, q, nullptr);
+  return impl_->added(q, nullptr, nullptr);
+}
+
+namespace {
+
+// the largest relative difference between two evaluations of the metrics, each against the
+// larger of the two and 1e-4 of the largest metric of its unit (a metric that vanishes by
+// cancellation is known only to the round-off of its terms)
+double verification_error(const std::vector<cp::ColumnMetric>& table, const std::vector<double>& a,
+                          const std::vector<double>& b) {
+  std::map<std::string, double> scale;
+  for (std::size_t k = 0; k < table.size(); ++k)
+    scale[table[k].unit] = std::max({scale[table[k].unit], std::abs(a[k]), std::abs(b[k])});
+  double worst = 0;
+  for (std::size_t k = 0; k < table.size(); ++k) {
+    const double s = std::max({std::abs(a[k]), std::abs(b[k]), 1e-4 * scale[table[k].unit]});
+    if (s == 0) continue;
+    const double e = std::abs(a[k] - b[k]) / s;
+    if (!std::isfinite(e)) return std::numeric_limits<double>::infinity();
+    worst = std::max(worst, e);
+  }
+  return worst;
+}
+
+}  // namespace
+
+Result optimize(const DesignProblem& problem, const OptimizeOptions& options) {
+  if (const Problem e = options.validate()) throw InputError("optimize options: " + e->text());
+  const PlanarNlp nlp(problem);
+  if (options.algorithm == Algorithm::kMma && problem.force_balance) {
+    throw InputError(FieldError{"algorithm", -1,
+                                "'mma' takes inequality constraints only, and force_balance adds "
+                                "equalities; use slsqp, ipopt, mlsl or cobyla"});
+  }
+  const detail::Solved s = detail::solve(nlp, nlp.start(), options);
+  Result r;
+  r.algorithm = options.algorithm;
+  r.termination = s.termination;
+  r.message = s.message;
+  r.x = s.x;
+  r.variable_names = nlp.variable_names();
+  r.objective = s.objective;
+  r.constraint_violation = s.constraint_violation;
+  r.iterations = s.iterations;
+  r.evaluations = s.evaluations;
+  r.seconds = s.seconds;
+  r.design = nlp.design(r.x);
+  r.counterweights = nlp.counterweights(r.x);
+  r.metric_table = nlp.metric_table();
+  r.original = nlp.original_metrics();
+  r.metrics = nlp.metrics(r.x);
+  r.added_mass = nlp.added_mass(r.x);
+  // the design simulated by the engine, against the regressor's evaluation
+  const cp::Trajectory t = cp::simulate_driven(cp::Model(r.design), problem.scene);
+  if (!t.ok()) {
+    r.verification_error = std::numeric_limits<double>::infinity();
+    r.message += "; the optimum's simulation failed: " + t.message;
+    return r;
+  }
+  r.verified = cp::metric_values(r.metric_table, t.table);
+  r.verification_error = verification_error(r.metric_table, r.metrics, r.verified);
+  return r;
+}
+
+}  // namespace bd::optimize::planar

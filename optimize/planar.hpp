@@ -1,0 +1,157 @@
+#pragma once
+/// Optimisation of any planar linkage's mass design in a driven scene: counterweights on its
+/// links and its links' own mass parameters as variables, an objective and limits on the
+/// linkage's metrics (core/planar/metrics.hpp) and the added mass, and full force balance as
+/// linear equalities (balance/planar.hpp). Solved by the same drivers as the four-bar
+/// (optimize/program.hpp).
+///
+/// In a driven scene the motion is prescribed, so every output of the engine's table (shaking
+/// force and moment, drive efforts, every support and joint force) is affine in the mass
+/// parameters π (per link m, m e, m f and J about its first node; per point mass m): the
+/// regressor y = y0 + A (π - π0) is taken from the engine itself, one driven run per parameter
+/// (exact: the outputs are affine, so a difference is a column). Every metric and its exact
+/// gradient through ∂π/∂x then costs no simulation. Link forces applied at a centre of mass
+/// would move with the design's centre of mass (not affine in π): such a linkage is refused.
+///
+/// Variables, in this order: per counterweight its mass in [0, mass_max] [kg] and its centre
+/// (x, y) [m] in the link's axes from its pivot (the link's ground node, or its first node),
+/// boxed in [-distance_max, distance_max] with the envelope x² + y² <= distance_max²; per link
+/// parameter its value within its bounds.
+///
+/// Objective: Σ w sqrt(r² + ε²) over the RMS terms, r = metric / original (ε the smoothing, as
+/// the four-bar's linear form, optimize/nlp.hpp), + w added_mass / (original total mass). A
+/// peak (a `_max` metric) can be limited, not minimised. Limits: (metric / (value original))² - 1
+/// <= 0 for an RMS; the same at every sample for a peak; (added_mass - value) / (original total
+/// mass) <= 0. Force balance: the independent rows of the momentum conditions.
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "balance/counterweight.hpp"
+#include "balance/planar.hpp"
+#include "core/planar/metrics.hpp"
+#include "core/planar/model.hpp"
+#include "core/planar/simulate.hpp"
+#include "optimize/optimize.hpp"
+#include "optimize/problem.hpp"
+#include "optimize/program.hpp"
+
+namespace bd::optimize::planar {
+
+namespace cp = core::planar;
+
+/// A counterweight as design variables on a link (grounded or floating).
+struct CounterweightVariables {
+  int link{};
+  double mass_max = 10.0;     // [kg] > 0
+  double distance_max = 1.0;  // [m] > 0, from the link's pivot
+  balance::CounterweightShape shape = balance::CounterweightShape::kPoint;
+  double thickness = 0.02;  // disc [m] > 0
+  double density = 7850.0;  // disc [kg/m^3] > 0
+};
+
+/// One of a link's own mass parameters as a variable, within bounds.
+struct LinkParameterVariable {
+  int link{};
+  using Parameter = optimize::LinkParameterVariable::Parameter;
+  Parameter parameter = Parameter::kMass;
+  double lower{}, upper{};  // [kg], [m], [m], [kg m^2]; mass lower > 0, inertia lower >= 0
+};
+
+/// A term of the objective: a metric of the linkage's table by name (an RMS, "Fsh_rms",
+/// "RA0_rms", "tau_rms"), or "added_mass".
+struct Term {
+  std::string metric;
+  double weight = 1.0;  // >= 0
+};
+/// metric <= value · original (a metric of the table, RMS or peak), or added_mass <= value [kg].
+struct Limit {
+  std::string metric;
+  double value = 1.0;
+};
+
+struct DesignProblem {
+  cp::Linkage original;
+  cp::DrivenScene scene;
+  std::vector<CounterweightVariables> counterweights;
+  std::vector<LinkParameterVariable> link_parameters;
+  std::vector<Term> objective;
+  std::vector<Limit> limits;
+  bool force_balance = false;  // full force balance as equalities
+  double smoothing = kDefaultSmoothing;
+  /// Empty when valid, else the first problem; its field: "counterweights" or
+  /// "link_parameters" with the element's index, "objective" or "limits" with the term's
+  /// index, "original" (a link force at a centre of mass), "scene"; e.g. text()
+  /// "objective[0]: Fsh_max is a peak; minimise an RMS and limit the peak".
+  bd::Problem validate() const;
+};
+
+/// The program the drivers solve (optimize/program.hpp), with what a study needs to report it.
+class PlanarNlp final : public Program {
+ public:
+  /// @throws bd::InputError for an invalid problem, an original that cannot run in the scene,
+  ///         or a normaliser (the original's metric) that is zero.
+  explicit PlanarNlp(const DesignProblem& problem);
+  ~PlanarNlp() override;
+
+  int n() const override;
+  int n_eq() const override;
+  int n_ineq() const override;
+  const Eigen::VectorXd& lower() const override;
+  const Eigen::VectorXd& upper() const override;
+  const std::vector<std::string>& variable_names() const override;
+  const std::vector<std::string>& constraint_names() const override;
+  bool has_gradients() const override { return true; }
+  double objective(const Eigen::VectorXd& x, Eigen::VectorXd* grad) const override;
+  void equalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
+                  Eigen::MatrixXd* jac) const override;
+  void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
+                    Eigen::MatrixXd* jac) const override;
+
+  /// The original's link parameters (clamped to their bounds); each counterweight at half its
+  /// mass_max, half its distance_max from the pivot away from the link's other node.
+  Eigen::VectorXd start() const;
+  /// The design at x: its links with their parameters and counterweights merged in.
+  cp::Linkage design(const Eigen::VectorXd& x) const;
+  std::vector<balance::planar::LinkCounterweight> counterweights(const Eigen::VectorXd& x) const;
+  /// The metric table's values at x from the regressor (in core's table order), and the added
+  /// mass [kg].
+  std::vector<double> metrics(const Eigen::VectorXd& x) const;
+  double added_mass(const Eigen::VectorXd& x) const;
+  /// The metric table (names, units) and the original's values.
+  const std::vector<cp::ColumnMetric>& metric_table() const;
+  const std::vector<double>& original_metrics() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+struct Result {
+  Algorithm algorithm = Algorithm::kSlsqp;
+  Termination termination = Termination::kNotRun;
+  std::string message;
+  Eigen::VectorXd x;
+  std::vector<std::string> variable_names;
+  double objective{}, constraint_violation{};
+  int iterations{}, evaluations{};
+  double seconds{};
+  cp::Linkage design;
+  std::vector<balance::planar::LinkCounterweight> counterweights;
+  std::vector<cp::ColumnMetric> metric_table;
+  std::vector<double> original, metrics;  // as the regressor evaluates them
+  double added_mass{};                    // [kg]
+  std::vector<double> verified;           // the design simulated by the engine
+  double verification_error{};            // largest relative difference metrics vs verified
+  bool ok() const {
+    return termination == Termination::kConverged || termination == Termination::kMaxEvaluations;
+  }
+};
+
+/// Solves the problem from PlanarNlp::start() and verifies the optimum by simulating it.
+/// @throws bd::InputError as PlanarNlp's constructor, for invalid options, or for an
+///         algorithm that cannot take the problem (mma with force balance).
+Result optimize(const DesignProblem& problem, const OptimizeOptions& options);
+
+}  // namespace bd::optimize::planar

@@ -1,0 +1,263 @@
+// Optimisation of general planar linkages (optimize/planar.hpp), checked by other routes:
+//  - the program's gradients against central differences of its own values, and its values
+//    against the engine's simulation of the design at the same point (the regressor is built
+//    from engine runs, so a wrong column or a non-affine output shows there);
+//  - the least RMS shaking force of a slider-crank with a crank counterweight against the
+//    balance layer's closed-form least-squares design (a linear least-squares solve on the
+//    momentum of the motion), reached by every gradient algorithm;
+//  - six-bars: the optimum force balanced by equality constraints shakes no more (engine), and
+//    its RMS shaking moment is no worse than the force-balanced design the balance layer makes;
+//  - mistakes named by field.
+#include "optimize/planar.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "balance/planar.hpp"
+#include "core/input_error.hpp"
+#include "core/planar/metrics.hpp"
+#include "tests/support/balance_motion.hpp"
+#include "tests/support/planar_mechanisms.hpp"
+
+namespace bd::testing::planar {
+namespace {
+
+namespace op = optimize::planar;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+// the linkage without its link forces (they act at centres of mass the variables move)
+cp::Linkage unloaded(cp::Linkage l, bool gravity) {
+  l.loads.link_loads.clear();
+  l.loads.node_forces.clear();
+  if (!gravity) l.loads.gravity = Vec2(0, 0);
+  l.springs.clear();
+  return cp::make_linkage(l);
+}
+
+cp::DrivenScene scene_of(double speed, int samples) {
+  cp::DrivenScene s;
+  s.speeds = {speed};
+  s.samples = samples;
+  return s;
+}
+
+double metric_of(const op::Result& r, const std::string& name, bool verified = false) {
+  for (std::size_t k = 0; k < r.metric_table.size(); ++k)
+    if (r.metric_table[k].name == name) return verified ? r.verified[k] : r.metrics[k];
+  ADD_FAILURE() << "no metric " << name;
+  return 0;
+}
+
+// The program's gradients are its values' derivatives, and its values the engine's.
+TEST(PlanarOptimize, GradientsAndValuesAgreeWithDifferencesAndTheEngine) {
+  Rng rng(501);
+  double worst_gradient = 0, worst_value = 0;
+  for (int i = 0; i < 6; ++i) {
+    const cp::Linkage l =
+        unloaded(i % 2 ? six_bar_or_retry(rng, coin(rng)) : slider_crank(rng, false), true);
+    op::DesignProblem p;
+    p.original = l;
+    p.scene = scene_of(uniform(rng, 4, 12), 48);
+    const std::vector<bp::LinkCounterweightSpec> grounded = bp::grounded_links(l);
+    for (const bp::LinkCounterweightSpec& g : grounded) {
+      op::CounterweightVariables c;
+      c.link = g.link;
+      c.mass_max = 3;
+      c.distance_max = 0.3;
+      if (coin(rng)) c.shape = balance::CounterweightShape::kDisc;
+      p.counterweights.push_back(c);
+    }
+    const int floating = l.inputs[0].link == 0 ? 1 : 0;  // a link that is not the crank
+    const cp::Link& fl = l.links[static_cast<std::size_t>(floating)];
+    using Par = op::LinkParameterVariable::Parameter;
+    p.link_parameters.push_back({floating, Par::kMass, 0.5 * fl.mass, 2 * fl.mass});
+    p.link_parameters.push_back({floating, Par::kE, fl.e - 0.05, fl.e + 0.05});
+    p.link_parameters.push_back({floating, Par::kInertia, 0, 3 * fl.inertia + 0.01});
+    p.objective = {{"Fsh_rms", 1.0}, {"Msh_rms", 0.5}, {"added_mass", 0.1}};
+    p.limits = {{"Fsh_max", 2.0}, {"tau_rms", 3.0}, {"added_mass", 2.0}};
+    p.force_balance = i % 3 == 1;
+    const op::PlanarNlp nlp(p);
+    // a point inside the box, off the start
+    VectorXd x = nlp.start();
+    for (int j = 0; j < nlp.n(); ++j)
+      x[j] = nlp.lower()[j] + uniform(rng, 0.2, 0.8) * (nlp.upper()[j] - nlp.lower()[j]);
+    VectorXd g;
+    nlp.objective(x, &g);
+    VectorXd ce, ci;
+    MatrixXd je, ji;
+    nlp.equalities(x, ce, &je);
+    nlp.inequalities(x, ci, &ji);
+    for (int j = 0; j < nlp.n(); ++j) {
+      const double h = 1e-6 * std::max(1.0, std::abs(x[j]));
+      VectorXd a = x, b = x;
+      a[j] += h;
+      b[j] -= h;
+      const double dg = (nlp.objective(a, nullptr) - nlp.objective(b, nullptr)) / (2 * h);
+      worst_gradient =
+          std::max(worst_gradient, std::abs(dg - g[j]) / std::max(1.0, std::abs(g[j])));
+      VectorXd ca, cb;
+      nlp.inequalities(a, ca, nullptr);
+      nlp.inequalities(b, cb, nullptr);
+      const VectorXd d = (ca - cb) / (2 * h);
+      for (Eigen::Index r = 0; r < d.size(); ++r) {
+        worst_gradient =
+            std::max(worst_gradient, std::abs(d[r] - ji(r, j)) / std::max(1.0, std::abs(ji(r, j))));
+      }
+      if (nlp.n_eq() > 0) {
+        nlp.equalities(a, ca, nullptr);
+        nlp.equalities(b, cb, nullptr);
+        worst_gradient =
+            std::max(worst_gradient, ((ca - cb) / (2 * h) - je.col(j)).cwiseAbs().maxCoeff());
+      }
+    }
+    // the values at x against the engine's simulation of the design at x
+    const cp::Linkage d = nlp.design(x);
+    const cp::Trajectory t = cp::simulate_driven(cp::Model(d), p.scene);
+    ASSERT_TRUE(t.ok()) << t.message;
+    const std::vector<double> want = cp::metric_values(nlp.metric_table(), t.table);
+    const std::vector<double> got = nlp.metrics(x);
+    double largest = 0;
+    for (double w : want) largest = std::max(largest, w);
+    for (std::size_t k = 0; k < want.size(); ++k)
+      worst_value = std::max(worst_value, std::abs(got[k] - want[k]) / largest);
+    EXPECT_NEAR(nlp.added_mass(x), cp::total_mass(d) - cp::total_mass(l),
+                1e-12 * cp::total_mass(l));
+  }
+  std::printf(
+      "planar program: gradients against differences %.2e, metrics against the engine %.2e\n",
+      worst_gradient, worst_value);
+  EXPECT_LE(worst_gradient, 1e-6);
+  EXPECT_LE(worst_value, 1e-11);
+}
+
+// The least RMS shaking force of a slider-crank with a counterweight on its crank is the balance
+// layer's least-squares design (full balance is out of reach: the piston); every gradient
+// algorithm finds it.
+TEST(PlanarOptimize, EveryGradientAlgorithmReachesTheLeastSquaresEngineDesign) {
+  Rng rng(502);
+  for (int i = 0; i < 3; ++i) {
+    const cp::Linkage l = unloaded(slider_crank(rng, i % 2 == 0), false);
+    const double speed = uniform(rng, 50, 300);
+    const cp::Trajectory tr = revolution(l, {speed}, 90);
+    ASSERT_TRUE(tr.ok());
+    const bp::ForceBalance ls = bp::force_balance(l, kinematics_of(l, tr), bp::grounded_links(l));
+    ASSERT_FALSE(ls.full);
+    op::DesignProblem p;
+    p.original = l;
+    p.scene = scene_of(speed, 90);
+    op::CounterweightVariables c;
+    c.link = 0;
+    c.mass_max = 20 * cp::total_mass(l);
+    c.distance_max = 2 * cp::element_length(l, 0);
+    p.counterweights = {c};
+    p.objective = {{"Fsh_rms", 1.0}};
+    for (optimize::Algorithm a : {optimize::Algorithm::kSlsqp, optimize::Algorithm::kMma,
+                                  optimize::Algorithm::kIpopt, optimize::Algorithm::kMlsl}) {
+      optimize::OptimizeOptions o;
+      o.algorithm = a;
+      o.max_evaluations = 3000;
+      const op::Result r = op::optimize(p, o);
+      ASSERT_TRUE(r.ok()) << optimize::to_string(a) << ": " << r.message;
+      EXPECT_NEAR(metric_of(r, "Fsh_rms"), ls.Fsh_rms_after, 1e-6 * ls.Fsh_rms_before)
+          << optimize::to_string(a) << " #" << i;
+      EXPECT_NEAR(metric_of(r, "Fsh_rms", true), metric_of(r, "Fsh_rms"),
+                  1e-10 * ls.Fsh_rms_before);
+      EXPECT_LE(r.verification_error, 1e-9);
+    }
+  }
+}
+
+// Six-bars: the least RMS shaking moment among force-balanced designs (counterweights on the
+// three grounded links); the optimum shakes no more in the engine's simulation, and its shaking
+// moment is no worse than that of the balance layer's force-balanced design (a feasible point).
+TEST(PlanarOptimize, ForceBalancedSixBarsWithTheLeastShakingMoment) {
+  Rng rng(503);
+  for (int i = 0; i < 3; ++i) {
+    const cp::Linkage l = unloaded(six_bar_or_retry(rng, i % 2 == 1), false);
+    const double speed = uniform(rng, 4, 12);
+    const cp::Trajectory tr = revolution(l, {speed}, 72);
+    ASSERT_TRUE(tr.ok());
+    std::vector<bp::LinkCounterweightSpec> asks = bp::grounded_links(l);
+    const bp::ForceBalance fb = bp::force_balance(l, kinematics_of(l, tr), asks);
+    ASSERT_TRUE(fb.full);
+    const cp::Trajectory fbt = revolution(fb.linkage, {speed}, 72);
+    const std::vector<double> fbm =
+        cp::metric_values(cp::metric_table(cp::Model(fb.linkage)), fbt.table);
+    op::DesignProblem p;
+    p.original = l;
+    p.scene = scene_of(speed, 72);
+    double farthest = 0;
+    for (const bp::LinkCounterweight& a : fb.added)
+      farthest = std::max(farthest, a.counterweight.distance);
+    for (const bp::LinkCounterweightSpec& g : asks) {
+      op::CounterweightVariables c;
+      c.link = g.link;
+      c.mass_max = 4 * fb.added_mass;
+      c.distance_max = 1.5 * farthest;
+      p.counterweights.push_back(c);
+    }
+    p.objective = {{"Msh_rms", 1.0}};
+    p.force_balance = true;
+    optimize::OptimizeOptions o;
+    o.algorithm = optimize::Algorithm::kSlsqp;
+    o.max_evaluations = 4000;
+    const op::Result r = op::optimize(p, o);
+    ASSERT_TRUE(r.ok()) << r.message;
+    const double original_force = r.original[0];  // Fsh_rms, the table's first metric
+    EXPECT_LE(metric_of(r, "Fsh_rms", true), 1e-7 * original_force) << i;
+    EXPECT_LE(metric_of(r, "Msh_rms", true), fbm[2] * (1 + 1e-9)) << i;  // Msh_rms: third
+    std::printf(
+        "six-bar #%d: Msh_rms original %.4g, force balanced by the balance layer %.4g, "
+        "optimum %.4g (Fsh %.2e)\n",
+        i, r.original[2], fbm[2], metric_of(r, "Msh_rms", true), metric_of(r, "Fsh_rms", true));
+  }
+}
+
+TEST(PlanarOptimize, MistakesAreNamed) {
+  Rng rng(504);
+  const cp::Linkage l = unloaded(slider_crank(rng, true), false);
+  op::DesignProblem p;
+  p.original = l;
+  p.scene = scene_of(100, 36);
+  p.counterweights = {{0, 1.0, 0.1}};
+  p.objective = {{"Fsh_rms", 1.0}};
+  auto text = [&](const op::DesignProblem& q) {
+    const Problem e = q.validate();
+    return e ? e->text() : std::string("valid");
+  };
+  EXPECT_EQ(text(p), "valid");
+  op::DesignProblem q = p;
+  q.objective = {{"Fsh_max", 1.0}};
+  EXPECT_EQ(text(q), "objective[0]: Fsh_max is a peak; minimise an RMS and limit the peak");
+  q = p;
+  q.objective = {{"Fsh_rmz", 1.0}};
+  EXPECT_NE(text(q).find("objective[0]: no metric Fsh_rmz (metrics: Fsh_rms, Fsh_max"),
+            std::string::npos);
+  q = p;
+  q.counterweights.push_back(q.counterweights[0]);
+  EXPECT_EQ(text(q), "counterweights[1]: a second counterweight on the link");
+  q = p;
+  q.counterweights[0].mass_max = 0;
+  EXPECT_EQ(text(q), "counterweights[0].mass_max must be > 0 kg, got 0");
+  q = p;
+  q.original.loads.link_loads.push_back({0, Vec2(1, 0), 0.0});
+  EXPECT_NE(text(q).find("original: link crank carries a force at its centre of mass"),
+            std::string::npos)
+      << text(q);
+  q = p;
+  q.limits = {{"RO_max", 0}};
+  EXPECT_EQ(text(q), "limits[0].value must be > 0 (a fraction of the original), got 0");
+  // a normaliser that vanishes: the drive torque of a linkage already balanced for it
+  optimize::OptimizeOptions o;
+  o.algorithm = optimize::Algorithm::kMma;
+  q = p;
+  q.force_balance = true;
+  EXPECT_THROW((void)op::optimize(q, o), InputError);
+}
+
+}  // namespace
+}  // namespace bd::testing::planar
