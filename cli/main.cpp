@@ -300,12 +300,18 @@ void print_planar_balance(const st::Study& study, const st::RunResult& r) {
                 b.full ? "force balanced" : "not force balanced");
   }
   if (!b.message.empty()) std::printf("           %s\n", b.message.c_str());
+  // the name column: as wide as the longest link or shaft name
+  int width = 7;
+  for (const bd::core::planar::Link& k : b.linkage.links)
+    width = std::max(width, static_cast<int>(k.name.size()));
+  for (const bd::core::planar::BalanceShaft& s : b.linkage.shafts)
+    width = std::max(width, static_cast<int>(s.name.size()));
   for (const bd::balance::planar::LinkCounterweight& c : b.added) {
     const bd::balance::Counterweight& w = c.counterweight;
-    std::printf("  %-7s  counterweight %.6g kg at [%.6g, %.6g] m from %s (%.6g m)",
-                l.links[static_cast<std::size_t>(c.link)].name.c_str(), w.mass, w.position.x(),
-                w.position.y(), l.nodes[static_cast<std::size_t>(c.pivot)].name.c_str(),
-                w.distance);
+    std::printf("  %-*s  counterweight %.6g kg at [%.6g, %.6g] m from %s (%.6g m)", width,
+                l.links[static_cast<std::size_t>(c.link)].name.c_str(), w.mass,
+                w.position.x() + 0.0, w.position.y() + 0.0,  // + 0.0: no "-0"
+                l.nodes[static_cast<std::size_t>(c.pivot)].name.c_str(), w.distance);
     if (w.radius > 0) std::printf(", radius %.6g m", w.radius);
     std::printf("\n");
   }
@@ -314,9 +320,9 @@ void print_planar_balance(const st::Study& study, const st::RunResult& r) {
       const bd::core::planar::BalanceShaft& s =
           run.shafts->linkage.shafts[static_cast<std::size_t>(i)];
       std::printf(
-          "  %-7s  balance shaft at [%.6g, %.6g] m turning %d times the %s: %.6g kg at "
+          "  %-*s  balance shaft at [%.6g, %.6g] m turning %d times the %s: %.6g kg at "
           "%.6g m\n",
-          s.name.c_str(), s.at.x(), s.at.y(), s.ratio,
+          width, s.name.c_str(), s.at.x(), s.at.y(), s.ratio,
           l.links[static_cast<std::size_t>(s.link)].name.c_str(), s.mass, s.eccentricity.norm());
     }
   }
@@ -325,9 +331,9 @@ void print_planar_balance(const st::Study& study, const st::RunResult& r) {
       const bd::core::planar::BalanceShaft& s =
           run.moment->linkage.shafts[static_cast<std::size_t>(i)];
       std::printf(
-          "  %-7s  counter-rotation J = %.6g kg m^2 on a shaft at [%.6g, %.6g] m, ratio %d\n",
-          l.links[static_cast<std::size_t>(s.link)].name.c_str(), s.inertia, s.at.x(), s.at.y(),
-          s.ratio);
+          "  %-*s  counter-rotation J = %.6g kg m^2 on a shaft at [%.6g, %.6g] m, ratio %d\n",
+          width, l.links[static_cast<std::size_t>(s.link)].name.c_str(), s.inertia, s.at.x(),
+          s.at.y(), s.ratio);
     }
     std::printf("  balance  moment full: the balanced design is %s\n",
                 run.moment->full ? "moment balanced" : "not moment balanced");
