@@ -251,7 +251,7 @@ TEST(PlanarOptimize, MistakesAreNamed) {
   q = p;
   q.limits = {{"RO_max", 0}};
   EXPECT_EQ(text(q), "limits[0].value must be > 0 (a fraction of the original), got 0");
-  // a normaliser that vanishes: the drive torque of a linkage already balanced for it
+  // mma takes no equalities, and force balance is equalities
   optimize::OptimizeOptions o;
   o.algorithm = optimize::Algorithm::kMma;
   q = p;
