@@ -35,14 +35,6 @@ LinkFrame frame_of(const cp::Linkage& l, int k) {
   return f;
 }
 
-// a drawn point in link k's axes, from its first node
-Vec2 in_link_axes(const cp::Linkage& l, int k, const Vec2& point) {
-  const LinkFrame f = frame_of(l, k);
-  const Vec2 d = point - l.nodes[static_cast<std::size_t>(f.p)].position;
-  const double c = std::cos(f.angle), s = std::sin(f.angle);
-  return {c * d.x() + s * d.y(), -s * d.x() + c * d.y()};
-}
-
 // a residual that cancels to round-off against the sum of its terms' sizes
 bool cancels(const VectorXd& residual, double terms) {
   return residual.norm() <= 1e-10 * std::max(terms, 1e-300);
@@ -54,6 +46,18 @@ double rms_of_pairs(const VectorXd& v) {  // v = (x0, y0, x1, y1, ...): RMS of t
 }
 
 }  // namespace
+
+Vec2 in_link_axes(const cp::Linkage& l, int k, const Vec2& point) {
+  const LinkFrame f = frame_of(l, k);
+  const Vec2 d = point - l.nodes[static_cast<std::size_t>(f.p)].position;
+  const double c = std::cos(f.angle), s = std::sin(f.angle);
+  return {c * d.x() + s * d.y(), -s * d.x() + c * d.y()};
+}
+
+int counterweight_pivot(const cp::Linkage& l, int link) {
+  const int g = cp::pivot_of(l, link);
+  return g >= 0 ? g : l.links[static_cast<std::size_t>(link)].nodes[0];
+}
 
 Eigen::VectorXd Parameters::of(const cp::Linkage& l) {
   VectorXd theta = VectorXd::Zero(count(l));
@@ -107,6 +111,7 @@ Expected<Kinematics, cp::PlanarError> kinematics(
       ok = cp::inverse_dynamics(model, ws, 0.0, unit, zero);
       if (!ok) return Unexpected<cp::PlanarError>(ok.error());
       s.unit_rate_velocity.push_back(ws.instant.v);
+      s.unit_rate_omega.push_back(ws.instant.omega);
     }
     ok = cp::inverse_dynamics(model, ws, 0.0, rates[i], accelerations[i]);
     if (!ok) return Unexpected<cp::PlanarError>(ok.error());
@@ -236,10 +241,10 @@ Eigen::MatrixXd angular_momentum_regressor(const cp::Linkage& l, const Kinematic
       for (std::size_t j = 0; j < l.links.size(); ++j) {
         const int i = static_cast<int>(j);
         const LinkFrame f = frame_of(l, i);
-        const std::size_t p = static_cast<std::size_t>(f.p), q = static_cast<std::size_t>(f.q);
-        const Vec2 xp = s.x[p], vp = v[p], dx = s.x[q] - xp;
-        const double w = cross(dx, v[q] - vp) / dx.squaredNorm();
-        const Vec2 u = dx / dx.norm(), n = perp(u);
+        const std::size_t p = static_cast<std::size_t>(f.p);
+        const Vec2 xp = s.x[p], vp = v[p];
+        const double w = s.unit_rate_omega[d][j];
+        const Vec2 u = unit(s.angle[j]), n = perp(u);
         // H of a rigid link about the origin, with r = c - p = (m e u + m f n)/m rotating with
         // it and S = m r: m p × v_p + ω (p · S) + S × v_p + J ω
         H(row, Parameters::link_mass(i)) = cross(xp, vp);
@@ -270,12 +275,8 @@ ShaftSeries shaft_series(const cp::Linkage& l, const Kinematics& k) {
       const Vec2 r = cp::shaft_centre(b, s.angle[L] - f.angle);
       const double w = b.ratio * s.omega[L], al = b.ratio * s.alpha[L];
       const Vec2 a = al * perp(r) - w * w * r;
-      const Vec2 d = s.x[static_cast<std::size_t>(f.q)] - s.x[static_cast<std::size_t>(f.p)];
       for (std::size_t j = 0; j < dof; ++j) {
-        const std::vector<Vec2>& v = s.unit_rate_velocity[j];
-        const double rate =
-            cross(d, v[static_cast<std::size_t>(f.q)] - v[static_cast<std::size_t>(f.p)]) /
-            d.squaredNorm();
+        const double rate = s.unit_rate_omega[j][L];
         out.momentum.segment<2>(static_cast<Eigen::Index>(2 * (i * dof + j))) +=
             b.mass * b.ratio * rate * perp(r);
         // spin about its centre of mass, and its centre's turn about the shaft seen from O

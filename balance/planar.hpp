@@ -56,6 +56,7 @@ struct Kinematics {
     std::vector<Vec2> x, a;                             // per node
     std::vector<double> angle, omega, alpha;            // per link
     std::vector<std::vector<Vec2>> unit_rate_velocity;  // per input, per node [m/rad or m/m]
+    std::vector<std::vector<double>> unit_rate_omega;   // per input, per link [rad/rad or rad/m]
   };
   std::vector<Sample> samples;
 };
@@ -101,6 +102,14 @@ ShaftSeries shaft_series(const cp::Linkage& linkage, const Kinematics& k);
 /// True when the linkage's linear momentum (its shafts' included) vanishes to round-off in every
 /// configuration of `k`: against the sum of its terms' sizes, to 1e-10.
 bool force_balanced(const cp::Linkage& linkage, const Kinematics& k);
+
+/// Where a counterweight on a link is measured from: the link's ground node, or its first node
+/// for a link that does not turn about the frame.
+int counterweight_pivot(const cp::Linkage& linkage, int link);
+
+/// A drawn point in a link's axes (along and to the left of its first-to-second node line), from
+/// its first node [m].
+Vec2 in_link_axes(const cp::Linkage& linkage, int link, const Vec2& point);
 
 /// A counterweight asked for on a link, realised as balance::CounterweightSpec says. Its position
 /// is measured in link axes (along and to the left of the link's first-to-second node line) from

@@ -35,12 +35,8 @@ MatrixXd link_rates(const cp::Linkage& l, const Kinematics& k,
   for (const Kinematics::Sample& s : k.samples) {
     for (std::size_t d = 0; d < dof; ++d, ++row) {
       for (std::size_t c = 0; c < requests.size(); ++c) {
-        const auto& nodes = l.links[static_cast<std::size_t>(requests[c].link)].nodes;
-        const std::size_t p = static_cast<std::size_t>(nodes[0]),
-                          q = static_cast<std::size_t>(nodes[1]);
-        const Vec2 dx = s.x[q] - s.x[p];
         W(row, static_cast<Eigen::Index>(c)) =
-            cross(dx, s.unit_rate_velocity[d][q] - s.unit_rate_velocity[d][p]) / dx.squaredNorm();
+            s.unit_rate_omega[d][static_cast<std::size_t>(requests[c].link)];
       }
     }
   }

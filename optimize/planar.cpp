@@ -2,6 +2,7 @@
 
 #include <Eigen/SVD>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -24,23 +25,6 @@ using Param = LinkParameterVariable::Parameter;
 
 Problem field(const std::string& name, int index, const std::string& message) {
   return FieldError{name, index, message};
-}
-
-// a link's node that turns about the frame, else its first node: where its counterweight's
-// position is measured from
-int pivot(const cp::Linkage& l, int link) {
-  const int g = cp::pivot_of(l, link);
-  return g >= 0 ? g : l.links[static_cast<std::size_t>(link)].nodes[0];
-}
-
-// a drawn point in link k's axes, from its first node
-Vec2 in_link_axes(const cp::Linkage& l, int k, const Vec2& point) {
-  const auto& nodes = l.links[static_cast<std::size_t>(k)].nodes;
-  const Vec2 p = l.nodes[static_cast<std::size_t>(nodes[0])].position;
-  const Vec2 d = l.nodes[static_cast<std::size_t>(nodes[1])].position - p;
-  const double a = std::atan2(d.y(), d.x()), c = std::cos(a), s = std::sin(a);
-  const Vec2 r = point - p;
-  return {c * r.x() + s * r.y(), -s * r.x() + c * r.y()};
 }
 
 double disc_inertia_per_mass2(const CounterweightVariables& c) {  // I = m² / (2 ρ π t)
@@ -177,6 +161,7 @@ struct PlanarNlp::Impl {
   VectorXd lower, upper;
   std::vector<std::string> variable_names, constraint_names;
   std::vector<int> cw_var, param_var;
+  std::map<int, std::array<int, 4>> link_vars;  // link -> variable of its m, e, f, I (or -1)
   std::vector<int> cw_pivot;
   std::vector<Vec2> cw_pivot_in_link, cw_away;
   // objective weights per metric (table order) and on added_mass
@@ -333,14 +318,14 @@ void PlanarNlp::Impl::set_up_variables() {
   };
   for (const CounterweightVariables& c : p.counterweights) {
     const std::string name = l.links[static_cast<std::size_t>(c.link)].name;
-    const int pv = pivot(l, c.link);
+    const int pv = bp::counterweight_pivot(l, c.link);
     cw_pivot.push_back(pv);
     cw_pivot_in_link.push_back(
-        in_link_axes(l, c.link, l.nodes[static_cast<std::size_t>(pv)].position));
+        bp::in_link_axes(l, c.link, l.nodes[static_cast<std::size_t>(pv)].position));
     // away from the link's other node (its second, or its first when the pivot is the second)
     const auto& nodes = l.links[static_cast<std::size_t>(c.link)].nodes;
     const int other = nodes[0] == pv ? nodes[1] : nodes[0];
-    const Vec2 d = in_link_axes(l, c.link, l.nodes[static_cast<std::size_t>(other)].position) -
+    const Vec2 d = bp::in_link_axes(l, c.link, l.nodes[static_cast<std::size_t>(other)].position) -
                    cw_pivot_in_link.back();
     cw_away.push_back(-d.normalized());
     cw_var.push_back(add(0.0, c.mass_max, name + " counterweight mass [kg]"));
@@ -351,6 +336,8 @@ void PlanarNlp::Impl::set_up_variables() {
     param_var.push_back(
         add(v.lower, v.upper,
             l.links[static_cast<std::size_t>(v.link)].name + "." + parameter_text(v.parameter)));
+    auto [it, _] = link_vars.try_emplace(v.link, std::array<int, 4>{-1, -1, -1, -1});
+    it->second[static_cast<std::size_t>(v.parameter)] = param_var.back();
   }
 }
 
@@ -390,13 +377,7 @@ void PlanarNlp::Impl::q_of(const VectorXd& x, VectorXd& q, MatrixXd* J) const {
   q = q0;
   if (J) J->setZero(nq, n);
   // link parameters: the link's (m, e, f, I) with the variables' values, as π
-  std::map<int, std::array<int, 4>> vars;  // link -> variable of m, e, f, I (or -1)
-  for (std::size_t i = 0; i < p.link_parameters.size(); ++i) {
-    const LinkParameterVariable& v = p.link_parameters[i];
-    auto [it, _] = vars.try_emplace(v.link, std::array<int, 4>{-1, -1, -1, -1});
-    it->second[static_cast<std::size_t>(v.parameter)] = param_var[i];
-  }
-  for (const auto& [k, var] : vars) {
+  for (const auto& [k, var] : link_vars) {
     const cp::Link& link = l.links[static_cast<std::size_t>(k)];
     const double m = var[0] >= 0 ? x[var[0]] : link.mass, e = var[1] >= 0 ? x[var[1]] : link.e,
                  f = var[2] >= 0 ? x[var[2]] : link.f, I = var[3] >= 0 ? x[var[3]] : link.inertia;
