@@ -293,6 +293,20 @@ TEST(PlanarMomentBalance, WhatCannotBeCancelledIsNamedAndLeastSquares) {
                   1e-9 * c.cwiseAbs().maxCoeff())
           << i << " " << d.name;
     }
+    // the angular momentum left, per unit crank rate: the referee's with the discs' c ω
+    double h2 = 0, left2 = 0;
+    for (int j = 0; j < n; ++j) {
+      const double h = ref[static_cast<std::size_t>(j)].angular_momentum / speed;
+      double left = h;
+      for (std::size_t s = 0; s < asks.size(); ++s) {
+        left += c[static_cast<Eigen::Index>(s)] *
+                tr.table.column_values("omega_" + names[s])[static_cast<std::size_t>(j)] / speed;
+      }
+      h2 += h * h;
+      left2 += left * left;
+    }
+    EXPECT_NEAR(m.angular_momentum_left, std::sqrt(left2 / h2), 1e-9) << i;
+    EXPECT_GT(m.angular_momentum_left, 1e-3) << i;
     const double fit = std::sqrt((A * fitted - b).squaredNorm() / n);
     EXPECT_NEAR(m.Msh_rms_after, fit, 1e-10 * before);
     EXPECT_LT(m.Msh_rms_after, before);

@@ -212,6 +212,28 @@ TEST(PlanarBalanceStudy, ABerkofFourBarOnTrussElementsIsForceAndMomentBalanced) 
   for (std::size_t i = 0; i < m1.size(); ++i) EXPECT_EQ(m1[i], m2[i]);
 }
 
+// An engine cannot be fully force balanced by its crank counterweight, so a moment balance has
+// nothing to start from: no discs are added, and the message and summary.json say why.
+TEST(PlanarBalanceStudy, NoCounterRotationsWithoutFullForceBalance) {
+  const Study study = parse_study(kEngine + "balance:\n  moment: full\n", "e.yaml");
+  ASSERT_TRUE(study.planar_balance && study.planar_balance->counter_rotations);
+  const fs::path out = fs::path(BD_BINARY_DIR) / "test-output" / "planar-balance" / "no-discs";
+  fs::remove_all(out);
+  RunResult r = compute_study(study);
+  write_run(study, r, out);
+  ASSERT_TRUE(r.ok() && r.balanced && r.balanced->design);
+  EXPECT_FALSE(r.balanced->moment.has_value());
+  EXPECT_TRUE(r.balanced->design->linkage.shafts.empty());
+  const nlohmann::json j = nlohmann::json::parse(bd::testing::read(out / "summary.json"));
+  EXPECT_EQ(j["balance"]["moment"], "full");
+  EXPECT_EQ(j["balance"]["moment_balanced"], false);
+  EXPECT_FALSE(j["balance"].contains("counter_rotations"));
+  EXPECT_NE(j["balance"]["message"].get<std::string>().find(
+                "no counter-rotations: a moment balance starts from full force balance, which "
+                "is not reached"),
+            std::string::npos);
+}
+
 TEST(PlanarBalanceStudy, CounterweightsDefaultToTheLinksThatTurnAboutTheFrame) {
   const Study s = parse_study(kEngine + "balance:\n", "e.yaml");
   ASSERT_TRUE(s.planar_balance.has_value());
