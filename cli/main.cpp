@@ -283,6 +283,21 @@ void print_balance(const st::Study& study, const st::RunResult& r) {
   print_comparison(study, r);
 }
 
+// a planar linkage's counterweights, one line each, names in a column `width` wide
+void print_planar_counterweights(const bd::core::planar::Linkage& l,
+                                 const std::vector<bd::balance::planar::LinkCounterweight>& cws,
+                                 int width) {
+  for (const bd::balance::planar::LinkCounterweight& c : cws) {
+    const bd::balance::Counterweight& w = c.counterweight;
+    std::printf("  %-*s  counterweight %.6g kg at [%.6g, %.6g] m from %s (%.6g m)", width,
+                l.links[static_cast<std::size_t>(c.link)].name.c_str(), w.mass + 0.0,
+                w.position.x() + 0.0, w.position.y() + 0.0,  // + 0.0: no "-0"
+                l.nodes[static_cast<std::size_t>(c.pivot)].name.c_str(), w.distance);
+    if (w.radius > 0) std::printf(", radius %.6g m", w.radius);
+    std::printf("\n");
+  }
+}
+
 // a planar linkage's balanced design: the counterweights, whether full force balance is
 // reached (else why not), and before / after / ratio of every metric
 void print_planar_balance(const st::Study& study, const st::RunResult& r) {
@@ -306,15 +321,7 @@ void print_planar_balance(const st::Study& study, const st::RunResult& r) {
     width = std::max(width, static_cast<int>(k.name.size()));
   for (const bd::core::planar::BalanceShaft& s : b.linkage.shafts)
     width = std::max(width, static_cast<int>(s.name.size()));
-  for (const bd::balance::planar::LinkCounterweight& c : b.added) {
-    const bd::balance::Counterweight& w = c.counterweight;
-    std::printf("  %-*s  counterweight %.6g kg at [%.6g, %.6g] m from %s (%.6g m)", width,
-                l.links[static_cast<std::size_t>(c.link)].name.c_str(), w.mass,
-                w.position.x() + 0.0, w.position.y() + 0.0,  // + 0.0: no "-0"
-                l.nodes[static_cast<std::size_t>(c.pivot)].name.c_str(), w.distance);
-    if (w.radius > 0) std::printf(", radius %.6g m", w.radius);
-    std::printf("\n");
-  }
+  print_planar_counterweights(l, b.added, width);
   if (run.shafts) {
     for (int i : run.shafts->added) {
       const bd::core::planar::BalanceShaft& s =
@@ -373,6 +380,29 @@ void print_optimize(const st::Study& study, const st::RunResult& r) {
                 bd::optimize::to_string(req.pareto->first),
                 bd::optimize::to_string(req.pareto->second), found, run.pareto.size());
   }
+  print_comparison(study, r);
+}
+
+// a planar linkage's optimum: how the solver ended, its counterweights, and before / after /
+// ratio
+void print_planar_optimize(const st::Study& study, const st::RunResult& r) {
+  const st::PlanarOptimizeRequest& req = *study.planar_optimize;
+  const st::OptimizedRun& run = *r.optimized;
+  const bd::optimize::planar::Result& o = run.planar_result;
+  std::printf("  optimize %s: minimise %s\n", bd::optimize::to_string(req.options.algorithm),
+              st::objective_text(req).c_str());
+  std::printf("           subject to %s\n", st::constraints_text(req).c_str());
+  std::printf("           %s\n", o.termination == bd::optimize::Termination::kNotRun
+                                     ? o.message.c_str()
+                                     : o.brief_report().c_str());
+  if (!run.found()) return;
+  int width = 7;
+  for (const bd::core::planar::Link& k : study.planar().links)
+    width = std::max(width, static_cast<int>(k.name.size()));
+  print_planar_counterweights(study.planar(), o.counterweights, width);
+  const st::RunStatus status = run.status();
+  std::printf("  optimum: method %s, %zu samples, status %s\n", st::to_string(run.method.method),
+              status.samples, bd::core::to_string(status.status));
   print_comparison(study, r);
 }
 
@@ -440,6 +470,7 @@ void print_summary(const st::Study& study, const st::RunResult& r) {
   if (study.balance && r.balanced) print_balance(study, r);
   if (study.planar_balance && r.balanced) print_planar_balance(study, r);
   if (study.optimize && r.optimized) print_optimize(study, r);
+  if (study.planar_optimize && r.optimized) print_planar_optimize(study, r);
   std::printf("  wrote    %s\n", r.timeseries.string().c_str());
   if (!r.harmonics_file.empty()) std::printf("           %s\n", r.harmonics_file.string().c_str());
   if (r.balanced) {
@@ -564,18 +595,18 @@ int run(const RunArgs& args) {
       std::fprintf(stderr, "%s: simulation of the balanced design stopped early: %s\n",
                    args.study.c_str(), result.balanced->status().message.c_str());
     }
-    if (result.optimized && result.optimized->found() && !result.optimized->trajectory.ok()) {
+    if (result.optimized && result.optimized->found() && !result.optimized->status().ok()) {
       std::fprintf(stderr, "%s: simulation of the optimised design stopped early: %s\n",
-                   args.study.c_str(), result.optimized->trajectory.message.c_str());
+                   args.study.c_str(), result.optimized->status().message.c_str());
     }
     return kExitStoppedEarly;
   }
   if (result.optimized && result.optimized->failed()) {
     // one line: the optimiser's message names the binding constraint
-    std::string message = result.optimized->result.message;
+    std::string message = result.optimized->message();
     std::replace(message.begin(), message.end(), '\n', ' ');
     std::fprintf(stderr, "%s: no optimum (%s): %s\n", args.study.c_str(),
-                 bd::optimize::to_string(result.optimized->result.termination), message.c_str());
+                 bd::optimize::to_string(result.optimized->termination()), message.c_str());
     return kExitNoOptimum;
   }
   return kExitOk;
@@ -676,9 +707,9 @@ constexpr const char* kDescription =
     ": shaking-force and shaking-moment balancing of planar linkages.\n"
     "Simulates the linkage of a study file (a four-bar or any planar linkage of links, pins and\n"
     "sliders; free motion or driven inputs) and writes its reaction and joint forces, shaking\n"
-    "force and moment and drive efforts; with a balance section (four-bars) it also synthesises\n"
-    "the balanced design (counterweights, counter-rotations), simulates it in the same scene\n"
-    "and compares the two; with an optimize section (four-bars) it searches for the best design\n"
+    "force and moment and drive efforts; with a balance section it also synthesises the\n"
+    "balanced design (counterweights, counter-rotations, balance shafts), simulates it in the\n"
+    "same scene and compares the two; with an optimize section it searches for the best design\n"
     "(NLopt, Ipopt) under constraints and does the same with it.\n\n"
     "Commands:\n"
     "  balance-design run STUDY.yaml [--out DIR]   run a study, write its outputs into DIR\n"

@@ -238,11 +238,7 @@ const char* to_string(Termination t) {
 }
 
 std::string OptimizeResult::brief_report() const {
-  std::string s = std::string(to_string(algorithm)) + ": " + to_string(termination) + ", " +
-                  std::to_string(iterations) + " iterations, " + std::to_string(evaluations) +
-                  " evaluations, " + text::digits(seconds, 3) + " s, objective " +
-                  text::digits(objective, 9) + ", constraint violation " +
-                  text::digits(constraint_violation, 2);
+  std::string s = solver_report(*this);
   if (termination == Termination::kNotRun || std::isnan(verification_error)) {
     s += ", not verified";
   } else {

@@ -8,6 +8,7 @@
 
 #include "balance/counterweight.hpp"
 #include "core/fourbar/metrics.hpp"
+#include "core/number_text.hpp"
 #include "optimize/problem.hpp"
 
 namespace bd::optimize {
@@ -60,6 +61,17 @@ struct PlacedCounterweight {
   int link{};  // 1 or 3
   balance::Counterweight counterweight;
 };
+
+/// The solver's part of a result's one-line report: "slsqp: converged, 12 iterations, 15
+/// evaluations, 0.01 s, objective 0.2, constraint violation 0" (either linkage type's result).
+template <class Result>
+std::string solver_report(const Result& r) {
+  return std::string(to_string(r.algorithm)) + ": " + to_string(r.termination) + ", " +
+         std::to_string(r.iterations) + " iterations, " + std::to_string(r.evaluations) +
+         " evaluations, " + text::digits(r.seconds, 3) + " s, objective " +
+         text::digits(r.objective, 9) + ", constraint violation " +
+         text::digits(r.constraint_violation, 2);
+}
 
 struct OptimizeResult {
   Termination termination = Termination::kNotRun;

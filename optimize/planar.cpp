@@ -688,6 +688,12 @@ double verification_error(const std::vector<cp::ColumnMetric>& table, const std:
 
 }  // namespace
 
+std::string Result::brief_report() const {
+  std::string s = solver_report(*this);
+  if (verified.empty()) return s + ", not verified";
+  return s + ", verified by simulating it to " + text::digits(verification_error, 2);
+}
+
 Result optimize(const DesignProblem& problem, const OptimizeOptions& options) {
   if (const Problem e = options.validate()) throw InputError("optimize options: " + e->text());
   const PlanarNlp nlp(problem);

@@ -147,6 +147,9 @@ struct Result {
   bool ok() const {
     return termination == Termination::kConverged || termination == Termination::kMaxEvaluations;
   }
+  /// One line: algorithm, termination, iterations, evaluations, seconds, objective, constraint
+  /// violation, verification.
+  std::string brief_report() const;
 };
 
 /// Solves the problem from PlanarNlp::start() and verifies the optimum by simulating it.

@@ -69,10 +69,12 @@ struct CounterweightPart {
   Vec2 position{0, 0};
 };
 
-// the counterweights of a balanced design, from summary.json's balance section
+// the counterweights of a balanced or optimised design, from summary.json's balance or
+// optimize section
 std::vector<CounterweightPart> counterweight_parts(const Linkage& l, const Json& summary) {
   std::vector<CounterweightPart> parts;
   const Json* b = member(summary, "balance");
+  if (!b) b = member(summary, "optimize");
   const Json* cws = b ? member(*b, "counterweights") : nullptr;
   if (!cws || !cws->is_array()) return parts;
   for (const Json& c : *cws) {
@@ -445,9 +447,10 @@ std::string planar_report_html(const Study& study, const fs::path& dir, const st
   h += second_design_section(summary, second.design);
   // the measurements of `balance-design bench` when the folder has them (work_precision.hpp)
   h += work_precision_section(study, dir, gnuplot);
-  return h + data_files_html(dir, {"timeseries.csv", "summary.json", "balanced-timeseries.csv",
-                                   "balanced.yaml", "comparison.csv", "harmonics.csv",
-                                   "work-precision.csv", "driven-convergence.csv"});
+  return h + data_files_html(
+                 dir, {"timeseries.csv", "summary.json", "balanced-timeseries.csv", "balanced.yaml",
+                       "optimized-timeseries.csv", "optimized.yaml", "comparison.csv",
+                       "harmonics.csv", "work-precision.csv", "driven-convergence.csv"});
 }
 
 }  // namespace bd::studies::report_support

@@ -467,6 +467,9 @@ std::string study_section(const Study& study, const Sweep& s) {
   if (study.optimize) {
     h += "<tr><th>optimize</th><td>minimise " + esc(objective_text(*study.optimize)) +
          "; constraints: " + esc(constraints_text(*study.optimize)) + "</td></tr>";
+  } else if (study.planar_optimize) {
+    h += "<tr><th>optimize</th><td>minimise " + esc(objective_text(*study.planar_optimize)) +
+         "; constraints: " + esc(constraints_text(*study.planar_optimize)) + "</td></tr>";
   }
   h += "</table>\n<h3>Linkage</h3>\n" + linkage_tables_html(study);
   return h;

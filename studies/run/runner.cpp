@@ -52,6 +52,7 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original) {
   o.method = sim.method;
   o.trajectory = sim.fourbar;
   o.metrics = core::metrics(o.trajectory);
+  o.metric_list = metric_list(o.metrics);
   if (req.pareto) {
     o.pareto = optimize::pareto_front(problem, req.pareto->first, req.pareto->second,
                                       req.pareto->points, req.options);
@@ -59,7 +60,34 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original) {
   return o;
 }
 
+// a planar study's optimum: solved in its driven scene (the regressor comes from the original's
+// run), then simulated; not run when the original stopped early
+OptimizedRun planar_optimize_study(const Study& study, const RunResult& original) {
+  OptimizedRun o;
+  o.is_planar = true;
+  if (!original.status().ok()) {
+    o.planar_result.message = "not run: the original design's simulation stopped early (" +
+                              original.status().message + ")";
+    return o;
+  }
+  o.planar_result =
+      optimize::planar::optimize(planar_design_problem(study), study.planar_optimize->options);
+  o.variable_names = o.planar_result.variable_names;
+  o.design_variables = static_cast<int>(o.variable_names.size());
+  if (!o.found()) return o;
+  const Study best = planar_optimized_study(study, o.planar_result.design);
+  Simulation sim = simulate(best);
+  o.method = sim.method;
+  o.metric_list = metric_list(best, sim);
+  o.planar = std::move(sim.planar);
+  return o;
+}
+
 }  // namespace
+
+RunStatus OptimizedRun::status() const {
+  return is_planar ? run_status(planar) : run_status(trajectory);
+}
 
 void write_table(const core::Series& table, const fs::path& file) {
   AtomicFile out(file);
@@ -114,10 +142,14 @@ std::vector<ComparisonRow> comparison(const Study& study, const RunResult& resul
     b = run->metric_list;
     mass = run->design ? run->design->added_mass : study.balance->added_mass;
     inertia = run->design ? run->design->added_inertia : study.balance->added_inertia;
+  } else if (const OptimizedRun& o = *result.optimized; o.is_planar) {
+    b = o.metric_list;
+    mass = o.planar_result.added_mass;
+    inertia = added_inertia(study.planar(), o.planar_result.design);
   } else {
-    b = metric_list(result.optimized->metrics);
-    mass = added_mass(study.fourbar(), result.optimized->result.design);
-    inertia = added_inertia(study.fourbar(), result.optimized->result.design);
+    b = o.metric_list;
+    mass = added_mass(study.fourbar(), o.result.design);
+    inertia = added_inertia(study.fourbar(), o.result.design);
   }
   std::vector<ComparisonRow> rows;
   // by name: a balanced design's new parts (a balance shaft's bearing) add metrics, 0 before
@@ -216,7 +248,41 @@ std::string balanced_yaml(const Study& study, const balance::planar::ForceBalanc
   return study_yaml(planar_balanced_study(study, design.linkage), header);
 }
 
+namespace {
+
+// a planar study's optimized.yaml
+std::string planar_optimized_yaml(const Study& study, const OptimizedRun& run) {
+  assert(study.planar_optimize.has_value() && run.found());
+  const PlanarOptimizeRequest& req = *study.planar_optimize;
+  const optimize::planar::Result& r = run.planar_result;
+  const core::planar::Linkage& l = study.planar();
+  std::string header = "The optimised design of study '" + study.name + "', found by\n";
+  header += "balance-design from its optimize section";
+  header += study.source.empty() ? std::string(".\n") : " in\n  " + study.source + "\n";
+  header += "Objective: minimise " + objective_text(req) + ".\n";
+  header += "Constraints: " + constraints_text(req) + ".\n";
+  header += fmt::format(
+      "Solver: {}, {} after {} evaluations; objective {:.6g}; verified by simulating it (largest "
+      "relative difference {:.3g}).\n",
+      optimize::to_string(req.options.algorithm), optimize::to_string(r.termination), r.evaluations,
+      r.objective, r.verification_error);
+  for (const balance::planar::LinkCounterweight& c : r.counterweights) {
+    const balance::Counterweight& w = c.counterweight;
+    if (w.mass <= 0) continue;
+    header += fmt::format(
+        "Link {} carries a counterweight of {:.6g} kg at ({:.6g}, {:.6g}) m from node {} in the "
+        "link's axes (merged into the link below).\n",
+        l.links[static_cast<std::size_t>(c.link)].name, w.mass, w.position.x(), w.position.y(),
+        l.nodes[static_cast<std::size_t>(c.pivot)].name);
+  }
+  header += "Run it with\n  balance-design optimized.yaml";
+  return study_yaml(planar_optimized_study(study, r.design), header);
+}
+
+}  // namespace
+
 std::string optimized_yaml(const Study& study, const OptimizedRun& run) {
+  if (run.is_planar) return planar_optimized_yaml(study, run);
   assert(study.optimize.has_value() && run.found());
   const OptimizeRequest& req = *study.optimize;
   const optimize::OptimizeResult& r = run.result;
@@ -357,6 +423,7 @@ RunResult compute_study(const Study& study) {
   }
   if (study.planar_balance) result.balanced = planar_balanced_run(study, result);
   if (study.optimize) result.optimized = optimize_study(study, result);
+  if (study.planar_optimize) result.optimized = planar_optimize_study(study, result);
   return result;
 }
 
@@ -403,10 +470,14 @@ void write_run(const Study& study, RunResult& result, const fs::path& out_dir) {
     o.timeseries = out_dir / "optimized-timeseries.csv";
     o.study_file = out_dir / "optimized.yaml";
     o.comparison = out_dir / "comparison.csv";
-    write_timeseries(o.trajectory, o.timeseries);
+    if (o.is_planar) {
+      write_table(o.planar.table, o.timeseries);
+    } else {
+      write_timeseries(o.trajectory, o.timeseries);
+    }
     write_text_file(optimized_yaml(study, o), o.study_file);
     write_text_file(comparison_csv(study, result), o.comparison);
-    if (study.optimize->pareto) {
+    if (study.optimize && study.optimize->pareto) {
       o.pareto_file = out_dir / "pareto.csv";
       write_text_file(pareto_csv(study, o), o.pareto_file);
     }

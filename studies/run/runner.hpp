@@ -14,6 +14,7 @@
 #include "core/fourbar/metrics.hpp"
 #include "core/fourbar/simulate.hpp"
 #include "optimize/optimize.hpp"
+#include "optimize/planar.hpp"
 #include "studies/run/files.hpp"
 #include "studies/run/harmonics.hpp"
 #include "studies/run/simulation.hpp"
@@ -59,27 +60,42 @@ struct BalancedRun {
 /// The optimisation in an optimize study, and the optimum's run (same scene, method chosen for it
 /// alike).
 struct OptimizedRun {
-  optimize::OptimizeResult result;            // what optimize() returned (termination kNotRun,
-                                              // with a message, when it was not run)
-  std::vector<std::string> variable_names;    // of result.x, in order (optimize::Nlp's names)
-  int design_variables{};                     // the first ones of result.x: the design's own
-                                              // (the rest are bound variables of peak metrics)
+  bool is_planar{};                           // a planar linkage's study
+  optimize::OptimizeResult result;            // a four-bar study: what optimize() returned
+                                              // (termination kNotRun, with a message, when it
+                                              // was not run)
+  optimize::planar::Result planar_result;     // a planar study: optimize::planar::optimize()'s
+  std::vector<std::string> variable_names;    // of the result's x, in order
+  int design_variables{};                     // the first ones of x: the design's own (the rest
+                                              // are bound variables of a four-bar's peaks)
   std::vector<optimize::ParetoPoint> pareto;  // with optimize.pareto, point by point
   MethodChoice method;                        // formulation used for the optimum, and why
-  core::Trajectory trajectory;                // the optimum simulated (none when not found)
-  core::Metrics metrics;                      // over its samples
+  core::Trajectory trajectory;                // a four-bar study: the optimum simulated
+  core::Metrics metrics;                      // a four-bar study: over its samples
+  core::planar::Trajectory planar;            // a planar study: the optimum simulated
+  MetricList metric_list;                     // its metrics in its table's order (either type)
   std::filesystem::path timeseries;           // out_dir/optimized-timeseries.csv (when found)
   std::filesystem::path study_file;           // out_dir/optimized.yaml (when found)
   std::filesystem::path comparison;           // out_dir/comparison.csv (when found)
   std::filesystem::path pareto_file;          // out_dir/pareto.csv (with a front, when found)
+  /// How the optimiser ended, and its message (either type).
+  optimize::Termination termination() const {
+    return is_planar ? planar_result.termination : result.termination;
+  }
+  const std::string& message() const { return is_planar ? planar_result.message : result.message; }
   /// True when the optimiser returned a design (converged, or the budget ran out at a feasible
   /// point): the optimum was simulated and its files written.
-  bool found() const { return result.ok(); }
+  bool found() const {
+    return termination() == optimize::Termination::kConverged ||
+           termination() == optimize::Termination::kMaxEvaluations;
+  }
   /// True when the optimiser ran and found no design (infeasible, or it failed): exit code 4.
   bool failed() const {
-    return result.termination == optimize::Termination::kInfeasible ||
-           result.termination == optimize::Termination::kFailed;
+    return termination() == optimize::Termination::kInfeasible ||
+           termination() == optimize::Termination::kFailed;
   }
+  /// How the optimum's simulation ended (either linkage type).
+  RunStatus status() const;
 };
 
 struct RunResult;
@@ -106,13 +122,13 @@ struct RunResult {
   RunStatus status() const { return simulation_status(*this); }
   bool ok() const {
     return status().ok() && (!balanced || balanced->ok()) &&
-           (!optimized || (optimized->found() && optimized->trajectory.ok()));
+           (!optimized || (optimized->found() && optimized->status().ok()));
   }
   /// True when a simulation stopped early (the original's, the balanced design's or the
   /// optimum's): exit code 3.
   bool stopped_early() const {
     return !status().ok() || (balanced && !balanced->ok()) ||
-           (optimized && optimized->found() && !optimized->trajectory.ok());
+           (optimized && optimized->found() && !optimized->status().ok());
   }
 };
 
@@ -183,7 +199,8 @@ std::string balanced_yaml(const Study& study);
 std::string balanced_yaml(const Study& study, const balance::planar::ForceBalance& design);
 
 /// The optimized.yaml text of an optimize study whose optimum was found:
-/// study_yaml(optimized_study(study, design)) with a header comment saying how it was found.
+/// study_yaml(optimized_study(study, design)) (planar_optimized_study() for a planar linkage)
+/// with a header comment saying how it was found.
 std::string optimized_yaml(const Study& study, const OptimizedRun& run);
 
 /// The pareto.csv text: header `epsilon,<first>,<second>,termination,verification_error` and the

@@ -156,6 +156,16 @@ Json balance_json(const balance::BalancedDesign& b) {
   return j;
 }
 
+// a counterweight on a planar linkage's link, with the node its position is measured from
+Json planar_counterweight_json(const core::planar::Linkage& l,
+                               const balance::planar::LinkCounterweight& c,
+                               balance::CounterweightShape shape) {
+  Json cw = counterweight_json(l.links[static_cast<std::size_t>(c.link)].name.c_str(), shape,
+                               c.counterweight);
+  cw["from_node"] = l.nodes[static_cast<std::size_t>(c.pivot)].name;
+  return cw;
+}
+
 // a planar linkage's balance section: the counterweights added, whether full force balance is
 // reached (else why not), and the inertial shaking force before and after
 Json planar_balance_json(const Study& study, const BalancedRun& run) {
@@ -170,10 +180,7 @@ Json planar_balance_json(const Study& study, const BalancedRun& run) {
     for (const balance::planar::LinkCounterweightSpec& ask : study.planar_balance->counterweights) {
       if (ask.link == c.link) shape = ask.spec.shape;
     }
-    Json cw = counterweight_json(l.links[static_cast<std::size_t>(c.link)].name.c_str(), shape,
-                                 c.counterweight);
-    cw["from_node"] = l.nodes[static_cast<std::size_t>(c.pivot)].name;
-    cws.push_back(std::move(cw));
+    cws.push_back(planar_counterweight_json(l, c, shape));
   }
   j["counterweights"] = cws;
   j["added_mass"] = b.added_mass;
@@ -263,12 +270,9 @@ Json problem_json(const OptimizeRequest& req, const MethodChoice& method) {
   return j;
 }
 
-// the optimize section: the problem, how the solver ended, the optimum
-Json optimize_json(const Study& study, const RunResult& result) {
-  const OptimizeRequest& req = *study.optimize;
-  const OptimizedRun& o = *result.optimized;
-  const optimize::OptimizeResult& r = o.result;
-  Json j = problem_json(req, result.method);
+// how the solver ended and where (a four-bar's or a planar linkage's result)
+template <class Result>
+void add_solver_fields(Json& j, const Result& r, const OptimizedRun& o) {
   j["termination"] = optimize::to_string(r.termination);
   j["message"] = r.message;
   j["iterations"] = r.iterations;
@@ -285,6 +289,16 @@ Json optimize_json(const Study& study, const RunResult& result) {
     }
   }
   j["variables"] = variables;
+}
+
+// the optimize section: the problem, how the solver ended, the optimum
+Json optimize_json(const Study& study, const RunResult& result) {
+  const OptimizeRequest& req = *study.optimize;
+  const OptimizedRun& o = *result.optimized;
+  const optimize::OptimizeResult& r = o.result;
+  Json j = problem_json(req, result.method);
+  add_solver_fields(j, r, o);
+  const bool found = o.found();
   j["counterweights"] = found ? optimum_counterweights_json(req, r.counterweights) : Json::array();
   if (found) {
     j["added_mass"] = added_mass(study.fourbar(), r.design);
@@ -297,6 +311,46 @@ Json optimize_json(const Study& study, const RunResult& result) {
                    {"second", optimize::to_string(req.pareto->second)},
                    {"points", o.pareto.size()}};
   }
+  j["brief_report"] = r.brief_report();
+  return j;
+}
+
+// a planar study's optimize section: the problem, how the solver ended, the optimum
+Json planar_optimize_json(const Study& study, const RunResult& result) {
+  const PlanarOptimizeRequest& req = *study.planar_optimize;
+  const OptimizedRun& o = *result.optimized;
+  const optimize::planar::Result& r = o.planar_result;
+  const core::planar::Linkage& l = study.planar();
+  Json j = {{"algorithm", optimize::to_string(req.options.algorithm)},
+            {"formulation", to_string(result.method.method)}};
+  Json terms = Json::array();
+  for (const optimize::planar::Term& t : req.objective)
+    terms.push_back({{"metric", t.metric}, {"weight", t.weight}});
+  j["terms"] = terms;
+  j["force_balance"] = req.force_balance;
+  Json limits = Json::array();
+  for (const optimize::planar::Limit& lim : req.limits) {
+    limits.push_back({{"metric", lim.metric},
+                      {"value", lim.value},
+                      {"unit", lim.metric == "added_mass" ? "kg" : "fraction of the original"}});
+  }
+  j["limits"] = limits;
+  add_solver_fields(j, r, o);
+  const bool found = o.found();
+  Json cws = Json::array();
+  if (found) {
+    for (const balance::planar::LinkCounterweight& c : r.counterweights) {
+      balance::CounterweightShape shape = balance::CounterweightShape::kPoint;
+      for (const optimize::planar::CounterweightVariables& v : req.counterweights)
+        if (v.link == c.link) shape = v.shape;
+      cws.push_back(planar_counterweight_json(l, c, shape));
+    }
+    j["added_mass"] = r.added_mass;
+    j["added_inertia"] = added_inertia(l, r.design);
+    j["verified_with"] = "the optimum simulated";
+    j["verification_error"] = r.verification_error;
+  }
+  j["counterweights"] = cws;
   j["brief_report"] = r.brief_report();
   return j;
 }
@@ -341,12 +395,13 @@ std::string summary_json(const Study& study, const RunResult& result) {
       j["balance"] = {{"force", "full"}, {"moment", "none"}, {"message", b.status().message}};
     }
   }
-  if (study.optimize && result.optimized) {
+  if (study.optimizes() && result.optimized) {
     const OptimizedRun& o = *result.optimized;
-    j["optimize"] = optimize_json(study, result);
+    j["optimize"] =
+        o.is_planar ? planar_optimize_json(study, result) : optimize_json(study, result);
     if (o.found()) {
-      add_second_run(j, study, "optimized", o.method, run_status(o.trajectory), result.metric_list,
-                     metric_list(o.metrics));
+      add_second_run(j, study, "optimized", o.method, o.status(), result.metric_list,
+                     o.metric_list);
     }
   }
   // invalid UTF-8 in a message (a key copied from a study file) is replaced, never a failure

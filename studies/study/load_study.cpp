@@ -92,15 +92,10 @@ class StudyParser {
     }
   }
 
-  // balance or optimize: the design sections (optimize: a four-bar's)
+  // balance or optimize: the design sections, each read by its linkage type's reader
   void read_design_sections(const MapReader& top, const MapReader::Entry& name, Study& study) {
     const MapReader::Entry* balance = top.find("balance");
     const MapReader::Entry* opt = top.find("optimize");
-    if (opt && !study.is_fourbar()) {
-      r_.fail(opt->key_mark,
-              "optimize is available for a four-bar (linkage.type: fourbar); a planar linkage is "
-              "balanced by its balance section");
-    }
     if (balance && opt) {
       // one or the other: a balanced design and an optimised one would compete for the outputs
       const bool later = opt->key_mark.pos > balance->key_mark.pos;
@@ -122,7 +117,11 @@ class StudyParser {
     }
     if (opt) {
       check_name_room(name, study, kOptimizedSuffix, "an optimize section", "optimized.yaml");
-      study.optimize = read_optimize(r_, *opt, study);
+      if (study.is_fourbar()) {
+        study.optimize = read_optimize(r_, *opt, study);
+      } else {
+        study.planar_optimize = read_planar_optimize(r_, *opt, study);
+      }
     }
   }
 

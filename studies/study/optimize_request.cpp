@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "balance/planar.hpp"
 #include "core/number_text.hpp"
 
 namespace bd::studies {
@@ -75,6 +76,50 @@ std::string constraints_text(const OptimizeRequest& request) {
     }
   }
   return text.empty() ? "none" : text;
+}
+
+std::string objective_text(const PlanarOptimizeRequest& request) {
+  std::string text;
+  for (const optimize::planar::Term& t : request.objective) {
+    if (!text.empty()) text += " + ";
+    text += text::digits(t.weight, 6) + " x " + t.metric;
+  }
+  return text + " (each / original)";
+}
+
+std::string constraints_text(const PlanarOptimizeRequest& request) {
+  std::string text;
+  auto add = [&](const std::string& s) { text += (text.empty() ? "" : "; ") + s; };
+  if (request.force_balance) add("full force balance");
+  for (const optimize::planar::Limit& l : request.limits) {
+    if (l.metric == "added_mass") {
+      add("added_mass <= " + text::digits(l.value, 6) + " kg");
+    } else {
+      add(l.metric + " <= " + text::digits(l.value, 6) + " x original");
+    }
+  }
+  return text.empty() ? "none" : text;
+}
+
+double added_inertia(const core::planar::Linkage& original, const core::planar::Linkage& design) {
+  namespace bp = balance::planar;
+  double sum = 0;
+  for (std::size_t k = 0; k < original.links.size() && k < design.links.size(); ++k) {
+    const int link = static_cast<int>(k);
+    const int pivot = bp::counterweight_pivot(original, link);
+    const Vec2 p =
+        bp::in_link_axes(original, link, original.nodes[static_cast<std::size_t>(pivot)].position);
+    auto about = [&](const core::planar::Link& l) {
+      return l.inertia + l.mass * (Vec2(l.e, l.f) - p).squaredNorm();
+    };
+    sum += about(design.links[k]) - about(original.links[k]);
+  }
+  for (const core::planar::BalanceShaft& s : design.shafts) {
+    bool had = false;
+    for (const core::planar::BalanceShaft& o : original.shafts) had = had || o.name == s.name;
+    if (!had) sum += s.inertia + s.mass * s.eccentricity.squaredNorm();
+  }
+  return sum;
 }
 
 }  // namespace bd::studies

@@ -9,7 +9,9 @@
 
 #include "core/fourbar/metrics.hpp"
 #include "core/fourbar/model.hpp"
+#include "core/planar/model.hpp"
 #include "optimize/optimize.hpp"
+#include "optimize/planar.hpp"
 #include "optimize/problem.hpp"
 
 namespace bd::studies {
@@ -33,6 +35,18 @@ struct OptimizeRequest {
   bool force_balance = false;  // eq. 57 as equalities (full shaking-force balance)
   optimize::OptimizeOptions options;
   std::optional<ParetoRequest> pareto;
+};
+
+/// A planar linkage study's `optimize:` section (docs/study-format.md "optimize"), defaults in
+/// place: the variables, objective and constraints of optimize::planar::DesignProblem, whose
+/// original and scene are the study's (planar_design_problem() in studies/study.hpp).
+struct PlanarOptimizeRequest {
+  std::vector<optimize::planar::CounterweightVariables> counterweights;  // in the file's order
+  std::vector<optimize::planar::LinkParameterVariable> link_parameters;  // in the file's order
+  std::vector<optimize::planar::Term> objective;                         // in the file's order
+  std::vector<optimize::planar::Limit> limits;                           // in the file's order
+  bool force_balance = false;  // the momentum conditions as equalities (full force balance)
+  optimize::OptimizeOptions options;
 };
 
 /// All algorithms, in the order the docs list them.
@@ -61,5 +75,14 @@ std::string objective_text(const OptimizeRequest& request);
 /// The constraints in words, e.g. "full force balance; Fsh_rms <= 0.2 x original;
 /// added_mass <= 6 kg"; "none" when there are none.
 std::string constraints_text(const OptimizeRequest& request);
+
+/// A planar study's objective and constraints in words, as above.
+std::string objective_text(const PlanarOptimizeRequest& request);
+std::string constraints_text(const PlanarOptimizeRequest& request);
+
+/// The change of a planar design's inertia [kg m²]: for each link, the change of its inertia
+/// about its pivot (the ground node it turns about, else its first node), plus the inertias of
+/// balance shafts the design has and the original lacks.
+double added_inertia(const core::planar::Linkage& original, const core::planar::Linkage& design);
 
 }  // namespace bd::studies

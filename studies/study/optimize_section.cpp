@@ -1,15 +1,21 @@
-// The optimize section of a four-bar study: objective, constraints, variables, solver and Pareto
-// front, checked by the optimize layer (validate(), check_algorithm(), the normalisers), each
+// The optimize section of a study: a four-bar's (objective, constraints, variables, solver and
+// Pareto front) and a planar linkage's (objective, constraints, variables on links by name,
+// solver), checked by the optimize layer (validate(), check_algorithm(), the normalisers), each
 // complaint at the key whose field it names.
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "core/planar/metrics.hpp"
 #include "optimize/nlp.hpp"
 #include "optimize/optimize.hpp"
+#include "optimize/planar.hpp"
 #include "studies/study/sections.hpp"
 #include "studies/study/yaml_reader.hpp"
 
@@ -29,21 +35,7 @@ class OptimizeReader {
                       "pareto)");
     o.check_keys({"algorithm", "objective", "constraints", "variables", "max_evaluations",
                   "tolerance", "pareto"});
-
-    YAML::Mark algorithm_mark = e.key_mark, evaluations_mark = e.key_mark,
-               tolerance_mark = e.key_mark;
-    if (const MapReader::Entry* a = o.find("algorithm")) {
-      const std::string name = read_text(r_, *a, "optimize.algorithm");
-      algorithm_mark = mark_of(a->value, a->key_mark);
-      const auto alg = optimize::algorithm_named(name);
-      if (!alg) {
-        std::vector<std::string> all;
-        for (optimize::Algorithm x : kAlgorithms) all.emplace_back(optimize::to_string(x));
-        r_.fail(algorithm_mark, "unknown algorithm '" + name +
-                                    "' in optimize.algorithm; expected one of " + join(all));
-      }
-      req.options.algorithm = *alg;
-    }
+    const SolverMarks marks = read_solver(o, e.key_mark, req.options);
     read_objective(o.require("objective", "the metrics to minimise, each with a weight"), study,
                    req);
     if (const MapReader::Entry* c = o.find("constraints")) read_constraints(*c, study, req);
@@ -51,21 +43,6 @@ class OptimizeReader {
                              "what may change: counterweights on crank and rocker, links' "
                              "mass parameters"),
                    study.fourbar(), req);
-    if (const MapReader::Entry* n = o.find("max_evaluations")) {
-      req.options.max_evaluations = read_count(r_, *n, "optimize.max_evaluations", 1, 1e9);
-      evaluations_mark = mark_of(n->value, n->key_mark);
-    }
-    if (const MapReader::Entry* t = o.find("tolerance")) {
-      const double tol = read_number(r_, *t, "optimize.tolerance", "");
-      tolerance_mark = mark_of(t->value, t->key_mark);
-      if (!(tol > 0 && tol < 1)) {
-        r_.fail(tolerance_mark,
-                "optimize.tolerance must be > 0 and < 1 (relative, on the variables and the "
-                "objective), got " +
-                    text::exact(tol));
-      }
-      req.options.relative_tolerance = tol;
-    }
     if (const MapReader::Entry* p = o.find("pareto")) req.pareto = read_pareto(*p, study.scene);
 
     // the optimize layer's own checks of the whole problem and of the options, at the section
@@ -73,18 +50,251 @@ class OptimizeReader {
     with.optimize = req;
     const optimize::DesignProblem problem = design_problem(with);
     if (const Problem p = problem.validate()) r_.fail(e.key_mark, "optimize: " + p->text());
-    if (const Problem p = req.options.validate()) {
-      YAML::Mark where = e.key_mark;
-      if (p->field == "max_evaluations") where = evaluations_mark;
-      if (p->field == "relative_tolerance" || p->field == "constraint_tolerance") {
-        where = tolerance_mark;
-      }
-      if (p->field == "algorithm") where = algorithm_mark;
-      r_.fail(where, "optimize: " + p->text());
-    }
+    check_options(req.options, marks);
     check_evaluation(problem, req, e.key_mark);
-    check_algorithm(problem, req, algorithm_mark);
+    check_algorithm(problem, req, marks.algorithm);
     return req;
+  }
+
+  // a planar linkage's optimize: {algorithm, objective, constraints, variables, max_evaluations,
+  // tolerance}, in a driven scene
+  PlanarOptimizeRequest read_planar_optimize(const MapReader::Entry& e, const Study& study) {
+    namespace op = optimize::planar;
+    PlanarOptimizeRequest req;
+    const core::planar::Linkage& linkage = study.planar();
+    const MapReader o(r_, e.value, "optimize", e.key_mark,
+                      "(algorithm, objective, constraints, variables, max_evaluations, "
+                      "tolerance)");
+    if (const MapReader::Entry* p = o.find("pareto")) {
+      r_.fail(p->key_mark,
+              "optimize.pareto is available for a four-bar (linkage.type: fourbar); for a planar "
+              "linkage, run a sweep over a bound in optimize.constraints");
+    }
+    o.check_keys(
+        {"algorithm", "objective", "constraints", "variables", "max_evaluations", "tolerance"});
+    if (!std::holds_alternative<core::planar::DrivenScene>(study.scene)) {
+      r_.fail(e.key_mark,
+              "optimize for a planar linkage needs a driven scene (scene.type: driven): there "
+              "every output is linear in the masses, so each candidate is exact without a new "
+              "simulation; free scenes are optimised for a four-bar (linkage.type: fourbar)");
+    }
+    const SolverMarks marks = read_solver(o, e.key_mark, req.options);
+    table_ = core::planar::metric_table(core::planar::Model(linkage));
+
+    // objective: {metric: weight}
+    const MapReader::Entry& objective =
+        o.require("objective", "the metrics to minimise, each with a weight");
+    const MapReader terms(r_, objective.value, "optimize.objective", objective.key_mark,
+                          "of metric: weight (e.g. Msh_rms: 1.0)");
+    bool positive = false;
+    for (const MapReader::Entry& x : terms.entries()) {
+      const std::string path = "optimize.objective." + x.key;
+      check_planar_metric(x.key, x.key_mark, "optimize.objective");
+      const double w = read_number(r_, x, path, "");
+      if (w < 0) {
+        r_.fail(mark_of(x.value, x.key_mark),
+                path + " must be >= 0 (a weight), got " + text::exact(w));
+      }
+      positive = positive || w > 0;
+      req.objective.push_back({x.key, w});
+      term_marks_.push_back(x.key_mark);
+    }
+    if (!positive) {
+      r_.fail(objective.key_mark, "optimize.objective needs at least one metric with a weight > 0");
+    }
+
+    // constraints: {force_balance: bool, metric: fraction, added_mass: kg}
+    const MapReader::Entry* constraints = o.find("constraints");
+    if (constraints && !constraints->value.IsNull()) {
+      const MapReader m(r_, constraints->value, "optimize.constraints", constraints->key_mark,
+                        "(force_balance, and metric: bound)");
+      for (const MapReader::Entry& x : m.entries()) {
+        const std::string path = "optimize.constraints." + x.key;
+        if (x.key == "force_balance") {
+          req.force_balance = read_bool(r_, x, path);
+          continue;
+        }
+        check_planar_metric(x.key, x.key_mark, "optimize.constraints", "force_balance or ");
+        req.limits.push_back({x.key, read_limit(x, path, x.key == "added_mass")});
+        limit_marks_.push_back(x.key_mark);
+      }
+    }
+
+    // variables: {counterweights: {<link>: {...}}, links: {<link>: {mass, e, f, inertia}}}
+    const MapReader::Entry& variables =
+        o.require("variables", "what may change: counterweights on links, links' mass parameters");
+    const MapReader v(r_, variables.value, "optimize.variables", variables.key_mark,
+                      "(counterweights, links)");
+    v.check_keys({"counterweights", "links"});
+    std::map<std::pair<std::string, int>, YAML::Mark> marks_of;  // (list, index) -> its key
+    auto link_of = [&](const MapReader::Entry& x, const std::string& path) {
+      const int link = core::planar::link_index(linkage, x.key);
+      if (link < 0)
+        r_.fail(x.key_mark, path + ": no link of that name (links: " + links(linkage) + ")");
+      return link;
+    };
+    if (const MapReader::Entry* cw = v.find("counterweights"); cw && !cw->value.IsNull()) {
+      const MapReader m(r_, cw->value, "optimize.variables.counterweights", cw->key_mark,
+                        "(a link's name and its counterweight's envelope: {} or mass_max, "
+                        "distance_max, shape, thickness, density)");
+      for (const MapReader::Entry& x : m.entries()) {
+        const std::string path = "optimize.variables.counterweights." + x.key;
+        const int link = link_of(x, path);
+        marks_of[{"counterweights", static_cast<int>(req.counterweights.size())}] = x.key_mark;
+        req.counterweights.push_back(read_counterweight_variables<op::CounterweightVariables>(
+            x, path, link, core::planar::element_length(linkage, link)));
+      }
+    }
+    if (const MapReader::Entry* lk = v.find("links"); lk && !lk->value.IsNull()) {
+      const MapReader m(r_, lk->value, "optimize.variables.links", lk->key_mark,
+                        "(a link's name and its parameters: mass, e, f, inertia, each [lower, "
+                        "upper])");
+      for (const MapReader::Entry& x : m.entries()) {
+        const std::string path = "optimize.variables.links." + x.key;
+        const int link = link_of(x, path);
+        const std::size_t first = req.link_parameters.size();
+        read_link_parameters(x, path, link, req.link_parameters);
+        for (std::size_t i = first; i < req.link_parameters.size(); ++i)
+          marks_of[{"link_parameters", static_cast<int>(i)}] = x.key_mark;
+      }
+    }
+    if (req.counterweights.empty() && req.link_parameters.empty()) {
+      r_.fail(variables.key_mark,
+              "optimize.variables: no design variable; give counterweights (on links by name) "
+              "or links (mass, e, f, inertia within bounds)");
+    }
+    for (std::size_t i = 0; i < term_marks_.size(); ++i)
+      marks_of[{"objective", static_cast<int>(i)}] = term_marks_[i];
+    for (std::size_t i = 0; i < limit_marks_.size(); ++i)
+      marks_of[{"limits", static_cast<int>(i)}] = limit_marks_[i];
+
+    // the optimize layer's own checks, at the key whose field they name
+    Study with = study;
+    with.planar_optimize = req;
+    const op::DesignProblem problem = planar_design_problem(with);
+    auto at = [&](const FieldError& f) -> std::optional<YAML::Mark> {
+      if (const auto it = marks_of.find({f.field, f.index}); it != marks_of.end())
+        return it->second;
+      return std::nullopt;
+    };
+    auto path_of = [&](const FieldError& f) -> std::string {
+      if (f.field == "objective") return "optimize.objective." + req.objective[f.index].metric;
+      if (f.field == "limits") return "optimize.constraints." + req.limits[f.index].metric;
+      if (f.field == "counterweights") {
+        return "optimize.variables.counterweights." +
+               linkage.links[static_cast<std::size_t>(req.counterweights[f.index].link)].name;
+      }
+      if (f.field == "link_parameters") {
+        const op::LinkParameterVariable& p = req.link_parameters[f.index];
+        return "optimize.variables.links." + linkage.links[static_cast<std::size_t>(p.link)].name +
+               "." + to_string(p.parameter);
+      }
+      return "optimize";
+    };
+    if (const Problem p = problem.validate()) {
+      if (const auto mark = at(*p)) r_.fail(*mark, p->joined(path_of(*p)));
+      r_.fail(e.key_mark, "optimize: " + p->text());
+    }
+    check_options(req.options, marks);
+    if (req.options.algorithm == optimize::Algorithm::kMma && req.force_balance) {
+      r_.fail(marks.algorithm,
+              "optimize.algorithm: 'mma' takes inequality constraints only, and force_balance "
+              "adds equalities; use slsqp, ipopt, mlsl or cobyla");
+    }
+    try {
+      const op::PlanarNlp nlp(problem);  // the original run; its metrics are the normalisers
+    } catch (const InputError& err) {
+      if (const auto& f = err.field()) {
+        if (const auto mark = at(*f)) r_.fail(*mark, f->joined(path_of(*f)));
+      }
+      r_.fail(e.key_mark, "optimize: " + std::string(err.what()));
+    }
+    return req;
+  }
+
+  // a planar linkage's metric by name (or added_mass); `or_else` leads the list in the message
+  void check_planar_metric(const std::string& name, const YAML::Mark& mark,
+                           const std::string& where, const std::string& or_else = "") {
+    std::string names;
+    for (const core::planar::ColumnMetric& m : table_) {
+      if (m.name == name) return;
+      names += m.name + ", ";
+    }
+    if (name == "added_mass") return;
+    r_.fail(mark, "unknown " +
+                      std::string(where == "optimize.objective" ? "metric" : "constraint") + " '" +
+                      name + "' in " + where + "; expected " + or_else + "one of " + names +
+                      "added_mass");
+  }
+
+  static std::string links(const core::planar::Linkage& linkage) {
+    std::string names;
+    for (const core::planar::Link& l : linkage.links) names += (names.empty() ? "" : ", ") + l.name;
+    return names;
+  }
+
+  struct SolverMarks {
+    YAML::Mark section, algorithm, evaluations, tolerance;
+  };
+
+  // algorithm, max_evaluations, tolerance; each mark defaults to the section's
+  SolverMarks read_solver(const MapReader& o, const YAML::Mark& section,
+                          optimize::OptimizeOptions& options) {
+    SolverMarks marks{section, section, section, section};
+    if (const MapReader::Entry* a = o.find("algorithm")) {
+      const std::string name = read_text(r_, *a, "optimize.algorithm");
+      marks.algorithm = mark_of(a->value, a->key_mark);
+      const auto alg = optimize::algorithm_named(name);
+      if (!alg) {
+        std::vector<std::string> all;
+        for (optimize::Algorithm x : kAlgorithms) all.emplace_back(optimize::to_string(x));
+        r_.fail(marks.algorithm, "unknown algorithm '" + name +
+                                     "' in optimize.algorithm; expected one of " + join(all));
+      }
+      options.algorithm = *alg;
+    }
+    if (const MapReader::Entry* n = o.find("max_evaluations")) {
+      options.max_evaluations = read_count(r_, *n, "optimize.max_evaluations", 1, 1e9);
+      marks.evaluations = mark_of(n->value, n->key_mark);
+    }
+    if (const MapReader::Entry* t = o.find("tolerance")) {
+      const double tol = read_number(r_, *t, "optimize.tolerance", "");
+      marks.tolerance = mark_of(t->value, t->key_mark);
+      if (!(tol > 0 && tol < 1)) {
+        r_.fail(marks.tolerance,
+                "optimize.tolerance must be > 0 and < 1 (relative, on the variables and the "
+                "objective), got " +
+                    text::exact(tol));
+      }
+      options.relative_tolerance = tol;
+    }
+    return marks;
+  }
+
+  // the optimize layer's check of the options, at the key it names
+  void check_options(const optimize::OptimizeOptions& options, const SolverMarks& marks) {
+    const Problem p = options.validate();
+    if (!p) return;
+    YAML::Mark where = marks.section;
+    if (p->field == "max_evaluations") where = marks.evaluations;
+    if (p->field == "relative_tolerance" || p->field == "constraint_tolerance") {
+      where = marks.tolerance;
+    }
+    if (p->field == "algorithm") where = marks.algorithm;
+    r_.fail(where, "optimize: " + p->text());
+  }
+
+  // a limit's bound: added_mass in kg (may be 0 or negative: keep the mass as it is, or take
+  // some away), else a fraction of the original's value (> 0)
+  double read_limit(const MapReader::Entry& x, const std::string& path, bool kg) {
+    if (kg) return read_number(r_, x, path, "kg");
+    const double v = read_number(r_, x, path, "");
+    if (!(v > 0)) {
+      r_.fail(
+          mark_of(x.value, x.key_mark),
+          path + " must be > 0 (a fraction of the original design's value), got " + text::exact(v));
+    }
+    return v;
   }
 
   // the optimize layer sets up the problem as it will solve it: the original simulated in the
@@ -199,13 +409,8 @@ class OptimizeReader {
                       "(force_balance, and metric: bound)");
     for (const MapReader::Entry& x : m.entries()) {
       const std::string path = "optimize.constraints." + x.key;
-      const YAML::Mark vm = mark_of(x.value, x.key_mark);
       if (x.key == "force_balance") {
-        bool b = false;
-        if (!x.value.IsScalar() || !YAML::convert<bool>::decode(x.value, b)) {
-          r_.fail(vm, path + " must be true or false, got " + describe(x.value));
-        }
-        req.force_balance = b;
+        req.force_balance = read_bool(r_, x, path);
         continue;
       }
       if (!optimize::metric_named(x.key)) {
@@ -215,19 +420,8 @@ class OptimizeReader {
       }
       const optimize::Metric metric = *optimize::metric_named(x.key);
       check_metric_in_scene(metric, study.scene, x.key_mark, path);
-      if (metric == optimize::Metric::kAddedMass) {
-        // may be 0 or negative: keep the mass as it is, or take some away
-        req.limits.push_back({metric, read_number(r_, x, path, "kg")});
-        limit_marks_.push_back(x.key_mark);
-      } else {
-        const double v = read_number(r_, x, path, "");
-        if (!(v > 0)) {
-          r_.fail(vm, path + " must be > 0 (a fraction of the original design's value), got " +
-                          text::exact(v));
-        }
-        req.limits.push_back({metric, v});
-        limit_marks_.push_back(x.key_mark);
-      }
+      req.limits.push_back({metric, read_limit(x, path, metric == optimize::Metric::kAddedMass)});
+      limit_marks_.push_back(x.key_mark);
     }
   }
 
@@ -242,9 +436,10 @@ class OptimizeReader {
       for (int i = 0; i < 2; ++i) {
         if (const MapReader::Entry* x = sides.find(kSides[i])) {
           const int link = i == 0 ? 1 : 3;
-          req.counterweights.push_back(read_counterweight_variables(
-              *x, "optimize.variables.counterweights." + std::string(kSides[i]), link,
-              core::link(model, link).length));
+          req.counterweights.push_back(
+              read_counterweight_variables<optimize::CounterweightVariables>(
+                  *x, "optimize.variables.counterweights." + std::string(kSides[i]), link,
+                  core::link(model, link).length));
         }
       }
     }
@@ -254,7 +449,7 @@ class OptimizeReader {
       lk.check_keys({"crank", "coupler", "rocker"});
       for (const MapReader::Entry& x : lk.entries()) {
         const int link = x.key == "crank" ? 1 : x.key == "coupler" ? 2 : 3;
-        read_link_parameters(x, "optimize.variables.links." + x.key, link, req);
+        read_link_parameters(x, "optimize.variables.links." + x.key, link, req.link_parameters);
       }
     }
     if (req.counterweights.empty() && req.link_parameters.empty()) {
@@ -265,10 +460,10 @@ class OptimizeReader {
   }
 
   // {mass_max, distance_max, shape, thickness, density}
-  optimize::CounterweightVariables read_counterweight_variables(const MapReader::Entry& e,
-                                                                const std::string& path, int link,
-                                                                double length) {
-    optimize::CounterweightVariables cw;
+  template <class Variables>  // optimize::CounterweightVariables or its planar twin
+  Variables read_counterweight_variables(const MapReader::Entry& e, const std::string& path,
+                                         int link, double length) {
+    Variables cw;
     cw.link = link;
     cw.distance_max = length;  // default: the envelope of the link itself
     if (e.value.IsNull()) return cw;
@@ -293,8 +488,9 @@ class OptimizeReader {
   }
 
   // {mass: [lo, hi], e: [lo, hi], f: [lo, hi], inertia: [lo, hi]}, at least one
+  template <class Variable>  // optimize::LinkParameterVariable or its planar twin
   void read_link_parameters(const MapReader::Entry& e, const std::string& path, int link,
-                            OptimizeRequest& req) {
+                            std::vector<Variable>& out) {
     using P = optimize::LinkParameterVariable::Parameter;
     const MapReader m(r_, e.value, path, e.key_mark, "(mass, e, f, inertia, each [lower, upper])");
     m.check_keys({"mass", "e", "f", "inertia"});
@@ -328,12 +524,12 @@ class OptimizeReader {
         r_.fail(mark_of(x.value[0], vm),
                 xp + " lower bound must be >= 0 kg m^2, got " + text::exact(lo));
       }
-      optimize::LinkParameterVariable v;
+      Variable v;
       v.link = link;
       v.parameter = p;
       v.lower = lo;
       v.upper = hi;
-      req.link_parameters.push_back(v);
+      out.push_back(v);
     }
   }
 
@@ -373,12 +569,18 @@ class OptimizeReader {
   std::vector<YAML::Mark> term_marks_;   // optimize.objective's keys, one per term
   std::vector<YAML::Mark> limit_marks_;  // optimize.constraints' metric keys, one per limit
   YAML::Mark pareto_marks_[2];           // optimize.pareto.first and .second
+  std::vector<core::planar::ColumnMetric> table_;  // a planar linkage's metrics
 };
 
 }  // namespace
 
 OptimizeRequest read_optimize(const Reporter& r, const MapReader::Entry& e, const Study& study) {
   return OptimizeReader(r).read_optimize(e, study);
+}
+
+PlanarOptimizeRequest read_planar_optimize(const Reporter& r, const MapReader::Entry& e,
+                                           const Study& study) {
+  return OptimizeReader(r).read_planar_optimize(e, study);
 }
 
 }  // namespace bd::studies::detail

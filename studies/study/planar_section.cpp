@@ -156,22 +156,13 @@ class PlanarSection::Impl {
         n.position =
             read_vec2(r_, nm.require("at", "the position [x, y] in m"), path + ".at", "m", marks);
         if (const MapReader::Entry* g = nm.find("ground"))
-          n.ground = read_bool(*g, path + ".ground");
+          n.ground = read_bool(r_, *g, path + ".ground");
       } else {
         n.position = read_vec2(r_, x, path, "m", marks);
       }
       places_["nodes[" + std::to_string(l.nodes.size()) + "]"] = {path, x.key_mark};
       l.nodes.push_back(n);
     }
-  }
-
-  bool read_bool(const MapReader::Entry& x, const std::string& path) {
-    bool b = false;
-    if (!x.value.IsScalar() || !YAML::convert<bool>::decode(x.value, b)) {
-      r_.fail(mark_of(x.value, x.key_mark),
-              path + " must be true or false, got " + describe(x.value));
-    }
-    return b;
   }
 
   // links: {crank: {nodes: [A0, A1], mass, e, f | s, sigma, inertia}, ...}

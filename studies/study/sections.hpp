@@ -4,7 +4,7 @@
 /// - fourbar_section.cpp: linkage (type: fourbar), loads and scene of a four-bar;
 /// - planar_section.cpp: linkage (type: planar), loads and scene of a general planar linkage;
 /// - balance_section.cpp: the balance section (a four-bar's or a planar linkage's);
-/// - optimize_section.cpp: a four-bar's optimize section;
+/// - optimize_section.cpp: the optimize section (a four-bar's or a planar linkage's);
 /// - sweep_section.cpp: the sweep section, its paths checked against the file's tree.
 #include <memory>
 
@@ -65,8 +65,11 @@ balance::BalancedDesign read_balance(const Reporter& r, const MapReader::Entry& 
 /// turn about a ground node), checked against the linkage.
 balance::planar::BalanceRequest read_planar_balance(const Reporter& r, const MapReader::Entry& e,
                                                     const core::planar::Linkage& linkage);
-/// The optimize section, checked by the optimize layer.
+/// A four-bar's optimize section, checked by the optimize layer.
 OptimizeRequest read_optimize(const Reporter& r, const MapReader::Entry& e, const Study& study);
+/// A planar linkage's optimize section (a driven scene), checked by the optimize layer.
+PlanarOptimizeRequest read_planar_optimize(const Reporter& r, const MapReader::Entry& e,
+                                           const Study& study);
 /// The sweep section; each path is checked against `root`, the study file's tree.
 SweepRequest read_sweep(const Reporter& r, const MapReader::Entry& e, const YAML::Node& root);
 

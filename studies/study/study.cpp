@@ -71,6 +71,16 @@ Study derived(const Study& study, const std::string& suffix, const Linkage& mode
   return d;
 }
 
+// the request's variables, objective and constraints into its design problem (either type)
+template <class Problem, class Request>
+void set_request(Problem& p, const Request& r) {
+  p.counterweights = r.counterweights;
+  p.link_parameters = r.link_parameters;
+  p.objective = r.objective;
+  p.limits = r.limits;
+  p.force_balance = r.force_balance;
+}
+
 }  // namespace
 
 Study balanced_study(const Study& study) {
@@ -86,6 +96,20 @@ Study optimized_study(const Study& study, const core::FourBar& design) {
   return derived(study, "-optimized", design);
 }
 
+Study planar_optimized_study(const Study& study, const core::planar::Linkage& design) {
+  return derived(study, "-optimized", core::planar::make_linkage(design));
+}
+
+optimize::planar::DesignProblem planar_design_problem(const Study& study) {
+  assert(study.planar_optimize.has_value() && !study.is_fourbar());
+  const PlanarOptimizeRequest& r = *study.planar_optimize;
+  optimize::planar::DesignProblem p;
+  p.original = study.planar();
+  p.scene = std::get<core::planar::DrivenScene>(study.scene);
+  set_request(p, r);
+  return p;
+}
+
 optimize::DesignProblem design_problem(const Study& study) {
   assert(study.optimize.has_value() && study.is_fourbar());
   const OptimizeRequest& r = *study.optimize;
@@ -97,11 +121,7 @@ optimize::DesignProblem design_problem(const Study& study) {
   const MethodChoice method = choose_method(study);
   p.formulation = method.formulation;
   p.tolerance = study.tolerance;
-  p.counterweights = r.counterweights;
-  p.link_parameters = r.link_parameters;
-  p.objective = r.objective;
-  p.limits = r.limits;
-  p.force_balance = r.force_balance;
+  set_request(p, r);
   return p;
 }
 

@@ -5,7 +5,8 @@
 /// The linkage is of one of two types, and the scene is of that type:
 /// - `fourbar`: the planar 4R four-bar (core/fourbar/), with its closed-form formulations;
 /// - `planar`: any planar linkage on the paper's truss elements (core/planar/).
-/// Sections that exist for the four-bar only (balance, optimize) need a four-bar study.
+/// Each type has its own balance and optimize sections (a four-bar's are read into `balance` and
+/// `optimize`, a planar linkage's into `planar_balance` and `planar_optimize`).
 #include <optional>
 #include <string>
 #include <variant>
@@ -67,6 +68,9 @@ struct Study {
   /// The study file's `optimize:` section, checked at load time and solved by the runner; empty
   /// when absent. A study has a balance section or an optimize section, never both.
   std::optional<OptimizeRequest> optimize;
+  /// A planar study's `optimize:` section (a driven scene), checked at load time and solved by the
+  /// runner; empty when absent. Never with a balance section.
+  std::optional<PlanarOptimizeRequest> planar_optimize;
   /// The study file's `sweep:` section, checked at load time; empty when absent. A study with
   /// a sweep is run point by point (run_sweep() in studies/studies.hpp); its own linkage and
   /// scene are the file's values, valid on their own.
@@ -78,6 +82,8 @@ struct Study {
   core::FourBar& fourbar() { return std::get<core::FourBar>(linkage); }
   /// The linkage of a planar study (precondition: !is_fourbar()).
   const core::planar::Linkage& planar() const { return std::get<core::planar::Linkage>(linkage); }
+  /// True when the study has an optimize section (of either linkage type).
+  bool optimizes() const { return optimize.has_value() || planar_optimize.has_value(); }
   /// "auto" or the requested method's name.
   std::string method_name() const { return to_string(method); }
 };
@@ -93,6 +99,15 @@ Study planar_balanced_study(const Study& study, const core::planar::Linkage& bal
 /// The study of an optimised design: name `<name>-optimized`, model `design`, the same scene,
 /// method and tolerance, no balance or optimize section, no source.
 Study optimized_study(const Study& study, const core::FourBar& design);
+
+/// The study of a planar linkage's optimised design: name `<name>-optimized`, the linkage
+/// `design`, the same scene, method and tolerance, no sections, no source.
+Study planar_optimized_study(const Study& study, const core::planar::Linkage& design);
+
+/// The design problem of a planar study's optimize section: its variables, objective and
+/// constraints, with the study's linkage as the original and its (driven) scene.
+/// Precondition: study.planar_optimize is set and the scene is driven.
+optimize::planar::DesignProblem planar_design_problem(const Study& study);
 
 /// The design problem of an optimize study: the request's variables, objective, constraints,
 /// with the study's model as the original, its scene and tolerance, and the formulation its run

@@ -178,6 +178,14 @@ inline int read_count(const Reporter& r, const MapReader::Entry& e, const std::s
   return static_cast<int>(v);
 }
 
+inline bool read_bool(const Reporter& r, const MapReader::Entry& e, const std::string& path) {
+  bool b = false;
+  if (!e.value.IsScalar() || !YAML::convert<bool>::decode(e.value, b)) {
+    r.fail(mark_of(e.value, e.key_mark), path + " must be true or false, got " + describe(e.value));
+  }
+  return b;
+}
+
 inline std::string read_text(const Reporter& r, const MapReader::Entry& e,
                              const std::string& path) {
   if (!e.value.IsScalar()) {

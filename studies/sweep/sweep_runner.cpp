@@ -113,11 +113,10 @@ PointRow point_row(const Study& base, int index, std::span<const double> values,
       const auto [mass, inertia] = have ? added(study, r) : std::pair<double, double>{};
       second_design_cells(body, have ? &r.balanced->metric_list : nullptr, count, mass, inertia);
     }
-    if (base.optimize) {
+    if (base.optimizes()) {
       const bool have = r.optimized && r.optimized->found();
       const auto [mass, inertia] = have ? added(study, r) : std::pair<double, double>{};
-      const MetricList list = have ? metric_list(r.optimized->metrics) : MetricList{};
-      second_design_cells(body, have ? &list : nullptr, count, mass, inertia);
+      second_design_cells(body, have ? &r.optimized->metric_list : nullptr, count, mass, inertia);
     }
     if (r.stopped_early()) {
       status = "stopped-early";
@@ -126,11 +125,11 @@ PointRow point_row(const Study& base, int index, std::span<const double> values,
       } else if (r.balanced && !r.balanced->ok()) {
         message = "balanced design: " + r.balanced->status().message;
       } else {
-        message = "optimised design: " + r.optimized->trajectory.message;
+        message = "optimised design: " + r.optimized->status().message;
       }
     } else if (r.optimized && !r.optimized->found()) {
       status = "no-optimum";
-      message = r.optimized->result.message;
+      message = r.optimized->message();
     }
   } catch (const InputError& e) {  // StudyError from point_study() included
     status = "bad-input";
@@ -339,7 +338,7 @@ std::vector<std::string> sweep_columns(const Study& study) {
   for (const std::string& m : metric_names(study)) columns.push_back(m);
   for (const char* prefix : {"balanced_", "optimized_"}) {
     const bool balance = study.balance || study.planar_balance;
-    if (prefix[0] == 'b' ? !balance : !study.optimize) continue;
+    if (prefix[0] == 'b' ? !balance : !study.optimizes()) continue;
     for (const std::string& m : metric_names(study)) columns.push_back(prefix + m);
     columns.push_back("added_mass");
     columns.push_back("added_inertia");
@@ -381,8 +380,7 @@ Existing existing_rows(const Study& study, const fs::path& out_dir, const SweepR
     }
     if (static_cast<int>(e.csv.rows.size()) < folder_points) {
       throw InputError(out_dir.string() + " holds an unfinished sweep (" +
-                       std::to_string(e.csv.rows.size()) + " of " +
-                       std::to_string(folder_points) +
+                       std::to_string(e.csv.rows.size()) + " of " + std::to_string(folder_points) +
                        " points): pass --resume to continue it, or remove the folder to start "
                        "over");
     }

@@ -39,8 +39,8 @@ TEST(Examples, EveryExampleRunsToTheEnd) {
       continue;
     }
     const RunResult r = run_example(entry.path().filename().string());
-    EXPECT_TRUE(r.ok()) << entry.path() << ": " << r.trajectory.message
-                        << (r.optimized ? " / " + r.optimized->result.message : "");
+    EXPECT_TRUE(r.ok()) << entry.path() << ": " << r.status().message
+                        << (r.optimized ? " / " + r.optimized->message() : "");
   }
   EXPECT_GE(count, 5);
 }

@@ -36,19 +36,12 @@ void expect_error(const std::string& text, int line, int column, const std::stri
   bd::testing::expect_study_error(text, "e.yaml", line, column, message);
 }
 
-std::string example(const std::string& file) {
-  return std::string(BD_SOURCE_DIR) + "/studies/examples/" + file;
-}
+using bd::testing::example_path;
+using bd::testing::rms_norm;
 
 // the column `name` of a planar run's table
 std::vector<double> column(const core::planar::Trajectory& t, const std::string& name) {
   return t.table.column_values(name);
-}
-
-double rms_norm(const std::vector<double>& x, const std::vector<double>& y) {
-  double s = 0;
-  for (std::size_t i = 0; i < x.size(); ++i) s += x[i] * x[i] + y[i] * y[i];
-  return std::sqrt(s / static_cast<double>(x.size()));
 }
 
 TEST(PlanarBalanceStudy, MistakesAreOneLineAtTheirPlace) {
@@ -93,7 +86,7 @@ TEST(PlanarBalanceStudy, MistakesAreOneLineAtTheirPlace) {
 TEST(PlanarBalanceStudy, TheLanchesterEngineLosesOrdersOneAndTwoAndItsStudyRunsByItself) {
   const fs::path dir = fs::path(BD_BINARY_DIR) / "test-output" / "planar-balance" / "lanchester";
   fs::remove_all(dir);
-  const Study study = load_study(example("engine-lanchester.yaml"));
+  const Study study = load_study(example_path("engine-lanchester.yaml"));
   RunResult r = compute_study(study);
   write_run(study, r, dir);
   ASSERT_TRUE(r.ok() && r.balanced && r.balanced->ok() && r.balanced->shafts);
@@ -178,7 +171,7 @@ TEST(PlanarBalanceStudy, ABerkofFourBarOnTrussElementsIsForceAndMomentBalanced) 
   const bp::MomentBalance& m = *r.balanced->moment;
   EXPECT_TRUE(m.full) << m.message;
 
-  const Study fourbar = load_study(example("berkof-inline-moment-balanced.yaml"));
+  const Study fourbar = load_study(example_path("berkof-inline-moment-balanced.yaml"));
   const core::CounterRotations& want = fourbar.balance->model.counter_rotations;
   ASSERT_EQ(m.added.size(), 2u);
   const core::planar::BalanceShaft& c = m.linkage.shafts[static_cast<std::size_t>(m.added[0])];
@@ -240,7 +233,7 @@ TEST(PlanarBalanceStudy, CounterweightsDefaultToTheLinksThatTurnAboutTheFrame) {
   ASSERT_EQ(s.planar_balance->counterweights.size(), 1u);
   EXPECT_EQ(s.planar_balance->counterweights[0].link, 0);  // the crank, not the rod
 
-  const Study w = load_study(example("watt-sixbar-balanced.yaml"));
+  const Study w = load_study(example_path("watt-sixbar-balanced.yaml"));
   ASSERT_TRUE(w.planar_balance.has_value());
   std::vector<std::string> links;
   for (const bp::LinkCounterweightSpec& c : w.planar_balance->counterweights) {
@@ -254,7 +247,7 @@ TEST(PlanarBalanceStudy, CounterweightsDefaultToTheLinksThatTurnAboutTheFrame) {
 // referee's of the design read back from balanced.yaml, find no inertial shaking force left; the
 // files say what was added and the balanced study runs by itself to the same numbers.
 TEST(PlanarBalanceStudy, TheExampleSixBarIsFullyForceBalancedAndItsStudyRunsByItself) {
-  const Study study = load_study(example("watt-sixbar-balanced.yaml"));
+  const Study study = load_study(example_path("watt-sixbar-balanced.yaml"));
   const fs::path out = fs::path(BD_BINARY_DIR) / "test-output" / "planar-balance" / "watt";
   fs::remove_all(out);
   RunResult r = compute_study(study);
@@ -370,7 +363,7 @@ TEST(PlanarBalanceStudy, AnEnginesCrankCounterweightLeavesWhatTheMessageSays) {
 // the balanced design, released alike, shakes its frame with no inertial force whatever motion
 // the spring and motor give it (its linear momentum is zero in every configuration).
 TEST(PlanarBalanceStudy, AFreeSixBarBalancedFromItsSwingShakesNoMoreInItsOwnSwing) {
-  std::string text = bd::testing::read(example("stephenson-sixbar-free.yaml"));
+  std::string text = bd::testing::read(example_path("stephenson-sixbar-free.yaml"));
   const std::string gravity = "loads:\n  gravity: [0, -9.81]\n";
   ASSERT_NE(text.find(gravity), std::string::npos);
   text.replace(text.find(gravity), gravity.size(), "");

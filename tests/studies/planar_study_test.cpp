@@ -105,8 +105,6 @@ TEST(PlanarStudy, MistakesAreOneLineAtTheirPlace) {
   expect_error(edit(crank, "e: 0.012, f: 0, s: 0.1, inertia"), 9, 55,
                "linkage.links.crank gives its centre of mass both as {s, sigma} and as {e, f}");
   expect_error(edit(crank, "inertia"), 9, 5, "linkage.links.crank: missing the centre of mass");
-  expect_error(kEngine + "optimize: {}\n", 20, 1,
-               "optimize is available for a four-bar (linkage.type: fourbar)");
   // a start the linkage cannot reach: a slider-crank driven from the piston past its stroke;
   // the message names where, on the way from the drawn position, it stopped closing
   const std::string from_piston =

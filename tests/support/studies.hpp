@@ -1,8 +1,22 @@
 #pragma once
 // Test support: study-file texts the tests share.
+#include <cmath>
 #include <string>
+#include <vector>
 
 namespace bd::testing {
+
+/// The path of an example study in the source tree, e.g. "watt-sixbar.yaml".
+inline std::string example_path(const std::string& file) {
+  return std::string(BD_SOURCE_DIR) + "/studies/examples/" + file;
+}
+
+/// The RMS over samples of the magnitude of (x, y).
+inline double rms_norm(const std::vector<double>& x, const std::vector<double>& y) {
+  double s = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) s += x[i] * x[i] + y[i] * y[i];
+  return std::sqrt(s / static_cast<double>(x.size()));
+}
 
 /// The paper's loaded four-bar in free motion (20 s, 201 samples) with an LHS sweep of `points`
 /// points over coupler mass [1, 5] kg and initial crank speed [-2, 2] rad/s; `extra` (e.g.

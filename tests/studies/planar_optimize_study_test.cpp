@@ -1,0 +1,245 @@
+// A planar linkage's optimize section, from the study file to the files a run writes: the loader
+// places every mistake at its file:line:column; the runner solves the design problem in the
+// driven scene, simulates the optimum and writes it as a study that runs by itself.
+//
+// The optimum is checked against an independent route: the paper's four-bar optimisation of
+// berkof-lowen-min-shaking-moment.yaml (the four-bar's closed-form kinematics and dynamics, its
+// own problem with eq. 57 as the force balance) written as a planar linkage on truss elements
+// (the general engine, the regressor from its runs, the momentum conditions) must reach the same
+// optimum.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/number_text.hpp"
+#include "studies/run/runner.hpp"
+#include "studies/studies.hpp"
+#include "studies/study/load_study.hpp"
+#include "tests/support/studies.hpp"
+#include "tests/support/study_errors.hpp"
+#include "tests/support/text.hpp"
+
+namespace bd::studies {
+namespace {
+
+namespace fs = std::filesystem;
+
+// a slider-crank driven by its crank; line numbers below refer to it (the section starts at 20)
+const std::string kEngine = bd::testing::engine_study(72);
+
+void expect_error(const std::string& text, int line, int column, const std::string& message) {
+  bd::testing::expect_study_error(text, "e.yaml", line, column, message);
+}
+
+using bd::testing::example_path;
+using bd::testing::rms_norm;
+
+// the optimize section with `objective`, `constraints` and `variables` lines after its key
+std::string section(const std::string& body) { return kEngine + "optimize:\n" + body; }
+
+const std::string kObjective = "  objective: {Msh_rms: 1}\n";                           // line 21
+const std::string kVariables = "  variables:\n    counterweights:\n      crank: {}\n";  // 22-24
+
+TEST(PlanarOptimizeStudy, MistakesAreOneLineAtTheirPlace) {
+  // the section's own keys
+  expect_error(section(kObjective), 20, 1,
+               "optimize: missing required key 'variables' (what may change");
+  expect_error(section("  objective: {Fsh_rms: 1}\n  pareto: {first: Fsh_rms, second: Msh_rms}\n" +
+                       kVariables),
+               22, 3, "optimize.pareto is available for a four-bar");
+  expect_error(section(kObjective + kVariables + "  colour: red\n"), 25, 3, "colour");
+  expect_error(section("  algorithm: newton\n" + kObjective + kVariables), 21, 14,
+               "unknown algorithm 'newton' in optimize.algorithm");
+  expect_error(section(kObjective + kVariables + "  tolerance: 2\n"), 25, 14,
+               "optimize.tolerance must be > 0 and < 1");
+  // objective and constraints: the linkage's metrics by name
+  expect_error(section("  objective: {Msh: 1}\n" + kVariables), 21, 15,
+               "unknown metric 'Msh' in optimize.objective; expected one of Fsh_rms, Fsh_max, "
+               "Msh_rms");
+  expect_error(section("  objective: {Fsh_max: 1}\n" + kVariables), 21, 15,
+               "optimize.objective.Fsh_max: Fsh_max is a peak; minimise an RMS and limit the peak");
+  expect_error(section("  objective: {Msh_rms: 0}\n" + kVariables), 21, 3,
+               "optimize.objective needs at least one metric with a weight > 0");
+  expect_error(section(kObjective + "  constraints: {RO_max: -1}\n" + kVariables), 22, 25,
+               "optimize.constraints.RO_max must be > 0 (a fraction of the original design's");
+  expect_error(section(kObjective + "  constraints: {torque: 1}\n" + kVariables), 22, 17,
+               "unknown constraint 'torque' in optimize.constraints; expected force_balance or "
+               "one of Fsh_rms");
+  expect_error(section(kObjective + "  constraints: {force_balance: maybe}\n" + kVariables), 22, 32,
+               "optimize.constraints.force_balance must be true or false");
+  // variables: links by name, their envelopes and bounds
+  expect_error(section(kObjective + "  variables:\n    counterweights:\n      piston: {}\n"), 24, 7,
+               "optimize.variables.counterweights.piston: no link of that name (links: crank, "
+               "rod)");
+  expect_error(
+      section(kObjective + "  variables:\n    counterweights:\n      crank: {mass_max: 0}\n"), 24,
+      25, "optimize.variables.counterweights.crank.mass_max must be > 0 kg, got 0");
+  expect_error(section(kObjective + "  variables:\n    links:\n      rod: {mass: [0, 1]}\n"), 24,
+               20, "optimize.variables.links.rod.mass lower bound must be > 0 kg");
+  expect_error(section(kObjective + "  variables:\n    links:\n      rod: {}\n"), 24, 7,
+               "optimize.variables.links.rod: give at least one of mass, e, f, inertia");
+  expect_error(section(kObjective + "  variables: {}\n"), 22, 3,
+               "optimize.variables: no design variable");
+  // what the optimize layer refuses, at the key it names
+  expect_error(section("  algorithm: mma\n" + kObjective +
+                       "  constraints: {force_balance: true}\n" + kVariables),
+               21, 14, "optimize.algorithm: 'mma' takes inequality constraints only");
+  // the scene: a free one has no exact regressor
+  std::string free = kEngine;
+  free.replace(free.find("  type: driven\n"), 15, "  type: free\n  duration: 0.1\n");
+  free.erase(free.find("  speeds:"), free.find("  samples:") - free.find("  speeds:"));
+  expect_error(free + "optimize:\n" + kObjective + kVariables, 20, 1,
+               "optimize for a planar linkage needs a driven scene");
+  // a balance section beside it
+  expect_error(kEngine + "balance: {}\noptimize:\n" + kObjective + kVariables, 21, 1,
+               "a study has a balance section or an optimize section, not both");
+}
+
+// The four-bar of berkof-lowen-min-shaking-moment.yaml on truss elements (crank A0-A1, coupler
+// A1-A2, rocker A2-A3 as the four-bar's links, centres of mass from their first joints) with
+// the same optimize section: least RMS shaking moment among force-balanced designs, with
+// counterweights on crank and rocker and the coupler's mass and inertia as variables.
+std::string berkof_lowen_planar() {
+  const double l1 = 1, l2 = 3, l3 = 2, l4 = 3.2;
+  // A2 where the coupler (l2 from A1 = (l1, 0)) meets the rocker (l3 from A3 = (l4, 0)), above
+  // the frame (branch 1: the original's metrics below must agree)
+  const double d = l4 - l1, a = (l2 * l2 - l3 * l3 + d * d) / (2 * d);
+  const double h = std::sqrt(l2 * l2 - a * a);
+  auto link = [](const std::string& name, const std::string& nodes, double mass, double s,
+                 double sigma, double inertia) {
+    return "    " + name + ": {nodes: [" + nodes + "], mass: " + text::exact(mass) +
+           ", e: " + text::exact(s * std::cos(sigma)) + ", f: " + text::exact(s * std::sin(sigma)) +
+           ", inertia: " + text::exact(inertia) + "}\n";
+  };
+  return "name: berkof-lowen-planar\n"
+         "linkage:\n"
+         "  type: planar\n"
+         "  nodes:\n"
+         "    A0: {at: [0, 0], ground: true}\n"
+         "    A3: {at: [3.2, 0], ground: true}\n"
+         "    A1: [1, 0]\n"
+         "    A2: [" +
+         text::exact(l1 + a) + ", " + text::exact(h) +
+         "]\n"
+         "  links:\n" +
+         link("crank", "A0, A1", 2.1, 0.6, 0.3, 1.1) +
+         link("coupler", "A1, A2", 3.0, 1.45, 0.4, 3.1) +
+         link("rocker", "A2, A3", 2.2, 1.66, -0.4, 2.1) +
+         "  inputs:\n"
+         "    crank: {link: crank}\n"
+         "scene:\n"
+         "  type: driven\n"
+         "  speeds: [6.283185307179586]\n"
+         "  samples: 360\n"
+         "optimize:\n"
+         "  algorithm: slsqp\n"
+         "  objective: {Msh_rms: 1.0}\n"
+         "  constraints: {force_balance: true}\n"
+         "  variables:\n"
+         "    counterweights:\n"
+         "      crank:  {mass_max: 10.0, distance_max: 1.0}\n"
+         "      rocker: {mass_max: 10.0, distance_max: 2.0}\n"
+         "    links:\n"
+         "      coupler: {mass: [2.0, 4.0], inertia: [1.0, 8.0]}\n"
+         "  max_evaluations: 2000\n"
+         "  tolerance: 1.0e-10\n";
+}
+
+double metric(const MetricList& list, const std::string& name) {
+  for (const MetricValue& m : list)
+    if (m.name == name) return m.value;
+  ADD_FAILURE() << "no metric " << name;
+  return std::nan("");
+}
+
+TEST(PlanarOptimizeStudy, TheFourBarsOptimumIsReachedOnTrussElements) {
+  const Study planar = parse_study(berkof_lowen_planar(), "berkof-lowen-planar.yaml");
+  ASSERT_TRUE(planar.planar_optimize.has_value());
+  const fs::path out = fs::path(BD_BINARY_DIR) / "test-output" / "planar-optimize" / "berkof";
+  fs::remove_all(out);
+  RunResult r = compute_study(planar);
+  write_run(planar, r, out);
+  ASSERT_TRUE(r.ok() && r.optimized && r.optimized->found()) << r.optimized->message();
+
+  const Study fourbar = load_study(example_path("berkof-lowen-min-shaking-moment.yaml"));
+  const RunResult f = compute_study(fourbar);
+  ASSERT_TRUE(f.ok() && f.optimized && f.optimized->found());
+
+  // the same linkage and motion: the originals agree to round-off
+  for (const char* m : {"Fsh_rms", "Msh_rms", "tau_rms"}) {
+    EXPECT_NEAR(metric(r.metric_list, m), metric(f.metric_list, m),
+                1e-12 * metric(f.metric_list, m))
+        << m;
+  }
+  // the same optimum: objective (Msh_rms / original) to the solvers' tolerance, the coupler's
+  // parameters, the counterweights' masses and distances from their pivots
+  const optimize::planar::Result& p = r.optimized->planar_result;
+  const optimize::OptimizeResult& q = f.optimized->result;
+  EXPECT_NEAR(p.objective, q.objective, 1e-7 * q.objective);
+  EXPECT_NEAR(p.design.links[1].mass, q.design.coupler.mass, 1e-6);
+  EXPECT_NEAR(p.design.links[1].inertia, q.design.coupler.inertia, 1e-6);
+  ASSERT_EQ(p.counterweights.size(), 2u);
+  ASSERT_EQ(q.counterweights.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_NEAR(p.counterweights[k].counterweight.mass, q.counterweights[k].counterweight.mass,
+                1e-6)
+        << k;
+    EXPECT_NEAR(p.counterweights[k].counterweight.distance,
+                q.counterweights[k].counterweight.distance, 1e-6)
+        << k;
+  }
+  // the optimum simulated: force balanced (no gravity), its shaking moment the four-bar's
+  const core::planar::Trajectory& t = r.optimized->planar;
+  const double fsh0 = metric(r.metric_list, "Fsh_rms");
+  EXPECT_LE(rms_norm(t.table.column_values("Fshx"), t.table.column_values("Fshy")), 1e-10 * fsh0);
+  EXPECT_NEAR(metric(r.optimized->metric_list, "Msh_rms"),
+              metric(f.optimized->metric_list, "Msh_rms"),
+              1e-6 * metric(f.optimized->metric_list, "Msh_rms"));
+
+  // the files: summary.json's optimum, comparison.csv, and optimized.yaml running by itself to
+  // the same samples
+  const nlohmann::json j = nlohmann::json::parse(bd::testing::read(out / "summary.json"));
+  EXPECT_EQ(j["optimize"]["termination"], "converged");
+  EXPECT_EQ(j["optimize"]["force_balance"], true);
+  EXPECT_EQ(j["optimize"]["counterweights"].size(), 2u);
+  EXPECT_EQ(j["optimize"]["counterweights"][1]["from_node"], "A3");
+  EXPECT_LE(j["optimize"]["verification_error"].get<double>(), 1e-9);
+  EXPECT_EQ(j["optimize"]["added_mass"].get<double>(), p.added_mass);
+  EXPECT_EQ(j["optimized_run"]["study"], "berkof-lowen-planar-optimized");
+  EXPECT_EQ(j["optimized_metrics"]["Msh_rms"].get<double>(),
+            metric(r.optimized->metric_list, "Msh_rms"));
+  EXPECT_TRUE(fs::exists(out / "comparison.csv"));
+  EXPECT_NE(bd::testing::read(out / "comparison.csv").find("added_mass,0,"), std::string::npos);
+  const Study again = load_study((out / "optimized.yaml").string());
+  EXPECT_FALSE(again.optimizes());
+  const RunResult rerun = compute_study(again);
+  ASSERT_TRUE(rerun.ok());
+  const std::vector<double> m1 = t.table.column_values("Msh"),
+                            m2 = rerun.planar.table.column_values("Msh");
+  ASSERT_EQ(m1.size(), m2.size());
+  for (std::size_t i = 0; i < m1.size(); ++i) EXPECT_EQ(m1[i], m2[i]);
+}
+
+// The six-bar example: least RMS shaking moment among the force-balanced designs is below the
+// shaking moment of the balance section's least-mass design of the same counterweights, and the
+// optimum is force balanced when simulated.
+TEST(PlanarOptimizeStudy, TheSixBarExampleBeatsTheLeastMassBalance) {
+  const Study study = load_study(example_path("watt-sixbar-optimized.yaml"));
+  const RunResult r = compute_study(study);
+  ASSERT_TRUE(r.ok() && r.optimized && r.optimized->found()) << r.optimized->message();
+  const Study balanced = load_study(example_path("watt-sixbar-balanced.yaml"));
+  const RunResult b = compute_study(balanced);
+  ASSERT_TRUE(b.ok() && b.balanced && b.balanced->design && b.balanced->design->full);
+  const double fsh0 = metric(r.metric_list, "Fsh_rms");
+  EXPECT_LE(metric(r.optimized->metric_list, "Fsh_rms"), 1e-10 * fsh0);
+  EXPECT_LT(metric(r.optimized->metric_list, "Msh_rms"),
+            0.6 * metric(b.balanced->metric_list, "Msh_rms"));
+  EXPECT_LE(r.optimized->planar_result.added_mass, 12 + 1e-9);
+}
+
+}  // namespace
+}  // namespace bd::studies
