@@ -403,6 +403,13 @@ void print_planar_optimize(const st::Study& study, const st::RunResult& r) {
   const st::RunStatus status = run.status();
   std::printf("  optimum: method %s, %zu samples, status %s\n", st::to_string(run.method.method),
               status.samples, bd::core::to_string(status.status));
+  if (req.pareto) {
+    std::size_t found = 0;
+    for (const bd::optimize::planar::ParetoPoint& p : run.planar_pareto)
+      found += p.result.ok() ? 1 : 0;
+    std::printf("  pareto   %s vs %s: %zu of %zu points found\n", req.pareto->first.c_str(),
+                req.pareto->second.c_str(), found, run.planar_pareto.size());
+  }
   print_comparison(study, r);
 }
 

@@ -7,6 +7,7 @@
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
 #include "optimize/check_inputs.hpp"
+#include "optimize/epsilon_front.hpp"
 #include "optimize/nlp.hpp"
 #include "optimize/optimize.hpp"
 
@@ -14,21 +15,31 @@ namespace bd::optimize {
 
 namespace {
 
-// the value of `m` at a result, in the units of a Limit on it: the fraction of the original's
-// value, or kg for added_mass
-double limit_value(const OptimizeResult& r, const DesignProblem& problem, const Nlp& nlp,
-                   Metric m) {
-  if (m == Metric::kAddedMass) {
-    return core::total_mass(r.design) - core::total_mass(problem.original);
+// the four-bar's problems for the ε-constraint method (epsilon_front.hpp)
+struct FourBarFront {
+  using Problem = DesignProblem;
+  using Metric = optimize::Metric;
+  using Result = OptimizeResult;
+  const DesignProblem& problem;
+  const OptimizeOptions& options;
+  const Nlp& nlp;  // the original's metrics: the normalisers of the bounds
+  Problem minimising(Metric m) const {
+    DesignProblem p = problem;
+    p.objective = {Term{m, 1.0}};
+    return p;
   }
-  return value(r.metrics, m) / nlp.original(m);
-}
-
-DesignProblem minimising(const DesignProblem& problem, Metric m) {
-  DesignProblem p = problem;
-  p.objective = {Term{m, 1.0}};
-  return p;
-}
+  static void limit(Problem& p, Metric m, double bound) { p.limits.push_back(Limit{m, bound}); }
+  Result solve(const Problem& p) const { return optimize(p, options); }
+  // the value of `m` at a result, in the units of a Limit on it: the fraction of the original's
+  // value, or kg for added_mass
+  double value(const Result& r, Metric m) const {
+    if (m == Metric::kAddedMass) {
+      return core::total_mass(r.design) - core::total_mass(problem.original);
+    }
+    return optimize::value(r.metrics, m) / nlp.original(m);
+  }
+  static bool is_mass(Metric m) { return m == Metric::kAddedMass; }
+};
 
 }  // namespace
 
@@ -48,37 +59,10 @@ std::vector<ParetoPoint> pareto_front(const DesignProblem& problem, Metric first
                      " of the original design is " + text::digits(nlp.original(second), 6) +
                      ", so no bound relative to it can be set");
   }
-
-  // the extremes: each metric minimised alone. The first's minimiser need not be unique (a
-  // force-balanced design keeps Fsh = 0 whatever the counterweights' masses, and those change
-  // the shaking moment), so the loose end is lexicographic: the second minimised with the first
-  // held within 1e-3 of its range above its minimum.
-  const OptimizeResult best_first = optimize(minimising(problem, first), options);
-  const OptimizeResult best_second = optimize(minimising(problem, second), options);
-  const double first_lo = limit_value(best_first, problem, nlp, first);
-  const double first_hi = limit_value(best_second, problem, nlp, first);
-  double bound = first_lo + 1e-3 * std::max(0.0, first_hi - first_lo);
-  if (first != Metric::kAddedMass) bound = std::max(bound, 1e-12);  // a limit must be > 0
-  DesignProblem lexicographic = minimising(problem, second);
-  lexicographic.limits.push_back(Limit{first, bound});
-  const OptimizeResult loose = optimize(lexicographic, options);
-  const double a = loose.ok()
-                       ? limit_value(loose, problem, nlp, second)
-                       : limit_value(best_first, problem, nlp, second);  // loosest useful bound
-  const double b = limit_value(best_second, problem, nlp, second);       // tightest reachable bound
-  const double hi = std::max(a, b), lo = std::min(a, b);
-
-  // ε from hi down to lo; the tightest is kept 1e-3 of the span above lo, so the feasible set
-  // at the last point is not a single design the solver must hit exactly
   std::vector<ParetoPoint> front;
-  front.reserve(static_cast<size_t>(points));
-  for (int i = 0; i < points; ++i) {
-    const double fraction = static_cast<double>(i) / (points - 1);
-    double epsilon = hi - (hi - lo) * fraction * (1.0 - 1e-3);
-    if (second != Metric::kAddedMass) epsilon = std::max(epsilon, 1e-12);  // a limit is > 0
-    DesignProblem p = minimising(problem, first);
-    p.limits.push_back(Limit{second, epsilon});
-    front.push_back(ParetoPoint{epsilon, optimize(p, options)});
+  for (auto& [epsilon, result] :
+       detail::epsilon_front(FourBarFront{problem, options, nlp}, first, second, points)) {
+    front.push_back(ParetoPoint{epsilon, std::move(result)});
   }
   return front;
 }

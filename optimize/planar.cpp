@@ -11,6 +11,7 @@
 
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
+#include "optimize/epsilon_front.hpp"
 #include "optimize/nlopt_driver.hpp"
 
 namespace bd::optimize::planar {
@@ -328,14 +329,18 @@ void PlanarNlp::Impl::set_up_variables() {
     const Vec2 d = bp::in_link_axes(l, c.link, l.nodes[static_cast<std::size_t>(other)].position) -
                    cw_pivot_in_link.back();
     cw_away.push_back(-d.normalized());
+    const std::string from = " from " + l.nodes[static_cast<std::size_t>(pv)].name;
     cw_var.push_back(add(0.0, c.mass_max, name + " counterweight mass [kg]"));
-    add(-c.distance_max, c.distance_max, name + " counterweight x [m]");
-    add(-c.distance_max, c.distance_max, name + " counterweight y [m]");
+    add(-c.distance_max, c.distance_max, name + " counterweight x" + from + " in link axes [m]");
+    add(-c.distance_max, c.distance_max, name + " counterweight y" + from + " in link axes [m]");
   }
   for (const LinkParameterVariable& v : p.link_parameters) {
-    param_var.push_back(
-        add(v.lower, v.upper,
-            l.links[static_cast<std::size_t>(v.link)].name + "." + parameter_text(v.parameter)));
+    const char* unit = v.parameter == Param::kMass      ? " [kg]"
+                       : v.parameter == Param::kInertia ? " [kg m^2]"
+                                                        : " [m]";
+    param_var.push_back(add(
+        v.lower, v.upper,
+        l.links[static_cast<std::size_t>(v.link)].name + " " + parameter_text(v.parameter) + unit));
     auto [it, _] = link_vars.try_emplace(v.link, std::array<int, 4>{-1, -1, -1, -1});
     it->second[static_cast<std::size_t>(v.parameter)] = param_var.back();
   }
@@ -730,6 +735,59 @@ Result optimize(const DesignProblem& problem, const OptimizeOptions& options) {
   r.verified = cp::metric_values(r.metric_table, t.table);
   r.verification_error = verification_error(r.metric_table, r.metrics, r.verified);
   return r;
+}
+
+namespace {
+
+// a planar linkage's problems for the ε-constraint method (epsilon_front.hpp)
+struct PlanarFront {
+  using Problem = DesignProblem;
+  using Metric = std::string;
+  using Result = planar::Result;
+  const DesignProblem& problem;
+  const OptimizeOptions& options;
+  Problem minimising(const Metric& m) const {
+    DesignProblem p = problem;
+    p.objective = {Term{m, 1.0}};
+    return p;
+  }
+  static void limit(Problem& p, const Metric& m, double bound) {
+    p.limits.push_back(Limit{m, bound});
+  }
+  Result solve(const Problem& p) const { return optimize(p, options); }
+  // the value of `m` at a result, in the units of a Limit on it: the fraction of the original's
+  // value, or kg for added_mass
+  static double value(const Result& r, const Metric& m) {
+    if (m == "added_mass") return r.added_mass;
+    for (std::size_t k = 0; k < r.metric_table.size(); ++k)
+      if (r.metric_table[k].name == m) return r.metrics[k] / r.original[k];
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  static bool is_mass(const Metric& m) { return m == "added_mass"; }
+};
+
+}  // namespace
+
+std::vector<ParetoPoint> pareto_front(const DesignProblem& problem, const std::string& first,
+                                      const std::string& second, int points,
+                                      const OptimizeOptions& options) {
+  if (points < 2)
+    throw InputError("pareto_front: points must be >= 2, got " + std::to_string(points));
+  if (first == second)
+    throw InputError("pareto_front: the two metrics must differ, got " + first + " twice");
+  if (const Problem e = options.validate()) throw InputError("optimize options: " + e->text());
+  // every problem of the front is set up once here, so a metric it cannot take is reported
+  // before any solve: `first` as the objective, `second` as a limit
+  DesignProblem check = problem;
+  check.objective = {Term{first, 1.0}};
+  check.limits.push_back(Limit{second, 1.0});
+  (void)PlanarNlp(check);
+  std::vector<ParetoPoint> front;
+  for (auto& [epsilon, result] :
+       detail::epsilon_front(PlanarFront{problem, options}, first, second, points)) {
+    front.push_back(ParetoPoint{epsilon, std::move(result)});
+  }
+  return front;
 }
 
 }  // namespace bd::optimize::planar

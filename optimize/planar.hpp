@@ -157,4 +157,23 @@ struct Result {
 ///         algorithm that cannot take the problem (mma with force balance).
 Result optimize(const DesignProblem& problem, const OptimizeOptions& options);
 
+/// A point of a Pareto front: the bound ε on the second metric (a fraction of the original's,
+/// or kg for added_mass) and the design found under it.
+struct ParetoPoint {
+  double epsilon{};
+  Result result;
+};
+
+/// The ε-constraint trade-off between two metrics of the problem's linkage (names of its metric
+/// table, or "added_mass"), as the four-bar's pareto_front() (optimize/optimize.hpp): minimise
+/// `first` alone under the problem's constraints and second <= ε for `points` values of ε spaced
+/// between the extremes found by minimising each metric alone. `first` is an RMS or added_mass;
+/// `second` any metric. The problem's own objective is not used.
+/// @throws bd::InputError for points < 2, equal metrics, a metric the problem cannot take (a
+///         peak as `first`, a name not in the table), or a second metric that is 0 for the
+///         original (no bound relative to it).
+std::vector<ParetoPoint> pareto_front(const DesignProblem& problem, const std::string& first,
+                                      const std::string& second, int points,
+                                      const OptimizeOptions& options);
+
 }  // namespace bd::optimize::planar

@@ -267,10 +267,9 @@ struct FourBarCharts {
 };
 
 FourBarCharts fourbar_charts(const Study& study, const fs::path& dir, const SecondDesign& sd,
-                             const Csv& ts, const Csv* pareto) {
+                             const Csv& ts) {
   FourBarCharts out;
   const std::string second = sd.key, second_label = sd.label, second_file = sd.file;
-  const bool has_pareto = pareto != nullptr;
   std::vector<Chart>& charts = out.charts;
   std::string& datablocks = out.datablocks;
   // the linkage at four samples evenly spread over the run, and the path of S; the second
@@ -410,16 +409,6 @@ FourBarCharts fourbar_charts(const Study& study, const fs::path& dir, const Seco
                 "balanced, S stays in one place.";
     charts.push_back(c);
   }
-  if (has_pareto && pareto->header.size() >= 3) {
-    charts.push_back({"pareto", "Pareto front",
-                      "Each point a design found by the epsilon-constraint method (pareto.csv); "
-                      "points without a design are left out.",
-                      "set title 'Pareto front'\nset xlabel " + gp_string(pareto->header[1]) +
-                          "\nset ylabel " + gp_string(pareto->header[2]) + "\nplot " +
-                          gp_string((abs_dir / "pareto.csv").string()) +
-                          " skip 1 using 2:3 with linespoints lw 2 pt 7 title 'front'"});
-  }
-
   return out;
 }
 
@@ -429,9 +418,6 @@ std::string fourbar_report_html(const Study& study, const fs::path& dir, const s
                                 const Json& summary) {
   const Csv ts = read_csv(dir / "timeseries.csv");
   const SecondDesign second = second_design(summary, dir);
-  const bool has_pareto = fs::exists(dir / "pareto.csv");
-  Csv pareto;
-  if (has_pareto) pareto = read_csv(dir / "pareto.csv");
   std::string h = page_start(study, summary) + simulation_section(summary);
   h += "<h2>Linkage</h2>\n" + fourbar_linkage_tables(study.fourbar());
   h +=
@@ -441,7 +427,8 @@ std::string fourbar_report_html(const Study& study, const fs::path& dir, const s
                       "over the samples, max of magnitudes.");
   h += comparison_section(dir, second);
   h += harmonics_section(dir);
-  const FourBarCharts c = fourbar_charts(study, dir, second, ts, has_pareto ? &pareto : nullptr);
+  FourBarCharts c = fourbar_charts(study, dir, second, ts);
+  for (Chart& chart : pareto_charts(dir)) c.charts.push_back(std::move(chart));
   h += charts_section(gnuplot, c.datablocks, c.charts);
   if (!c.original.poses.empty()) {
     h += "<h3>The linkage at the drawn samples</h3>" + poses_table(c.original);
@@ -451,10 +438,7 @@ std::string fourbar_report_html(const Study& study, const fs::path& dir, const s
          " linkage at the drawn samples</h3>" + poses_table(c.second);
   }
   h += second_design_section(summary, second);
-  if (has_pareto) {
-    h += "<h2>Pareto front</h2>\n<p>From <a href=\"pareto.csv\">pareto.csv</a>.</p>" +
-         csv_table(pareto);
-  }
+  h += pareto_section(dir);
   // the measurements of `balance-design bench` when the folder has them (work_precision.hpp)
   h += work_precision_section(study, dir, gnuplot);
   return h + data_files_html(dir, {"timeseries.csv", "summary.json", "balanced-timeseries.csv",

@@ -442,9 +442,11 @@ std::string planar_report_html(const Study& study, const fs::path& dir, const st
   h += comparison_section(dir, second.design);
   h += harmonics_section(dir);
   std::string datablocks;
-  const std::vector<Chart> charts = planar_charts(study, dir, ts, second, datablocks);
+  std::vector<Chart> charts = planar_charts(study, dir, ts, second, datablocks);
+  for (Chart& chart : pareto_charts(dir)) charts.push_back(std::move(chart));
   h += charts_section(gnuplot, datablocks, charts);
   h += second_design_section(summary, second.design);
+  h += pareto_section(dir);
   // the measurements of `balance-design bench` when the folder has them (work_precision.hpp)
   h += work_precision_section(study, dir, gnuplot);
   return h + data_files_html(

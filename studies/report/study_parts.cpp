@@ -148,6 +148,25 @@ std::string charts_section(const std::string& gnuplot, const std::string& databl
   return h;
 }
 
+std::vector<Chart> pareto_charts(const fs::path& dir) {
+  if (!fs::exists(dir / "pareto.csv")) return {};
+  const Csv pareto = read_csv(dir / "pareto.csv");
+  if (pareto.header.size() < 3) return {};
+  return {{"pareto", "Pareto front",
+           "Each point a design found by the epsilon-constraint method (pareto.csv); points "
+           "without a design are left out.",
+           "set title 'Pareto front'\nset xlabel " + gp_string(pareto.header[1]) + "\nset ylabel " +
+               gp_string(pareto.header[2]) + "\nplot " +
+               gp_string((fs::absolute(dir) / "pareto.csv").string()) +
+               " skip 1 using 2:3 with linespoints lw 2 pt 7 title 'front'"}};
+}
+
+std::string pareto_section(const fs::path& dir) {
+  if (!fs::exists(dir / "pareto.csv")) return "";
+  return "<h2>Pareto front</h2>\n<p>From <a href=\"pareto.csv\">pareto.csv</a>.</p>" +
+         csv_table(read_csv(dir / "pareto.csv"));
+}
+
 std::string time_axis(const Scene& scene) {
   if (std::holds_alternative<core::DrivenScene>(scene))
     return "t [s] (crank driven at constant speed)";

@@ -39,6 +39,10 @@ std::string second_design_section(const Json& summary, const SecondDesign& secon
 /// charts need gnuplot.
 std::string charts_section(const std::string& gnuplot, const std::string& datablocks,
                            const std::vector<Chart>& charts);
+/// The Pareto front of pareto.csv, when the folder has it (no chart otherwise).
+std::vector<Chart> pareto_charts(const std::filesystem::path& dir);
+/// "Pareto front": pareto.csv as a table, when the folder has it.
+std::string pareto_section(const std::filesystem::path& dir);
 /// The gnuplot axis label of the time axis of a scene.
 std::string time_axis(const Scene& scene);
 

@@ -80,6 +80,11 @@ OptimizedRun planar_optimize_study(const Study& study, const RunResult& original
   o.method = sim.method;
   o.metric_list = metric_list(best, sim);
   o.planar = std::move(sim.planar);
+  if (const std::optional<PlanarParetoRequest>& p = study.planar_optimize->pareto) {
+    o.planar_pareto =
+        optimize::planar::pareto_front(planar_design_problem(study), p->first, p->second, p->points,
+                                       study.planar_optimize->options);
+  }
   return o;
 }
 
@@ -314,7 +319,43 @@ std::string optimized_yaml(const Study& study, const OptimizedRun& run) {
   return study_yaml(optimized_study(study, r.design), header);
 }
 
+namespace {
+
+// a planar study's pareto.csv
+std::string planar_pareto_csv(const Study& study, const OptimizedRun& run) {
+  assert(study.planar_optimize && study.planar_optimize->pareto);
+  const PlanarParetoRequest& p = *study.planar_optimize->pareto;
+  std::string text = "epsilon," + p.first + "," + p.second + ",termination,verification_error";
+  for (const std::string& name : run.variable_names) text += "," + csv_field(name);
+  text += "\n";
+  // a metric's value at a design: from the optimiser's evaluation, as the four-bar's
+  auto value = [](const optimize::planar::Result& r, const std::string& m) {
+    if (m == "added_mass") return r.added_mass;
+    for (std::size_t k = 0; k < r.metric_table.size(); ++k)
+      if (r.metric_table[k].name == m) return r.metrics[k];
+    return std::nan("");
+  };
+  for (const optimize::planar::ParetoPoint& point : run.planar_pareto) {
+    const optimize::planar::Result& r = point.result;
+    text += text::exact(point.epsilon);
+    text += r.ok() ? "," + text::exact(value(r, p.first)) + "," + text::exact(value(r, p.second))
+                   : std::string(",,");
+    text += std::string(",") + optimize::to_string(r.termination) + "," +
+            (r.ok() ? text::exact(r.verification_error) : std::string());
+    for (std::size_t k = 0; k < run.variable_names.size(); ++k) {
+      text += "," + (static_cast<Eigen::Index>(k) < r.x.size()
+                         ? text::exact(r.x[static_cast<Eigen::Index>(k)])
+                         : std::string());
+    }
+    text += "\n";
+  }
+  return text;
+}
+
+}  // namespace
+
 std::string pareto_csv(const Study& study, const OptimizedRun& run) {
+  if (run.is_planar) return planar_pareto_csv(study, run);
   assert(study.optimize && study.optimize->pareto);
   const ParetoRequest& p = *study.optimize->pareto;
   std::string text = std::string("epsilon,") + optimize::to_string(p.first) + "," +
@@ -477,7 +518,8 @@ void write_run(const Study& study, RunResult& result, const fs::path& out_dir) {
     }
     write_text_file(optimized_yaml(study, o), o.study_file);
     write_text_file(comparison_csv(study, result), o.comparison);
-    if (study.optimize && study.optimize->pareto) {
+    if ((study.optimize && study.optimize->pareto) ||
+        (study.planar_optimize && study.planar_optimize->pareto)) {
       o.pareto_file = out_dir / "pareto.csv";
       write_text_file(pareto_csv(study, o), o.pareto_file);
     }

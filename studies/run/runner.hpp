@@ -68,16 +68,17 @@ struct OptimizedRun {
   std::vector<std::string> variable_names;    // of the result's x, in order
   int design_variables{};                     // the first ones of x: the design's own (the rest
                                               // are bound variables of a four-bar's peaks)
-  std::vector<optimize::ParetoPoint> pareto;  // with optimize.pareto, point by point
-  MethodChoice method;                        // formulation used for the optimum, and why
-  core::Trajectory trajectory;                // a four-bar study: the optimum simulated
-  core::Metrics metrics;                      // a four-bar study: over its samples
-  core::planar::Trajectory planar;            // a planar study: the optimum simulated
-  MetricList metric_list;                     // its metrics in its table's order (either type)
-  std::filesystem::path timeseries;           // out_dir/optimized-timeseries.csv (when found)
-  std::filesystem::path study_file;           // out_dir/optimized.yaml (when found)
-  std::filesystem::path comparison;           // out_dir/comparison.csv (when found)
-  std::filesystem::path pareto_file;          // out_dir/pareto.csv (with a front, when found)
+  std::vector<optimize::ParetoPoint> pareto;  // with optimize.pareto, point by point (a four-bar)
+  std::vector<optimize::planar::ParetoPoint> planar_pareto;  // the same, a planar linkage's
+  MethodChoice method;                // formulation used for the optimum, and why
+  core::Trajectory trajectory;        // a four-bar study: the optimum simulated
+  core::Metrics metrics;              // a four-bar study: over its samples
+  core::planar::Trajectory planar;    // a planar study: the optimum simulated
+  MetricList metric_list;             // its metrics in its table's order (either type)
+  std::filesystem::path timeseries;   // out_dir/optimized-timeseries.csv (when found)
+  std::filesystem::path study_file;   // out_dir/optimized.yaml (when found)
+  std::filesystem::path comparison;   // out_dir/comparison.csv (when found)
+  std::filesystem::path pareto_file;  // out_dir/pareto.csv (with a front, when found)
   /// How the optimiser ended, and its message (either type).
   optimize::Termination termination() const {
     return is_planar ? planar_result.termination : result.termination;
@@ -205,7 +206,7 @@ std::string optimized_yaml(const Study& study, const OptimizedRun& run);
 
 /// The pareto.csv text: header `epsilon,<first>,<second>,termination,verification_error` and the
 /// design variables' names, then one row per point ("%.17g"; numbers empty for a point where no
-/// design was found). Precondition: study.optimize->pareto is set.
+/// design was found). Precondition: the study's optimize section (either type's) has a pareto.
 std::string pareto_csv(const Study& study, const OptimizedRun& run);
 
 }  // namespace bd::studies

@@ -351,6 +351,11 @@ Json planar_optimize_json(const Study& study, const RunResult& result) {
     j["verification_error"] = r.verification_error;
   }
   j["counterweights"] = cws;
+  if (req.pareto) {
+    j["pareto"] = {{"first", req.pareto->first},
+                   {"second", req.pareto->second},
+                   {"points", o.planar_pareto.size()}};
+  }
   j["brief_report"] = r.brief_report();
   return j;
 }

@@ -37,6 +37,15 @@ struct OptimizeRequest {
   std::optional<ParetoRequest> pareto;
 };
 
+/// A planar study's ε-constraint trade-off (optimize.pareto): minimise `first` (an RMS metric of
+/// the linkage's table, or added_mass) subject to second <= ε · second(original) (kg for
+/// added_mass) for `points` values of ε.
+struct PlanarParetoRequest {
+  std::string first = "Fsh_rms";
+  std::string second = "Msh_rms";
+  int points = 9;  // >= 2
+};
+
 /// A planar linkage study's `optimize:` section (docs/study-format.md "optimize"), defaults in
 /// place: the variables, objective and constraints of optimize::planar::DesignProblem, whose
 /// original and scene are the study's (planar_design_problem() in studies/study.hpp).
@@ -47,6 +56,7 @@ struct PlanarOptimizeRequest {
   std::vector<optimize::planar::Limit> limits;                           // in the file's order
   bool force_balance = false;  // the momentum conditions as equalities (full force balance)
   optimize::OptimizeOptions options;
+  std::optional<PlanarParetoRequest> pareto;
 };
 
 /// All algorithms, in the order the docs list them.

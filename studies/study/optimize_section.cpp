@@ -65,13 +65,8 @@ class OptimizeReader {
     const MapReader o(r_, e.value, "optimize", e.key_mark,
                       "(algorithm, objective, constraints, variables, max_evaluations, "
                       "tolerance)");
-    if (const MapReader::Entry* p = o.find("pareto")) {
-      r_.fail(p->key_mark,
-              "optimize.pareto is available for a four-bar (linkage.type: fourbar); for a planar "
-              "linkage, run a sweep over a bound in optimize.constraints");
-    }
-    o.check_keys(
-        {"algorithm", "objective", "constraints", "variables", "max_evaluations", "tolerance"});
+    o.check_keys({"algorithm", "objective", "constraints", "variables", "max_evaluations",
+                  "tolerance", "pareto"});
     if (!std::holds_alternative<core::planar::DrivenScene>(study.scene)) {
       r_.fail(e.key_mark,
               "optimize for a planar linkage needs a driven scene (scene.type: driven): there "
@@ -168,6 +163,8 @@ class OptimizeReader {
     for (std::size_t i = 0; i < limit_marks_.size(); ++i)
       marks_of[{"limits", static_cast<int>(i)}] = limit_marks_[i];
 
+    if (const MapReader::Entry* p = o.find("pareto")) req.pareto = read_planar_pareto(*p);
+
     // the optimize layer's own checks, at the key whose field they name
     Study with = study;
     with.planar_optimize = req;
@@ -209,7 +206,50 @@ class OptimizeReader {
       }
       r_.fail(e.key_mark, "optimize: " + std::string(err.what()));
     }
+    if (req.pareto) {
+      // each point minimises `first` with a bound on `second`: that problem checked and set up
+      op::DesignProblem p = problem;
+      p.objective = {op::Term{req.pareto->first, 1.0}};
+      p.limits.push_back(op::Limit{req.pareto->second, 1.0});
+      auto fail_at = [&](const FieldError& f, const std::string& text) {
+        if (f.field == "objective") r_.fail(pareto_marks_[0], f.joined("optimize.pareto.first"));
+        if (f.field == "limits" && f.index == static_cast<int>(p.limits.size()) - 1) {
+          r_.fail(pareto_marks_[1], f.joined("optimize.pareto.second"));
+        }
+        r_.fail(e.key_mark, "optimize: " + text);
+      };
+      if (const Problem f = p.validate()) fail_at(*f, f->text());
+      try {
+        const op::PlanarNlp nlp(p);
+      } catch (const InputError& err) {
+        if (err.field()) fail_at(*err.field(), err.what());
+        r_.fail(e.key_mark, "optimize: " + std::string(err.what()));
+      }
+    }
     return req;
+  }
+
+  // a planar linkage's optimize.pareto: {first, second, points}
+  PlanarParetoRequest read_planar_pareto(const MapReader::Entry& e) {
+    PlanarParetoRequest p;
+    const MapReader m(r_, e.value, "optimize.pareto", e.key_mark, "(first, second, points)");
+    m.check_keys({"first", "second", "points"});
+    const MapReader::Entry& first = m.require("first", "the metric minimised along the front");
+    const MapReader::Entry& second = m.require("second", "the metric bounded along the front");
+    pareto_marks_[0] = mark_of(first.value, first.key_mark);
+    pareto_marks_[1] = mark_of(second.value, second.key_mark);
+    p.first = read_text(r_, first, "optimize.pareto.first");
+    check_planar_metric(p.first, pareto_marks_[0], "optimize.pareto.first");
+    p.second = read_text(r_, second, "optimize.pareto.second");
+    check_planar_metric(p.second, pareto_marks_[1], "optimize.pareto.second");
+    if (p.first == p.second) {
+      r_.fail(pareto_marks_[1],
+              "optimize.pareto.second must differ from first (both are " + p.first + ")");
+    }
+    if (const MapReader::Entry* n = m.find("points")) {
+      p.points = read_count(r_, *n, "optimize.pareto.points", 2, 1000);
+    }
+    return p;
   }
 
   // a planar linkage's metric by name (or added_mass); `or_else` leads the list in the message
@@ -222,8 +262,8 @@ class OptimizeReader {
     }
     if (name == "added_mass") return;
     r_.fail(mark, "unknown " +
-                      std::string(where == "optimize.objective" ? "metric" : "constraint") + " '" +
-                      name + "' in " + where + "; expected " + or_else + "one of " + names +
+                      std::string(where == "optimize.constraints" ? "constraint" : "metric") +
+                      " '" + name + "' in " + where + "; expected " + or_else + "one of " + names +
                       "added_mass");
   }
 
