@@ -289,6 +289,11 @@ void print_planar_counterweights(const bd::core::planar::Linkage& l,
                                  int width) {
   for (const bd::balance::planar::LinkCounterweight& c : cws) {
     const bd::balance::Counterweight& w = c.counterweight;
+    if (!(w.mass > 0)) {
+      std::printf("  %-*s  no counterweight (0 kg)\n", width,
+                  l.links[static_cast<std::size_t>(c.link)].name.c_str());
+      continue;
+    }
     std::printf("  %-*s  counterweight %.6g kg at [%.6g, %.6g] m from %s (%.6g m)", width,
                 l.links[static_cast<std::size_t>(c.link)].name.c_str(), w.mass + 0.0,
                 w.position.x() + 0.0, w.position.y() + 0.0,  // + 0.0: no "-0"
@@ -400,6 +405,10 @@ void print_planar_optimize(const st::Study& study, const st::RunResult& r) {
   for (const bd::core::planar::Link& k : study.planar().links)
     width = std::max(width, static_cast<int>(k.name.size()));
   print_planar_counterweights(study.planar(), o.counterweights, width);
+  // the links' own parameters that were variables: after the counterweights' three each
+  for (int k = 3 * static_cast<int>(req.counterweights.size()); k < o.design_variables; ++k) {
+    std::printf("  %s = %.6g\n", o.variable_names[static_cast<std::size_t>(k)].c_str(), o.x[k]);
+  }
   const st::RunStatus status = run.status();
   std::printf("  optimum: method %s, %zu samples, status %s\n", st::to_string(run.method.method),
               status.samples, bd::core::to_string(status.status));

@@ -98,6 +98,7 @@ Problem DesignProblem::validate() const {
       return field("link_parameters", k, ": " + what + ".lower must be > 0 kg");
     if (v.parameter == Param::kInertia && !(v.lower >= 0))
       return field("link_parameters", k, ": " + what + ".lower must be >= 0 kg m^2");
+    // mass too: the regressor's columns move the centre of mass one parameter at a time
     if (v.parameter != Param::kInertia) moved.insert(v.link);
   }
   for (const cp::LinkLoad& load : l.loads.link_loads) {
@@ -117,13 +118,9 @@ Problem DesignProblem::validate() const {
       return field("objective", k, ".weight must be >= 0, got " + text::shortest(t.weight));
     positive = positive || t.weight > 0;
     if (t.metric == "added_mass") continue;
-    const cp::ColumnMetric* m = metric(t.metric);
-    if (!m)
+    if (!metric(t.metric))
       return field("objective", k,
                    ": no metric " + t.metric + " (metrics: " + names + ", added_mass)");
-    if (m->statistic == core::Statistic::kMax)
-      return field("objective", k,
-                   ": " + t.metric + " is a peak; minimise an RMS and limit the peak");
   }
   if (!positive) return field("objective", -1, ": at least one weight must be > 0");
   for (std::size_t i = 0; i < limits.size(); ++i) {
@@ -168,11 +165,14 @@ struct PlanarNlp::Impl {
   // objective weights per metric (table order) and on added_mass
   std::vector<double> weight;
   double added_weight{};
+  // a peak in the objective: its bound variable t (the metric's unit), per metric or -1
+  std::vector<int> bound_var;
+  int design_n{};  // the design's own variables, before the bound variables
   // constraints
   MatrixXd balance_rows;  // r x nq: U_rᵀ Z / (M0 L)
   VectorXd balance_offset;
   struct Row {
-    enum class Kind { kEnvelope, kRmsLimit, kPeakLimit, kAddedMass } kind{};
+    enum class Kind { kEnvelope, kRmsLimit, kPeakLimit, kPeakBound, kAddedMass } kind{};
     int index{};   // counterweight, or metric
     int sample{};  // peak limits
     double value{};
@@ -182,6 +182,8 @@ struct PlanarNlp::Impl {
   void build_regressor();
   void set_up_variables();
   void set_up_constraints();
+  void check_balance_reachable(const MatrixXd& Z, const VectorXd& z0,
+                               const bp::Kinematics& k) const;
   void q_of(const VectorXd& x, VectorXd& q, MatrixXd* J) const;
   const cp::ColumnMetric& metric(int k) const { return table[static_cast<std::size_t>(k)]; }
   int metric_index(const std::string& name) const {
@@ -213,6 +215,20 @@ struct PlanarNlp::Impl {
     if (grad) *grad /= samples;
     return s / samples;
   }
+  // the largest magnitude over the samples of metric k's columns at q
+  double peak(int k, const VectorXd& q) const {
+    const Columns c = columns(k, q, nullptr);
+    double worst = 0;
+    for (int s = 0; s < samples; ++s) {
+      double s2 = 0;
+      for (const VectorXd& y : c.y) s2 += y[s] * y[s];
+      worst = std::max(worst, std::sqrt(s2));
+    }
+    return worst;
+  }
+  // a bound on each |q_j - q0_j| over the variables' box (counterweights within their
+  // envelopes, link parameters within their bounds)
+  VectorXd q_spread() const;
   double added(const VectorXd& q, const MatrixXd* J, VectorXd* grad) const {
     double a = 0;
     if (grad) grad->setZero(n);
@@ -304,7 +320,51 @@ void PlanarNlp::Impl::build_regressor() {
     const MatrixXd U = svd.matrixU().leftCols(svd.rank());
     balance_rows = U.transpose() * Z / (mass0 * length);
     balance_offset = U.transpose() * z0 / (mass0 * length);
+    check_balance_reachable(Z, z0, *k);
   }
+}
+
+// Full force balance asks the momentum Z q + z0 to vanish, and the variables move q only in
+// the mass and first moments of the links they act on: if no such move cancels it (whatever
+// the bounds), say so now, in the balance layer's words where they apply, rather than let the
+// solver report a violated condition.
+void PlanarNlp::Impl::check_balance_reachable(const MatrixXd& Z, const VectorXd& z0,
+                                              const bp::Kinematics& k) const {
+  const cp::Linkage& l = p.original;
+  std::set<int> links;
+  for (const CounterweightVariables& c : p.counterweights) links.insert(c.link);
+  for (const LinkParameterVariable& v : p.link_parameters)
+    if (v.parameter != Param::kInertia) links.insert(v.link);
+  std::vector<int> cols;
+  for (int i : links) cols.insert(cols.end(), {P::link_mass(i), P::link_me(i), P::link_mf(i)});
+  MatrixXd A(Z.rows(), static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t j = 0; j < cols.size(); ++j)
+    A.col(static_cast<Eigen::Index>(j)) = Z.col(cols[j]);
+  const VectorXd b = Z * q0 + z0;
+  const VectorXd left = b - A * A.completeOrthogonalDecomposition().solve(b);
+  if (!(left.norm() > 1e-8 * b.norm())) return;
+  std::string names;
+  for (int i : links)
+    names += (names.empty() ? "" : ", ") + l.links[static_cast<std::size_t>(i)].name;
+  std::string why = "full force balance is out of reach with variables on " + names + ": " +
+                    text::digits(100 * left.norm() / b.norm(), 3) +
+                    " % of the original's linear momentum is left whatever they are";
+  if (p.link_parameters.empty()) {  // the balance layer names what is left
+    std::vector<bp::LinkCounterweightSpec> specs;
+    for (const CounterweightVariables& c : p.counterweights) {
+      bp::LinkCounterweightSpec spec{c.link, {}};
+      const int pivot = bp::counterweight_pivot(l, c.link);
+      if (!l.nodes[static_cast<std::size_t>(pivot)].ground) spec.spec.mass = c.mass_max;
+      specs.push_back(spec);
+    }
+    try {
+      const bp::ForceBalance fb = bp::force_balance(l, k, specs);
+      if (!fb.full && !fb.message.empty()) why = fb.message;
+    } catch (const InputError&) {
+      // the generic words stand
+    }
+  }
+  throw InputError(FieldError{"force_balance", -1, ": " + why});
 }
 
 void PlanarNlp::Impl::set_up_variables() {
@@ -344,11 +404,73 @@ void PlanarNlp::Impl::set_up_variables() {
     auto [it, _] = link_vars.try_emplace(v.link, std::array<int, 4>{-1, -1, -1, -1});
     it->second[static_cast<std::size_t>(v.parameter)] = param_var.back();
   }
+  design_n = n;
+  // a bound variable t per peak of the objective, |y_s| <= t at every sample. Boxed in
+  // [-t_max, t_max], t_max above the peak of any design in the box (the regressor's rows
+  // against the spread of the parameters): with a lower bound at 0, SLSQP's subproblems put t on
+  // it at infeasible iterates and stop early (as the four-bar's, docs/performance.md)
+  bound_var.assign(table.size(), -1);
+  const VectorXd spread = q_spread();
+  for (std::size_t k = 0; k < table.size(); ++k) {
+    if (!(weight[k] > 0) || table[k].statistic != core::Statistic::kMax) continue;
+    double worst = 0;
+    for (int i = 0; i < samples; ++i) {
+      double sum = 0;
+      for (const std::string& c : table[k].columns) {
+        const auto& [base, B] = outputs.at(c);
+        sum += std::abs(base[i]) + B.row(i).cwiseAbs().dot(spread);
+      }
+      worst = std::max(worst, sum);
+    }
+    // in units of the original's value, as the objective's terms
+    const double t_max = std::hypot(worst / original[k], p.smoothing) * (1 + 1e-9);
+    bound_var[k] = add(-t_max, t_max, "bound on " + table[k].name + " / original");
+  }
+}
+
+VectorXd PlanarNlp::Impl::q_spread() const {
+  const cp::Linkage& l = p.original;
+  VectorXd spread = VectorXd::Zero(nq);
+  // a link's own parameters: their largest magnitudes within the bounds
+  for (const auto& [i, var] : link_vars) {
+    const cp::Link& link = l.links[static_cast<std::size_t>(i)];
+    double big[4] = {link.mass, std::abs(link.e), std::abs(link.f), link.inertia};
+    for (const LinkParameterVariable& v : p.link_parameters) {
+      if (v.link == i) {
+        big[static_cast<std::size_t>(v.parameter)] = std::max(std::abs(v.lower), std::abs(v.upper));
+      }
+    }
+    const double m = big[0], e = big[1], f = big[2], I = big[3];
+    spread[P::link_mass(i)] = m + std::abs(q0[P::link_mass(i)]);
+    spread[P::link_me(i)] = m * e + std::abs(q0[P::link_me(i)]);
+    spread[P::link_mf(i)] = m * f + std::abs(q0[P::link_mf(i)]);
+    spread[P::link_J(i)] = I + m * (e * e + f * f) + std::abs(q0[P::link_J(i)]);
+  }
+  // counterweights: a mass up to mass_max within distance_max of the pivot
+  for (std::size_t c = 0; c < p.counterweights.size(); ++c) {
+    const CounterweightVariables& cw = p.counterweights[c];
+    const int k = cw.link;
+    const double r = cw_pivot_in_link[c].norm() + cw.distance_max, mc = cw.mass_max;
+    spread[P::link_mass(k)] += mc;
+    spread[P::link_me(k)] += mc * r;
+    spread[P::link_mf(k)] += mc * r;
+    spread[P::link_J(k)] += mc * r * r + disc_inertia_per_mass2(cw) * mc * mc;
+  }
+  return spread;
 }
 
 void PlanarNlp::Impl::set_up_constraints() {
   for (Eigen::Index r = 0; r < balance_rows.rows(); ++r)
     constraint_names.push_back("force balance, condition " + std::to_string(r + 1));
+  for (std::size_t k = 0; k < table.size(); ++k) {
+    if (bound_var[k] < 0) continue;
+    for (int s = 0; s < samples; ++s) {
+      rows.push_back({Row::Kind::kPeakBound, static_cast<int>(k), s, 0.0});
+      constraint_names.push_back("|" + table[k].name +
+                                 "| at t = " + text::digits(times[static_cast<std::size_t>(s)], 6) +
+                                 " s <= bound on " + table[k].name);
+    }
+  }
   for (std::size_t c = 0; c < p.counterweights.size(); ++c) {
     rows.push_back({Row::Kind::kEnvelope, static_cast<int>(c), 0, 0.0});
     constraint_names.push_back(
@@ -477,6 +599,7 @@ PlanarNlp::PlanarNlp(const DesignProblem& problem) : impl_(std::make_unique<Impl
 PlanarNlp::~PlanarNlp() = default;
 
 int PlanarNlp::n() const { return impl_->n; }
+int PlanarNlp::design_variables() const { return impl_->design_n; }
 int PlanarNlp::n_eq() const { return static_cast<int>(impl_->balance_rows.rows()); }
 int PlanarNlp::n_ineq() const { return static_cast<int>(impl_->rows.size()); }
 const VectorXd& PlanarNlp::lower() const { return impl_->lower; }
@@ -499,6 +622,11 @@ double PlanarNlp::objective(const VectorXd& x, VectorXd* grad) const {
   for (std::size_t k = 0; k < m.table.size(); ++k) {
     if (m.weight[k] == 0) continue;
     const double o = m.original[k];
+    if (const int t = m.bound_var[k]; t >= 0) {  // a peak: its bound variable
+      f += m.weight[k] * x[t];
+      if (grad) (*grad)[t] += m.weight[k];
+      continue;
+    }
     const double r2 =
         m.rms2(m.columns(static_cast<int>(k), q, grad ? &J : nullptr), grad ? &g : nullptr) /
         (o * o);
@@ -560,6 +688,23 @@ void PlanarNlp::inequalities(const VectorXd& x, VectorXd& c, MatrixXd* jac) cons
         if (jac) jac->row(r) = g.transpose() / (bound * bound);
         break;
       }
+      case Impl::Row::Kind::kPeakBound: {
+        // sqrt(|y_s|² / o² + ε²) - t: linear in t, its gradient never vanishes
+        const auto k = static_cast<std::size_t>(row.index);
+        const double o = m.original[k], eps = m.p.smoothing;
+        const int t = m.bound_var[k];
+        const Impl::Columns& y = columns(row.index);
+        double s2 = 0;
+        for (std::size_t j = 0; j < y.y.size(); ++j) s2 += y.y[j][row.sample] * y.y[j][row.sample];
+        const double root = std::sqrt(s2 / (o * o) + eps * eps);
+        c[r] = root - x[t];
+        if (jac) {
+          for (std::size_t j = 0; j < y.y.size(); ++j)
+            jac->row(r) += y.y[j][row.sample] * y.dy[j].row(row.sample) / (root * o * o);
+          (*jac)(r, t) = -1;
+        }
+        break;
+      }
       case Impl::Row::Kind::kPeakLimit: {
         const double bound = row.value * m.original[static_cast<std::size_t>(row.index)];
         const Impl::Columns& y = columns(row.index);
@@ -576,13 +721,13 @@ void PlanarNlp::inequalities(const VectorXd& x, VectorXd& c, MatrixXd* jac) cons
   }
 }
 
-VectorXd PlanarNlp::start() const {
+VectorXd PlanarNlp::start(bool original) const {
   const Impl& m = *impl_;
   VectorXd x(m.n);
   for (std::size_t c = 0; c < m.p.counterweights.size(); ++c) {
     const CounterweightVariables& cw = m.p.counterweights[c];
     const int v = m.cw_var[c];
-    x[v] = cw.mass_max / 2;
+    x[v] = original ? 0.0 : cw.mass_max / 2;
     x.segment<2>(v + 1) = cw.distance_max / 2 * m.cw_away[c];
   }
   for (std::size_t i = 0; i < m.p.link_parameters.size(); ++i) {
@@ -593,6 +738,15 @@ VectorXd PlanarNlp::start() const {
                          : v.parameter == Param::kF  ? link.f
                                                      : link.inertia;
     x[m.param_var[i]] = std::clamp(value, v.lower, v.upper);
+  }
+  // each bound variable a hair above its smoothed peak at the start design
+  VectorXd q;
+  m.q_of(x, q, nullptr);
+  for (std::size_t k = 0; k < m.table.size(); ++k) {
+    const int t = m.bound_var[k];
+    if (t < 0) continue;
+    const double peak = std::hypot(m.peak(static_cast<int>(k), q) / m.original[k], m.p.smoothing);
+    x[t] = std::min(peak * (1 + 1e-12), m.upper[t]);
   }
   return x;
 }
@@ -648,17 +802,10 @@ std::vector<double> PlanarNlp::metrics(const VectorXd& x) const {
   m.q_of(x, q, nullptr);
   std::vector<double> out;
   for (std::size_t k = 0; k < m.table.size(); ++k) {
-    const Impl::Columns c = m.columns(static_cast<int>(k), q, nullptr);
     if (m.metric(static_cast<int>(k)).statistic == core::Statistic::kRms) {
-      out.push_back(std::sqrt(m.rms2(c, nullptr)));
+      out.push_back(std::sqrt(m.rms2(m.columns(static_cast<int>(k), q, nullptr), nullptr)));
     } else {
-      double peak = 0;
-      for (int s = 0; s < m.samples; ++s) {
-        double s2 = 0;
-        for (const VectorXd& y : c.y) s2 += y[s] * y[s];
-        peak = std::max(peak, std::sqrt(s2));
-      }
-      out.push_back(peak);
+      out.push_back(m.peak(static_cast<int>(k), q));
     }
   }
   return out;
@@ -707,13 +854,25 @@ Result optimize(const DesignProblem& problem, const OptimizeOptions& options) {
                                 "'mma' takes inequality constraints only, and force_balance adds "
                                 "equalities; use slsqp, ipopt, mlsl or cobyla"});
   }
-  const detail::Solved s = detail::solve(nlp, nlp.start(), options);
+  detail::Solved s = detail::solve(nlp, nlp.start(), options);
+  if (s.termination == Termination::kInfeasible || s.termination == Termination::kFailed) {
+    // a second start, the original design itself (no counterweight mass): it meets every limit
+    // of 1 or more and any added-mass limit >= 0, where the first start may be far outside
+    detail::Solved again = detail::solve(nlp, nlp.start(true), options);
+    again.evaluations += s.evaluations;
+    again.iterations += s.iterations;
+    again.seconds += s.seconds;
+    const bool found = again.termination == Termination::kConverged ||
+                       again.termination == Termination::kMaxEvaluations;
+    if (found || again.constraint_violation < s.constraint_violation) s = std::move(again);
+  }
   Result r;
   r.algorithm = options.algorithm;
   r.termination = s.termination;
   r.message = s.message;
   r.x = s.x;
   r.variable_names = nlp.variable_names();
+  r.design_variables = nlp.design_variables();
   r.objective = s.objective;
   r.constraint_violation = s.constraint_violation;
   r.iterations = s.iterations;
@@ -725,6 +884,7 @@ Result optimize(const DesignProblem& problem, const OptimizeOptions& options) {
   r.original = nlp.original_metrics();
   r.metrics = nlp.metrics(r.x);
   r.added_mass = nlp.added_mass(r.x);
+  if (!r.ok()) return r;  // no design: nothing to verify
   // the design simulated by the engine, against the regressor's evaluation
   const cp::Trajectory t = cp::simulate_driven(cp::Model(r.design), problem.scene);
   if (!t.ok()) {

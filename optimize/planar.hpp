@@ -19,8 +19,10 @@
 /// parameter its value within its bounds.
 ///
 /// Objective: Σ w sqrt(r² + ε²) over the RMS terms, r = metric / original (ε the smoothing, as
-/// the four-bar's linear form, optimize/nlp.hpp), + w added_mass / (original total mass). A
-/// peak (a `_max` metric) can be limited, not minimised. Limits: (metric / (value original))² - 1
+/// the four-bar's linear form, optimize/nlp.hpp), + Σ w t over the peaks (a `_max`
+/// metric), each with a bound variable t (a fraction of the original's peak) and
+/// sqrt(|y_s|² / original² + ε²) <= t at every sample,
+/// + w added_mass / (original total mass). Limits: (metric / (value original))² - 1
 /// <= 0 for an RMS; the same at every sample for a peak; (added_mass - value) / (original total
 /// mass) <= 0. Force balance: the independent rows of the momentum conditions.
 #include <Eigen/Core>
@@ -109,9 +111,13 @@ class PlanarNlp final : public Program {
   void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
                     Eigen::MatrixXd* jac) const override;
 
+  /// The design's own variables: the first ones of x (then one bound variable per peak of the
+  /// objective, t >= the peak's magnitude at every sample).
+  int design_variables() const;
   /// The original's link parameters (clamped to their bounds); each counterweight at half its
-  /// mass_max, half its distance_max from the pivot away from the link's other node.
-  Eigen::VectorXd start() const;
+  /// mass_max (0 with `original`: the original design itself), half its distance_max from the
+  /// pivot away from the link's other node.
+  Eigen::VectorXd start(bool original = false) const;
   /// The design at x: its links with their parameters and counterweights merged in.
   cp::Linkage design(const Eigen::VectorXd& x) const;
   std::vector<balance::planar::LinkCounterweight> counterweights(const Eigen::VectorXd& x) const;
@@ -134,6 +140,7 @@ struct Result {
   std::string message;
   Eigen::VectorXd x;
   std::vector<std::string> variable_names;
+  int design_variables{};  // the first ones of x; the rest are bound variables of peaks
   double objective{}, constraint_violation{};
   int iterations{}, evaluations{};
   double seconds{};
@@ -152,7 +159,8 @@ struct Result {
   std::string brief_report() const;
 };
 
-/// Solves the problem from PlanarNlp::start() and verifies the optimum by simulating it.
+/// Solves the problem from PlanarNlp::start() (and, when that finds no design, once more from the
+/// original design) and verifies the optimum by simulating it.
 /// @throws bd::InputError as PlanarNlp's constructor, for invalid options, or for an
 ///         algorithm that cannot take the problem (mma with force balance).
 Result optimize(const DesignProblem& problem, const OptimizeOptions& options);

@@ -441,10 +441,7 @@ std::string fourbar_report_html(const Study& study, const fs::path& dir, const s
   h += pareto_section(dir);
   // the measurements of `balance-design bench` when the folder has them (work_precision.hpp)
   h += work_precision_section(study, dir, gnuplot);
-  return h + data_files_html(dir, {"timeseries.csv", "summary.json", "balanced-timeseries.csv",
-                                   "balanced.yaml", "optimized-timeseries.csv", "optimized.yaml",
-                                   "comparison.csv", "harmonics.csv", "pareto.csv",
-                                   "work-precision.csv", "driven-convergence.csv"});
+  return h + data_files_html(dir, data_files());
 }
 
 }  // namespace bd::studies::report_support

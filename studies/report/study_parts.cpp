@@ -1,7 +1,10 @@
 #include "studies/report/study_parts.hpp"
 
 #include <algorithm>
+#include <iterator>
 #include <variant>
+
+#include "studies/run/runner.hpp"
 
 namespace bd::studies::report_support {
 
@@ -146,6 +149,12 @@ std::string charts_section(const std::string& gnuplot, const std::string& databl
          "</figcaption>\n</figure>\n";
   }
   return h;
+}
+
+std::vector<std::string> data_files() {
+  std::vector<std::string> names(std::begin(kRunFiles), std::end(kRunFiles));
+  names.insert(names.end(), {"work-precision.csv", "driven-convergence.csv"});
+  return names;
 }
 
 std::vector<Chart> pareto_charts(const fs::path& dir) {

@@ -43,6 +43,9 @@ std::string charts_section(const std::string& gnuplot, const std::string& databl
 std::vector<Chart> pareto_charts(const std::filesystem::path& dir);
 /// "Pareto front": pareto.csv as a table, when the folder has it.
 std::string pareto_section(const std::filesystem::path& dir);
+/// The data files a study's folder may hold, in the order the report lists them: the run's
+/// (kRunFiles, studies/run/runner.hpp), then `balance-design bench`'s.
+std::vector<std::string> data_files();
 /// The gnuplot axis label of the time axis of a scene.
 std::string time_axis(const Scene& scene);
 

@@ -53,6 +53,7 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original) {
   o.trajectory = sim.fourbar;
   o.metrics = core::metrics(o.trajectory);
   o.metric_list = metric_list(o.metrics);
+  o.harmonics = harmonics(best, o.trajectory, o.planar);
   if (req.pareto) {
     o.pareto = optimize::pareto_front(problem, req.pareto->first, req.pareto->second,
                                       req.pareto->points, req.options);
@@ -73,13 +74,14 @@ OptimizedRun planar_optimize_study(const Study& study, const RunResult& original
   o.planar_result =
       optimize::planar::optimize(planar_design_problem(study), study.planar_optimize->options);
   o.variable_names = o.planar_result.variable_names;
-  o.design_variables = static_cast<int>(o.variable_names.size());
+  o.design_variables = o.planar_result.design_variables;
   if (!o.found()) return o;
   const Study best = planar_optimized_study(study, o.planar_result.design);
   Simulation sim = simulate(best);
   o.method = sim.method;
   o.metric_list = metric_list(best, sim);
   o.planar = std::move(sim.planar);
+  o.harmonics = harmonics(best, o.trajectory, o.planar);
   if (const std::optional<PlanarParetoRequest>& p = study.planar_optimize->pareto) {
     o.planar_pareto =
         optimize::planar::pareto_front(planar_design_problem(study), p->first, p->second, p->points,
@@ -280,6 +282,10 @@ std::string planar_optimized_yaml(const Study& study, const OptimizedRun& run) {
         l.links[static_cast<std::size_t>(c.link)].name, w.mass, w.position.x(), w.position.y(),
         l.nodes[static_cast<std::size_t>(c.pivot)].name);
   }
+  for (int k = 3 * static_cast<int>(req.counterweights.size()); k < r.design_variables; ++k) {
+    header += fmt::format("Link parameter {} = {:.6g} (a variable).\n",
+                          r.variable_names[static_cast<std::size_t>(k)], r.x[k]);
+  }
   header += "Run it with\n  balance-design optimized.yaml";
   return study_yaml(planar_optimized_study(study, r.design), header);
 }
@@ -326,7 +332,8 @@ std::string planar_pareto_csv(const Study& study, const OptimizedRun& run) {
   assert(study.planar_optimize && study.planar_optimize->pareto);
   const PlanarParetoRequest& p = *study.planar_optimize->pareto;
   std::string text = "epsilon," + p.first + "," + p.second + ",termination,verification_error";
-  for (const std::string& name : run.variable_names) text += "," + csv_field(name);
+  const auto n = static_cast<std::size_t>(run.design_variables);
+  for (std::size_t k = 0; k < n; ++k) text += "," + csv_field(run.variable_names[k]);
   text += "\n";
   // a metric's value at a design: from the optimiser's evaluation, as the four-bar's
   auto value = [](const optimize::planar::Result& r, const std::string& m) {
@@ -342,7 +349,7 @@ std::string planar_pareto_csv(const Study& study, const OptimizedRun& run) {
                    : std::string(",,");
     text += std::string(",") + optimize::to_string(r.termination) + "," +
             (r.ok() ? text::exact(r.verification_error) : std::string());
-    for (std::size_t k = 0; k < run.variable_names.size(); ++k) {
+    for (std::size_t k = 0; k < n; ++k) {
       text += "," + (static_cast<Eigen::Index>(k) < r.x.size()
                          ? text::exact(r.x[static_cast<Eigen::Index>(k)])
                          : std::string());
@@ -476,6 +483,14 @@ void write_run(const Study& study, RunResult& result, const fs::path& out_dir) {
     throw std::runtime_error("cannot create the output directory " + out_dir.string() + ": " +
                              ec.message());
   }
+  // an earlier run's files in the folder would be read as this run's (a report listing the
+  // Pareto front of another design)
+  for (const char* name : kRunFiles) {
+    if (fs::remove(out_dir / name, ec); ec) {
+      throw std::runtime_error("cannot remove the earlier run's " + (out_dir / name).string() +
+                               ": " + ec.message());
+    }
+  }
   result.timeseries = out_dir / "timeseries.csv";
   result.summary = out_dir / "summary.json";
   if (study.is_fourbar()) {
@@ -502,6 +517,9 @@ void write_run(const Study& study, RunResult& result, const fs::path& out_dir) {
         std::string(kHarmonicsHeader) + "\n" + harmonics_rows("original", *result.harmonics);
     if (result.balanced && result.balanced->harmonics) {
       text += harmonics_rows("balanced", *result.balanced->harmonics);
+    }
+    if (result.optimized && result.optimized->found() && result.optimized->harmonics) {
+      text += harmonics_rows("optimized", *result.optimized->harmonics);
     }
     result.harmonics_file = out_dir / "harmonics.csv";
     write_text_file(text, result.harmonics_file);

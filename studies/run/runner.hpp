@@ -27,6 +27,19 @@ inline constexpr const char* kTimeseriesHeader =
     "t,theta1,theta2,theta3,omega1,omega2,omega3,alpha1,alpha2,alpha3,RA0x,RA0y,RA3x,RA3y,Fshx,"
     "Fshy,Msh,tau";
 
+/// Every file write_run() may write into a run's folder, in the order the report lists them.
+/// write_run() removes those of an earlier run first, so no file of another study or design is
+/// left beside the new ones.
+inline constexpr const char* kRunFiles[] = {"timeseries.csv",
+                                            "summary.json",
+                                            "balanced-timeseries.csv",
+                                            "balanced.yaml",
+                                            "optimized-timeseries.csv",
+                                            "optimized.yaml",
+                                            "comparison.csv",
+                                            "harmonics.csv",
+                                            "pareto.csv"};
+
 /// The header line of comparison.csv (without the newline).
 inline constexpr const char* kComparisonHeader = "metric,before,after,ratio";
 
@@ -70,15 +83,16 @@ struct OptimizedRun {
                                               // are bound variables of a four-bar's peaks)
   std::vector<optimize::ParetoPoint> pareto;  // with optimize.pareto, point by point (a four-bar)
   std::vector<optimize::planar::ParetoPoint> planar_pareto;  // the same, a planar linkage's
-  MethodChoice method;                // formulation used for the optimum, and why
-  core::Trajectory trajectory;        // a four-bar study: the optimum simulated
-  core::Metrics metrics;              // a four-bar study: over its samples
-  core::planar::Trajectory planar;    // a planar study: the optimum simulated
-  MetricList metric_list;             // its metrics in its table's order (either type)
-  std::filesystem::path timeseries;   // out_dir/optimized-timeseries.csv (when found)
-  std::filesystem::path study_file;   // out_dir/optimized.yaml (when found)
-  std::filesystem::path comparison;   // out_dir/comparison.csv (when found)
-  std::filesystem::path pareto_file;  // out_dir/pareto.csv (with a front, when found)
+  MethodChoice method;                 // formulation used for the optimum, and why
+  core::Trajectory trajectory;         // a four-bar study: the optimum simulated
+  core::Metrics metrics;               // a four-bar study: over its samples
+  core::planar::Trajectory planar;     // a planar study: the optimum simulated
+  MetricList metric_list;              // its metrics in its table's order (either type)
+  std::optional<Harmonics> harmonics;  // its harmonic orders (a driven scene)
+  std::filesystem::path timeseries;    // out_dir/optimized-timeseries.csv (when found)
+  std::filesystem::path study_file;    // out_dir/optimized.yaml (when found)
+  std::filesystem::path comparison;    // out_dir/comparison.csv (when found)
+  std::filesystem::path pareto_file;   // out_dir/pareto.csv (with a front, when found)
   /// How the optimiser ended, and its message (either type).
   optimize::Termination termination() const {
     return is_planar ? planar_result.termination : result.termination;

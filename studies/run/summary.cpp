@@ -407,6 +407,7 @@ std::string summary_json(const Study& study, const RunResult& result) {
     if (o.found()) {
       add_second_run(j, study, "optimized", o.method, o.status(), result.metric_list,
                      o.metric_list);
+      if (o.harmonics) j["optimized_harmonics"] = harmonics_json(*o.harmonics);
     }
   }
   // invalid UTF-8 in a message (a key copied from a study file) is replaced, never a failure

@@ -64,7 +64,7 @@ class OptimizeReader {
     const core::planar::Linkage& linkage = study.planar();
     const MapReader o(r_, e.value, "optimize", e.key_mark,
                       "(algorithm, objective, constraints, variables, max_evaluations, "
-                      "tolerance)");
+                      "tolerance, pareto)");
     o.check_keys({"algorithm", "objective", "constraints", "variables", "max_evaluations",
                   "tolerance", "pareto"});
     if (!std::holds_alternative<core::planar::DrivenScene>(study.scene)) {
@@ -88,7 +88,7 @@ class OptimizeReader {
       const double w = read_number(r_, x, path, "");
       if (w < 0) {
         r_.fail(mark_of(x.value, x.key_mark),
-                path + " must be >= 0 (a weight), got " + text::exact(w));
+                path + " must be >= 0 (a weight), got " + text::shortest(w));
       }
       positive = positive || w > 0;
       req.objective.push_back({x.key, w});
@@ -107,6 +107,7 @@ class OptimizeReader {
         const std::string path = "optimize.constraints." + x.key;
         if (x.key == "force_balance") {
           req.force_balance = read_bool(r_, x, path);
+          force_balance_mark_ = x.key_mark;
           continue;
         }
         check_planar_metric(x.key, x.key_mark, "optimize.constraints", "force_balance or ");
@@ -158,6 +159,7 @@ class OptimizeReader {
               "optimize.variables: no design variable; give counterweights (on links by name) "
               "or links (mass, e, f, inertia within bounds)");
     }
+    marks_of[{"force_balance", -1}] = force_balance_mark_;
     for (std::size_t i = 0; i < term_marks_.size(); ++i)
       marks_of[{"objective", static_cast<int>(i)}] = term_marks_[i];
     for (std::size_t i = 0; i < limit_marks_.size(); ++i)
@@ -175,6 +177,7 @@ class OptimizeReader {
       return std::nullopt;
     };
     auto path_of = [&](const FieldError& f) -> std::string {
+      if (f.field == "force_balance") return "optimize.constraints.force_balance";
       if (f.field == "objective") return "optimize.objective." + req.objective[f.index].metric;
       if (f.field == "limits") return "optimize.constraints." + req.limits[f.index].metric;
       if (f.field == "counterweights") {
@@ -223,6 +226,18 @@ class OptimizeReader {
         const op::PlanarNlp nlp(p);
       } catch (const InputError& err) {
         if (err.field()) fail_at(*err.field(), err.what());
+        r_.fail(e.key_mark, "optimize: " + std::string(err.what()));
+      }
+      // the front's other end minimises `second` alone
+      op::DesignProblem q = problem;
+      q.objective = {op::Term{req.pareto->second, 1.0}};
+      try {
+        const op::PlanarNlp nlp(q);
+      } catch (const InputError& err) {
+        const auto& f = err.field();
+        if (f && f->field == "objective") {
+          r_.fail(pareto_marks_[1], f->joined("optimize.pareto.second"));
+        }
         r_.fail(e.key_mark, "optimize: " + std::string(err.what()));
       }
     }
@@ -304,7 +319,7 @@ class OptimizeReader {
         r_.fail(marks.tolerance,
                 "optimize.tolerance must be > 0 and < 1 (relative, on the variables and the "
                 "objective), got " +
-                    text::exact(tol));
+                    text::shortest(tol));
       }
       options.relative_tolerance = tol;
     }
@@ -330,9 +345,9 @@ class OptimizeReader {
     if (kg) return read_number(r_, x, path, "kg");
     const double v = read_number(r_, x, path, "");
     if (!(v > 0)) {
-      r_.fail(
-          mark_of(x.value, x.key_mark),
-          path + " must be > 0 (a fraction of the original design's value), got " + text::exact(v));
+      r_.fail(mark_of(x.value, x.key_mark),
+              path + " must be > 0 (a fraction of the original design's value), got " +
+                  text::shortest(v));
     }
     return v;
   }
@@ -431,7 +446,7 @@ class OptimizeReader {
       const double w = read_number(r_, x, path, "");
       if (w < 0) {
         r_.fail(mark_of(x.value, x.key_mark),
-                path + " must be >= 0 (a weight), got " + text::exact(w));
+                path + " must be >= 0 (a weight), got " + text::shortest(w));
       }
       positive = positive || w > 0;
       req.objective.push_back({metric, w});
@@ -553,16 +568,16 @@ class OptimizeReader {
       const double lo = read_number(r_, x.value[0], vm, xp + "[0]", unit);
       const double hi = read_number(r_, x.value[1], vm, xp + "[1]", unit);
       if (!(lo < hi)) {
-        r_.fail(vm, xp + " must have lower < upper, got [" + text::exact(lo) + ", " +
-                        text::exact(hi) + "]");
+        r_.fail(vm, xp + " must have lower < upper, got [" + text::shortest(lo) + ", " +
+                        text::shortest(hi) + "]");
       }
       if (p == P::kMass && !(lo > 0)) {
         r_.fail(mark_of(x.value[0], vm),
-                xp + " lower bound must be > 0 kg (a link has mass), got " + text::exact(lo));
+                xp + " lower bound must be > 0 kg (a link has mass), got " + text::shortest(lo));
       }
       if (p == P::kInertia && lo < 0) {
         r_.fail(mark_of(x.value[0], vm),
-                xp + " lower bound must be >= 0 kg m^2, got " + text::exact(lo));
+                xp + " lower bound must be >= 0 kg m^2, got " + text::shortest(lo));
       }
       Variable v;
       v.link = link;
@@ -610,6 +625,7 @@ class OptimizeReader {
   std::vector<YAML::Mark> limit_marks_;  // optimize.constraints' metric keys, one per limit
   YAML::Mark pareto_marks_[2];           // optimize.pareto.first and .second
   std::vector<core::planar::ColumnMetric> table_;  // a planar linkage's metrics
+  YAML::Mark force_balance_mark_;                  // optimize.constraints.force_balance
 };
 
 }  // namespace

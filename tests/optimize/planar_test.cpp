@@ -77,7 +77,7 @@ TEST(PlanarOptimize, GradientsAndValuesAgreeWithDifferencesAndTheEngine) {
     p.link_parameters.push_back({floating, Par::kMass, 0.5 * fl.mass, 2 * fl.mass});
     p.link_parameters.push_back({floating, Par::kE, fl.e - 0.05, fl.e + 0.05});
     p.link_parameters.push_back({floating, Par::kInertia, 0, 3 * fl.inertia + 0.01});
-    p.objective = {{"Fsh_rms", 1.0}, {"Msh_rms", 0.5}, {"added_mass", 0.1}};
+    p.objective = {{"Fsh_rms", 1.0}, {"Msh_rms", 0.5}, {"added_mass", 0.1}, {"Fsh_max", 0.7}};
     p.limits = {{"Fsh_max", 2.0}, {"tau_rms", 3.0}, {"added_mass", 2.0}};
     p.force_balance = i % 3 == 1;
     const op::PlanarNlp nlp(p);
@@ -171,6 +171,71 @@ TEST(PlanarOptimize, EveryGradientAlgorithmReachesTheLeastSquaresEngineDesign) {
   }
 }
 
+// The least peak shaking force of a slider-crank with a crank counterweight (a minimax problem,
+// through a bound variable): the gradient algorithms agree on it, and no design near the optimum
+// has a smaller peak when the engine simulates it (random feasible steps of 1e-4 of the
+// envelope); the optimum's peak is below that of the least-RMS design.
+TEST(PlanarOptimize, TheLeastPeakShakingForceIsALocalMinimumOfTheSimulatedPeak) {
+  Rng rng(505);
+  const cp::Linkage l = unloaded(slider_crank(rng, true), false);
+  const double speed = 150;
+  op::DesignProblem p;
+  p.original = l;
+  p.scene = scene_of(speed, 120);
+  op::CounterweightVariables c;
+  c.link = 0;
+  c.mass_max = 20 * cp::total_mass(l);
+  c.distance_max = 2 * cp::element_length(l, 0);
+  p.counterweights = {c};
+  p.objective = {{"Fsh_max", 1.0}};
+  double best = 0;
+  Eigen::VectorXd x_best;
+  for (optimize::Algorithm a : {optimize::Algorithm::kSlsqp, optimize::Algorithm::kIpopt}) {
+    optimize::OptimizeOptions o;
+    o.algorithm = a;
+    o.max_evaluations = 3000;
+    const op::Result r = op::optimize(p, o);
+    ASSERT_TRUE(r.ok()) << optimize::to_string(a) << ": " << r.message;
+    EXPECT_EQ(r.design_variables, 3);
+    std::printf("%s\n", r.brief_report().c_str());
+    ASSERT_EQ(r.x.size(), 4);
+    EXPECT_LE(r.verification_error, 1e-9);
+    const double peak = metric_of(r, "Fsh_max", true);
+    // the bound variable sits on the peak (smoothed by 1e-6 of the original's)
+    EXPECT_NEAR(r.x[3] * r.original[1], peak, 1e-5 * peak + 1e-6 * r.original[1]);
+    if (x_best.size() == 0) {
+      best = peak;
+      x_best = r.x.head(3);
+    } else {
+      EXPECT_NEAR(peak, best, 1e-6 * best) << optimize::to_string(a);
+    }
+  }
+  // the engine's peak at random feasible steps around the optimum
+  const op::PlanarNlp nlp(p);
+  const double h = 1e-4 * c.distance_max;
+  int worse = 0;
+  for (int k = 0; k < 24; ++k) {
+    Eigen::VectorXd x(4);
+    x.head(3) =
+        x_best + h * Eigen::Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1))
+                         .cwiseProduct(Eigen::Vector3d(c.mass_max / c.distance_max, 1, 1));
+    x[3] = 0;
+    x[0] = std::clamp(x[0], 0.0, c.mass_max);
+    if (x.segment<2>(1).norm() > c.distance_max) continue;
+    const cp::Trajectory t = cp::simulate_driven(cp::Model(nlp.design(x)), p.scene);
+    ASSERT_TRUE(t.ok());
+    const double peak = cp::metric_values(nlp.metric_table(), t.table)[1];
+    EXPECT_GE(peak, best * (1 - 1e-9)) << "step " << k;
+    worse += peak > best ? 1 : 0;
+  }
+  EXPECT_GT(worse, 0);
+  // the least-RMS design has a larger peak
+  p.objective = {{"Fsh_rms", 1.0}};
+  const op::Result rms = op::optimize(p, optimize::OptimizeOptions{});
+  ASSERT_TRUE(rms.ok());
+  EXPECT_GT(metric_of(rms, "Fsh_max", true), best);
+}
+
 // Six-bars: the least RMS shaking moment among force-balanced designs (counterweights on the
 // three grounded links); the optimum shakes no more in the engine's simulation, and its shaking
 // moment is no worse than that of the balance layer's force-balanced design (a feasible point).
@@ -231,9 +296,6 @@ TEST(PlanarOptimize, MistakesAreNamed) {
   };
   EXPECT_EQ(text(p), "valid");
   op::DesignProblem q = p;
-  q.objective = {{"Fsh_max", 1.0}};
-  EXPECT_EQ(text(q), "objective[0]: Fsh_max is a peak; minimise an RMS and limit the peak");
-  q = p;
   q.objective = {{"Fsh_rmz", 1.0}};
   EXPECT_NE(text(q).find("objective[0]: no metric Fsh_rmz (metrics: Fsh_rms, Fsh_max"),
             std::string::npos);

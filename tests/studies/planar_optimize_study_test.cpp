@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <numbers>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -49,8 +50,6 @@ TEST(PlanarOptimizeStudy, MistakesAreOneLineAtTheirPlace) {
   // the section's own keys
   expect_error(section(kObjective), 20, 1,
                "optimize: missing required key 'variables' (what may change");
-  expect_error(section(kObjective + kVariables + "  pareto: {first: Fsh_max, second: Msh_rms}\n"),
-               25, 19, "optimize.pareto.first: Fsh_max is a peak; minimise an RMS");
   expect_error(section(kObjective + kVariables + "  pareto: {first: Fsh_rms, second: Fsh}\n"), 25,
                36, "unknown metric 'Fsh' in optimize.pareto.second");
   expect_error(section(kObjective + kVariables + "  pareto: {first: Fsh_rms, second: Fsh_rms}\n"),
@@ -67,8 +66,6 @@ TEST(PlanarOptimizeStudy, MistakesAreOneLineAtTheirPlace) {
   expect_error(section("  objective: {Msh: 1}\n" + kVariables), 21, 15,
                "unknown metric 'Msh' in optimize.objective; expected one of Fsh_rms, Fsh_max, "
                "Msh_rms");
-  expect_error(section("  objective: {Fsh_max: 1}\n" + kVariables), 21, 15,
-               "optimize.objective.Fsh_max: Fsh_max is a peak; minimise an RMS and limit the peak");
   expect_error(section("  objective: {Msh_rms: 0}\n" + kVariables), 21, 3,
                "optimize.objective needs at least one metric with a weight > 0");
   expect_error(section(kObjective + "  constraints: {RO_max: -1}\n" + kVariables), 22, 25,
@@ -95,6 +92,10 @@ TEST(PlanarOptimizeStudy, MistakesAreOneLineAtTheirPlace) {
   expect_error(section("  algorithm: mma\n" + kObjective +
                        "  constraints: {force_balance: true}\n" + kVariables),
                21, 14, "optimize.algorithm: 'mma' takes inequality constraints only");
+  // full force balance that no counterweight on the crank can give (the piston): said at the key
+  expect_error(section(kObjective + "  constraints: {force_balance: true}\n" + kVariables), 22, 17,
+               "optimize.constraints.force_balance: full force balance cannot be reached with "
+               "counterweights on crank: the largest part of the linear momentum left is node B's");
   // the scene: a free one has no exact regressor
   std::string free = kEngine;
   free.replace(free.find("  type: driven\n"), 15, "  type: free\n  duration: 0.1\n");
@@ -272,6 +273,18 @@ TEST(PlanarOptimizeStudy, TheFourBarsParetoFrontIsReachedOnTrussElements) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);
   const nlohmann::json j = nlohmann::json::parse(bd::testing::read(out / "summary.json"));
   EXPECT_EQ(j["optimize"]["pareto"]["points"], 4);
+
+  // a plain run into the same folder leaves no file of the optimisation behind
+  Study plain = planar;
+  plain.planar_optimize.reset();
+  RunResult again = compute_study(plain);
+  write_run(plain, again, out);
+  for (const char* file :
+       {"pareto.csv", "optimized.yaml", "optimized-timeseries.csv", "comparison.csv"}) {
+    EXPECT_FALSE(fs::exists(out / file)) << file;
+  }
+  EXPECT_TRUE(fs::exists(out / "timeseries.csv"));
+  EXPECT_TRUE(fs::exists(out / "summary.json"));
 }
 
 // The six-bar example: least RMS shaking moment among the force-balanced designs is below the
@@ -284,8 +297,14 @@ TEST(PlanarOptimizeStudy, TheSixBarExampleHasLessShakingMomentThanTheBalanceSect
   const Study balanced = load_study(example_path("watt-sixbar-balanced.yaml"));
   const RunResult b = compute_study(balanced);
   ASSERT_TRUE(b.ok() && b.balanced && b.balanced->design && b.balanced->design->full);
-  const double fsh0 = metric(r.metric_list, "Fsh_rms");
-  EXPECT_LE(metric(r.optimized->metric_list, "Fsh_rms"), 1e-10 * fsh0);
+  // force balanced to the solver's feasibility: the momentum conditions hold to its constraint
+  // violation (scaled by the linkage's mass times its longest link), so the shaking force left
+  // is at most ω² times that momentum, ~1e-8 N here
+  const optimize::planar::Result& o = r.optimized->planar_result;
+  EXPECT_LE(o.constraint_violation, 1e-9);
+  const double omega = 2 * std::numbers::pi, mass = core::planar::total_mass(study.planar());
+  EXPECT_LE(metric(r.optimized->metric_list, "Fsh_rms"),
+            10 * omega * omega * mass * 0.5 * std::max(o.constraint_violation, 1e-13));
   EXPECT_LT(metric(r.optimized->metric_list, "Msh_rms"),
             0.6 * metric(b.balanced->metric_list, "Msh_rms"));
   EXPECT_LE(r.optimized->planar_result.added_mass, 12 + 1e-9);
