@@ -261,10 +261,14 @@ void check_feasibility(const Program& nlp, const OptimizeOptions& options,
     const std::string& name = nlp.constraint_names()[static_cast<size_t>(worst)];
     const bool equality = worst < nlp.n_eq();
     r.termination = Termination::kInfeasible;
-    r.message = "no feasible design found: the binding constraint is '" + name + "' at " +
-                text::digits(worst_value, 6) + (equality ? " (must be 0" : " (must be <= 0") +
-                ", tolerance " + text::digits(options.constraint_tolerance, 2) + ") [" + solver +
-                "]";
+    const std::string words = nlp.constraint_text(worst, r.x);
+    r.message =
+        "no feasible design found: the binding constraint is '" + name + "'" +
+        (words.empty() ? " at " + text::digits(worst_value, 6) +
+                             (equality ? " (must be 0" : " (must be <= 0") + ", tolerance " +
+                             text::digits(options.constraint_tolerance, 2) + ")"
+                       : ": " + words) +
+        " [" + solver + "]";
   } else if (r.termination == Termination::kInfeasible) {
     // the solver gave up on feasibility yet stopped at a feasible point: say so plainly
     r.termination = Termination::kFailed;

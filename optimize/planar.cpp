@@ -721,6 +721,50 @@ void PlanarNlp::inequalities(const VectorXd& x, VectorXd& c, MatrixXd* jac) cons
   }
 }
 
+std::string PlanarNlp::constraint_text(int i, const VectorXd& x) const {
+  const Impl& m = *impl_;
+  VectorXd q;
+  m.q_of(x, q, nullptr);
+  if (i < n_eq()) {  // the momentum conditions, against the original's imbalance
+    const double now = (m.balance_rows * q + m.balance_offset).norm();
+    const double was = (m.balance_rows * m.q0 + m.balance_offset).norm();
+    return "the linear momentum left in the balance conditions is " +
+           text::digits(was > 0 ? now / was : 0.0, 3) + " of the original's";
+  }
+  const Impl::Row& row = m.rows[static_cast<std::size_t>(i - n_eq())];
+  switch (row.kind) {
+    case Impl::Row::Kind::kEnvelope: {
+      const int v = m.cw_var[static_cast<std::size_t>(row.index)];
+      return "the counterweight's centre is " + text::digits(x.segment<2>(v + 1).norm(), 6) +
+             " m from its pivot, at most " +
+             text::digits(m.p.counterweights[static_cast<std::size_t>(row.index)].distance_max, 6) +
+             " m";
+    }
+    case Impl::Row::Kind::kAddedMass:
+      return "the added mass is " + text::digits(m.added(q, nullptr, nullptr), 6) +
+             " kg, at most " + text::digits(row.value, 6) + " kg";
+    case Impl::Row::Kind::kRmsLimit: {
+      const auto k = static_cast<std::size_t>(row.index);
+      const double value = std::sqrt(m.rms2(m.columns(row.index, q, nullptr), nullptr));
+      return m.table[k].name + " is " + text::digits(value, 6) + " " + m.table[k].unit + " = " +
+             text::digits(value / m.original[k], 4) + " x the original's, at most " +
+             text::digits(row.value, 6) + " x";
+    }
+    case Impl::Row::Kind::kPeakLimit: {
+      const auto k = static_cast<std::size_t>(row.index);
+      const Impl::Columns c = m.columns(row.index, q, nullptr);
+      double s2 = 0;
+      for (const VectorXd& y : c.y) s2 += y[row.sample] * y[row.sample];
+      return "|" + m.table[k].name + "| there is " + text::digits(std::sqrt(s2), 6) + " " +
+             m.table[k].unit + " = " + text::digits(std::sqrt(s2) / m.original[k], 4) +
+             " x the original's peak, at most " + text::digits(row.value, 6) + " x";
+    }
+    case Impl::Row::Kind::kPeakBound:
+      break;
+  }
+  return {};
+}
+
 VectorXd PlanarNlp::start(bool original) const {
   const Impl& m = *impl_;
   VectorXd x(m.n);

@@ -34,6 +34,10 @@ class Program {
   /// c_in(x) (size n_ineq) and, when `jac` is not null, its Jacobian (n_ineq x n).
   virtual void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
                             Eigen::MatrixXd* jac) const = 0;
+  /// Constraint i (equalities first) at x in an engineer's words and units, e.g. "Fsh_rms is
+  /// 0.31 x the original's, at most 0.0001 x"; empty when the program has no such words (a
+  /// message then gives the scaled value).
+  virtual std::string constraint_text(int /*i*/, const Eigen::VectorXd& /*x*/) const { return {}; }
 };
 
 }  // namespace bd::optimize

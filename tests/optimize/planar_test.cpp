@@ -282,6 +282,28 @@ TEST(PlanarOptimize, ForceBalancedSixBarsWithTheLeastShakingMoment) {
   }
 }
 
+// A limit no design in the box meets: infeasible, and the message gives the binding limit's
+// metric in its unit and as a fraction of the original's (what the limit is stated in).
+TEST(PlanarOptimize, AnInfeasibleLimitIsSaidInTheMetricsUnits) {
+  Rng rng(506);
+  const cp::Linkage l = unloaded(slider_crank(rng, true), false);
+  op::DesignProblem p;
+  p.original = l;
+  p.scene = scene_of(100, 36);
+  p.counterweights = {{0, 1.0, 0.1}};
+  p.objective = {{"Msh_rms", 1.0}};
+  p.limits = {{"Fsh_rms", 1e-4}};  // the piston's force cannot be cancelled on the crank
+  const op::Result r = op::optimize(p, optimize::OptimizeOptions{});
+  EXPECT_EQ(r.termination, optimize::Termination::kInfeasible);
+  EXPECT_NE(r.message.find("the binding constraint is 'Fsh_rms <= 0.0001 x original': Fsh_rms is "),
+            std::string::npos)
+      << r.message;
+  EXPECT_NE(r.message.find(" N = "), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find(" x the original's, at most 0.0001 x"), std::string::npos) << r.message;
+  EXPECT_TRUE(r.verified.empty());  // no design, nothing verified
+  EXPECT_NE(r.brief_report().find("not verified"), std::string::npos);
+}
+
 TEST(PlanarOptimize, MistakesAreNamed) {
   Rng rng(504);
   const cp::Linkage l = unloaded(slider_crank(rng, true), false);
