@@ -199,21 +199,26 @@ Problem OptimizeOptions::validate() const {
   return std::nullopt;
 }
 
-Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options) {
+Problem check_algorithm(const OptimizeOptions& options, bool free_scene, bool force_balance) {
   const std::string name = std::string("'") + to_string(options.algorithm) + "'";
-  if (uses_gradients(options.algorithm) && std::holds_alternative<core::FreeScene>(problem.scene)) {
+  if (uses_gradients(options.algorithm) && free_scene) {
     return FieldError{"algorithm", -1,
                       name +
                           " needs gradients, which a free scene does not provide; use cobyla "
                           "or isres"};
   }
-  if (options.algorithm == Algorithm::kMma && problem.force_balance) {
+  if (options.algorithm == Algorithm::kMma && force_balance) {
     return FieldError{"algorithm", -1,
                       name +
                           " takes inequality constraints only, and force_balance adds "
                           "equalities; use slsqp, ipopt, mlsl or cobyla"};
   }
   return std::nullopt;
+}
+
+Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options) {
+  return check_algorithm(options, std::holds_alternative<core::FreeScene>(problem.scene),
+                         problem.force_balance);
 }
 
 void detail::check_inputs(const DesignProblem& problem, const OptimizeOptions& options) {

@@ -46,6 +46,8 @@ struct OptimizeOptions {
 /// problem with field "algorithm", e.g. text() "algorithm 'slsqp' needs gradients, which a free
 /// scene does not provide; use cobyla or isres". optimize() refuses what this refuses.
 bd::Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options);
+/// The same for any linkage type's problem: in a free scene or not, with force balance or not.
+bd::Problem check_algorithm(const OptimizeOptions& options, bool free_scene, bool force_balance);
 
 enum class Termination {
   kNotRun,

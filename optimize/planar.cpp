@@ -6,8 +6,10 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <numbers>
 #include <set>
+#include <stdexcept>
 
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
@@ -146,6 +148,11 @@ Problem DesignProblem::validate() const {
 
 struct PlanarNlp::Impl {
   DesignProblem p;
+  bool free{};  // a free scene: metrics by simulation, no regressor
+  // a free scene's last simulation: its x and metrics (table order; +inf when it failed)
+  mutable std::mutex cache_mutex;
+  mutable VectorXd cached_x;
+  mutable std::vector<double> cached;
   int nq{}, samples{};
   VectorXd q0;
   double mass0{}, length{};
@@ -184,6 +191,7 @@ struct PlanarNlp::Impl {
   void set_up_constraints();
   void check_balance_reachable(const MatrixXd& Z, const VectorXd& z0,
                                const bp::Kinematics& k) const;
+  void balance_conditions(const cp::Trajectory& base);
   void q_of(const VectorXd& x, VectorXd& q, MatrixXd* J) const;
   const cp::ColumnMetric& metric(int k) const { return table[static_cast<std::size_t>(k)]; }
   int metric_index(const std::string& name) const {
@@ -258,14 +266,23 @@ void PlanarNlp::Impl::build_regressor() {
     }
     for (std::size_t j = 0; j < l.point_masses.size(); ++j)
       d.point_masses[j].mass = q[P::point_mass(l, static_cast<int>(j))];
-    const cp::Trajectory t = cp::simulate_driven(cp::Model(cp::make_linkage(d)), p.scene);
+    const cp::Trajectory t =
+        cp::simulate_driven(cp::Model(cp::make_linkage(d)), std::get<cp::DrivenScene>(p.scene));
     if (!t.ok()) throw InputError(std::string(what) + " cannot run in the scene: " + t.message);
     return t;
   };
-  const cp::Trajectory base = run(q0, "the original design");
+  const cp::Trajectory base =
+      free ? cp::simulate_free(cp::Model(l), std::get<cp::FreeScene>(p.scene), p.simulate)
+           : run(q0, "the original design");
+  if (free && !base.ok())
+    throw InputError("the original design cannot run in the scene: " + base.message);
   samples = static_cast<int>(base.table.rows());
   times = base.table.column_values("t");
   original = cp::metric_values(table, base.table);
+  if (free) {  // the balance conditions come from the configurations the original passes through
+    balance_conditions(base);
+    return;
+  }
   for (const std::string& c : used) {
     const std::vector<double> v = base.table.column_values(c);
     outputs[c] = {Eigen::Map<const VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())),
@@ -301,7 +318,12 @@ void PlanarNlp::Impl::build_regressor() {
             (yb[static_cast<std::size_t>(s)] - ya[static_cast<std::size_t>(s)]) / step;
     }
   }
-  // the force-balance conditions: the momentum per unit input rate, in its independent rows
+  balance_conditions(base);
+}
+
+// the force-balance conditions: the momentum per unit input rate, in its independent rows
+void PlanarNlp::Impl::balance_conditions(const cp::Trajectory& base) {
+  const cp::Linkage& l = p.original;
   if (p.force_balance) {
     const cp::Model model(l);
     const bp::InputSeries in = bp::input_series(model, base.table);
@@ -412,7 +434,7 @@ void PlanarNlp::Impl::set_up_variables() {
   bound_var.assign(table.size(), -1);
   const VectorXd spread = q_spread();
   for (std::size_t k = 0; k < table.size(); ++k) {
-    if (!(weight[k] > 0) || table[k].statistic != core::Statistic::kMax) continue;
+    if (free || !(weight[k] > 0) || table[k].statistic != core::Statistic::kMax) continue;
     double worst = 0;
     for (int i = 0; i < samples; ++i) {
       double sum = 0;
@@ -490,10 +512,12 @@ void PlanarNlp::Impl::set_up_constraints() {
       rows.push_back({Row::Kind::kRmsLimit, k, 0, lim.value});
       constraint_names.push_back(what + " x original");
     } else {
-      for (int s = 0; s < samples; ++s) {
-        rows.push_back({Row::Kind::kPeakLimit, k, s, lim.value});
-        constraint_names.push_back(what + " x original at t = " +
-                                   text::digits(times[static_cast<std::size_t>(s)], 6) + " s");
+      for (int s = 0; s < (free ? 1 : samples); ++s) {
+        rows.push_back({Row::Kind::kPeakLimit, k, free ? -1 : s, lim.value});
+        constraint_names.push_back(free ? what + " x original"
+                                        : what + " x original at t = " +
+                                              text::digits(times[static_cast<std::size_t>(s)], 6) +
+                                              " s");
       }
     }
   }
@@ -555,6 +579,7 @@ PlanarNlp::PlanarNlp(const DesignProblem& problem) : impl_(std::make_unique<Impl
   Impl& m = *impl_;
   m.p = problem;
   m.p.original = cp::make_linkage(problem.original);
+  m.free = std::holds_alternative<cp::FreeScene>(problem.scene);
   if (const Problem e = m.p.validate()) throw InputError("invalid design problem: " + e->text());
   const cp::Linkage& l = m.p.original;
   m.nq = P::count(l);
@@ -598,6 +623,22 @@ PlanarNlp::PlanarNlp(const DesignProblem& problem) : impl_(std::make_unique<Impl
 
 PlanarNlp::~PlanarNlp() = default;
 
+bool PlanarNlp::has_gradients() const { return !impl_->free; }
+
+// a free scene: the metrics of the design at x simulated (the last one kept: the objective and
+// the constraints at the same x simulate once); +inf when the simulation fails
+std::vector<double> PlanarNlp::simulated(const VectorXd& x) const {
+  const Impl& m = *impl_;
+  const std::lock_guard<std::mutex> lock(m.cache_mutex);
+  if (m.cached_x.size() == x.size() && m.cached_x == x) return m.cached;
+  const cp::Trajectory t =
+      cp::simulate_free(cp::Model(design(x)), std::get<cp::FreeScene>(m.p.scene), m.p.simulate);
+  m.cached = t.ok() ? cp::metric_values(m.table, t.table)
+                    : std::vector<double>(m.table.size(), std::numeric_limits<double>::infinity());
+  m.cached_x = x;
+  return m.cached;
+}
+
 int PlanarNlp::n() const { return impl_->n; }
 int PlanarNlp::design_variables() const { return impl_->design_n; }
 int PlanarNlp::n_eq() const { return static_cast<int>(impl_->balance_rows.rows()); }
@@ -613,6 +654,22 @@ const std::vector<double>& PlanarNlp::original_metrics() const { return impl_->o
 
 double PlanarNlp::objective(const VectorXd& x, VectorXd* grad) const {
   const Impl& m = *impl_;
+  if (m.free) {  // RMS smoothed as in driven scenes, a peak exactly (no bound variable)
+    if (grad) throw std::logic_error("PlanarNlp: a free scene has no gradients");
+    const std::vector<double> v = simulated(x);
+    double f = 0;
+    for (std::size_t k = 0; k < m.table.size(); ++k) {
+      if (!(m.weight[k] > 0)) continue;
+      const double r = v[k] / m.original[k];
+      f += m.weight[k] * (m.table[k].statistic == core::Statistic::kMax
+                              ? r
+                              : std::sqrt(r * r + m.p.smoothing * m.p.smoothing));
+    }
+    VectorXd q;
+    m.q_of(x, q, nullptr);
+    if (m.added_weight > 0) f += m.added_weight * m.added(q, nullptr, nullptr) / m.mass0;
+    return f;
+  }
   VectorXd q;
   MatrixXd J;
   m.q_of(x, q, grad ? &J : nullptr);
@@ -657,6 +714,14 @@ void PlanarNlp::inequalities(const VectorXd& x, VectorXd& c, MatrixXd* jac) cons
   m.q_of(x, q, jac ? &J : nullptr);
   c.resize(static_cast<Eigen::Index>(m.rows.size()));
   if (jac) jac->setZero(static_cast<Eigen::Index>(m.rows.size()), m.n);
+  if (m.free && jac) throw std::logic_error("PlanarNlp: a free scene has no gradients");
+  const std::vector<double> simulated_metrics = m.free ? simulated(x) : std::vector<double>{};
+  // a free scene's limit: (metric / bound)² - 1 from the simulation, a peak over all samples
+  auto free_limit = [&](const Impl::Row& row) {
+    const auto k = static_cast<std::size_t>(row.index);
+    const double ratio = simulated_metrics[k] / (row.value * m.original[k]);
+    return ratio * ratio - 1;
+  };
   std::map<int, Impl::Columns> cache;  // per metric
   auto columns = [&](int k) -> const Impl::Columns& {
     auto it = cache.find(k);
@@ -683,6 +748,10 @@ void PlanarNlp::inequalities(const VectorXd& x, VectorXd& c, MatrixXd* jac) cons
         if (jac) jac->row(r) = g.transpose() / m.mass0;
         break;
       case Impl::Row::Kind::kRmsLimit: {
+        if (m.free) {
+          c[r] = free_limit(row);
+          break;
+        }
         const double bound = row.value * m.original[static_cast<std::size_t>(row.index)];
         c[r] = m.rms2(columns(row.index), jac ? &g : nullptr) / (bound * bound) - 1;
         if (jac) jac->row(r) = g.transpose() / (bound * bound);
@@ -706,6 +775,10 @@ void PlanarNlp::inequalities(const VectorXd& x, VectorXd& c, MatrixXd* jac) cons
         break;
       }
       case Impl::Row::Kind::kPeakLimit: {
+        if (m.free) {
+          c[r] = free_limit(row);
+          break;
+        }
         const double bound = row.value * m.original[static_cast<std::size_t>(row.index)];
         const Impl::Columns& y = columns(row.index);
         double s2 = 0;
@@ -745,13 +818,20 @@ std::string PlanarNlp::constraint_text(int i, const VectorXd& x) const {
              " kg, at most " + text::digits(row.value, 6) + " kg";
     case Impl::Row::Kind::kRmsLimit: {
       const auto k = static_cast<std::size_t>(row.index);
-      const double value = std::sqrt(m.rms2(m.columns(row.index, q, nullptr), nullptr));
+      const double value =
+          m.free ? simulated(x)[k] : std::sqrt(m.rms2(m.columns(row.index, q, nullptr), nullptr));
       return m.table[k].name + " is " + text::digits(value, 6) + " " + m.table[k].unit + " = " +
              text::digits(value / m.original[k], 4) + " x the original's, at most " +
              text::digits(row.value, 6) + " x";
     }
     case Impl::Row::Kind::kPeakLimit: {
       const auto k = static_cast<std::size_t>(row.index);
+      if (m.free) {
+        const double value = simulated(x)[k];
+        return m.table[k].name + " is " + text::digits(value, 6) + " " + m.table[k].unit + " = " +
+               text::digits(value / m.original[k], 4) + " x the original's, at most " +
+               text::digits(row.value, 6) + " x";
+      }
       const Impl::Columns c = m.columns(row.index, q, nullptr);
       double s2 = 0;
       for (const VectorXd& y : c.y) s2 += y[row.sample] * y[row.sample];
@@ -842,6 +922,7 @@ cp::Linkage PlanarNlp::design(const VectorXd& x) const {
 
 std::vector<double> PlanarNlp::metrics(const VectorXd& x) const {
   const Impl& m = *impl_;
+  if (m.free) return simulated(x);
   VectorXd q;
   m.q_of(x, q, nullptr);
   std::vector<double> out;
@@ -890,14 +971,15 @@ std::string Result::brief_report() const {
   return s + ", verified by simulating it to " + text::digits(verification_error, 2);
 }
 
+Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options) {
+  return optimize::check_algorithm(options, std::holds_alternative<cp::FreeScene>(problem.scene),
+                                   problem.force_balance);
+}
+
 Result optimize(const DesignProblem& problem, const OptimizeOptions& options) {
   if (const Problem e = options.validate()) throw InputError("optimize options: " + e->text());
+  if (const Problem e = check_algorithm(problem, options)) throw InputError(*e);
   const PlanarNlp nlp(problem);
-  if (options.algorithm == Algorithm::kMma && problem.force_balance) {
-    throw InputError(FieldError{"algorithm", -1,
-                                "'mma' takes inequality constraints only, and force_balance adds "
-                                "equalities; use slsqp, ipopt, mlsl or cobyla"});
-  }
   detail::Solved s = detail::solve(nlp, nlp.start(), options);
   if (s.termination == Termination::kInfeasible || s.termination == Termination::kFailed) {
     // a second start, the original design itself (no counterweight mass): it meets every limit
@@ -929,8 +1011,14 @@ Result optimize(const DesignProblem& problem, const OptimizeOptions& options) {
   r.metrics = nlp.metrics(r.x);
   r.added_mass = nlp.added_mass(r.x);
   if (!r.ok()) return r;  // no design: nothing to verify
-  // the design simulated by the engine, against the regressor's evaluation
-  const cp::Trajectory t = cp::simulate_driven(cp::Model(r.design), problem.scene);
+  // the design simulated by the engine, against the regressor's evaluation; in a free scene by
+  // the other route (dae), against the reduced route's evaluations
+  cp::SimulateOptions other = problem.simulate;
+  other.route = problem.simulate.route == cp::Route::kDae ? cp::Route::kReduced : cp::Route::kDae;
+  const cp::Trajectory t =
+      std::holds_alternative<cp::FreeScene>(problem.scene)
+          ? cp::simulate_free(cp::Model(r.design), std::get<cp::FreeScene>(problem.scene), other)
+          : cp::simulate_driven(cp::Model(r.design), std::get<cp::DrivenScene>(problem.scene));
   if (!t.ok()) {
     r.verification_error = std::numeric_limits<double>::infinity();
     r.message += "; the optimum's simulation failed: " + t.message;

@@ -28,6 +28,7 @@
 #include <Eigen/Core>
 #include <memory>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "balance/counterweight.hpp"
@@ -75,7 +76,11 @@ struct Limit {
 
 struct DesignProblem {
   cp::Linkage original;
-  cp::DrivenScene scene;
+  /// A driven scene: exact gradients from the regressor. A free scene: every evaluation is a
+  /// simulation of the design (the reduced route, `simulate`), without gradients (cobyla,
+  /// isres); the optimum is verified by the other route (dae).
+  std::variant<cp::DrivenScene, cp::FreeScene> scene;
+  cp::SimulateOptions simulate;  // a free scene's integration
   std::vector<CounterweightVariables> counterweights;
   std::vector<LinkParameterVariable> link_parameters;
   std::vector<Term> objective;
@@ -104,7 +109,7 @@ class PlanarNlp final : public Program {
   const Eigen::VectorXd& upper() const override;
   const std::vector<std::string>& variable_names() const override;
   const std::vector<std::string>& constraint_names() const override;
-  bool has_gradients() const override { return true; }
+  bool has_gradients() const override;
   double objective(const Eigen::VectorXd& x, Eigen::VectorXd* grad) const override;
   void equalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
                   Eigen::MatrixXd* jac) const override;
@@ -131,6 +136,7 @@ class PlanarNlp final : public Program {
   const std::vector<double>& original_metrics() const;
 
  private:
+  std::vector<double> simulated(const Eigen::VectorXd& x) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
@@ -159,6 +165,10 @@ struct Result {
   /// violation, verification.
   std::string brief_report() const;
 };
+
+/// Empty when the algorithm can take the problem, else why not (field "algorithm"): a gradient
+/// method in a free scene, mma with force balance.
+bd::Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options);
 
 /// Solves the problem from PlanarNlp::start() (and, when that finds no design, once more from the
 /// original design) and verifies the optimum by simulating it.

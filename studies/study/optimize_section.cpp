@@ -57,7 +57,7 @@ class OptimizeReader {
   }
 
   // a planar linkage's optimize: {algorithm, objective, constraints, variables, max_evaluations,
-  // tolerance}, in a driven scene
+  // tolerance, pareto}
   PlanarOptimizeRequest read_planar_optimize(const MapReader::Entry& e, const Study& study) {
     namespace op = optimize::planar;
     PlanarOptimizeRequest req;
@@ -67,12 +67,6 @@ class OptimizeReader {
                       "tolerance, pareto)");
     o.check_keys({"algorithm", "objective", "constraints", "variables", "max_evaluations",
                   "tolerance", "pareto"});
-    if (!std::holds_alternative<core::planar::DrivenScene>(study.scene)) {
-      r_.fail(e.key_mark,
-              "optimize for a planar linkage needs a driven scene (scene.type: driven): there "
-              "every output is linear in the masses, so each candidate is exact without a new "
-              "simulation; free scenes are optimised for a four-bar (linkage.type: fourbar)");
-    }
     const SolverMarks marks = read_solver(o, e.key_mark, req.options);
     table_ = core::planar::metric_table(core::planar::Model(linkage));
 
@@ -196,10 +190,8 @@ class OptimizeReader {
       r_.fail(e.key_mark, "optimize: " + p->text());
     }
     check_options(req.options, marks);
-    if (req.options.algorithm == optimize::Algorithm::kMma && req.force_balance) {
-      r_.fail(marks.algorithm,
-              "optimize.algorithm: 'mma' takes inequality constraints only, and force_balance "
-              "adds equalities; use slsqp, ipopt, mlsl or cobyla");
+    if (const Problem p = op::check_algorithm(problem, req.options)) {
+      r_.fail(marks.algorithm, "optimize.algorithm: " + p->text());
     }
     try {
       const op::PlanarNlp nlp(problem);  // the original run; its metrics are the normalisers

@@ -67,7 +67,7 @@ balance::planar::BalanceRequest read_planar_balance(const Reporter& r, const Map
                                                     const core::planar::Linkage& linkage);
 /// A four-bar's optimize section, checked by the optimize layer.
 OptimizeRequest read_optimize(const Reporter& r, const MapReader::Entry& e, const Study& study);
-/// A planar linkage's optimize section (a driven scene), checked by the optimize layer.
+/// A planar linkage's optimize section, checked by the optimize layer.
 PlanarOptimizeRequest read_planar_optimize(const Reporter& r, const MapReader::Entry& e,
                                            const Study& study);
 /// The sweep section; each path is checked against `root`, the study file's tree.

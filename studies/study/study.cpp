@@ -105,7 +105,12 @@ optimize::planar::DesignProblem planar_design_problem(const Study& study) {
   const PlanarOptimizeRequest& r = *study.planar_optimize;
   optimize::planar::DesignProblem p;
   p.original = study.planar();
-  p.scene = std::get<core::planar::DrivenScene>(study.scene);
+  if (const auto* free = std::get_if<core::planar::FreeScene>(&study.scene)) {
+    p.scene = *free;
+  } else {
+    p.scene = std::get<core::planar::DrivenScene>(study.scene);
+  }
+  p.simulate.tolerance = study.tolerance;
   set_request(p, r);
   return p;
 }

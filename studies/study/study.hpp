@@ -68,7 +68,7 @@ struct Study {
   /// The study file's `optimize:` section, checked at load time and solved by the runner; empty
   /// when absent. A study has a balance section or an optimize section, never both.
   std::optional<OptimizeRequest> optimize;
-  /// A planar study's `optimize:` section (a driven scene), checked at load time and solved by the
+  /// A planar study's `optimize:` section, checked at load time and solved by the
   /// runner; empty when absent. Never with a balance section.
   std::optional<PlanarOptimizeRequest> planar_optimize;
   /// The study file's `sweep:` section, checked at load time; empty when absent. A study with
@@ -105,8 +105,8 @@ Study optimized_study(const Study& study, const core::FourBar& design);
 Study planar_optimized_study(const Study& study, const core::planar::Linkage& design);
 
 /// The design problem of a planar study's optimize section: its variables, objective and
-/// constraints, with the study's linkage as the original and its (driven) scene.
-/// Precondition: study.planar_optimize is set and the scene is driven.
+/// constraints, with the study's linkage as the original, its scene and (a free scene) its
+/// tolerance. Precondition: study.planar_optimize is set.
 optimize::planar::DesignProblem planar_design_problem(const Study& study);
 
 /// The design problem of an optimize study: the request's variables, objective, constraints,

@@ -116,7 +116,7 @@ TEST(PlanarOptimize, GradientsAndValuesAgreeWithDifferencesAndTheEngine) {
     }
     // the values at x against the engine's simulation of the design at x
     const cp::Linkage d = nlp.design(x);
-    const cp::Trajectory t = cp::simulate_driven(cp::Model(d), p.scene);
+    const cp::Trajectory t = cp::simulate_driven(cp::Model(d), std::get<cp::DrivenScene>(p.scene));
     ASSERT_TRUE(t.ok()) << t.message;
     const std::vector<double> want = cp::metric_values(nlp.metric_table(), t.table);
     const std::vector<double> got = nlp.metrics(x);
@@ -222,7 +222,8 @@ TEST(PlanarOptimize, TheLeastPeakShakingForceIsALocalMinimumOfTheSimulatedPeak) 
     x[3] = 0;
     x[0] = std::clamp(x[0], 0.0, c.mass_max);
     if (x.segment<2>(1).norm() > c.distance_max) continue;
-    const cp::Trajectory t = cp::simulate_driven(cp::Model(nlp.design(x)), p.scene);
+    const cp::Trajectory t =
+        cp::simulate_driven(cp::Model(nlp.design(x)), std::get<cp::DrivenScene>(p.scene));
     ASSERT_TRUE(t.ok());
     const double peak = cp::metric_values(nlp.metric_table(), t.table)[1];
     EXPECT_GE(peak, best * (1 - 1e-9)) << "step " << k;

@@ -12,8 +12,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <numbers>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -91,17 +91,18 @@ TEST(PlanarOptimizeStudy, MistakesAreOneLineAtTheirPlace) {
   // what the optimize layer refuses, at the key it names
   expect_error(section("  algorithm: mma\n" + kObjective +
                        "  constraints: {force_balance: true}\n" + kVariables),
-               21, 14, "optimize.algorithm: 'mma' takes inequality constraints only");
+               21, 14, "optimize.algorithm: algorithm 'mma' takes inequality constraints only");
   // full force balance that no counterweight on the crank can give (the piston): said at the key
   expect_error(section(kObjective + "  constraints: {force_balance: true}\n" + kVariables), 22, 17,
                "optimize.constraints.force_balance: full force balance cannot be reached with "
                "counterweights on crank: the largest part of the linear momentum left is node B's");
-  // the scene: a free one has no exact regressor
+  // a free scene: every evaluation a simulation, no gradients
   std::string free = kEngine;
   free.replace(free.find("  type: driven\n"), 15, "  type: free\n  duration: 0.1\n");
   free.erase(free.find("  speeds:"), free.find("  samples:") - free.find("  speeds:"));
   expect_error(free + "optimize:\n" + kObjective + kVariables, 20, 1,
-               "optimize for a planar linkage needs a driven scene");
+               "optimize.algorithm: algorithm 'slsqp' needs gradients, which a free scene does not "
+               "provide; use cobyla or isres");
   // a balance section beside it
   expect_error(kEngine + "balance: {}\noptimize:\n" + kObjective + kVariables, 21, 1,
                "a study has a balance section or an optimize section, not both");
@@ -111,7 +112,11 @@ TEST(PlanarOptimizeStudy, MistakesAreOneLineAtTheirPlace) {
 // A1-A2, rocker A2-A3 as the four-bar's links, centres of mass from their first joints) with
 // the same optimize section: least RMS shaking moment among force-balanced designs, with
 // counterweights on crank and rocker and the coupler's mass and inertia as variables.
-std::string berkof_lowen_planar() {
+std::string berkof_lowen_planar(const std::string& scene =
+                                    "scene:\n"
+                                    "  type: driven\n"
+                                    "  speeds: [6.283185307179586]\n"
+                                    "  samples: 360\n") {
   const double l1 = 1, l2 = 3, l3 = 2, l4 = 3.2;
   // A2 where the coupler (l2 from A1 = (l1, 0)) meets the rocker (l3 from A3 = (l4, 0)), above
   // the frame (branch 1: the original's metrics below must agree)
@@ -138,11 +143,8 @@ std::string berkof_lowen_planar() {
          link("coupler", "A1, A2", 3.0, 1.45, 0.4, 3.1) +
          link("rocker", "A2, A3", 2.2, 1.66, -0.4, 2.1) +
          "  inputs:\n"
-         "    crank: {link: crank}\n"
-         "scene:\n"
-         "  type: driven\n"
-         "  speeds: [6.283185307179586]\n"
-         "  samples: 360\n"
+         "    crank: {link: crank}\n" +
+         scene +
          "optimize:\n"
          "  algorithm: slsqp\n"
          "  objective: {Msh_rms: 1.0}\n"
@@ -285,6 +287,55 @@ TEST(PlanarOptimizeStudy, TheFourBarsParetoFrontIsReachedOnTrussElements) {
   }
   EXPECT_TRUE(fs::exists(out / "timeseries.csv"));
   EXPECT_TRUE(fs::exists(out / "summary.json"));
+}
+
+// A free scene: every evaluation a simulation (the four-bar's closed form against the truss
+// engine's reduced route), derivative-free (cobyla); the same linkage coasting from 2π rad/s
+// reaches the same optimum of Fsh_rms + Msh_rms, and the planar optimum is verified by the dae
+// route.
+TEST(PlanarOptimizeStudy, AFreeSceneReachesTheFourBarsOptimum) {
+  const std::string optimize =
+      "optimize:\n"
+      "  algorithm: cobyla\n"
+      "  objective: {Fsh_rms: 1.0, Msh_rms: 1.0}\n"
+      "  variables:\n"
+      "    counterweights:\n"
+      "      crank:  {mass_max: 10.0, distance_max: 1.0}\n"
+      "      rocker: {mass_max: 10.0, distance_max: 2.0}\n"
+      "  max_evaluations: 3000\n"
+      "  tolerance: 1.0e-10\n";
+  std::string planar_text = berkof_lowen_planar(
+      "scene: {type: free, rates: [6.283185307179586], duration: 1.0, samples: 101}\n");
+  planar_text = planar_text.substr(0, planar_text.find("optimize:\n")) + optimize;
+  const Study planar = parse_study(planar_text, "p.yaml");
+  std::string fourbar_text =
+      bd::testing::read(example_path("berkof-lowen-min-shaking-moment.yaml"));
+  fourbar_text = fourbar_text.substr(0, fourbar_text.find("scene:")) +
+                 "scene: {type: free, theta1: 0.0, omega1: 6.283185307179586, duration: 1.0, "
+                 "samples: 101}\n" +
+                 optimize;
+  const Study fourbar = parse_study(fourbar_text, "f.yaml");
+  const RunResult r = compute_study(planar);
+  const RunResult f = compute_study(fourbar);
+  ASSERT_TRUE(r.ok()) << r.optimized->message();
+  ASSERT_TRUE(f.ok()) << f.optimized->message();
+  const optimize::planar::Result& p = r.optimized->planar_result;
+  const optimize::OptimizeResult& q = f.optimized->result;
+  // cobyla's optimum: the objective to 1e-7, the variables to 1e-3 (the objective is flat along
+  // the crank's counterweight to within its tolerance)
+  EXPECT_NEAR(p.objective, q.objective, 1e-7 * q.objective);
+  ASSERT_EQ(p.counterweights.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_NEAR(p.counterweights[k].counterweight.mass, q.counterweights[k].counterweight.mass,
+                1e-3 * q.counterweights[k].counterweight.mass)
+        << k;
+  }
+  // verified by the other route: two integrations at tolerance 1e-10
+  EXPECT_LE(p.verification_error, 1e-6);
+  EXPECT_EQ(p.verified.size(), p.metrics.size());
+  EXPECT_NEAR(metric(r.optimized->metric_list, "Msh_rms"),
+              metric(f.optimized->metric_list, "Msh_rms"),
+              1e-4 * metric(f.optimized->metric_list, "Msh_rms"));
 }
 
 // The six-bar example: least RMS shaking moment among the force-balanced designs is below the
