@@ -19,6 +19,7 @@ trap 'rm -rf "$tmp"' EXIT
 "$bin" run studies/examples/watt-sixbar-balanced.yaml --out "$tmp/watt-balanced" >/dev/null
 "$bin" run studies/examples/engine-slider-crank-balanced.yaml --out "$tmp/engine-balanced" \
   >/dev/null
+"$bin" run studies/examples/watt-sixbar-optimized.yaml --out "$tmp/watt-optimized" >/dev/null
 
 source docs/figures/extract-chart.sh
 # the shaking-force hodograph of the driven paper four-bar, original and force balanced, straight
@@ -38,6 +39,8 @@ extract_chart "$tmp/watt-balanced/report.html" linkage-balanced \
   "$out/watt-sixbar-balanced-linkage.svg"
 extract_chart "$tmp/engine-balanced/report.html" hodograph \
   "$out/engine-slider-crank-balanced-hodograph.svg"
+# the six-bar's least shaking moment among force-balanced designs against the added mass
+extract_chart "$tmp/watt-optimized/report.html" pareto "$out/watt-sixbar-pareto.svg"
 
 gnuplot <<GP
 set datafile separator ','
