@@ -968,13 +968,63 @@ double verification_error(const std::vector<cp::ColumnMetric>& table, const std:
 std::string Result::brief_report() const {
   std::string s = solver_report(*this);
   if (verified.empty()) return s + ", not verified";
-  return s + ", verified by simulating it to " + text::digits(verification_error, 2);
+  s += ", verified by simulating it to " + text::digits(verification_error, 2);
+  if (!std::isnan(inertial_error)) {
+    s += ", its inertial shaking force and moment by the bodies' accelerations to " +
+         text::digits(inertial_error, 2);
+  }
+  return s;
 }
 
 Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options) {
   return optimize::check_algorithm(options, std::holds_alternative<cp::FreeScene>(problem.scene),
                                    problem.force_balance);
 }
+
+namespace {
+
+// A second route for the inertial shaking force and moment of a simulated design: Newton's law
+// on each body's centre of mass from the kinematics alone (the balance layer's regressors, -Σ m a
+// and -dH/dt), against the engine's kinetostatic sums over the supports; the largest difference
+// over the samples relative to the largest value of each (NaN when the motion cannot be
+// evaluated).
+double inertial_error(const cp::Linkage& design, const core::Series& table) {
+  const cp::Model model(design);
+  const bp::InputSeries in = bp::input_series(model, table);
+  const auto k = bp::kinematics(model, in.values, in.rates, in.accelerations);
+  if (!k) return std::numeric_limits<double>::quiet_NaN();
+  const VectorXd q = P::of(design);
+  const bp::ShaftSeries shafts = bp::shaft_series(design, *k);
+  const VectorXd force = bp::shaking_force_regressor(design, *k) * q + shafts.force;
+  const VectorXd moment = bp::shaking_moment_regressor(design, *k) * q + shafts.moment;
+  const std::vector<double> fx = table.column_values("Fshx_inertial"),
+                            fy = table.column_values("Fshy_inertial"),
+                            msh = table.column_values("Msh_inertial");
+  // the scales: a shaking force that vanishes by cancellation is known to the round-off of the
+  // support forces it sums, its moment to that times the linkage's reach from the origin
+  double f = 0, reach = 0;
+  for (std::size_t c = 0; c < table.width(); ++c) {
+    const std::string& name = table.columns[c];
+    const bool support =
+        name.size() > 1 && name[0] == 'R' && (name.back() == 'x' || name.back() == 'y');
+    const bool node = name.rfind("x_", 0) == 0 || name.rfind("y_", 0) == 0;
+    if (!support && !node) continue;
+    for (double v : table.column_values(name))
+      (support ? f : reach) = std::max(support ? f : reach, std::abs(v));
+  }
+  double df = 0, dm = 0, mm = 0;
+  for (std::size_t i = 0; i < msh.size(); ++i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    df = std::max(df, std::hypot(force[2 * r] - fx[i], force[2 * r + 1] - fy[i]));
+    f = std::max(f, std::hypot(fx[i], fy[i]));
+    dm = std::max(dm, std::abs(moment[r] - msh[i]));
+    mm = std::max(mm, std::abs(msh[i]));
+  }
+  mm = std::max(mm, f * reach);
+  return std::max(f > 0 ? df / f : df, mm > 0 ? dm / mm : dm);
+}
+
+}  // namespace
 
 Result optimize(const DesignProblem& problem, const OptimizeOptions& options) {
   if (const Problem e = options.validate()) throw InputError("optimize options: " + e->text());
@@ -1026,6 +1076,7 @@ Result optimize(const DesignProblem& problem, const OptimizeOptions& options) {
   }
   r.verified = cp::metric_values(r.metric_table, t.table);
   r.verification_error = verification_error(r.metric_table, r.metrics, r.verified);
+  r.inertial_error = inertial_error(r.design, t.table);
   return r;
 }
 

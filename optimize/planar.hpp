@@ -26,6 +26,7 @@
 /// <= 0 for an RMS; the same at every sample for a peak; (added_mass - value) / (original total
 /// mass) <= 0. Force balance: the independent rows of the momentum conditions.
 #include <Eigen/Core>
+#include <limits>
 #include <memory>
 #include <string>
 #include <variant>
@@ -158,6 +159,10 @@ struct Result {
   double added_mass{};                    // [kg]
   std::vector<double> verified;           // the design simulated by the engine
   double verification_error{};            // largest relative difference metrics vs verified
+  /// A second route: the optimum's inertial shaking force and moment from Newton's law on each
+  /// body's centre of mass (the balance layer, kinematics alone) against the engine's (its
+  /// support forces): the largest difference relative to the largest value; NaN when not run.
+  double inertial_error = std::numeric_limits<double>::quiet_NaN();
   bool ok() const {
     return termination == Termination::kConverged || termination == Termination::kMaxEvaluations;
   }

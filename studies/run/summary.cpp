@@ -351,6 +351,7 @@ Json planar_optimize_json(const Study& study, const RunResult& result) {
     // other route of the engine (dae) against the reduced route's
     j["verified_with"] = is_free(study.scene) ? "dae route" : "the optimum simulated";
     j["verification_error"] = r.verification_error;
+    j["inertial_verification_error"] = r.inertial_error;  // null when not computed
   }
   j["counterweights"] = cws;
   if (req.pareto) {
