@@ -75,13 +75,23 @@ struct PointRow {
 // appends the cells of a second design (balanced or optimised): its metrics, added mass and
 // inertia, or as many empty cells
 // (`count`: how many metrics the study's linkage has)
-void second_design_cells(std::string& row, const MetricList* metrics, std::size_t count,
+void second_design_cells(std::string& row, const MetricList* metrics, const MetricList& columns,
                          double added_mass, double added_inertia) {
   if (!metrics) {
-    row.append(count + 2, ',');
+    row.append(columns.size() + 2, ',');
     return;
   }
-  for (const MetricValue& m : *metrics) row += "," + text::exact(m.value);
+  // by name, in the original's order: a balanced design's own parts (a balance shaft's
+  // bearing, as many as the point's synthesis adds) have no column
+  for (const MetricValue& c : columns) {
+    row += ",";
+    for (const MetricValue& m : *metrics) {
+      if (m.name == c.name) {
+        row += text::exact(m.value);
+        break;
+      }
+    }
+  }
   row += "," + text::exact(added_mass) + "," + text::exact(added_inertia);
 }
 
@@ -107,16 +117,17 @@ PointRow point_row(const Study& base, int index, std::span<const double> values,
     const Study study = point_study(base, values);
     const RunResult r = compute_study(study);
     for (const MetricValue& m : r.metric_list) body += "," + text::exact(m.value);
-    const std::size_t count = r.metric_list.size();
     if (base.balance || base.planar_balance) {
       const bool have = r.balanced && (study.balance || r.balanced->design);
       const auto [mass, inertia] = have ? added(study, r) : std::pair<double, double>{};
-      second_design_cells(body, have ? &r.balanced->metric_list : nullptr, count, mass, inertia);
+      second_design_cells(body, have ? &r.balanced->metric_list : nullptr, r.metric_list, mass,
+                          inertia);
     }
     if (base.optimizes()) {
       const bool have = r.optimized && r.optimized->found();
       const auto [mass, inertia] = have ? added(study, r) : std::pair<double, double>{};
-      second_design_cells(body, have ? &r.optimized->metric_list : nullptr, count, mass, inertia);
+      second_design_cells(body, have ? &r.optimized->metric_list : nullptr, r.metric_list, mass,
+                          inertia);
     }
     if (r.stopped_early()) {
       status = "stopped-early";

@@ -408,3 +408,53 @@ TEST(PlanarBalanceStudy, NoBalancedDesignWhenTheOriginalStopsEarly) {
 
 }  // namespace
 }  // namespace bd::studies
+
+namespace bd::studies {
+namespace {
+
+// A sweep over the balancing factor of an engine with a Lanchester balancer: each point's
+// synthesis adds its own shafts (their bearing forces are metrics of that point's balanced
+// design), yet every row of sweep.csv has the header's columns, the balanced_ ones by name.
+TEST(PlanarBalanceStudy, ASweepWithBalanceShaftsKeepsItsColumns) {
+  const std::string text = bd::testing::read(bd::testing::example_path("engine-lanchester.yaml")) +
+                           "sweep:\n  design: grid\n  parameters:\n"
+                           "    - {path: balance.balancing_factor, values: [0, 0.5, 1.0]}\n";
+  const Study study = parse_study(text, "sweep.yaml");
+  const fs::path out = fs::path(BD_BINARY_DIR) / "test-output" / "planar-balance" / "sweep";
+  fs::remove_all(out);
+  SweepOptions options;
+  options.threads = 1;
+
+  const SweepResult r = run_sweep(study, out, options);
+  ASSERT_TRUE(r.complete());
+  EXPECT_EQ(r.failed, 0);
+  const std::string csv = bd::testing::read(out / "sweep.csv");
+  std::vector<std::string> lines;
+  for (std::size_t a = 0, b; (b = csv.find('\n', a)) != std::string::npos; a = b + 1)
+    lines.push_back(csv.substr(a, b - a));
+  ASSERT_EQ(lines.size(), 4u);
+  const auto fields = [](const std::string& line) {
+    return std::count(line.begin(), line.end(), ',');
+  };
+  for (std::size_t i = 1; i < lines.size(); ++i) EXPECT_EQ(fields(lines[i]), fields(lines[0])) << i;
+  // the point at 0.5 is the example itself: its balanced shaking force in its column
+  const Study example = load_study(bd::testing::example_path("engine-lanchester.yaml"));
+  const RunResult e = compute_study(example);
+  ASSERT_TRUE(e.ok() && e.balanced);
+  double want = 0;
+  for (const MetricValue& m : e.balanced->metric_list)
+    if (m.name == "Fsh_rms") want = m.value;
+  std::vector<std::string> header, row;
+  for (const auto& [line, cells] : {std::pair{lines[0], &header}, std::pair{lines[2], &row}}) {
+    std::size_t a = 0;
+    for (std::size_t b; (b = line.find(',', a)) != std::string::npos; a = b + 1)
+      cells->push_back(line.substr(a, b - a));
+    cells->push_back(line.substr(a));
+  }
+  const auto column = std::find(header.begin(), header.end(), "balanced_Fsh_rms") - header.begin();
+  ASSERT_LT(static_cast<std::size_t>(column), row.size());
+  EXPECT_EQ(std::stod(row[static_cast<std::size_t>(column)]), want);
+}
+
+}  // namespace
+}  // namespace bd::studies
