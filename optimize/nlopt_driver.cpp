@@ -316,6 +316,11 @@ Run run_nlopt(nlopt_algorithm algorithm, bool mma, TrackedNlp& tracked, const Ve
     run.error = ctx.error;
   } else if (status < 0) {
     if (const char* msg = nlopt_get_errmsg(ctx.opt)) run.error = msg;
+    // NLopt's SLSQP says "bug: more than iter SQP iterations" when its line search gives up;
+    // it is not a bug of anyone's, and a user should not read it as one
+    if (run.error.find("more than iter SQP iterations") != std::string::npos) {
+      run.error = "its line search made no progress";
+    }
   }
   nlopt_destroy(ctx.opt);
   return run;

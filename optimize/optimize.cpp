@@ -329,6 +329,7 @@ detail::Solved detail::solve(const Program& nlp, const VectorXd& x0,
   r.iterations = outcome.iterations;
   r.evaluations = outcome.evaluations;
   r.seconds = std::chrono::duration<double>(stopped - started).count();
+  nlp.polish(r.x);
   r.objective = nlp.objective(r.x, nullptr);
   check_feasibility(nlp, options, outcome.message, r);
   return r;

@@ -65,7 +65,8 @@ Problem DesignProblem::validate() const {
   for (const cp::ColumnMetric& m : table) names += (names.empty() ? "" : ", ") + m.name;
   if (counterweights.empty() && link_parameters.empty())
     return field("", -1, "no design variable: give counterweights or link parameters");
-  std::set<int> moved;  // links whose centre of mass the variables move
+  std::map<int, std::pair<const char*, int>> moved;  // link -> the first variable moving its
+                                                     // centre of mass (list, index)
   std::set<int> with_cw;
   for (std::size_t i = 0; i < counterweights.size(); ++i) {
     const CounterweightVariables& c = counterweights[i];
@@ -83,7 +84,7 @@ Problem DesignProblem::validate() const {
         !(c.thickness > 0 && c.density > 0 && std::isfinite(c.thickness) &&
           std::isfinite(c.density)))
       return field("counterweights", k, ": a disc needs thickness > 0 m and density > 0 kg/m^3");
-    moved.insert(c.link);
+    moved.try_emplace(c.link, "counterweights", k);
   }
   std::set<std::pair<int, int>> seen;
   for (std::size_t i = 0; i < link_parameters.size(); ++i) {
@@ -101,14 +102,16 @@ Problem DesignProblem::validate() const {
     if (v.parameter == Param::kInertia && !(v.lower >= 0))
       return field("link_parameters", k, ": " + what + ".lower must be >= 0 kg m^2");
     // mass too: the regressor's columns move the centre of mass one parameter at a time
-    if (v.parameter != Param::kInertia) moved.insert(v.link);
+    if (v.parameter != Param::kInertia) moved.try_emplace(v.link, "link_parameters", k);
   }
   for (const cp::LinkLoad& load : l.loads.link_loads) {
-    if (moved.count(load.link) > 0 && load.force.norm() > 0) {
-      return field("original", -1,
+    const auto it = moved.find(load.link);
+    if (it != moved.end() && load.force.norm() > 0) {
+      return field(it->second.first, it->second.second,
                    ": link " + l.links[static_cast<std::size_t>(load.link)].name +
-                       " carries a force at its centre of mass, which the design variables move; "
-                       "apply it at a node to optimise this link");
+                       " carries a force at its centre of mass, which this variable moves (the "
+                       "outputs are then not linear in the masses); apply the force at a node to "
+                       "optimise this link");
     }
   }
   if (objective.empty()) return field("objective", -1, ": give at least one term");
@@ -845,6 +848,17 @@ std::string PlanarNlp::constraint_text(int i, const VectorXd& x) const {
   return {};
 }
 
+void PlanarNlp::polish(VectorXd& x) const {
+  const Impl& m = *impl_;
+  VectorXd q;
+  m.q_of(x, q, nullptr);
+  for (std::size_t k = 0; k < m.table.size(); ++k) {
+    const int t = m.bound_var[k];
+    if (t < 0) continue;
+    x[t] = std::hypot(m.peak(static_cast<int>(k), q) / m.original[k], m.p.smoothing);
+  }
+}
+
 VectorXd PlanarNlp::start(bool original) const {
   const Impl& m = *impl_;
   VectorXd x(m.n);
@@ -1046,6 +1060,13 @@ Result optimize(const DesignProblem& problem, const OptimizeOptions& options) {
   r.algorithm = options.algorithm;
   r.termination = s.termination;
   r.message = s.message;
+  if (s.termination == Termination::kInfeasible && !uses_gradients(options.algorithm) &&
+      s.evaluations >= options.max_evaluations) {
+    r.message += "; the evaluation budget ran out first: raise max_evaluations";
+  } else if (s.termination == Termination::kInfeasible) {
+    // a local solver that finds no feasible design from its starts does not prove there is none
+    r.message += "; another algorithm may find one (ipopt, cobyla)";
+  }
   r.x = s.x;
   r.variable_names = nlp.variable_names();
   r.design_variables = nlp.design_variables();

@@ -117,6 +117,7 @@ class PlanarNlp final : public Program {
   void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
                     Eigen::MatrixXd* jac) const override;
   std::string constraint_text(int i, const Eigen::VectorXd& x) const override;
+  void polish(Eigen::VectorXd& x) const override;
 
   /// The design's own variables: the first ones of x (then one bound variable per peak of the
   /// objective, t >= the peak's magnitude at every sample).

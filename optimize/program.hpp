@@ -34,6 +34,12 @@ class Program {
   /// c_in(x) (size n_ineq) and, when `jac` is not null, its Jacobian (n_ineq x n).
   virtual void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
                             Eigen::MatrixXd* jac) const = 0;
+  /// Sets the variables that only bound others (a peak's bound variable t >= |y_s|) to their
+  /// tightest feasible values at x, in place: a solver may return them a little loose (the
+  /// objective then overstates), a little tight (their rows then look violated although the
+  /// design is not), or, stopped where nothing is feasible, below the peak. The design's own
+  /// variables are not touched. Default: nothing to do.
+  virtual void polish(Eigen::VectorXd& /*x*/) const {}
   /// Constraint i (equalities first) at x in an engineer's words and units, e.g. "Fsh_rms is
   /// 0.31 x the original's, at most 0.0001 x"; empty when the program has no such words (a
   /// message then gives the scaled value).

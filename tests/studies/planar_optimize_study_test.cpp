@@ -96,6 +96,12 @@ TEST(PlanarOptimizeStudy, MistakesAreOneLineAtTheirPlace) {
   expect_error(section(kObjective + "  constraints: {force_balance: true}\n" + kVariables), 22, 17,
                "optimize.constraints.force_balance: full force balance cannot be reached with "
                "counterweights on crank: the largest part of the linear momentum left is node B's");
+  // a force at a centre of mass that a variable moves: at the variable
+  expect_error(kEngine + "loads:\n  links:\n    rod: {force: [0, -1]}\noptimize:\n" + kObjective +
+                   "  variables:\n    links:\n      rod: {mass: [0.3, 0.6]}\n",
+               27, 7,
+               "optimize.variables.links.rod.mass: link rod carries a force at its centre of mass, "
+               "which this variable moves");
   // a free scene: every evaluation a simulation, no gradients
   std::string free = kEngine;
   free.replace(free.find("  type: driven\n"), 15, "  type: free\n  duration: 0.1\n");
