@@ -877,6 +877,38 @@ VectorXd PlanarNlp::start(bool original) const {
                                                      : link.inertia;
     x[m.param_var[i]] = std::clamp(value, v.lower, v.upper);
   }
+  // with force balance asked for, the counterweights moved onto the balance conditions: for
+  // fixed masses the conditions are linear in the positions, so a least-norm step meets them;
+  // a position outside its envelope then takes more mass (same mass moment, up to mass_max) and
+  // the step is repeated. A start that meets the equalities is what SLSQP needs to find a
+  // feasible design at all on some linkages.
+  if (!original && n_eq() > 0 && !m.p.counterweights.empty()) {
+    for (int pass = 0; pass < 4; ++pass) {
+      VectorXd c;
+      MatrixXd jac;
+      equalities(x, c, &jac);
+      MatrixXd J(jac.rows(), 2 * static_cast<Eigen::Index>(m.p.counterweights.size()));
+      for (std::size_t k = 0; k < m.p.counterweights.size(); ++k)
+        J.middleCols(2 * static_cast<Eigen::Index>(k), 2) = jac.middleCols(m.cw_var[k] + 1, 2);
+      const VectorXd step = J.completeOrthogonalDecomposition().solve(c);
+      bool moved_mass = false;
+      for (std::size_t k = 0; k < m.p.counterweights.size(); ++k) {
+        const CounterweightVariables& cw = m.p.counterweights[k];
+        const int v = m.cw_var[k];
+        x.segment<2>(v + 1) -= step.segment<2>(2 * static_cast<Eigen::Index>(k));
+        const double r = x.segment<2>(v + 1).norm(), fit = 0.9 * cw.distance_max;
+        if (r > fit && x[v] > 0) {  // the same mass moment, further in, with more mass
+          const double mass = std::min(cw.mass_max, x[v] * r / fit);
+          x.segment<2>(v + 1) *= x[v] / mass;
+          x[v] = mass;
+          moved_mass = true;
+        }
+        if (x.segment<2>(v + 1).norm() > cw.distance_max)
+          x.segment<2>(v + 1) *= cw.distance_max / x.segment<2>(v + 1).norm();
+      }
+      if (!moved_mass) break;
+    }
+  }
   // each bound variable a hair above its smoothed peak at the start design
   VectorXd q;
   m.q_of(x, q, nullptr);

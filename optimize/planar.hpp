@@ -124,7 +124,9 @@ class PlanarNlp final : public Program {
   int design_variables() const;
   /// The original's link parameters (clamped to their bounds); each counterweight at half its
   /// mass_max (0 with `original`: the original design itself), half its distance_max from the
-  /// pivot away from the link's other node.
+  /// pivot away from the link's other node; with force balance (and not `original`), the
+  /// counterweights then moved onto the balance conditions (least-norm in their positions, more
+  /// mass where a position would leave its envelope).
   Eigen::VectorXd start(bool original = false) const;
   /// The design at x: its links with their parameters and counterweights merged in.
   cp::Linkage design(const Eigen::VectorXd& x) const;
