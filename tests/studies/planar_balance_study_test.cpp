@@ -412,6 +412,18 @@ TEST(PlanarBalanceStudy, NoBalancedDesignWhenTheOriginalStopsEarly) {
 namespace bd::studies {
 namespace {
 
+// added_inertia of a planar design (studies::added_inertia: each link's inertia about its pivot,
+// before and after, from the merged link parameters) against the balance layer's own sum of the
+// counterweights' inertias about their pivots.
+TEST(PlanarBalanceStudy, AddedInertiaIsTheCounterweightsInertiaAboutTheirPivots) {
+  const Study study = load_study(bd::testing::example_path("watt-sixbar-balanced.yaml"));
+  const RunResult r = compute_study(study);
+  ASSERT_TRUE(r.ok() && r.balanced && r.balanced->design);
+  const bp::ForceBalance& b = *r.balanced->design;
+  ASSERT_GT(b.added_inertia, 0);
+  EXPECT_NEAR(added_inertia(study.planar(), b.linkage), b.added_inertia, 1e-12 * b.added_inertia);
+}
+
 // A sweep over the balancing factor of an engine with a Lanchester balancer: each point's
 // synthesis adds its own shafts (their bearing forces are metrics of that point's balanced
 // design), yet every row of sweep.csv has the header's columns, the balanced_ ones by name.
