@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "optimize/optimize.hpp"
 #include "optimize/program.hpp"
@@ -94,9 +95,22 @@ struct Solved {
   Eigen::VectorXd x;
   int iterations{}, evaluations{};
   double seconds{}, objective{}, constraint_violation{};
+  /// The first-order conditions' residual at x (optimize/first_order.hpp), for a program with
+  /// gradients and a design found; NaN otherwise.
+  double stationarity = std::numeric_limits<double>::quiet_NaN();
   bool gradient_check_failed{};
 };
+/// A converged end, in a program with gradients, where the first-order conditions do not hold
+/// to stationarity_tolerance() (optimize/first_order.hpp) is not taken as converged: the run goes on from there, by the same
+/// algorithm once more and then by another local method (ipopt, or slsqp after ipopt), keeping
+/// each continuation that finds a design no worse; where they still do not hold, the result is
+/// Termination::kStoppedShort with the residual in the message.
 Solved solve(const Program& program, const Eigen::VectorXd& x0, const OptimizeOptions& options);
+/// solve() from the first of `starts` that is feasible, or, when none is, from the least
+/// violated; when that finds no design, from each other start in turn, keeping the first design
+/// found (or the least violated end). Counts and times add up over the runs.
+Solved solve_from(const Program& program, const std::vector<Eigen::VectorXd>& starts,
+                  const OptimizeOptions& options);
 
 DriverOutcome solve_with_nlopt(const Program& nlp, const Eigen::VectorXd& x0,
                                const OptimizeOptions& options);

@@ -33,7 +33,7 @@ const std::vector<std::string>& Nlp::constraint_names() const {
   return program_->constraint_names();
 }
 bool Nlp::has_gradients() const { return program_->has_gradients(); }
-Eigen::VectorXd Nlp::start() const { return program_->start(); }
+Eigen::VectorXd Nlp::start(bool original) const { return program_->start(original); }
 
 const detail::NlpProgram& Nlp::at(const Eigen::VectorXd& x) const {
   if (x.size() != program_->n()) {

@@ -104,7 +104,9 @@ class Nlp final : public Program {
   /// bounds); each counterweight, which the original lacks, at half its mass_max and half its
   /// distance_max on the far side of the pivot (crank: (-d/2, 0) from A0; rocker: (d/2, 0) from
   /// A3, beyond the pivot); bound variables at the start design's peaks (feasible).
-  Eigen::VectorXd start() const;
+  /// With `original`: the original design itself (every counterweight's mass 0, at the same
+  /// place), which meets any added-mass limit >= 0 and every limit of 1 or more.
+  Eigen::VectorXd start(bool original = false) const;
   /// Names of the variables and of the constraints, for messages ("crank counterweight mass [kg]",
   /// "force balance, crank side (real part)", "Fsh_rms <= 0.2 x original", ...).
   const std::vector<std::string>& variable_names() const override;

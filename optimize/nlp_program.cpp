@@ -333,12 +333,12 @@ void NlpProgram::require_gradients(bool asked, const char* function) const {
   }
 }
 
-Eigen::VectorXd NlpProgram::start() const {
+Eigen::VectorXd NlpProgram::start(bool original) const {
   Eigen::VectorXd x = Eigen::VectorXd::Zero(n_);
   for (std::size_t c = 0; c < problem_.counterweights.size(); ++c) {
     const CounterweightVariables& cw = problem_.counterweights[c];
     const int j = cw_var_[c];
-    x(j) = cw.mass_max / 2;
+    x(j) = original ? 0.0 : cw.mass_max / 2;
     x(j + 1) = (cw.link == 1 ? -0.5 : 0.5) * cw.distance_max;
   }
   for (std::size_t i = 0; i < problem_.link_parameters.size(); ++i) {

@@ -69,7 +69,7 @@ class NlpProgram {
   virtual bool has_gradients() const = 0;
 
   // Nlp's functions of the same names; x has n() entries (Nlp checks)
-  Eigen::VectorXd start() const;
+  Eigen::VectorXd start(bool original = false) const;
   virtual double objective(const Eigen::VectorXd& x, Eigen::VectorXd* grad) const = 0;
   void equalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac) const;
   void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac) const;

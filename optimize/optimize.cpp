@@ -7,10 +7,12 @@
 #include <limits>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
 #include "optimize/check_inputs.hpp"
+#include "optimize/first_order.hpp"
 #include "optimize/ipopt_driver.hpp"
 #include "optimize/nlopt_driver.hpp"
 #include "optimize/nlp.hpp"
@@ -226,6 +228,18 @@ void detail::check_inputs(const DesignProblem& problem, const OptimizeOptions& o
   if (const Problem e = problem.validate()) throw InputError("design problem: " + e->text());
 }
 
+std::string other_algorithms(Algorithm used, bool free_scene) {
+  const std::vector<Algorithm> driven = {Algorithm::kIpopt, Algorithm::kMlsl, Algorithm::kSlsqp,
+                                         Algorithm::kCobyla};
+  const std::vector<Algorithm> free = {Algorithm::kCobyla, Algorithm::kIsres};
+  std::string out;
+  for (Algorithm a : free_scene ? free : driven) {
+    if (a == used) continue;
+    out += (out.empty() ? "" : ", ") + std::string(to_string(a));
+  }
+  return out;
+}
+
 const char* to_string(Termination t) {
   switch (t) {
     case Termination::kNotRun:
@@ -234,6 +248,8 @@ const char* to_string(Termination t) {
       return "converged";
     case Termination::kMaxEvaluations:
       return "max evaluations";
+    case Termination::kStoppedShort:
+      return "stopped short";
     case Termination::kInfeasible:
       return "infeasible";
     case Termination::kFailed:
@@ -303,25 +319,15 @@ void verify(const DesignProblem& problem, OptimizeResult& r) {
 
 }  // namespace
 
-detail::Solved detail::solve(const Program& nlp, const VectorXd& x0,
-                             const OptimizeOptions& options) {
-  Solved r;
-  if (options.check_gradients && nlp.has_gradients()) {
-    // a wrong derivative would mislead every gradient method: stop before solving (Ceres)
-    if (std::string e = check_gradients(nlp, x0); !e.empty()) {
-      r.termination = Termination::kFailed;
-      r.message = std::move(e);
-      r.x = x0;
-      r.objective = nlp.objective(x0, nullptr);
-      r.constraint_violation = constraint_violation(nlp, x0);
-      r.gradient_check_failed = true;
-      return r;
-    }
-  }
+namespace {
+
+// One run of options.algorithm from x0, polished, its feasibility checked.
+detail::Solved run_once(const Program& nlp, const VectorXd& x0, const OptimizeOptions& options) {
+  detail::Solved r;
   const auto started = std::chrono::steady_clock::now();
-  DriverOutcome outcome = options.algorithm == Algorithm::kIpopt
-                              ? solve_with_ipopt(nlp, x0, options)
-                              : solve_with_nlopt(nlp, x0, options);
+  detail::DriverOutcome outcome = options.algorithm == Algorithm::kIpopt
+                                      ? detail::solve_with_ipopt(nlp, x0, options)
+                                      : detail::solve_with_nlopt(nlp, x0, options);
   const auto stopped = std::chrono::steady_clock::now();
   r.termination = outcome.termination;
   r.message = outcome.message;
@@ -335,11 +341,130 @@ detail::Solved detail::solve(const Program& nlp, const VectorXd& x0,
   return r;
 }
 
+void add_costs(const detail::Solved& from, detail::Solved& to) {
+  to.iterations += from.iterations;
+  to.evaluations += from.evaluations;
+  to.seconds += from.seconds;
+}
+
+// The methods that go on from a gradient method's end where the first-order conditions do not
+// hold: the same once more (a restart renews SLSQP's Hessian and MMA's asymptotes), then
+// another local method
+std::vector<Algorithm> continuations(Algorithm a) {
+  const Algorithm same = a == Algorithm::kMlsl ? Algorithm::kSlsqp : a;
+  return {same, same == Algorithm::kIpopt ? Algorithm::kSlsqp : Algorithm::kIpopt};
+}
+
+// A converged end of a gradient method checked against the first-order conditions, and
+// continued where they do not hold (nlopt_driver.hpp, solve()). Where a degenerate optimum keeps
+// the residual up (many constraints active together, as a peak's rows at a force-balanced
+// design), runs that go on from the point and change the objective by less than the tolerance
+// (relative to the objective's size, 1 for the original design) settle it: converged.
+void ensure_first_order(const Program& nlp, const OptimizeOptions& options, detail::Solved& r) {
+  if (!nlp.has_gradients() || r.termination != Termination::kConverged) return;
+  const double tolerance = detail::stationarity_tolerance(options.relative_tolerance);
+  r.stationarity = detail::stationarity_residual(nlp, r.x);
+  if (!(r.stationarity > tolerance)) return;
+  const double first = r.stationarity, f_first = r.objective;
+  std::string continued;
+  int runs = 0;
+  for (Algorithm a : continuations(options.algorithm)) {
+    if (r.evaluations >= options.max_evaluations) break;
+    OptimizeOptions next = options;
+    next.algorithm = a;
+    next.max_evaluations = options.max_evaluations - r.evaluations;
+    detail::Solved s = run_once(nlp, r.x, next);
+    add_costs(s, r);
+    ++runs;
+    continued += std::string(continued.empty() ? "" : ", then ") + to_string(a);
+    if (!found_design(s.termination) || s.objective > r.objective) continue;
+    r.x = s.x;
+    r.objective = s.objective;
+    r.constraint_violation = s.constraint_violation;
+    r.stationarity = detail::stationarity_residual(nlp, s.x);
+    if (!(r.stationarity > tolerance)) break;
+  }
+  std::string said = "; the first-order conditions held to " + text::digits(first, 2) +
+                     " only where it stopped (tolerance " + text::digits(tolerance, 2) + ")";
+  if (!continued.empty()) said += "; continued by " + continued;
+  if (!(r.stationarity > tolerance)) {
+    r.message += said + " to " + text::digits(r.stationarity, 2);
+    return;
+  }
+  const double gain = f_first - r.objective;
+  if (runs > 0 && gain <= options.relative_tolerance * std::max(std::abs(f_first), 1.0)) {
+    r.message += said + ", which changed the objective by " + text::digits(gain, 2) +
+                 " only: a degenerate optimum, taken as converged";
+    return;
+  }
+  r.termination = Termination::kStoppedShort;
+  r.message += said + (runs > 0 ? ", to " + text::digits(r.stationarity, 2) : std::string()) +
+               " at the design returned: it is feasible but may not be the optimum; another "
+               "algorithm or a larger max_evaluations may find a better one";
+}
+
+}  // namespace
+
+detail::Solved detail::solve(const Program& nlp, const VectorXd& x0,
+                             const OptimizeOptions& options) {
+  if (options.check_gradients && nlp.has_gradients()) {
+    // a wrong derivative would mislead every gradient method: stop before solving (Ceres)
+    if (std::string e = check_gradients(nlp, x0); !e.empty()) {
+      Solved r;
+      r.termination = Termination::kFailed;
+      r.message = std::move(e);
+      r.x = x0;
+      r.objective = nlp.objective(x0, nullptr);
+      r.constraint_violation = constraint_violation(nlp, x0);
+      r.gradient_check_failed = true;
+      return r;
+    }
+  }
+  Solved r = run_once(nlp, x0, options);
+  ensure_first_order(nlp, options, r);
+  return r;
+}
+
+detail::Solved detail::solve_from(const Program& nlp, const std::vector<VectorXd>& starts,
+                                  const OptimizeOptions& options) {
+  // the first feasible start, else the least violated
+  std::vector<std::size_t> order;
+  std::size_t first = 0;
+  double least = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < starts.size(); ++i) {
+    const double v = constraint_violation(nlp, starts[i]);
+    if (v <= options.constraint_tolerance) {
+      first = i;
+      break;
+    }
+    if (v < least) least = v, first = i;
+  }
+  order.push_back(first);
+  for (std::size_t i = 0; i < starts.size(); ++i) {
+    if (i != first) order.push_back(i);
+  }
+  Solved best, costs;
+  bool have = false;
+  for (std::size_t i : order) {
+    Solved s = solve(nlp, starts[i], options);
+    add_costs(s, costs);
+    if (!have || found_design(s.termination) || s.constraint_violation < best.constraint_violation) {
+      best = std::move(s);
+    }
+    have = true;
+    if (found_design(best.termination) || best.gradient_check_failed) break;
+  }
+  best.iterations = costs.iterations;
+  best.evaluations = costs.evaluations;
+  best.seconds = costs.seconds;
+  return best;
+}
+
 OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& options) {
   detail::check_inputs(problem, options);
   const Nlp nlp(problem);
   throw_if(check_algorithm(problem, options));
-  const detail::Solved solved = detail::solve(nlp, nlp.start(), options);
+  const detail::Solved solved = detail::solve_from(nlp, {nlp.start(), nlp.start(true)}, options);
 
   OptimizeResult r;
   r.algorithm = options.algorithm;

@@ -26,6 +26,14 @@ const char* to_string(Algorithm a);
 std::optional<Algorithm> algorithm_named(const std::string& name);
 /// True for the methods that need gradients.
 bool uses_gradients(Algorithm a);
+/// The methods other than `used` that can take a problem in such a scene, in the order worth
+/// trying, as words: "ipopt, mlsl, slsqp" (driven scenes), "isres" (free scenes, after cobyla).
+std::string other_algorithms(Algorithm used, bool free_scene);
+/// The method a study gets when it names none: slsqp in a driven scene (exact gradients from
+/// the regressor), cobyla in a free one (every evaluation a simulation, no gradients).
+constexpr Algorithm default_algorithm(bool free_scene) {
+  return free_scene ? Algorithm::kCobyla : Algorithm::kSlsqp;
+}
 
 struct OptimizeOptions {
   Algorithm algorithm = Algorithm::kSlsqp;
@@ -53,10 +61,20 @@ enum class Termination {
   kNotRun,
   kConverged,       // a tolerance was met at a feasible point
   kMaxEvaluations,  // stopped by the budget; the best feasible point so far is returned
+  /// the solver stopped at a feasible design where the first-order conditions do not hold to
+  /// the tolerance (optimize/first_order.hpp), even after the restarts: a design, maybe not
+  /// the best
+  kStoppedShort,
   kInfeasible,      // no feasible point found; the message names the binding constraint
   kFailed,          // the solver failed (roundoff, invalid problem); the message says why
 };
 const char* to_string(Termination t);
+/// True when a solver ending so returned a feasible design (converged, budget spent, stopped
+/// short): it is simulated, verified and written.
+constexpr bool found_design(Termination t) {
+  return t == Termination::kConverged || t == Termination::kMaxEvaluations ||
+         t == Termination::kStoppedShort;
+}
 
 /// A counterweight of the optimum, in the balance layer's terms.
 struct PlacedCounterweight {
@@ -92,9 +110,7 @@ struct OptimizeResult {
   double verification_error{};  // largest relative difference metrics vs verified
   /// One line for the console and summary.json.
   std::string brief_report() const;
-  bool ok() const {
-    return termination == Termination::kConverged || termination == Termination::kMaxEvaluations;
-  }
+  bool ok() const { return found_design(termination); }
 };
 
 /// Solves the problem from its natural start (every variable at its value in the original

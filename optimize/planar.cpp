@@ -133,7 +133,22 @@ Problem DesignProblem::validate() const {
     const int k = static_cast<int>(i);
     if (!std::isfinite(lim.value))
       return field("limits", k, ".value must be finite, got " + text::shortest(lim.value));
-    if (lim.metric == "added_mass") continue;
+    if (lim.metric == "added_mass") {
+      // counterweights add mass; only a link's own mass variable can take some away
+      double least = 0;
+      for (const LinkParameterVariable& v : link_parameters) {
+        if (v.parameter == Param::kMass)
+          least += v.lower - l.links[static_cast<std::size_t>(v.link)].mass;
+      }
+      if (lim.value < least - 1e-12 * cp::total_mass(l))
+        return field("limits", k,
+                     ": added_mass <= " + text::shortest(lim.value) +
+                         " kg cannot be met: the least the variables allow is " +
+                         text::digits(least, 6) +
+                         " kg (a counterweight's mass is >= 0; only a link's own mass, within "
+                         "its bounds, can take mass away)");
+      continue;
+    }
     if (!metric(lim.metric))
       return field("limits", k,
                    ": no metric " + lim.metric + " (metrics: " + names + ", added_mass)");
@@ -1076,18 +1091,9 @@ Result optimize(const DesignProblem& problem, const OptimizeOptions& options) {
   if (const Problem e = options.validate()) throw InputError("optimize options: " + e->text());
   if (const Problem e = check_algorithm(problem, options)) throw InputError(*e);
   const PlanarNlp nlp(problem);
-  detail::Solved s = detail::solve(nlp, nlp.start(), options);
-  if (s.termination == Termination::kInfeasible || s.termination == Termination::kFailed) {
-    // a second start, the original design itself (no counterweight mass): it meets every limit
-    // of 1 or more and any added-mass limit >= 0, where the first start may be far outside
-    detail::Solved again = detail::solve(nlp, nlp.start(true), options);
-    again.evaluations += s.evaluations;
-    again.iterations += s.iterations;
-    again.seconds += s.seconds;
-    const bool found = again.termination == Termination::kConverged ||
-                       again.termination == Termination::kMaxEvaluations;
-    if (found || again.constraint_violation < s.constraint_violation) s = std::move(again);
-  }
+  // the original design itself (no counterweight mass) is the second start: it meets every
+  // limit of 1 or more and any added-mass limit >= 0, where the first may be far outside
+  detail::Solved s = detail::solve_from(nlp, {nlp.start(), nlp.start(true)}, options);
   Result r;
   r.algorithm = options.algorithm;
   r.termination = s.termination;
@@ -1097,7 +1103,10 @@ Result optimize(const DesignProblem& problem, const OptimizeOptions& options) {
     r.message += "; the evaluation budget ran out first: raise max_evaluations";
   } else if (s.termination == Termination::kInfeasible) {
     // a local solver that finds no feasible design from its starts does not prove there is none
-    r.message += "; another algorithm may find one (ipopt, cobyla)";
+    r.message += "; another algorithm may find one (" +
+                 other_algorithms(options.algorithm,
+                                  std::holds_alternative<cp::FreeScene>(problem.scene)) +
+                 ")";
   }
   r.x = s.x;
   r.variable_names = nlp.variable_names();

@@ -166,9 +166,7 @@ struct Result {
   /// body's centre of mass (the balance layer, kinematics alone) against the engine's (its
   /// support forces): the largest difference relative to the largest value; NaN when not run.
   double inertial_error = std::numeric_limits<double>::quiet_NaN();
-  bool ok() const {
-    return termination == Termination::kConverged || termination == Termination::kMaxEvaluations;
-  }
+  bool ok() const { return found_design(termination); }
   /// One line: algorithm, termination, iterations, evaluations, seconds, objective, constraint
   /// violation, verification.
   std::string brief_report() const;

@@ -101,8 +101,7 @@ struct OptimizedRun {
   /// True when the optimiser returned a design (converged, or the budget ran out at a feasible
   /// point): the optimum was simulated and its files written.
   bool found() const {
-    return termination() == optimize::Termination::kConverged ||
-           termination() == optimize::Termination::kMaxEvaluations;
+    return optimize::found_design(termination());
   }
   /// True when the optimiser ran and found no design (infeasible, or it failed): exit code 4.
   bool failed() const {

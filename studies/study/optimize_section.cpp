@@ -35,7 +35,7 @@ class OptimizeReader {
                       "pareto)");
     o.check_keys({"algorithm", "objective", "constraints", "variables", "max_evaluations",
                   "tolerance", "pareto"});
-    const SolverMarks marks = read_solver(o, e.key_mark, req.options);
+    const SolverMarks marks = read_solver(o, e.key_mark, is_free(study.scene), req.options);
     read_objective(o.require("objective", "the metrics to minimise, each with a weight"), study,
                    req);
     if (const MapReader::Entry* c = o.find("constraints")) read_constraints(*c, study, req);
@@ -67,7 +67,7 @@ class OptimizeReader {
                       "tolerance, pareto)");
     o.check_keys({"algorithm", "objective", "constraints", "variables", "max_evaluations",
                   "tolerance", "pareto"});
-    const SolverMarks marks = read_solver(o, e.key_mark, req.options);
+    const SolverMarks marks = read_solver(o, e.key_mark, is_free(study.scene), req.options);
     table_ = core::planar::metric_table(core::planar::Model(linkage));
 
     // objective: {metric: weight}
@@ -285,9 +285,12 @@ class OptimizeReader {
   };
 
   // algorithm, max_evaluations, tolerance; each mark defaults to the section's
-  SolverMarks read_solver(const MapReader& o, const YAML::Mark& section,
+  SolverMarks read_solver(const MapReader& o, const YAML::Mark& section, bool free_scene,
                           optimize::OptimizeOptions& options) {
     SolverMarks marks{section, section, section, section};
+    // without the key, the method that suits the scene: a free scene's evaluations are
+    // simulations without derivatives
+    options.algorithm = optimize::default_algorithm(free_scene);
     if (const MapReader::Entry* a = o.find("algorithm")) {
       const std::string name = read_text(r_, *a, "optimize.algorithm");
       marks.algorithm = mark_of(a->value, a->key_mark);

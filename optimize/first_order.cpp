@@ -1,0 +1,77 @@
+#include "optimize/first_order.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <Eigen/QR>
+#include <vector>
+
+namespace bd::optimize::detail {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+double stationarity_residual(const Program& p, const VectorXd& x, double activity) {
+  const int n = p.n();
+  VectorXd w = (p.upper() - p.lower()).cwiseAbs();
+  for (int j = 0; j < n; ++j) {
+    if (!std::isfinite(w[j]) || w[j] == 0) w[j] = 1;
+  }
+  VectorXd g(n);
+  const double f = p.objective(x, &g);
+  const VectorXd gw = w.cwiseProduct(g);
+  // the columns of the active constraints' scaled gradients, with each multiplier's lower bound
+  std::vector<VectorXd> columns;
+  std::vector<double> floor;
+  const double inf = std::numeric_limits<double>::infinity();
+  VectorXd c;
+  MatrixXd jac;
+  if (p.n_eq() > 0) {
+    p.equalities(x, c, &jac);
+    for (int i = 0; i < c.size(); ++i) {
+      columns.emplace_back(w.cwiseProduct(jac.row(i).transpose()));
+      floor.push_back(-inf);
+    }
+  }
+  if (p.n_ineq() > 0) {
+    p.inequalities(x, c, &jac);
+    for (int i = 0; i < c.size(); ++i) {
+      if (!(c[i] >= -activity)) continue;
+      columns.emplace_back(w.cwiseProduct(jac.row(i).transpose()));
+      floor.push_back(0);
+    }
+  }
+  for (int j = 0; j < n; ++j) {
+    VectorXd e = VectorXd::Zero(n);
+    if (x[j] - p.lower()[j] <= activity * w[j]) {
+      e[j] = -w[j];  // -μ at a lower bound, in scaled units: the bound's gradient is -1
+    } else if (p.upper()[j] - x[j] <= activity * w[j]) {
+      e[j] = w[j];
+    } else {
+      continue;
+    }
+    columns.push_back(std::move(e));
+    floor.push_back(0);
+  }
+  // relative to the objective's size or its gradient's, whichever is larger
+  const double size = std::max({std::abs(f), gw.cwiseAbs().maxCoeff(), 1e-300});
+  if (columns.empty()) return gw.cwiseAbs().maxCoeff() / size;
+  MatrixXd A(n, static_cast<Eigen::Index>(columns.size()));
+  VectorXd lower(A.cols());
+  for (Eigen::Index k = 0; k < A.cols(); ++k) {
+    A.col(k) = columns[static_cast<std::size_t>(k)];
+    lower[k] = floor[static_cast<std::size_t>(k)];
+  }
+  // the least-squares multipliers of every active constraint first (the common case: none of
+  // them of the wrong sign); bounded least squares from there where some are
+  VectorXd z = A.completeOrthogonalDecomposition().solve(-gw);
+  const double scale = gw.cwiseAbs().maxCoeff();
+  bool signs = true;
+  for (Eigen::Index k = 0; k < z.size(); ++k) {
+    if (z[k] < lower[k] - 1e-12 * scale) signs = false;
+  }
+  if (!signs) z = bounded_least_squares(A, -gw, lower, z.cwiseMax(lower));
+  return (gw + A * z).cwiseAbs().maxCoeff() / size;
+}
+
+}  // namespace bd::optimize::detail

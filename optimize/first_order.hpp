@@ -1,0 +1,43 @@
+#pragma once
+/// Internal to bd_optimize: whether a point a solver returned satisfies the first-order
+/// (Karush-Kuhn-Tucker) conditions of a Program, checked from the program's own derivatives
+/// rather than taken from the solver's word.
+///
+/// At a feasible x, with each variable measured in units of its box width w_j = upper - lower
+/// (1 where a bound is infinite), the active set is every equality, every inequality with
+/// c_i >= -activity and every bound within activity · w_j of x. The multipliers
+///   min || w ∘ (∇f + Σ λ_i ∇c_i + Σ ν_k ∇h_k - μ_lower + μ_upper) ||,  λ, μ >= 0
+/// are fitted by least squares (bounded least squares, NLopt, where some come out of the wrong
+/// sign), and the residual's largest entry, divided by the larger of |f| and the scaled
+/// gradient's largest entry, is the stationarity residual: the objective's relative rate of
+/// decrease, per whole box width, along the best direction that the active constraints allow to
+/// first order. It is 0 at a Karush-Kuhn-Tucker point and of order one far from one.
+///
+/// Its tolerance is sqrt(relative tolerance) (1e-4 for the default 1e-8): a solver that stops
+/// when the objective changes by less than δ relative is within δ of a minimum of curvature H
+/// where the gradient is about sqrt(2 H δ), so that is what a converged end can show.
+#include <Eigen/Core>
+#include <cmath>
+
+#include "optimize/program.hpp"
+
+namespace bd::optimize::detail {
+
+/// The default activity threshold (scaled constraints and box-width units).
+inline constexpr double kActivity = 1e-6;
+
+/// The tolerance of the stationarity residual for a solver's relative tolerance.
+inline double stationarity_tolerance(double relative_tolerance) {
+  return std::sqrt(relative_tolerance);
+}
+
+/// The stationarity residual at x (see above), for a program with gradients.
+double stationarity_residual(const Program& program, const Eigen::VectorXd& x,
+                             double activity = kActivity);
+
+/// min ½ |A z - b|² subject to z_i >= lower_i (lower_i may be -infinity), by NLopt's SLSQP on
+/// the bound-constrained quadratic, from z0 (within the bounds).
+Eigen::VectorXd bounded_least_squares(const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
+                                      const Eigen::VectorXd& lower, const Eigen::VectorXd& z0);
+
+}  // namespace bd::optimize::detail
