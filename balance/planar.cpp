@@ -409,6 +409,29 @@ int condition_rank(const MatrixXd& Z, const cp::Linkage& l, double length) {
 
 }  // namespace
 
+int force_balance_conditions(const cp::Linkage& linkage, const Kinematics& k) {
+  double length = 0;
+  for (std::size_t j = 0; j < linkage.links.size(); ++j)
+    length = std::max(length, frame_of(linkage, static_cast<int>(j)).length);
+  return condition_rank(momentum_regressor(linkage, k), linkage, length);
+}
+
+Expected<Kinematics, cp::PlanarError> crank_revolution(const cp::Model& model, int samples,
+                                                       std::vector<double>* angles) {
+  const double start = cp::drawn_inputs(model)[0];
+  std::vector<std::vector<double>> values, rates, accelerations;
+  for (int j = 0; j < samples; ++j) {
+    values.push_back({start + 2 * std::numbers::pi * j / samples});
+    rates.push_back({1.0});
+    accelerations.push_back({0.0});
+  }
+  if (angles) {
+    angles->clear();
+    for (const auto& v : values) angles->push_back(v[0]);
+  }
+  return kinematics(model, values, rates, accelerations);
+}
+
 std::vector<LinkCounterweightSpec> grounded_links(const cp::Linkage& l) {
   std::vector<LinkCounterweightSpec> out;
   for (std::size_t k = 0; k < l.links.size(); ++k) {
@@ -486,10 +509,28 @@ std::string unbalanced_message(const cp::Linkage& l, const ForceBalance& out, co
   std::string links;
   for (const Placement& pl : pls)
     links += (links.empty() ? "" : ", ") + l.links[static_cast<std::size_t>(pl.ask.link)].name;
+  // nodes that slide on frame guides (pistons) carry a reciprocating mass that no counterweight
+  // on a turning link cancels: where there are any, they are what is left, whatever part of the
+  // momentum the least-squares design leaves at the nodes that turn (a crank pin's, there on
+  // purpose to cancel the pistons' first order in part)
+  std::string pistons;
+  double reciprocating = 0;
+  for (const cp::Slider& sl : l.sliders) {
+    const auto n = static_cast<std::size_t>(sl.node);
+    if (sl.link >= 0 || !(std::abs(mu[n]) > 1e-12 * cp::total_mass(l))) continue;
+    pistons += (pistons.empty() ? "" : ", ") + l.nodes[n].name;
+    reciprocating += std::abs(mu[n]);
+  }
+  const std::string left =
+      pistons.empty()
+          ? "the largest part of the linear momentum left is node " + l.nodes[worst].name +
+                "'s (equivalent mass " + text::digits(std::abs(mu[worst]), 4) + " kg)"
+          : "the reciprocating mass at " + pistons + " (" + text::digits(reciprocating, 4) +
+                " kg, sliding on frame guides) cannot be cancelled by counterweights on turning "
+                "links";
   return "full force balance cannot be reached with counterweights on " +
-         (links.empty() ? std::string("no link") : links) + ": the largest part of the " +
-         "linear momentum left is node " + l.nodes[worst].name + "'s (equivalent mass " +
-         text::digits(std::abs(mu[worst]), 4) + " kg); the least-squares design leaves " +
+         (links.empty() ? std::string("no link") : links) + ": " + left +
+         "; the least-squares design leaves " +
          "the RMS inertial shaking force at " +
          text::digits(out.Fsh_rms_before > 0 ? 100 * out.Fsh_rms_after / out.Fsh_rms_before : 0.0,
                       3) +

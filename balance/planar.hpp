@@ -13,6 +13,7 @@
 ///
 /// For a four-bar they are eq. 57 (tests/balance/planar_balance_test.cpp checks it).
 #include <Eigen/Dense>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -71,6 +72,13 @@ Expected<Kinematics, cp::PlanarError> kinematics(
     const std::vector<std::vector<double>>& rates,
     const std::vector<std::vector<double>>& accelerations);
 
+/// One revolution of a linkage's only input, a link's angle, at unit speed from its drawn value:
+/// `samples` configurations, equally spaced; `angles` (if not null) receives the input's values.
+/// @return the kinematics, or the first configuration that does not assemble (a crank that
+///         cannot turn fully).
+Expected<Kinematics, cp::PlanarError> crank_revolution(const cp::Model& model, int samples,
+                                                       std::vector<double>* angles = nullptr);
+
 /// The inputs' values, rates and accelerations at every row of a simulated run's table
 /// (core/planar/simulate.hpp, columns()).
 struct InputSeries {
@@ -99,6 +107,11 @@ struct ShaftSeries {
 };
 ShaftSeries shaft_series(const cp::Linkage& linkage, const Kinematics& k);
 
+/// How many independent conditions of full force balance the configurations of `k` show (the
+/// rank of the momentum regressor, as force_balance() counts them). A motion through too few
+/// configurations (a linkage at rest) shows fewer than the linkage has.
+int force_balance_conditions(const cp::Linkage& linkage, const Kinematics& k);
+
 /// True when the linkage's linear momentum (its shafts' included) vanishes to round-off in every
 /// configuration of `k`: against the sum of its terms' sizes, to 1e-10.
 bool force_balanced(const cp::Linkage& linkage, const Kinematics& k);
@@ -124,6 +137,7 @@ struct LinkCounterweightSpec {
 struct ShaftRequest {
   std::vector<int> orders;  // the orders of the shaking force to cancel, each >= 1
   std::optional<Vec2> at;   // where the shafts sit [m]; default: the crank's pivot
+  std::map<int, Vec2> at_shaft;  // where the shaft of a ratio (±order) sits, over `at` [m]
   std::optional<double>
       radius;  // their centres of mass from the shaft [m]; default: the crank's length
 };
@@ -179,7 +193,8 @@ struct ForceBalance {
   bool full{};                             // full force balance reached (L ≡ 0 to round-off)
   int conditions{};                        // independent conditions of full force balance
   /// Empty when full; else one line naming what cannot be balanced with the counterweights
-  /// allowed, and what the least-squares design leaves.
+  /// allowed, and what the least-squares design leaves. (A study's runner may add a note on
+  /// where the conditions came from: a scene that shows too few of them.)
   std::string message;
   /// |Z θ| over |Z θ0| at the design: the linear momentum left, relative to the original's.
   double momentum_left{};

@@ -1,5 +1,6 @@
 #include "balance/planar_shafts.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -24,21 +25,13 @@ struct Revolution {
   std::vector<double> angle;
 };
 Revolution revolution(const cp::Linkage& l) {
-  const cp::Model model(l);
-  const double start = cp::drawn_inputs(model)[0];
-  std::vector<std::vector<double>> values, rates, accelerations;
-  for (int j = 0; j < kSamples; ++j) {
-    values.push_back({start + 2 * std::numbers::pi * j / kSamples});
-    rates.push_back({1.0});
-    accelerations.push_back({0.0});
-  }
-  auto k = kinematics(model, values, rates, accelerations);
+  Revolution r;
+  auto k = crank_revolution(cp::Model(l), kSamples, &r.angle);
   if (!k) {
     refuse("balance shafts need a crank that turns a full revolution; " + l.inputs[0].name +
            " cannot (" + k.error().detail + ")");
   }
-  Revolution r{std::move(*k), {}};
-  for (const auto& v : values) r.angle.push_back(v[0]);
+  r.k = std::move(*k);
   return r;
 }
 
@@ -66,8 +59,15 @@ ShaftBalance balance_shafts(const cp::Linkage& linkage, const ShaftRequest& requ
     refuse("balance shafts are geared to a crank: the linkage needs one input, a link's angle");
   }
   if (request.orders.empty()) refuse("name the orders to cancel, e.g. orders: [1, 2]");
-  for (int n : request.orders) {
+  for (std::size_t i = 0; i < request.orders.size(); ++i) {
+    const int n = request.orders[i];
     if (n < 1) refuse("orders must be whole numbers >= 1, got " + std::to_string(n));
+    for (std::size_t j = 0; j < i; ++j) {
+      if (request.orders[j] == n) {
+        refuse("orders[" + std::to_string(i) + "] repeats order " + std::to_string(n) +
+               " (orders[" + std::to_string(j) + "])");
+      }
+    }
   }
   ShaftBalance out;
   out.crank = l.inputs[0].link;
@@ -79,7 +79,14 @@ ShaftBalance balance_shafts(const cp::Linkage& linkage, const ShaftRequest& requ
   const Revolution rev = revolution(l);
   const double drawn = rev.angle[0];
   const Eigen::VectorXd before = inertial_force(l, rev.k);
-  const double size = std::sqrt(before.squaredNorm() / kSamples) + 1e-300;
+  // a rotating part below 1e-12 of the linkage's scale gets no shaft: the RMS force, or, where
+  // counterweights have balanced it to round-off, the force its moving mass would shake with at
+  // the largest link's length (the revolution is at unit speed)
+  double reach = 0;
+  for (std::size_t k = 0; k < l.links.size(); ++k)
+    reach = std::max(reach, cp::element_length(l, static_cast<int>(k)));
+  const double size =
+      std::max(std::sqrt(before.squaredNorm() / kSamples), cp::total_mass(l) * reach) + 1e-300;
   for (int n : request.orders) {
     for (int k : {n, -n}) {
       const std::complex<double> C = coefficient(before, rev.angle, k);
@@ -93,7 +100,8 @@ ShaftBalance balance_shafts(const cp::Linkage& linkage, const ShaftRequest& requ
       }
       b.link = out.crank;
       b.ratio = k;
-      b.at = at;
+      const auto own = request.at_shaft.find(k);
+      b.at = own != request.at_shaft.end() ? own->second : at;
       b.mass = std::abs(me) / radius;
       b.eccentricity = Vec2(me.real(), me.imag()) / b.mass;
       out.added.push_back(static_cast<int>(out.linkage.shafts.size()));

@@ -393,6 +393,27 @@ std::string pareto_csv(const Study& study, const OptimizedRun& run) {
 
 namespace {
 
+// Full force balance holds in every configuration the linkage can take, not only in those a
+// scene passes through: where the scene's motion shows fewer of its conditions than a full
+// revolution of the crank does (a linkage at rest), the revolution's configurations (at unit
+// speed) are added to k, so that the conditions are the linkage's own; a design that cannot
+// meet them all is then the least-squares one over both. Returns what was done, in words, or
+// nothing.
+std::string with_every_condition(const core::planar::Linkage& l, const core::planar::Model& model,
+                                 balance::planar::Kinematics& k) {
+  namespace bp = balance::planar;
+  if (l.inputs.size() != 1 || l.inputs[0].kind != core::planar::Input::Kind::kAngle) return {};
+  const auto revolution = bp::crank_revolution(model, 360);
+  if (!revolution) return {};
+  const int seen = bp::force_balance_conditions(l, k);
+  const int all = bp::force_balance_conditions(l, *revolution);
+  if (seen >= all) return {};
+  k.samples.insert(k.samples.end(), revolution->samples.begin(), revolution->samples.end());
+  return "the scene's motion shows " + std::to_string(seen) + " of the " + std::to_string(all) +
+         " conditions of force balance, so they are taken from a full revolution of " +
+         l.inputs[0].name;
+}
+
 // a planar study's balanced design: synthesised from the original's motion (its configurations
 // give the balance conditions), then simulated in the same scene; not run when the original
 // stopped early
@@ -407,14 +428,16 @@ BalancedRun planar_balanced_run(const Study& study, const RunResult& original) {
   }
   const core::planar::Model model(study.planar());
   const bp::InputSeries in = bp::input_series(model, original.planar.table);
-  const auto k = bp::kinematics(model, in.values, in.rates, in.accelerations);
+  auto k = bp::kinematics(model, in.values, in.rates, in.accelerations);
   if (!k) {
     b.planar.message = "not run: the original's motion cannot be evaluated for balancing (" +
                        k.error().detail + ")";
     return b;
   }
   const bp::BalanceRequest& ask = *study.planar_balance;
+  const std::string shown = with_every_condition(study.planar(), model, *k);
   b.design = bp::force_balance(study.planar(), *k, ask.counterweights, ask.balancing_factor);
+  if (!shown.empty()) b.design->message += (b.design->message.empty() ? "" : "; ") + shown;
   if (ask.shafts) {
     b.shafts = bp::balance_shafts(b.design->linkage, *ask.shafts);
     bp::add_shafts(*b.design, *b.shafts, *k, study.planar());

@@ -194,11 +194,40 @@ balance::planar::ShaftRequest read_shafts(const Reporter& r_, const MapReader::E
       r_.fail(mark_of(o.value[i], om),
               path + " must be a whole number from 1 to 100, got " + text::shortest(n));
     }
+    for (std::size_t j = 0; j < q.orders.size(); ++j) {
+      if (q.orders[j] == static_cast<int>(n)) {
+        r_.fail(mark_of(o.value[i], om), path + " repeats order " + text::shortest(n) +
+                                             " (orders[" + std::to_string(j) + "])");
+      }
+    }
     q.orders.push_back(static_cast<int>(n));
   }
   if (const MapReader::Entry* a = m.find("at")) {
     YAML::Mark marks[2];
-    q.at = read_vec2(r_, *a, "balance.shafts.at", "m", marks);
+    if (a->value.IsMap()) {
+      // one place per shaft, by the name the synthesis gives it: shaft_<n>, shaft_-<n>
+      const MapReader places(r_, a->value, "balance.shafts.at", a->key_mark,
+                             "of shaft: [x, y] (e.g. shaft_2: [0, 0.1])");
+      std::string names;
+      for (int n : q.orders) {
+        names += (names.empty() ? "" : ", ") + std::string("shaft_") + std::to_string(n) +
+                 ", shaft_-" + std::to_string(n);
+      }
+      for (const MapReader::Entry& x : places.entries()) {
+        const std::string path = "balance.shafts.at." + x.key;
+        int ratio = 0;
+        for (int n : q.orders) {
+          if (x.key == "shaft_" + std::to_string(n)) ratio = n;
+          if (x.key == "shaft_-" + std::to_string(n)) ratio = -n;
+        }
+        if (ratio == 0) {
+          r_.fail(x.key_mark, path + ": no such shaft (the orders give " + names + ")");
+        }
+        q.at_shaft[ratio] = read_vec2(r_, x, path, "m", marks);
+      }
+    } else {
+      q.at = read_vec2(r_, *a, "balance.shafts.at", "m", marks);
+    }
   }
   if (const MapReader::Entry* x = m.find("radius")) {
     q.radius = read_number(r_, *x, "balance.shafts.radius", "m");
