@@ -183,6 +183,15 @@ TEST(Optimize, AlgorithmNamesRoundTrip) {
   EXPECT_FALSE(uses_gradients(Algorithm::kIsres));
   EXPECT_FALSE(uses_gradients(Algorithm::kCobyla));
   EXPECT_STREQ(to_string(Termination::kConverged), "converged");
+  EXPECT_STREQ(to_string(Termination::kStoppedShort), "stopped short");
+  EXPECT_TRUE(found_design(Termination::kStoppedShort));
+  EXPECT_FALSE(found_design(Termination::kInfeasible));
+  // the methods worth suggesting after one found nothing: never the one used, never a gradient
+  // method in a free scene
+  EXPECT_EQ(other_algorithms(Algorithm::kSlsqp, false), "ipopt, mlsl, cobyla");
+  EXPECT_EQ(other_algorithms(Algorithm::kCobyla, true), "isres");
+  EXPECT_EQ(default_algorithm(true), Algorithm::kCobyla);
+  EXPECT_EQ(default_algorithm(false), Algorithm::kSlsqp);
   EXPECT_STREQ(to_string(Termination::kInfeasible), "infeasible");
 }
 

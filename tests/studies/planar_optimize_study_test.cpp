@@ -96,6 +96,11 @@ TEST(PlanarOptimizeStudy, MistakesAreOneLineAtTheirPlace) {
   expect_error(section(kObjective + "  constraints: {force_balance: true}\n" + kVariables), 22, 17,
                "optimize.constraints.force_balance: full force balance cannot be reached with "
                "counterweights on crank: the reciprocating mass at B (");
+  // an added-mass limit that no design can meet: counterweights add mass, only a link's own
+  // mass variable can take some away (here none): at the limit
+  expect_error(section(kObjective + "  constraints: {added_mass: -5}\n" + kVariables), 22, 17,
+               "optimize.constraints.added_mass: added_mass <= -5 kg cannot be met: the least the "
+               "variables allow is 0 kg");
   // a force at a centre of mass that a variable moves: at the variable
   expect_error(kEngine + "loads:\n  links:\n    rod: {force: [0, -1]}\noptimize:\n" + kObjective +
                    "  variables:\n    links:\n      rod: {mass: [0.3, 0.6]}\n",
