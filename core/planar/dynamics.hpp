@@ -20,6 +20,7 @@
 
 #include "core/expected.hpp"
 #include "core/planar/model.hpp"
+#include "core/planar/small_lu.hpp"
 
 namespace bd::core::planar {
 
@@ -110,7 +111,7 @@ class Workspace {
   // scratch
   Eigen::VectorXd q, qd, qdd, g, gamma, F, rhs, lambda, step, c, right, zdd;
   Eigen::MatrixXd G, T, MT, reduced;
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu;
+  detail::SmallLu lu;
   bool factorised = false;  // lu holds the Jacobian at the last position solve_position solved
   Eigen::LDLT<Eigen::MatrixXd> ldlt;
   std::vector<Vec2> trial;

@@ -288,7 +288,7 @@ struct Motion {
   MatrixXd kkt;
   VectorXd kkt_rhs, kkt_solution, rate_residual;
   std::vector<double> none;  // no input values: the structural rows only
-  Eigen::PartialPivLU<MatrixXd> kkt_lu;
+  detail::SmallLu kkt_lu;
 };
 
 // the normalised determinant of the factorised constraints and inputs at ws
@@ -376,7 +376,7 @@ Expected<bool, PlanarError> dae_accelerations(Motion& m, double t, const double*
         PlanarError::Kind::kSingular,
         "the constraints lose rank (a lock-up or a branch point): the linkage cannot move on"});
   }
-  m.kkt_solution.noalias() = m.kkt_lu.solve(m.kkt_rhs);
+  m.kkt_lu.solve(m.kkt_rhs, m.kkt_solution);
   ws.qdd = m.kkt_solution.head(n);
   ws.lambda.setZero(s.rows);
   ws.lambda.head(r) = m.kkt_solution.tail(r);
