@@ -187,7 +187,7 @@ Workspace::Workspace(const Model& model) {
   c.setZero(s.n);
   right.setZero(model.inputs());
   zdd.setZero(model.inputs());
-  trial = instant.x;
+  target.assign(static_cast<std::size_t>(model.inputs()), Vec2(0, 0));
   on_link.assign(model.linkage().links.size() * model.linkage().nodes.size(), Vec2(0, 0));
 }
 
@@ -256,14 +256,14 @@ Unexpected<PlanarError> singular_at(const Model& model, const Workspace& ws,
 // contraction worse than kChordContraction, or too many steps, hands over to Newton. On success
 // the position is exact to round-off: after the step that moves no coordinate by more than the
 // step limit, one more (the remaining error shrinks by the contraction again).
-bool chord_iterations(const Model& model, Workspace& ws, const std::vector<double>& inputs) {
+bool chord_iterations(const Model& model, Workspace& ws) {
   const System& s = model.system();
   Instant& in = ws.instant;
   const double step_limit = kNewtonStep * model.length_scale();
   double previous = std::numeric_limits<double>::infinity();
   bool converged = false;
   for (int it = 0; it < kChordIterations; ++it) {
-    detail::constraint_values(s, in.x, inputs, ws.g);
+    detail::constraint_values(s, in.x, ws.target, ws.g);
     ws.lu.solve(ws.g, ws.step);
     const double size = ws.step.cwiseAbs().maxCoeff();
     if (!std::isfinite(size) || (it == 0 && size > kChordReach * model.length_scale()) ||
@@ -296,6 +296,7 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
     in.input = inputs;
     return true;
   }
+  detail::input_targets(s, inputs, ws.target);
   // the final factorisation, at the solution: the rates, accelerations and multipliers use it
   auto solved = [&]() -> Expected<bool, PlanarError> {
     detail::constraint_jacobian(s, in.x, s.rows, ws.G);
@@ -312,14 +313,14 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
   if (ws.factorised) {
     in.x = guess;
     detail::q_from_nodes(s, in.x, ws.q);
-    if (chord_iterations(model, ws, inputs)) return solved();
+    if (chord_iterations(model, ws)) return solved();
   }
   ws.factorised = false;
   in.x = guess;
   detail::q_from_nodes(s, in.x, ws.q);
   const double step_limit = kNewtonStep * model.length_scale();
   for (int it = 0; it < kNewtonIterations; ++it) {
-    detail::constraint_values(s, in.x, inputs, ws.g);
+    detail::constraint_values(s, in.x, ws.target, ws.g);
     detail::constraint_jacobian(s, in.x, s.rows, ws.G);
     if (!finite(ws.g) || !ws.G.allFinite()) {
       return Unexpected<PlanarError>(PlanarError{
@@ -355,7 +356,7 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
       return true;
     }
   }
-  detail::constraint_values(s, in.x, inputs, ws.g);
+  detail::constraint_values(s, in.x, ws.target, ws.g);
   Eigen::Index worst = 0;
   if (s.rows > 0) ws.g.cwiseAbs().maxCoeff(&worst);
   return Unexpected<PlanarError>(PlanarError{

@@ -114,7 +114,7 @@ class Workspace {
   detail::SmallLu lu;
   bool factorised = false;  // lu holds the Jacobian at the last position solve_position solved
   Eigen::LDLT<Eigen::MatrixXd> ldlt;
-  std::vector<Vec2> trial;
+  std::vector<Vec2> target;  // the inputs of the last position solve (detail::input_targets)
   std::vector<Vec2> on_link;  // force recovery: per link and node, the force from the joint
 };
 

@@ -287,7 +287,7 @@ struct Motion {
   // dae route scratch
   MatrixXd kkt;
   VectorXd kkt_rhs, kkt_solution, rate_residual;
-  std::vector<double> none;  // no input values: the structural rows only
+  std::vector<Vec2> none;  // no input targets: the structural rows only
   detail::SmallLu kkt_lu;
 };
 
@@ -426,7 +426,7 @@ void project(const Model& model, Workspace& ws, double* y) {
   const System& s = model.system();
   const int n = s.n, r = s.structural_rows;
   Eigen::Map<VectorXd> q(y, n), qd(y + n, n);
-  const std::vector<double> none;
+  const std::vector<Vec2> none;
   for (int it = 0; it < 4; ++it) {
     detail::nodes_from_q(s, q, ws.instant.x);
     detail::constraint_values(s, ws.instant.x, none, ws.g);

@@ -100,9 +100,9 @@ void SmallLu::compute(const Eigen::MatrixXd& a) {
     dynamic_.compute(a);
     return;
   }
+  a_ = a;  // for rcond(): the 1-norm, only when asked
   lu_ = a;
   perm_.resize(n_);
-  l1_norm_ = n_ > 0 ? a.cwiseAbs().colwise().sum().maxCoeff() : 0.0;
   swaps_ = by_size(n_, [&](auto size) {
     return factorise<decltype(size)::value>(lu_.data(), perm_.indices().data(), n_);
   });
@@ -192,10 +192,11 @@ double SmallLu::inverse_norm_estimate() const {
 double SmallLu::rcond() const {
   if (n_ > kFixedSize) return dynamic_.rcond();
   if (n_ == 0) return std::numeric_limits<double>::infinity();
-  if (l1_norm_ == 0.0) return 0.0;
+  const double l1_norm = a_.cwiseAbs().colwise().sum().maxCoeff();  // as Eigen's
+  if (l1_norm == 0.0) return 0.0;
   if (n_ == 1) return 1.0;
   const double inverse_norm = inverse_norm_estimate();
-  return inverse_norm == 0.0 ? 0.0 : (1.0 / inverse_norm) / l1_norm_;
+  return inverse_norm == 0.0 ? 0.0 : (1.0 / inverse_norm) / l1_norm;
 }
 
 }  // namespace bd::core::planar::detail

@@ -45,7 +45,7 @@ class SmallLu {
 
   int n_ = 0;
   int swaps_ = 0;
-  double l1_norm_ = 0;
+  Eigen::MatrixXd a_;   // the matrix factorised
   Eigen::MatrixXd lu_;  // L below the diagonal (unit diagonal implied), U on and above
   Eigen::Transpositions<Eigen::Dynamic, Eigen::Dynamic, int> perm_;  // P, the row swaps in order
   Eigen::PartialPivLU<Eigen::MatrixXd> dynamic_;                      // above kFixedSize
