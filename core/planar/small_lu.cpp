@@ -119,7 +119,10 @@ void SmallLu::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
     x.noalias() = dynamic_.solve(b);
     return;
   }
-  x = b;
+  if (&x != &b) {  // a plain copy: Eigen's assignment costs more than the 4 x 4 solve's half
+    x.resize(n_);
+    std::copy_n(b.data(), n_, x.data());
+  }
   solve_in_place(x.data());
 }
 

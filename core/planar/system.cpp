@@ -237,10 +237,13 @@ System::System(const Linkage& l) : linkage(l) {
 }
 
 void nodes_from_q(const System& s, const VectorXd& q, NodeVectors& x) {
-  x.resize(s.coord.size());
-  for (std::size_t i = 0; i < s.coord.size(); ++i) {
-    const int c = s.coord[i];
-    x[i] = c < 0 ? s.linkage.nodes[i].position : Vec2(q[c], q[c + 1]);
+  const std::size_t nodes = s.coord.size();
+  x.resize(nodes);
+  const int* coord = s.coord.data();
+  const double* qv = q.data();
+  for (std::size_t i = 0; i < nodes; ++i) {
+    const int c = coord[i];
+    x[i] = c < 0 ? s.linkage.nodes[i].position : Vec2(qv[c], qv[c + 1]);
   }
 }
 
