@@ -16,6 +16,9 @@
 //                             solve from the previous instant's nodes, then forward or inverse
 //                             dynamics with every force (core::planar)
 //   planar:driven             N driven revolutions of 360 samples on the general engine
+//   free, planar:free, planar:free-dae
+//                             N of the paper's free runs (5 s, 501 samples, CVODE Adams at 1e-10,
+//                             as BM_FreeRun): closed form, general engine reduced and dae route
 // The instants: the paper's four-bar, theta1 from 1 rad in steps of 1e-3 rad, omega1 2 rad/s,
 // alpha1 0.5 rad/s^2. Instructions per evaluation = (count(KIND, N) - count(none, 0)) / N.
 #include <cstdio>
@@ -46,6 +49,21 @@ int main(int argc, char** argv) {
     for (int i = 0; i < n; ++i) {
       const planar::Trajectory t = planar::simulate_driven(model, scene);
       checksum += t.table.values.back();
+    }
+  } else if (kind == "planar:free" || kind == "planar:free-dae") {
+    const planar::Model model(planar::linkage_of(samples::paper_fourbar(), 1.0));
+    planar::SimulateOptions o;
+    o.route = kind == "planar:free-dae" ? planar::Route::kDae : planar::Route::kReduced;
+    for (int i = 0; i < n; ++i) {
+      const planar::Trajectory t =
+          planar::simulate_free(model, planar::FreeScene{{1.0}, {0.0}, 5.0, 501}, o);
+      checksum += t.table.values.back();
+    }
+  } else if (kind == "free") {
+    for (int i = 0; i < n; ++i) {
+      checksum += simulate_free(samples::paper_fourbar(), FreeScene{1.0, 0.0, 5.0, 501})
+                      .samples.back()
+                      .tau;
     }
   } else if (kind == "planar:forward" || kind == "planar:inverse") {
     const planar::Model model(planar::linkage_of(samples::paper_fourbar(), 1.0));

@@ -47,11 +47,6 @@ constexpr double kSingularPivot = 1e-4;
 // (the rows have gradients of unit length and the systems are small)
 constexpr double kWellConditionedPivot = 1e-2;
 
-double pivot_ratio(const Eigen::PartialPivLU<MatrixXd>& lu) {
-  const auto d = lu.matrixLU().diagonal().cwiseAbs();
-  return d.minCoeff() / d.maxCoeff();
-}
-
 std::string inputs_text(const Model& model, const std::vector<double>& inputs) {
   std::string s;
   for (std::size_t k = 0; k < inputs.size(); ++k) {
@@ -187,13 +182,12 @@ Workspace::Workspace(const Model& model) {
   T.setZero(s.n, model.inputs());
   MT.setZero(s.n, model.inputs());
   reduced.setZero(model.inputs(), model.inputs());
-  lu = Eigen::PartialPivLU<MatrixXd>(std::max(s.n, 1));
   ldlt = Eigen::LDLT<MatrixXd>(std::max(model.inputs(), 1));
   step.setZero(s.n);
   c.setZero(s.n);
   right.setZero(model.inputs());
   zdd.setZero(model.inputs());
-  trial = instant.x;
+  target.assign(static_cast<std::size_t>(model.inputs()), Vec2(0, 0));
   on_link.assign(model.linkage().links.size() * model.linkage().nodes.size(), Vec2(0, 0));
 }
 
@@ -262,15 +256,15 @@ Unexpected<PlanarError> singular_at(const Model& model, const Workspace& ws,
 // contraction worse than kChordContraction, or too many steps, hands over to Newton. On success
 // the position is exact to round-off: after the step that moves no coordinate by more than the
 // step limit, one more (the remaining error shrinks by the contraction again).
-bool chord_iterations(const Model& model, Workspace& ws, const std::vector<double>& inputs) {
+bool chord_iterations(const Model& model, Workspace& ws) {
   const System& s = model.system();
   Instant& in = ws.instant;
   const double step_limit = kNewtonStep * model.length_scale();
   double previous = std::numeric_limits<double>::infinity();
   bool converged = false;
   for (int it = 0; it < kChordIterations; ++it) {
-    detail::constraint_values(s, in.x, inputs, ws.g);
-    ws.step.noalias() = ws.lu.solve(ws.g);
+    detail::constraint_values(s, in.x, ws.target, ws.g);
+    ws.lu.solve(ws.g, ws.step);
     const double size = ws.step.cwiseAbs().maxCoeff();
     if (!std::isfinite(size) || (it == 0 && size > kChordReach * model.length_scale()) ||
         (size > kChordContraction * previous && size > kRefactorStep * model.length_scale()))
@@ -302,6 +296,7 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
     in.input = inputs;
     return true;
   }
+  detail::input_targets(s, inputs, ws.target);
   // the final factorisation, at the solution: the rates, accelerations and multipliers use it
   auto solved = [&]() -> Expected<bool, PlanarError> {
     detail::constraint_jacobian(s, in.x, s.rows, ws.G);
@@ -309,7 +304,7 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
     ws.factorised = false;
     // a factorisation with well-sized pivots is well conditioned; estimate only the others
     if (!ws.G.allFinite() ||
-        (!(pivot_ratio(ws.lu) >= kWellConditionedPivot) && !(ws.lu.rcond() >= kSingularSolution)))
+        (!(ws.lu.pivot_ratio() >= kWellConditionedPivot) && !(ws.lu.rcond() >= kSingularSolution)))
       return singular_at(model, ws, inputs);
     ws.factorised = true;
     in.input = inputs;
@@ -318,14 +313,14 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
   if (ws.factorised) {
     in.x = guess;
     detail::q_from_nodes(s, in.x, ws.q);
-    if (chord_iterations(model, ws, inputs)) return solved();
+    if (chord_iterations(model, ws)) return solved();
   }
   ws.factorised = false;
   in.x = guess;
   detail::q_from_nodes(s, in.x, ws.q);
   const double step_limit = kNewtonStep * model.length_scale();
   for (int it = 0; it < kNewtonIterations; ++it) {
-    detail::constraint_values(s, in.x, inputs, ws.g);
+    detail::constraint_values(s, in.x, ws.target, ws.g);
     detail::constraint_jacobian(s, in.x, s.rows, ws.G);
     if (!finite(ws.g) || !ws.G.allFinite()) {
       return Unexpected<PlanarError>(PlanarError{
@@ -334,7 +329,7 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
     ws.lu.compute(ws.G);
     // inside the iterations a cheap guard (the smallest pivot against the largest; the rows
     // have gradients of unit length), the condition estimate only where it is poor
-    if (!(pivot_ratio(ws.lu) >= kSingularPivot) && !(ws.lu.rcond() >= kSingularRcond)) {
+    if (!(ws.lu.pivot_ratio() >= kSingularPivot) && !(ws.lu.rcond() >= kSingularRcond)) {
       // a singular Jacobian at a closed position is a singular position; away from closure it
       // means Newton cannot go on
       Eigen::Index worst = 0;
@@ -345,7 +340,7 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
                       "the linkage cannot be assembled at " + inputs_text(model, inputs) + ": " +
                           row_name(s, static_cast<int>(worst)) + " does not close"});
     }
-    ws.step.noalias() = ws.lu.solve(ws.g);
+    ws.lu.solve(ws.g, ws.step);
     ws.q -= ws.step;
     detail::nodes_from_q(s, ws.q, in.x);
     const double last_step = ws.step.cwiseAbs().maxCoeff();
@@ -354,14 +349,14 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
       // before it (up to step_limit away: a relative error of 1e-14 in every rate, which an
       // integrator at tight tolerance sees as noise)
       if (last_step > kRefactorStep * model.length_scale()) return solved();
-      if (!(pivot_ratio(ws.lu) >= kWellConditionedPivot) && !(ws.lu.rcond() >= kSingularSolution))
+      if (!(ws.lu.pivot_ratio() >= kWellConditionedPivot) && !(ws.lu.rcond() >= kSingularSolution))
         return singular_at(model, ws, inputs);
       ws.factorised = true;
       in.input = inputs;
       return true;
     }
   }
-  detail::constraint_values(s, in.x, inputs, ws.g);
+  detail::constraint_values(s, in.x, ws.target, ws.g);
   Eigen::Index worst = 0;
   if (s.rows > 0) ws.g.cwiseAbs().maxCoeff(&worst);
   return Unexpected<PlanarError>(PlanarError{
@@ -421,7 +416,7 @@ void velocities(const Model& model, Workspace& ws, const std::vector<double>& ra
     const double r = rates[static_cast<std::size_t>(in.input)];
     ws.rhs[in.row] = in.angle ? in.length * r : r;
   }
-  ws.qd.noalias() = ws.lu.solve(ws.rhs);
+  ws.lu.solve(ws.rhs, ws.qd);
   detail::node_rates_from(s, ws.qd, ws.instant.v);
   ws.instant.input_rate = rates;
 }
@@ -623,11 +618,9 @@ Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t) 
   detail::applied_forces(s, in.x, in.v, nullptr, ws.F);
   ws.rhs.noalias() = s.M * ws.qdd;
   ws.rhs -= ws.F;
-  // Gᵀ λ = rhs with G = P⁻¹ L U: Uᵀ, then Lᵀ, then the permutation, in place (no temporary)
+  // Gᵀ λ = rhs, in place
   ws.lambda = ws.rhs;
-  ws.lu.matrixLU().triangularView<Eigen::Upper>().transpose().solveInPlace(ws.lambda);
-  ws.lu.matrixLU().triangularView<Eigen::UnitLower>().transpose().solveInPlace(ws.lambda);
-  ws.lambda = ws.lu.permutationP().transpose() * ws.lambda;
+  ws.lu.solve_transpose(ws.lambda);
   for (const System::InputRow& ir : s.inputs) {
     in.effort[static_cast<std::size_t>(ir.input)] =
         ir.angle ? ws.lambda[ir.row] * ir.length : ws.lambda[ir.row];
@@ -658,7 +651,7 @@ Expected<bool, PlanarError> inverse_dynamics(const Model& model, Workspace& ws, 
     const double z = accelerations[static_cast<std::size_t>(in.input)];
     ws.rhs[in.row] += in.angle ? in.length * z : z;
   }
-  ws.qdd.noalias() = ws.lu.solve(ws.rhs);
+  ws.lu.solve(ws.rhs, ws.qdd);
   ws.instant.input_acceleration = accelerations;
   return finish(model, ws, t);
 }
@@ -672,10 +665,10 @@ Expected<bool, PlanarError> forward_dynamics(const Model& model, Workspace& ws, 
   // q̇ = T ż: T's columns solve G T = E (E the input rows, scaled as the rows are)
   ws.MT.setZero(s.n, dof);  // the input rows' unit columns, scaled as the rows are
   for (const System::InputRow& in : s.inputs) ws.MT(in.row, in.input) = in.angle ? in.length : 1.0;
-  ws.T.noalias() = ws.lu.solve(ws.MT);
+  ws.lu.solve(ws.MT, ws.T);
   // q̈ = T z̈ + c with G c = -γ
   detail::constraint_bias(s, ws.instant.x, ws.instant.v, s.rows, ws.gamma);
-  ws.c.noalias() = ws.lu.solve(ws.gamma);  // c = -G⁻¹ γ, the sign applied below
+  ws.lu.solve(ws.gamma, ws.c);  // c = -G⁻¹ γ, the sign applied below
   detail::applied_forces(s, ws.instant.x, ws.instant.v, nullptr, ws.F);
   ws.MT.noalias() = s.M * ws.T;
   ws.reduced.noalias() = ws.T.transpose() * ws.MT;

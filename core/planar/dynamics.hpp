@@ -20,6 +20,7 @@
 
 #include "core/expected.hpp"
 #include "core/planar/model.hpp"
+#include "core/planar/small_lu.hpp"
 
 namespace bd::core::planar {
 
@@ -110,10 +111,10 @@ class Workspace {
   // scratch
   Eigen::VectorXd q, qd, qdd, g, gamma, F, rhs, lambda, step, c, right, zdd;
   Eigen::MatrixXd G, T, MT, reduced;
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu;
+  detail::SmallLu lu;
   bool factorised = false;  // lu holds the Jacobian at the last position solve_position solved
   Eigen::LDLT<Eigen::MatrixXd> ldlt;
-  std::vector<Vec2> trial;
+  std::vector<Vec2> target;  // the inputs of the last position solve (detail::input_targets)
   std::vector<Vec2> on_link;  // force recovery: per link and node, the force from the joint
 };
 

@@ -287,8 +287,8 @@ struct Motion {
   // dae route scratch
   MatrixXd kkt;
   VectorXd kkt_rhs, kkt_solution, rate_residual;
-  std::vector<double> none;  // no input values: the structural rows only
-  Eigen::PartialPivLU<MatrixXd> kkt_lu;
+  std::vector<Vec2> none;  // no input targets: the structural rows only
+  detail::SmallLu kkt_lu;
 };
 
 // the normalised determinant of the factorised constraints and inputs at ws
@@ -376,7 +376,7 @@ Expected<bool, PlanarError> dae_accelerations(Motion& m, double t, const double*
         PlanarError::Kind::kSingular,
         "the constraints lose rank (a lock-up or a branch point): the linkage cannot move on"});
   }
-  m.kkt_solution.noalias() = m.kkt_lu.solve(m.kkt_rhs);
+  m.kkt_lu.solve(m.kkt_rhs, m.kkt_solution);
   ws.qdd = m.kkt_solution.head(n);
   ws.lambda.setZero(s.rows);
   ws.lambda.head(r) = m.kkt_solution.tail(r);
@@ -426,7 +426,7 @@ void project(const Model& model, Workspace& ws, double* y) {
   const System& s = model.system();
   const int n = s.n, r = s.structural_rows;
   Eigen::Map<VectorXd> q(y, n), qd(y + n, n);
-  const std::vector<double> none;
+  const std::vector<Vec2> none;
   for (int it = 0; it < 4; ++it) {
     detail::nodes_from_q(s, q, ws.instant.x);
     detail::constraint_values(s, ws.instant.x, none, ws.g);

@@ -32,14 +32,11 @@ double continued_angle(const Vec2& d, double near) {
   return a + 2 * kPi * std::round((near - a) / (2 * kPi));
 }
 
-// the angle from the direction `target` [rad] to d, in [-π, π], exact to round-off for any
-// |target|: continued_angle(d, target) - target would carry the round-off of target's whole
-// turns (ulp(80 rad) = 1.4e-14 rad), which after some 13 turns exceeds what Newton's stopping
-// test on the positions (1e-14 of the length scale) can see converge
-double angle_from(double target, const Vec2& d) {
-  const Vec2 u(std::cos(target), std::sin(target));
-  return std::atan2(cross(u, d), u.dot(d));
-}
+// the angle from the direction u (a target's) to d, in [-π, π], exact to round-off for any
+// |target|: the difference of two angles would carry the round-off of the target's whole turns
+// (ulp(80 rad) = 1.4e-14 rad), which after some 13 turns exceeds what Newton's stopping test on
+// the positions (1e-14 of the length scale) can see converge
+double angle_from(const Vec2& u, const Vec2& d) { return std::atan2(cross(u, d), u.dot(d)); }
 
 }  // namespace
 
@@ -240,10 +237,13 @@ System::System(const Linkage& l) : linkage(l) {
 }
 
 void nodes_from_q(const System& s, const VectorXd& q, NodeVectors& x) {
-  x.resize(s.coord.size());
-  for (std::size_t i = 0; i < s.coord.size(); ++i) {
-    const int c = s.coord[i];
-    x[i] = c < 0 ? s.linkage.nodes[i].position : Vec2(q[c], q[c + 1]);
+  const std::size_t nodes = s.coord.size();
+  x.resize(nodes);
+  const int* coord = s.coord.data();
+  const double* qv = q.data();
+  for (std::size_t i = 0; i < nodes; ++i) {
+    const int c = coord[i];
+    x[i] = c < 0 ? s.linkage.nodes[i].position : Vec2(qv[c], qv[c + 1]);
   }
 }
 
@@ -288,9 +288,18 @@ double slide_rate(const System&, const System::SliderRow& sl, const NodeVectors&
   return (ad.dot(b) + a.dot(bd)) / sl.length;
 }
 
-void constraint_values(const System& s, const NodeVectors& x, const std::vector<double>& inputs,
+void input_targets(const System& s, const std::vector<double>& inputs, std::vector<Vec2>& targets) {
+  targets.resize(inputs.size());
+  for (const System::InputRow& in : s.inputs) {
+    const double z = inputs[static_cast<std::size_t>(in.input)];
+    targets[static_cast<std::size_t>(in.input)] =
+        in.angle ? Vec2(std::cos(z), std::sin(z)) : Vec2(z, 0.0);
+  }
+}
+
+void constraint_values(const System& s, const NodeVectors& x, const std::vector<Vec2>& targets,
                        VectorXd& g) {
-  g.resize(inputs.empty() ? s.structural_rows : s.rows);
+  g.resize(targets.empty() ? s.structural_rows : s.rows);
   for (std::size_t k = 0; k < s.elements.size(); ++k) {
     const System::ElementRow& e = s.elements[k];
     g[static_cast<Eigen::Index>(k)] =
@@ -308,12 +317,12 @@ void constraint_values(const System& s, const NodeVectors& x, const std::vector<
       g[sl.row] = cross(a, b) / sl.length;
     }
   }
-  if (inputs.empty()) return;
+  if (targets.empty()) return;
   for (const System::InputRow& in : s.inputs) {
-    const double target = inputs[static_cast<std::size_t>(in.input)];
-    g[in.row] = in.angle
-                    ? in.length * angle_from(target, at(x, in.q) - at(x, in.p))
-                    : slide_position(s, s.sliders[static_cast<std::size_t>(in.slider)], x) - target;
+    const Vec2& target = targets[static_cast<std::size_t>(in.input)];
+    g[in.row] =
+        in.angle ? in.length * angle_from(target, at(x, in.q) - at(x, in.p))
+                 : slide_position(s, s.sliders[static_cast<std::size_t>(in.slider)], x) - target.x();
   }
 }
 

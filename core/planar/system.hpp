@@ -129,9 +129,13 @@ struct GradientEntry {
 /// returns how many.
 int row_gradient(const System& s, const NodeVectors& x, int row, GradientEntry out[3]);
 
-/// g(q) with the inputs at `inputs` (angles continued from them); the structural rows only when
-/// `inputs` is empty.
-void constraint_values(const System& s, const NodeVectors& x, const std::vector<double>& inputs,
+/// The inputs' targets as constraint_values() takes them: per input, the direction (cos θ, sin θ)
+/// of an angle input at θ, (s, 0) for a slide at s. Computed once per position solve, so that
+/// its iterations evaluate no trigonometric function.
+void input_targets(const System& s, const std::vector<double>& inputs, std::vector<Vec2>& targets);
+/// g(q) with the inputs at `targets` (input_targets()); the structural rows only when `targets`
+/// is empty.
+void constraint_values(const System& s, const NodeVectors& x, const std::vector<Vec2>& targets,
                        VectorXd& g);
 /// G = ∂g/∂q (rows x n); without the input rows when rows == structural_rows.
 void constraint_jacobian(const System& s, const NodeVectors& x, int rows, MatrixXd& G);
