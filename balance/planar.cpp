@@ -611,6 +611,18 @@ ForceBalance force_balance(const cp::Linkage& linkage, const Kinematics& k,
   } else if (!out.full) {
     out.message = unbalanced_message(l, out, k, pls);
   }
+  // a floating link's counterweight has its mass given and its place solved: say where that
+  // place is far outside the linkage (a mass too small for the moment it must carry)
+  for (const LinkCounterweight& a : out.added) {
+    const double reach = frame_of(l, a.link).length;
+    if (a.counterweight.distance > 3 * reach) {
+      out.message += std::string(out.message.empty() ? "" : "; ") + "the counterweight on " +
+                     l.links[static_cast<std::size_t>(a.link)].name + " sits " +
+                     text::digits(a.counterweight.distance, 4) + " m from its pivot, " +
+                     text::digits(a.counterweight.distance / reach, 3) +
+                     " times the link's length: give it more mass to bring it closer";
+    }
+  }
   return out;
 }
 

@@ -11,11 +11,15 @@ namespace bd::optimize::detail {
 ///   using Problem, Metric, Result;
 ///   Problem minimising(Metric m) const;              // the base problem, objective m alone
 ///   void limit(Problem& p, Metric m, double bound);  // adds m <= bound (a Limit's units)
-///   Result solve(const Problem& p) const;            // optimises and verifies
+///   Result solve(const Problem& p, const std::vector<const Result*>& warm) const;
+///                                                    // optimises and verifies, trying the
+///                                                    // designs of `warm` (when found) first
 ///   double value(const Result& r, Metric m) const;   // r's m in a Limit's units
 ///   bool is_mass(Metric m) const;                    // added_mass: its bound may be <= 0
 /// Returns (ε, result) per point: minimise `first` subject to the base constraints and
-/// second <= ε, ε spaced from the loosest useful bound down to the tightest reachable one.
+/// second <= ε, ε spaced from the loosest useful bound down to the tightest reachable one. Each
+/// point starts from its neighbour's design where that meets its bound, else from the design
+/// that minimises `second` alone (which meets every bound of the front), else as a lone solve.
 template <class Front>
 std::vector<std::pair<double, typename Front::Result>> epsilon_front(const Front& f,
                                                                      typename Front::Metric first,
@@ -26,15 +30,15 @@ std::vector<std::pair<double, typename Front::Result>> epsilon_front(const Front
   // force-balanced design keeps Fsh = 0 whatever the counterweights' masses, and those change
   // the shaking moment), so the loose end is lexicographic: the second minimised with the first
   // held within 1e-3 of its range above its minimum.
-  const Result best_first = f.solve(f.minimising(first));
-  const Result best_second = f.solve(f.minimising(second));
+  const Result best_first = f.solve(f.minimising(first), {});
+  const Result best_second = f.solve(f.minimising(second), {});
   const double first_lo = f.value(best_first, first);
   const double first_hi = f.value(best_second, first);
   double bound = first_lo + 1e-3 * std::max(0.0, first_hi - first_lo);
   if (!f.is_mass(first)) bound = std::max(bound, 1e-12);  // a limit must be > 0
   auto lexicographic = f.minimising(second);
   f.limit(lexicographic, first, bound);
-  const Result loose = f.solve(lexicographic);
+  const Result loose = f.solve(lexicographic, {&best_first});
   const double a =
       loose.ok() ? f.value(loose, second) : f.value(best_first, second);  // loosest useful bound
   const double b = f.value(best_second, second);  // tightest reachable bound
@@ -50,7 +54,10 @@ std::vector<std::pair<double, typename Front::Result>> epsilon_front(const Front
     if (!f.is_mass(second)) epsilon = std::max(epsilon, 1e-12);  // a limit is > 0
     auto p = f.minimising(first);
     f.limit(p, second, epsilon);
-    front.emplace_back(epsilon, f.solve(p));
+    std::vector<const Result*> warm;
+    if (!front.empty()) warm.push_back(&front.back().second);
+    warm.push_back(&best_second);
+    front.emplace_back(epsilon, f.solve(p, warm));
   }
   return front;
 }

@@ -34,6 +34,9 @@ const std::vector<std::string>& Nlp::constraint_names() const {
 }
 bool Nlp::has_gradients() const { return program_->has_gradients(); }
 Eigen::VectorXd Nlp::start(bool original) const { return program_->start(original); }
+Eigen::VectorXd Nlp::start_at(const Eigen::VectorXd& design) const {
+  return program_->start_at(design);
+}
 
 const detail::NlpProgram& Nlp::at(const Eigen::VectorXd& x) const {
   if (x.size() != program_->n()) {

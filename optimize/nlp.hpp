@@ -107,6 +107,9 @@ class Nlp final : public Program {
   /// With `original`: the original design itself (every counterweight's mass 0, at the same
   /// place), which meets any added-mass limit >= 0 and every limit of 1 or more.
   Eigen::VectorXd start(bool original = false) const;
+  /// The start at another design of the same problem's variables (e.g. a Pareto front's
+  /// neighbour): its design variables, clamped to their bounds, the bound variables set for it.
+  Eigen::VectorXd start_at(const Eigen::VectorXd& design) const;
   /// Names of the variables and of the constraints, for messages ("crank counterweight mass [kg]",
   /// "force balance, crank side (real part)", "Fsh_rms <= 0.2 x original", ...).
   const std::vector<std::string>& variable_names() const override;

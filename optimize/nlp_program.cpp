@@ -350,6 +350,15 @@ Eigen::VectorXd NlpProgram::start(bool original) const {
   return x;
 }
 
+Eigen::VectorXd NlpProgram::start_at(const Eigen::VectorXd& design) const {
+  Eigen::VectorXd x = start();
+  const int k = static_cast<int>(
+      std::min<std::size_t>(3 * cw_var_.size() + param_var_.size(), std::size_t(design.size())));
+  x.head(k) = design.head(k).cwiseMax(lower_.head(k)).cwiseMin(upper_.head(k));
+  start_extra_variables(x);
+  return x;
+}
+
 bool NlpProgram::sized(int m, Eigen::VectorXd& c, Eigen::MatrixXd* jac,
                        const char* function) const {
   require_gradients(jac != nullptr, function);

@@ -70,6 +70,9 @@ class NlpProgram {
 
   // Nlp's functions of the same names; x has n() entries (Nlp checks)
   Eigen::VectorXd start(bool original = false) const;
+  /// The start at another design: its design variables (the first entries of `design`, as in
+  /// this program's order), each within its bounds, and the rest set for it.
+  Eigen::VectorXd start_at(const Eigen::VectorXd& design) const;
   virtual double objective(const Eigen::VectorXd& x, Eigen::VectorXd* grad) const = 0;
   void equalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac) const;
   void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac) const;

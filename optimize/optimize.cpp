@@ -460,11 +460,16 @@ detail::Solved detail::solve_from(const Program& nlp, const std::vector<VectorXd
   return best;
 }
 
-OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& options) {
+OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& options,
+                        const std::vector<VectorXd>& designs) {
   detail::check_inputs(problem, options);
   const Nlp nlp(problem);
   throw_if(check_algorithm(problem, options));
-  const detail::Solved solved = detail::solve_from(nlp, {nlp.start(), nlp.start(true)}, options);
+  std::vector<VectorXd> starts;
+  for (const VectorXd& d : designs) starts.push_back(nlp.start_at(d));
+  starts.push_back(nlp.start());
+  starts.push_back(nlp.start(true));
+  const detail::Solved solved = detail::solve_from(nlp, starts, options);
 
   OptimizeResult r;
   r.algorithm = options.algorithm;

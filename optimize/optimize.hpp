@@ -117,7 +117,10 @@ struct OptimizeResult {
 /// design, or mid-range where the original has none).
 /// @throws bd::InputError if the problem or the options are invalid (validate()), if the problem
 /// cannot be set up (Nlp's constructor), or if check_algorithm() finds a problem.
-OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& options);
+/// `designs` are further starting points (results' x of the same variables, e.g. a Pareto front's
+/// neighbours), tried before the natural start where they are feasible (detail::solve_from).
+OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& options,
+                        const std::vector<Eigen::VectorXd>& designs = {});
 
 /// The ε-constraint trade-off between two metrics: minimise `first` subject to
 /// second <= ε_i · second(original) for `points` values of ε spaced between the extremes found by

@@ -29,7 +29,12 @@ struct FourBarFront {
     return p;
   }
   static void limit(Problem& p, Metric m, double bound) { p.limits.push_back(Limit{m, bound}); }
-  Result solve(const Problem& p) const { return optimize(p, options); }
+  Result solve(const Problem& p, const std::vector<const Result*>& warm) const {
+    std::vector<Eigen::VectorXd> designs;
+    for (const Result* r : warm)
+      if (r->ok()) designs.push_back(r->x);
+    return optimize(p, options, designs);
+  }
   // the value of `m` at a result, in the units of a Limit on it: the fraction of the original's
   // value, or kg for added_mass
   double value(const Result& r, Metric m) const {

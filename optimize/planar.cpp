@@ -924,7 +924,13 @@ VectorXd PlanarNlp::start(bool original) const {
       if (!moved_mass) break;
     }
   }
-  // each bound variable a hair above its smoothed peak at the start design
+  set_bound_variables(x);
+  return x;
+}
+
+// each bound variable a hair above its smoothed peak at the design of x
+void PlanarNlp::set_bound_variables(VectorXd& x) const {
+  const Impl& m = *impl_;
   VectorXd q;
   m.q_of(x, q, nullptr);
   for (std::size_t k = 0; k < m.table.size(); ++k) {
@@ -933,6 +939,14 @@ VectorXd PlanarNlp::start(bool original) const {
     const double peak = std::hypot(m.peak(static_cast<int>(k), q) / m.original[k], m.p.smoothing);
     x[t] = std::min(peak * (1 + 1e-12), m.upper[t]);
   }
+}
+
+VectorXd PlanarNlp::start_at(const VectorXd& design) const {
+  const Impl& m = *impl_;
+  VectorXd x = start(true);
+  const Eigen::Index k = std::min<Eigen::Index>(m.design_n, design.size());
+  x.head(k) = design.head(k).cwiseMax(m.lower.head(k)).cwiseMin(m.upper.head(k));
+  set_bound_variables(x);
   return x;
 }
 
@@ -1087,13 +1101,18 @@ double inertial_error(const cp::Linkage& design, const core::Series& table) {
 
 }  // namespace
 
-Result optimize(const DesignProblem& problem, const OptimizeOptions& options) {
+Result optimize(const DesignProblem& problem, const OptimizeOptions& options,
+                const std::vector<VectorXd>& designs) {
   if (const Problem e = options.validate()) throw InputError("optimize options: " + e->text());
   if (const Problem e = check_algorithm(problem, options)) throw InputError(*e);
   const PlanarNlp nlp(problem);
   // the original design itself (no counterweight mass) is the second start: it meets every
   // limit of 1 or more and any added-mass limit >= 0, where the first may be far outside
-  detail::Solved s = detail::solve_from(nlp, {nlp.start(), nlp.start(true)}, options);
+  std::vector<VectorXd> starts;
+  for (const VectorXd& d : designs) starts.push_back(nlp.start_at(d));
+  starts.push_back(nlp.start());
+  starts.push_back(nlp.start(true));
+  detail::Solved s = detail::solve_from(nlp, starts, options);
   Result r;
   r.algorithm = options.algorithm;
   r.termination = s.termination;
@@ -1159,7 +1178,12 @@ struct PlanarFront {
   static void limit(Problem& p, const Metric& m, double bound) {
     p.limits.push_back(Limit{m, bound});
   }
-  Result solve(const Problem& p) const { return optimize(p, options); }
+  Result solve(const Problem& p, const std::vector<const Result*>& warm) const {
+    std::vector<VectorXd> designs;
+    for (const Result* r : warm)
+      if (r->ok()) designs.push_back(r->x);
+    return optimize(p, options, designs);
+  }
   // the value of `m` at a result, in the units of a Limit on it: the fraction of the original's
   // value, or kg for added_mass
   static double value(const Result& r, const Metric& m) {

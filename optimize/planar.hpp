@@ -128,6 +128,9 @@ class PlanarNlp final : public Program {
   /// counterweights then moved onto the balance conditions (least-norm in their positions, more
   /// mass where a position would leave its envelope).
   Eigen::VectorXd start(bool original = false) const;
+  /// The start at another design of the same variables (e.g. a Pareto front's neighbour): its
+  /// design variables clamped to their bounds, each bound variable a hair above its peak there.
+  Eigen::VectorXd start_at(const Eigen::VectorXd& design) const;
   /// The design at x: its links with their parameters and counterweights merged in.
   cp::Linkage design(const Eigen::VectorXd& x) const;
   std::vector<balance::planar::LinkCounterweight> counterweights(const Eigen::VectorXd& x) const;
@@ -141,6 +144,7 @@ class PlanarNlp final : public Program {
 
  private:
   std::vector<double> simulated(const Eigen::VectorXd& x) const;
+  void set_bound_variables(Eigen::VectorXd& x) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
@@ -180,7 +184,10 @@ bd::Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions&
 /// original design) and verifies the optimum by simulating it.
 /// @throws bd::InputError as PlanarNlp's constructor, for invalid options, or for an
 ///         algorithm that cannot take the problem (mma with force balance).
-Result optimize(const DesignProblem& problem, const OptimizeOptions& options);
+/// `designs`: further starting points (results' x of the same variables), tried before the
+/// natural start where they are feasible.
+Result optimize(const DesignProblem& problem, const OptimizeOptions& options,
+                const std::vector<Eigen::VectorXd>& designs = {});
 
 /// A point of a Pareto front: the bound ε on the second metric (a fraction of the original's,
 /// or kg for added_mass) and the design found under it.

@@ -366,6 +366,29 @@ TEST(PlanarBalanceStudy, AnEnginesCrankCounterweightLeavesWhatTheMessageSays) {
   EXPECT_LT(d.Fsh_rms_after, d.Fsh_rms_before);
 }
 
+// A floating link's counterweight has its mass given and its place solved: a rod counterweight
+// of 1 g that balances the engine's piston must sit some 65 m out (the moment it must carry over
+// its mass), and the message says so; with 1 kg it sits within the linkage and nothing is said.
+TEST(PlanarBalanceStudy, AFloatingCounterweightFarOutsideTheLinkageIsSaid) {
+  auto balance = [](const std::string& mass) {
+    const Study study = parse_study(
+        kEngine + "balance:\n  counterweights:\n    crank: {}\n    rod: {mass: " + mass + "}\n",
+        "e.yaml");
+    const RunResult r = compute_study(study);
+    EXPECT_TRUE(r.ok() && r.balanced && r.balanced->design);
+    return *r.balanced->design;
+  };
+  const bp::ForceBalance light = balance("0.001"), heavy = balance("1");
+  EXPECT_TRUE(light.full && heavy.full);
+  ASSERT_EQ(light.added.size(), 2u);
+  EXPECT_GT(light.added[1].counterweight.distance, 3 * 0.14);
+  EXPECT_NE(light.message.find("the counterweight on rod sits"), std::string::npos)
+      << light.message;
+  EXPECT_NE(light.message.find("give it more mass"), std::string::npos) << light.message;
+  EXPECT_LT(heavy.added[1].counterweight.distance, 3 * 0.14);
+  EXPECT_EQ(heavy.message.find("sits"), std::string::npos) << heavy.message;
+}
+
 // momentum_left of a least-squares design (the engine: a piston no counterweight balances)
 // against a second route: the linear momentum of each design from its simulated node positions
 // alone (every body's centre of mass from the link's nodes and its e, f; the point masses at
