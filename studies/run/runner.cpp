@@ -435,7 +435,12 @@ BalancedRun planar_balanced_run(const Study& study, const RunResult& original) {
     return b;
   }
   const bp::BalanceRequest& ask = *study.planar_balance;
-  const std::string shown = with_every_condition(study.planar(), model, *k);
+  // a driven revolution of the crank passes through every configuration already
+  const auto* driven = std::get_if<core::planar::DrivenScene>(&study.scene);
+  const bool revolution = driven && driven->duration == 0 && driven->revolutions >= 1 &&
+                          !driven->speeds.empty() && driven->speeds[0] != 0;
+  const std::string shown = revolution ? std::string()
+                                       : with_every_condition(study.planar(), model, *k);
   b.design = bp::force_balance(study.planar(), *k, ask.counterweights, ask.balancing_factor);
   if (!shown.empty()) b.design->message += (b.design->message.empty() ? "" : "; ") + shown;
   if (ask.shafts) {
