@@ -366,6 +366,7 @@ void print_optimize(const st::Study& study, const st::RunResult& r) {
   std::printf("           subject to %s\n", st::constraints_text(req).c_str());
   std::printf("           %s\n", o.brief_report().c_str());
   if (!run.found()) return;
+  std::printf("           %s\n", o.optimality.c_str());
   for (const bd::optimize::PlacedCounterweight& p : o.counterweights) {
     const bd::balance::Counterweight& c = p.counterweight;
     std::printf("  %-7s  counterweight %.6g kg at [%.6g, %.6g] m from %s (%.6g m)",
@@ -401,6 +402,7 @@ void print_planar_optimize(const st::Study& study, const st::RunResult& r) {
                                      ? o.message.c_str()
                                      : o.brief_report().c_str());
   if (!run.found()) return;
+  std::printf("           %s\n", o.optimality.c_str());
   int width = 7;
   for (const bd::core::planar::Link& k : study.planar().links)
     width = std::max(width, static_cast<int>(k.name.size()));

@@ -84,9 +84,10 @@ class GroupOutputs {
 
 class DrivenNlp final : public NlpProgram {
  public:
-  explicit DrivenNlp(const DesignProblem& problem);
+  DrivenNlp(const DesignProblem& problem, CounterweightVariablesAs as);
 
   bool has_gradients() const override { return true; }
+  std::string why_not_convex() const override;
   double objective(const VectorXd& x, VectorXd* grad) const override;
   core::Trajectory trajectory(const VectorXd& x) const override {
     return trajectory_of(inertial(x, false).q);
@@ -133,12 +134,39 @@ class DrivenNlp final : public NlpProgram {
 // ---------------------------------------------------------------------------------------------
 // set-up
 
-DrivenNlp::DrivenNlp(const DesignProblem& problem) : NlpProgram(problem) {
+DrivenNlp::DrivenNlp(const DesignProblem& problem, CounterweightVariablesAs as)
+    : NlpProgram(problem, as) {
   add_bound_variables();
   build_regressor();
   set_up_constraints();
   add_peak_bounds();
   bound_peaks();
+}
+
+std::string DrivenNlp::why_not_convex() const {
+  // the metrics the program reads: the objective's (weight > 0) and the limits'
+  std::vector<Metric> used;
+  for (const Term& t : problem_.objective) {
+    if (t.weight > 0 && t.metric != Metric::kAddedMass) used.push_back(t.metric);
+    if (t.weight > 0 && is_peak(t.metric) && !linear_) {
+      return std::string("the squared objective form bounds the peak ") + to_string(t.metric) +
+             " by |y|² <= t², which is not convex in t (the linear form is)";
+    }
+  }
+  for (const Limit& l : problem_.limits) {
+    if (l.metric != Metric::kAddedMass) used.push_back(l.metric);
+  }
+  const std::vector<std::pair<int, std::string>> varying = non_affine_parameters();
+  for (Metric m : used) {
+    const MatrixXd& A = A_[static_cast<std::size_t>(group_of(m))];
+    const double scale = A.cwiseAbs().maxCoeff();
+    for (const auto& [i, why] : varying) {
+      if (A.col(i).cwiseAbs().maxCoeff() > 1e-9 * scale) {
+        return std::string(to_string(m)) + " depends on " + why;
+      }
+    }
+  }
+  return "";
 }
 
 // one bound variable t per peak metric of the objective, its upper bound set by bound_peaks()
@@ -551,8 +579,9 @@ void DrivenNlp::squared_peak_rows(const Block& b, const VectorXd& x, GroupOutput
 
 }  // namespace
 
-std::unique_ptr<NlpProgram> make_driven_nlp(const DesignProblem& problem) {
-  return std::make_unique<DrivenNlp>(problem);
+std::unique_ptr<NlpProgram> make_driven_nlp(const DesignProblem& problem,
+                                            CounterweightVariablesAs as) {
+  return std::make_unique<DrivenNlp>(problem, as);
 }
 
 }  // namespace bd::optimize::detail

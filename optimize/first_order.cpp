@@ -6,6 +6,8 @@
 #include <Eigen/QR>
 #include <vector>
 
+#include "core/number_text.hpp"
+
 namespace bd::optimize::detail {
 
 using Eigen::MatrixXd;
@@ -34,7 +36,7 @@ double stationarity_residual(const Program& p, const VectorXd& x, double activit
     }
   }
   if (p.n_ineq() > 0) {
-    p.inequalities(x, c, &jac);
+    p.first_order_inequalities(x, g, c, jac);
     for (int i = 0; i < c.size(); ++i) {
       if (!(c[i] >= -activity)) continue;
       columns.emplace_back(w.cwiseProduct(jac.row(i).transpose()));
@@ -53,8 +55,11 @@ double stationarity_residual(const Program& p, const VectorXd& x, double activit
     columns.push_back(std::move(e));
     floor.push_back(0);
   }
-  // relative to the objective's size or its gradient's, whichever is larger
-  const double size = std::max({std::abs(f), gw.cwiseAbs().maxCoeff(), 1e-300});
+  // relative to the objective's size or its gradient's, whichever is larger, and at least 1:
+  // the programs' objectives are normalised (1 per unit weight at the original design), so near
+  // an optimum where the objective itself nearly vanishes (a force-balanced design's smoothed
+  // Fsh, ~1e-6) the residual is still measured on the problem's own scale
+  const double size = std::max({std::abs(f), gw.cwiseAbs().maxCoeff(), 1.0});
   if (columns.empty()) return gw.cwiseAbs().maxCoeff() / size;
   MatrixXd A(n, static_cast<Eigen::Index>(columns.size()));
   VectorXd lower(A.cols());
@@ -72,6 +77,28 @@ double stationarity_residual(const Program& p, const VectorXd& x, double activit
   }
   if (!signs) z = bounded_least_squares(A, -gw, lower, z.cwiseMax(lower));
   return (gw + A * z).cwiseAbs().maxCoeff() / size;
+}
+
+Optimality optimality(const std::string& why_not_convex, bool converged, double stationarity,
+                      double relative_tolerance) {
+  if (!why_not_convex.empty()) return {false, "not proven global: " + why_not_convex};
+  const std::string convex =
+      "the problem is convex in the counterweights' masses and mass moments (the reactions it "
+      "reads are affine in them in a driven scene, each envelope is a cone, the added mass is "
+      "linear)";
+  if (!converged) {
+    return {false, "not proven global: " + convex + ", but the solver did not converge"};
+  }
+  const double tolerance = stationarity_tolerance(relative_tolerance);
+  if (!(stationarity <= tolerance)) {
+    return {false, "not proven global: " + convex +
+                       ", but the design meets the first-order conditions only to " +
+                       text::digits(stationarity, 2) + " (tolerance " +
+                       text::digits(tolerance, 2) + ")"};
+  }
+  return {true, "global: " + convex + ", and the design meets the first-order conditions to " +
+                    text::digits(stationarity, 2) + " (tolerance " + text::digits(tolerance, 2) +
+                    ")"};
 }
 
 }  // namespace bd::optimize::detail

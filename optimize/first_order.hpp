@@ -8,8 +8,9 @@
 /// c_i >= -activity and every bound within activity · w_j of x. The multipliers
 ///   min || w ∘ (∇f + Σ λ_i ∇c_i + Σ ν_k ∇h_k - μ_lower + μ_upper) ||,  λ, μ >= 0
 /// are fitted by least squares (bounded least squares, NLopt, where some come out of the wrong
-/// sign), and the residual's largest entry, divided by the larger of |f| and the scaled
-/// gradient's largest entry, is the stationarity residual: the objective's relative rate of
+/// sign), and the residual's largest entry, divided by the largest of |f|, the scaled
+/// gradient's largest entry and 1 (the objectives are normalised: 1 per unit weight at the
+/// original design), is the stationarity residual: the objective's relative rate of
 /// decrease, per whole box width, along the best direction that the active constraints allow to
 /// first order. It is 0 at a Karush-Kuhn-Tucker point and of order one far from one.
 ///
@@ -18,6 +19,7 @@
 /// where the gradient is about sqrt(2 H δ), so that is what a converged end can show.
 #include <Eigen/Core>
 #include <cmath>
+#include <string>
 
 #include "optimize/program.hpp"
 
@@ -34,6 +36,19 @@ inline double stationarity_tolerance(double relative_tolerance) {
 /// The stationarity residual at x (see above), for a program with gradients.
 double stationarity_residual(const Program& program, const Eigen::VectorXd& x,
                              double activity = kActivity);
+
+/// Whether a solved program's design is a proven global optimum, and why (or why that is not
+/// proven) in words for the result and summary.json.
+struct Optimality {
+  bool global = false;
+  std::string words;
+};
+/// Global when the program is convex (`why_not_convex` empty, as Nlp::why_not_convex() says) and
+/// the solver converged to a design whose stationarity residual is within the tolerance: a
+/// first-order point of a convex program is a global minimum. `converged` and `stationarity`
+/// are the solver's end (Solved).
+Optimality optimality(const std::string& why_not_convex, bool converged, double stationarity,
+                      double relative_tolerance);
 
 /// min ½ |A z - b|² subject to z_i >= lower_i (lower_i may be -infinity), by NLopt's SLSQP on
 /// the bound-constrained quadratic, from z0 (within the bounds).

@@ -24,7 +24,9 @@ core::Metrics infinite_metrics() {
 
 class FreeNlp final : public NlpProgram {
  public:
-  explicit FreeNlp(const DesignProblem& problem) : NlpProgram(problem) { set_up_constraints(); }
+  FreeNlp(const DesignProblem& problem, CounterweightVariablesAs as) : NlpProgram(problem, as) {
+    set_up_constraints();
+  }
 
   bool has_gradients() const override { return false; }
   double objective(const VectorXd& x, VectorXd* grad) const override;
@@ -88,8 +90,9 @@ void FreeNlp::metric_inequalities(const VectorXd& x, const Inertial&, VectorXd& 
 
 }  // namespace
 
-std::unique_ptr<NlpProgram> make_free_nlp(const DesignProblem& problem) {
-  return std::make_unique<FreeNlp>(problem);
+std::unique_ptr<NlpProgram> make_free_nlp(const DesignProblem& problem,
+                                          CounterweightVariablesAs as) {
+  return std::make_unique<FreeNlp>(problem, as);
 }
 
 }  // namespace bd::optimize::detail

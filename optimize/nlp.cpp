@@ -11,16 +11,18 @@ namespace bd::optimize {
 
 namespace {
 
-std::unique_ptr<detail::NlpProgram> program_for(const DesignProblem& problem) {
+std::unique_ptr<detail::NlpProgram> program_for(const DesignProblem& problem,
+                                                CounterweightVariablesAs as) {
   if (std::holds_alternative<core::DrivenScene>(problem.scene)) {
-    return detail::make_driven_nlp(problem);
+    return detail::make_driven_nlp(problem, as);
   }
-  return detail::make_free_nlp(problem);
+  return detail::make_free_nlp(problem, as);
 }
 
 }  // namespace
 
-Nlp::Nlp(const DesignProblem& problem) : program_(program_for(problem)) {}
+Nlp::Nlp(const DesignProblem& problem, CounterweightVariablesAs as)
+    : program_(program_for(problem, as)) {}
 Nlp::~Nlp() = default;
 
 int Nlp::n() const { return program_->n(); }
@@ -33,7 +35,17 @@ const std::vector<std::string>& Nlp::constraint_names() const {
   return program_->constraint_names();
 }
 bool Nlp::has_gradients() const { return program_->has_gradients(); }
+std::string Nlp::why_not_convex() const { return program_->why_not_convex(); }
+Eigen::VectorXd Nlp::from_positions(const Eigen::VectorXd& x) const {
+  return program_->start_at(program_->from_positions(x));
+}
+Eigen::VectorXd Nlp::to_positions(const Eigen::VectorXd& x) const {
+  return at(x).to_positions(x);
+}
 Eigen::VectorXd Nlp::start(bool original) const { return program_->start(original); }
+Eigen::VectorXd Nlp::start_scaled(double fraction) const {
+  return program_->start_scaled(fraction);
+}
 Eigen::VectorXd Nlp::start_at(const Eigen::VectorXd& design) const {
   return program_->start_at(design);
 }
@@ -56,6 +68,11 @@ void Nlp::equalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::Matrix
 
 void Nlp::inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac) const {
   at(x).inequalities(x, c, jac);
+}
+
+void Nlp::first_order_inequalities(const Eigen::VectorXd& x, const Eigen::VectorXd& g,
+                                   Eigen::VectorXd& c, Eigen::MatrixXd& jac) const {
+  at(x).first_order_inequalities(x, g, c, jac);
 }
 
 core::FourBar Nlp::design(const Eigen::VectorXd& x) const { return at(x).design(x); }

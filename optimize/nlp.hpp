@@ -78,6 +78,27 @@ namespace detail {
 class NlpProgram;
 }
 
+/// How a counterweight enters as variables.
+enum class CounterweightVariablesAs {
+  /// Its mass m and its centre r = (x, y) from the pivot: [kg], [m], [m] (the default; the
+  /// envelope (x² + y²)/distance_max² - 1 <= 0).
+  kPositions,
+  /// Its mass m and its mass moment p = m r about the pivot: [kg], [kg m], [kg m], each moment in
+  /// [-mass_max distance_max, mass_max distance_max]. The links' masses and first moments are
+  /// then affine in the variables, and the envelope is the convex cone |p| <= m distance_max,
+  /// smoothed where it meets its apex (m = 0, p = 0) as
+  ///   (sqrt(|p|² + δ²) - δ) / (mass_max distance_max) - m / mass_max <= 0,  δ = kConeSmoothing
+  /// (relative to mass_max distance_max): the same cone up to δ, never tighter, with a gradient
+  /// everywhere (the plain |p|² <= m² distance_max² has none at the apex, where "no
+  /// counterweight" lies). The design at x takes r = p / m, within distance_max (the δ of slack
+  /// removed), and r = 0 where m = 0. Used for the problems that are convex in these variables
+  /// (Nlp::why_not_convex()).
+  kMassMoments,
+};
+/// δ of the smoothed cone, relative to mass_max distance_max: the design's mass moment moves by
+/// at most δ when its position is brought within distance_max, so the objective by ~1e-10.
+inline constexpr double kConeSmoothing = 1e-10;
+
 class Nlp final : public Program {
  public:
   /// Precomputes what the problem needs (the regressor for a driven scene, the original's
@@ -90,7 +111,8 @@ class Nlp final : public Program {
   /// original's reactions), so that it cannot normalise: field "objective" or "limits", index
   /// that of the term or limit, e.g. text() "objective[0]: the original design's Fsh_rms is 0 N,
   /// too small to normalise by (it is already minimal)".
-  explicit Nlp(const DesignProblem& problem);
+  explicit Nlp(const DesignProblem& problem,
+               CounterweightVariablesAs as = CounterweightVariablesAs::kPositions);
   ~Nlp() override;
   Nlp(const Nlp&) = delete;
   Nlp& operator=(const Nlp&) = delete;
@@ -107,6 +129,10 @@ class Nlp final : public Program {
   /// With `original`: the original design itself (every counterweight's mass 0, at the same
   /// place), which meets any added-mass limit >= 0 and every limit of 1 or more.
   Eigen::VectorXd start(bool original = false) const;
+  /// The natural start with each counterweight's mass (and mass moment) scaled by `fraction`
+  /// (start() is 1, start(true) is 0): between the two, for a feasible start inside an
+  /// added-mass budget.
+  Eigen::VectorXd start_scaled(double fraction) const;
   /// The start at another design of the same problem's variables (e.g. a Pareto front's
   /// neighbour): its design variables, clamped to their bounds, the bound variables set for it.
   Eigen::VectorXd start_at(const Eigen::VectorXd& design) const;
@@ -116,6 +142,27 @@ class Nlp final : public Program {
   const std::vector<std::string>& constraint_names() const override;  // equalities first
   /// True when exact gradients are available (driven scenes).
   bool has_gradients() const override;
+  /// Empty when the program is convex in mass-moment variables
+  /// (CounterweightVariablesAs::kMassMoments), else why not in an engineer's words. Convex: a
+  /// driven scene (the motion, so every sample's outputs, is then independent of the design);
+  /// each metric of the objective and of the limits reads outputs that are affine in the
+  /// variables, i.e. its regressor has no column (to 1e-9 of its largest) on an inertial
+  /// parameter that is not: a link's inertia about its joint where a counterweight's position or
+  /// the link's own e or f vary (it varies with their square), its first moments where its mass
+  /// and e or f vary together, its centre of mass where an applied force acts on it and its mass
+  /// varies; and the linear objective form where a peak is minimised (the squared form's
+  /// |y|² <= t² is not convex in t). The objective (norms of affine maps, their smoothed
+  /// magnitudes and squares, weighted by w >= 0, plus linear added mass), the limits (squared
+  /// norms of affine maps below a constant), force balance (linear) and the envelopes (cones)
+  /// are then convex: a point that meets the first-order conditions is a global minimum.
+  std::string why_not_convex() const;
+  /// A design of a kPositions program in this program's variables (the first design variables
+  /// converted: r -> p = m r where this one takes moments), the rest set by start_at().
+  Eigen::VectorXd from_positions(const Eigen::VectorXd& x) const;
+  /// This program's design at x in position variables (p -> r = p / m within distance_max,
+  /// r = 0 where m = 0): the first design variables only, to hand to a kPositions program's
+  /// start_at().
+  Eigen::VectorXd to_positions(const Eigen::VectorXd& x) const;
 
   /// The objective and, when `grad` is not null, its gradient.
   double objective(const Eigen::VectorXd& x, Eigen::VectorXd* grad) const override;
@@ -132,6 +179,12 @@ class Nlp final : public Program {
   /// one otherwise throws std::logic_error. A wrong x.size() throws bd::InputError.
   void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
                     Eigen::MatrixXd* jac) const override;
+  /// With mass-moment variables, each envelope row as (|p| - m distance_max) / (mass_max
+  /// distance_max), its gradient (-1/mass_max, p/|p| / (mass_max distance_max)), and at the apex
+  /// (p = 0) the subgradient whose p part faces -g: the same cone, in a form whose gradient does
+  /// not vanish there (Program::first_order_inequalities()).
+  void first_order_inequalities(const Eigen::VectorXd& x, const Eigen::VectorXd& g,
+                                Eigen::VectorXd& c, Eigen::MatrixXd& jac) const override;
 
   /// The design at x (counterweights merged into their links), and its counterweights.
   core::FourBar design(const Eigen::VectorXd& x) const;

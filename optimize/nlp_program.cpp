@@ -30,7 +30,8 @@ double& parameter(core::Link& link, LinkParameterVariable::Parameter p) {
 // ---------------------------------------------------------------------------------------------
 // set-up
 
-NlpProgram::NlpProgram(const DesignProblem& p) : problem_(p) {
+NlpProgram::NlpProgram(const DesignProblem& p, CounterweightVariablesAs as)
+    : problem_(p), moments_(as == CounterweightVariablesAs::kMassMoments) {
   if (const Problem e = problem_.validate()) {
     throw InputError("invalid design problem: " + e->text());
   }
@@ -102,6 +103,12 @@ void NlpProgram::set_up_design_variables() {
     const double d = c.distance_max;
     cw_var_.push_back(add_variable(0.0, c.mass_max, name + "mass [kg]"));
     const char* pivot = c.link == 1 ? "A0" : "A3";
+    if (moments_) {
+      const double p = c.mass_max * d;
+      add_variable(-p, p, name + "mass moment x about " + pivot + " in link axes [kg m]");
+      add_variable(-p, p, name + "mass moment y about " + pivot + " in link axes [kg m]");
+      continue;
+    }
     add_variable(-d, d, name + "x from " + pivot + " in link axes [m]");
     add_variable(-d, d, name + "y from " + pivot + " in link axes [m]");
   }
@@ -180,6 +187,88 @@ std::vector<std::string> NlpProgram::peak_limit_names(const std::string& name) c
 void NlpProgram::start_extra_variables(Eigen::VectorXd&) const {}
 
 // ---------------------------------------------------------------------------------------------
+// mass-moment variables
+
+namespace {
+
+// the counterweight's centre from its mass and mass moment p about the pivot: p / m within
+// distance_max (the smoothed cone's slack removed), the pivot without mass
+Vec2 position_of(double mass, const Vec2& moment, double distance_max) {
+  if (!(mass > 0)) return Vec2::Zero();
+  Vec2 r = moment / mass;
+  const double d = r.norm();
+  if (d > distance_max) r *= distance_max / d;
+  return r;
+}
+
+}  // namespace
+
+Eigen::VectorXd NlpProgram::from_positions(const Eigen::VectorXd& x) const {
+  Eigen::VectorXd z = x;
+  if (!moments_) return z;
+  for (int j : cw_var_) {
+    if (j + 2 >= z.size()) break;
+    z(j + 1) *= z(j);
+    z(j + 2) *= z(j);
+  }
+  return z;
+}
+
+Eigen::VectorXd NlpProgram::to_positions(const Eigen::VectorXd& x) const {
+  Eigen::VectorXd out = x.head(static_cast<Eigen::Index>(3 * cw_var_.size() + param_var_.size()));
+  if (!moments_) return out;
+  for (std::size_t c = 0; c < cw_var_.size(); ++c) {
+    const int j = cw_var_[c];
+    out.segment<2>(j + 1) = position_of(x(j), Vec2(x(j + 1), x(j + 2)),
+                                    problem_.counterweights[c].distance_max);
+  }
+  return out;
+}
+
+std::string NlpProgram::why_not_convex() const {
+  return "a free scene: the motion, and with it every reaction, depends on the design";
+}
+
+std::vector<std::pair<int, std::string>> NlpProgram::non_affine_parameters() const {
+  std::vector<std::pair<int, std::string>> out;
+  for (int k = 1; k <= 3; ++k) {
+    const std::string name = core::link_name(k);
+    bool mass = false, offset = false, counterweight = false;
+    for (const LinkParameterVariable& v : problem_.link_parameters) {
+      if (v.link != k) continue;
+      mass = mass || v.parameter == LinkParameterVariable::Parameter::kMass;
+      offset = offset || v.parameter == LinkParameterVariable::Parameter::kE ||
+               v.parameter == LinkParameterVariable::Parameter::kF;
+    }
+    for (const CounterweightVariables& c : problem_.counterweights) {
+      counterweight = counterweight || c.link == k;
+    }
+    const int b = link_base(k), r = rho_base(k);
+    const std::string joint = k == 3 ? "A3" : k == 1 ? "A0" : "A1";
+    if (counterweight) {
+      out.emplace_back(b + 3, "the " + name + "'s inertia about " + joint +
+                                  ", which varies with the square of its counterweight's position");
+    } else if (offset) {
+      out.emplace_back(b + 3, "the " + name + "'s inertia about " + joint +
+                                  ", which varies with the square of its e or f");
+    }
+    if (mass && offset) {
+      for (int i : {b + 1, b + 2}) {
+        out.emplace_back(i, "the " + name + "'s first moments, its mass times e or f, both "
+                                            "varied");
+      }
+    }
+    if (mass || counterweight) {
+      for (int i : {r, r + 1}) {
+        out.emplace_back(i, "the " + name + "'s centre of mass, where its applied force acts, "
+                                            "which moves with its mass");
+      }
+    }
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
 // the design at x
 
 // The link's own parameters at x as q(b..b+3) = (m, m e, m f, J) and, when asked for, their
@@ -230,13 +319,39 @@ void NlpProgram::add_counterweight(int k, const core::Link& l, const Eigen::Vect
     const CounterweightVariables& cw = problem_.counterweights[c];
     if (cw.link != k) continue;
     const int j = cw_var_[c];
-    const double mc = x(j), rx = x(j + 1) + (k == 3 ? l.length : 0.0), ry = x(j + 2);
+    const double mc = x(j);
     double Ic = 0, dIc = 0;
     if (cw.shape == balance::CounterweightShape::kDisc) {
       const double area_density = cw.density * std::numbers::pi * cw.thickness;  // m/r²
       Ic = mc * mc / (2 * area_density);
       dIc = mc / area_density;
     }
+    if (moments_) {
+      // mass moment about the link's first joint: p + m (pivot), the pivot at (l3, 0) for the
+      // rocker; J = |that|² / m (0 without mass)
+      const double off = k == 3 ? l.length : 0.0, Mx = x(j + 1) + mc * off, My = x(j + 2);
+      const double J = mc > 0 ? (Mx * Mx + My * My) / mc : 0.0;
+      out.q(b) += mc;
+      out.q(b + 1) += Mx;
+      out.q(b + 2) += My;
+      out.q(b + 3) += Ic + J;
+      if (with_jacobian) {
+        auto dM = out.B.row(b), dMx = out.B.row(b + 1), dMy = out.B.row(b + 2);
+        auto dJ = out.B.row(b + 3);
+        dM(j) += 1;
+        dMx(j) += off;
+        dMx(j + 1) += 1;
+        dMy(j + 2) += 1;
+        dJ(j) += dIc;
+        if (mc > 0) {
+          dJ(j) += 2 * Mx * off / mc - J / mc;
+          dJ(j + 1) += 2 * Mx / mc;
+          dJ(j + 2) += 2 * My / mc;
+        }
+      }
+      continue;
+    }
+    const double rx = x(j + 1) + (k == 3 ? l.length : 0.0), ry = x(j + 2);
     out.q(b) += mc;
     out.q(b + 1) += mc * rx;
     out.q(b + 2) += mc * ry;
@@ -285,6 +400,7 @@ std::vector<PlacedCounterweight> NlpProgram::counterweights(const Eigen::VectorX
     balance::Counterweight w;
     w.mass = x(j);
     w.position = Vec2(x(j + 1), x(j + 2));
+    if (moments_) w.position = position_of(w.mass, w.position, cw.distance_max);
     w.distance = w.position.norm();
     if (cw.shape == balance::CounterweightShape::kDisc) {
       w.radius = std::sqrt(w.mass / (cw.density * std::numbers::pi * cw.thickness));
@@ -339,12 +455,22 @@ Eigen::VectorXd NlpProgram::start(bool original) const {
     const CounterweightVariables& cw = problem_.counterweights[c];
     const int j = cw_var_[c];
     x(j) = original ? 0.0 : cw.mass_max / 2;
-    x(j + 1) = (cw.link == 1 ? -0.5 : 0.5) * cw.distance_max;
+    x(j + 1) = (cw.link == 1 ? -0.5 : 0.5) * cw.distance_max * (moments_ ? x(j) : 1.0);
   }
   for (std::size_t i = 0; i < problem_.link_parameters.size(); ++i) {
     const LinkParameterVariable& v = problem_.link_parameters[i];
     core::Link l = core::link(problem_.original, v.link);
     x(param_var_[i]) = std::clamp(parameter(l, v.parameter), v.lower, v.upper);
+  }
+  start_extra_variables(x);
+  return x;
+}
+
+Eigen::VectorXd NlpProgram::start_scaled(double fraction) const {
+  Eigen::VectorXd x = start();
+  for (int j : cw_var_) {
+    x(j) *= fraction;
+    if (moments_) x.segment<2>(j + 1) *= fraction;
   }
   start_extra_variables(x);
   return x;
@@ -388,6 +514,20 @@ void NlpProgram::inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
       const int j = cw_var_[i];
       const double d2 =
           problem_.counterweights[i].distance_max * problem_.counterweights[i].distance_max;
+      if (moments_) {
+        // the smoothed cone (sqrt(|p|² + δ²) - δ) / (mass_max d) - m / mass_max
+        const double mmax = problem_.counterweights[i].mass_max, pmax = mmax * std::sqrt(d2);
+        const double ux = x(j + 1) / pmax, uy = x(j + 2) / pmax;
+        const double delta = kConeSmoothing, norm = std::sqrt(ux * ux + uy * uy + delta * delta);
+        c(row) = norm - delta - x(j) / mmax;
+        if (jac) {
+          (*jac)(row, j) = -1 / mmax;
+          (*jac)(row, j + 1) = ux / norm / pmax;
+          (*jac)(row, j + 2) = uy / norm / pmax;
+        }
+        row += b.count;
+        continue;
+      }
       c(row) = (x(j + 1) * x(j + 1) + x(j + 2) * x(j + 2)) / d2 - 1;
       if (jac) {
         (*jac)(row, j + 1) = 2 * x(j + 1) / d2;
@@ -398,6 +538,32 @@ void NlpProgram::inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
       if (jac) {
         for (int k = 1; k <= 3; ++k) jac->row(row) += in.B.row(link_base(k)) / original_mass_;
       }
+    }
+    row += b.count;
+  }
+}
+
+void NlpProgram::first_order_inequalities(const Eigen::VectorXd& x, const Eigen::VectorXd& g,
+                                          Eigen::VectorXd& c, Eigen::MatrixXd& jac) const {
+  inequalities(x, c, &jac);
+  if (!moments_) return;
+  int row = 0;
+  for (const Block& b : blocks_) {
+    if (b.kind == Block::Kind::kEnvelope) {
+      const auto i = static_cast<std::size_t>(b.counterweight);
+      const int j = cw_var_[i];
+      const double mmax = problem_.counterweights[i].mass_max,
+                   d = problem_.counterweights[i].distance_max, pmax = mmax * d;
+      const Vec2 p(x(j + 1), x(j + 2));
+      // the unit direction of p, or at the apex the one facing -g
+      Vec2 u = p;
+      if (!(u.norm() > 1e-12 * pmax)) u = -Vec2(g(j + 1), g(j + 2));
+      if (u.norm() > 0) u.normalize();
+      c(row) = (p.norm() - x(j) * d) / pmax;
+      jac.row(row).setZero();
+      jac(row, j) = -1 / mmax;
+      jac(row, j + 1) = u.x() / pmax;
+      jac(row, j + 2) = u.y() / pmax;
     }
     row += b.count;
   }

@@ -14,8 +14,10 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "optimize/nlp.hpp"
 #include "optimize/optimize.hpp"
 #include "optimize/problem.hpp"
 
@@ -67,15 +69,22 @@ class NlpProgram {
   const std::vector<std::string>& variable_names() const { return variable_names_; }
   const std::vector<std::string>& constraint_names() const { return constraint_names_; }
   virtual bool has_gradients() const = 0;
+  /// Nlp::why_not_convex(); the default: not convex, a free scene.
+  virtual std::string why_not_convex() const;
+  Eigen::VectorXd from_positions(const Eigen::VectorXd& x) const;
+  Eigen::VectorXd to_positions(const Eigen::VectorXd& x) const;
 
   // Nlp's functions of the same names; x has n() entries (Nlp checks)
   Eigen::VectorXd start(bool original = false) const;
+  Eigen::VectorXd start_scaled(double fraction) const;
   /// The start at another design: its design variables (the first entries of `design`, as in
   /// this program's order), each within its bounds, and the rest set for it.
   Eigen::VectorXd start_at(const Eigen::VectorXd& design) const;
   virtual double objective(const Eigen::VectorXd& x, Eigen::VectorXd* grad) const = 0;
   void equalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac) const;
   void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c, Eigen::MatrixXd* jac) const;
+  void first_order_inequalities(const Eigen::VectorXd& x, const Eigen::VectorXd& g,
+                                Eigen::VectorXd& c, Eigen::MatrixXd& jac) const;
   core::FourBar design(const Eigen::VectorXd& x) const;
   std::vector<PlacedCounterweight> counterweights(const Eigen::VectorXd& x) const;
   virtual core::Trajectory trajectory(const Eigen::VectorXd& x) const = 0;
@@ -92,7 +101,12 @@ class NlpProgram {
   /// "invalid design problem: "); an original that cannot be evaluated (no field: the problem
   /// as a whole); a normaliser that vanishes (field "objective" or "limits" with the index of
   /// the term or limit).
-  explicit NlpProgram(const DesignProblem& problem);
+  NlpProgram(const DesignProblem& problem, CounterweightVariablesAs as);
+
+  /// The inertial parameters (entries of q) that are not affine in the variables, each with why
+  /// in words ("the rocker's inertia about A3, which varies with the square of its
+  /// counterweight's position"), as Nlp::why_not_convex() lists them.
+  std::vector<std::pair<int, std::string>> non_affine_parameters() const;
 
   /// Adds a variable in [lower, upper]; returns its index.
   int add_variable(double lower, double upper, std::string name);
@@ -125,6 +139,7 @@ class NlpProgram {
   bool sized(int m, Eigen::VectorXd& c, Eigen::MatrixXd* jac, const char* function) const;
 
   DesignProblem problem_;  // the original made consistent (core::make_fourbar)
+  bool moments_{};         // counterweights as (m, p = m r): CounterweightVariablesAs::kMassMoments
   core::Metrics original_metrics_;
   double original_mass_{};
   bool linear_{};                                     // ObjectiveForm::kLinear
@@ -152,8 +167,10 @@ class NlpProgram {
 inline std::size_t metric_index(Metric m) { return static_cast<std::size_t>(m); }
 
 /// The program of a problem in a driven scene: every metric from the regressor, exact gradients.
-std::unique_ptr<NlpProgram> make_driven_nlp(const DesignProblem& problem);
+std::unique_ptr<NlpProgram> make_driven_nlp(const DesignProblem& problem,
+                                            CounterweightVariablesAs as);
 /// The program of a problem in a free scene: every evaluation a simulation, no gradients.
-std::unique_ptr<NlpProgram> make_free_nlp(const DesignProblem& problem);
+std::unique_ptr<NlpProgram> make_free_nlp(const DesignProblem& problem,
+                                          CounterweightVariablesAs as);
 
 }  // namespace bd::optimize::detail

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -465,13 +466,45 @@ OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& opt
   detail::check_inputs(problem, options);
   const Nlp nlp(problem);
   throw_if(check_algorithm(problem, options));
+  // A problem convex in the counterweights' masses and mass moments is solved in those
+  // variables by the local gradient methods, where a first-order point is the global optimum;
+  // its design is then taken back to the position variables, the ones the results and the rest
+  // of the tool read. (MLSL's and the derivative-free methods' own steps are scaled for the
+  // positions: they keep them.)
+  const std::string why_not = nlp.why_not_convex();
+  std::optional<Nlp> convex;
+  if (why_not.empty()) convex.emplace(problem, CounterweightVariablesAs::kMassMoments);
+  const bool in_moments = convex && uses_gradients(options.algorithm) &&
+                          options.algorithm != Algorithm::kMlsl;
+  const Nlp& program = in_moments ? *convex : nlp;
   std::vector<VectorXd> starts;
-  for (const VectorXd& d : designs) starts.push_back(nlp.start_at(d));
-  starts.push_back(nlp.start());
-  starts.push_back(nlp.start(true));
-  const detail::Solved solved = detail::solve_from(nlp, starts, options);
+  for (const VectorXd& d : designs) starts.push_back(program.from_positions(d));
+  // the natural start, and where it does not fit (an added-mass budget), the same with lighter
+  // counterweights, then the original design (no counterweight: feasible for any budget >= 0)
+  for (double fraction = 1; fraction > 1e-3; fraction /= 4) {
+    starts.push_back(program.start_scaled(fraction));
+  }
+  starts.push_back(program.start(true));
+  detail::Solved solved = detail::solve_from(program, starts, options);
+  if (in_moments) {
+    solved.x = nlp.start_at(convex->to_positions(solved.x));
+    solved.objective = nlp.objective(solved.x, nullptr);
+    if (found_design(solved.termination)) {
+      check_feasibility(nlp, options, solved.message, solved);
+    }
+  }
+  // the certificate: the first-order conditions of the convex program at the design, whichever
+  // program found it
+  const detail::Optimality optimality = detail::optimality(
+      why_not, solved.termination == Termination::kConverged,
+      convex && found_design(solved.termination)
+          ? detail::stationarity_residual(*convex, convex->from_positions(solved.x))
+          : solved.stationarity,
+      options.relative_tolerance);
 
   OptimizeResult r;
+  r.global = optimality.global && found_design(solved.termination);
+  r.optimality = optimality.words;
   r.algorithm = options.algorithm;
   r.termination = solved.termination;
   r.message = solved.message;

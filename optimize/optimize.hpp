@@ -108,6 +108,11 @@ struct OptimizeResult {
   core::Metrics verified;  // re-simulated with another formulation
   core::Formulation verified_with = core::Formulation::kMassMatrix;
   double verification_error{};  // largest relative difference metrics vs verified
+  /// True when the optimum is proven global: the problem is convex in the counterweights' masses
+  /// and mass moments (Nlp::why_not_convex()) and the design meets the first-order conditions
+  /// to the tolerance; `optimality` says why, or why that is not proven.
+  bool global{};
+  std::string optimality;
   /// One line for the console and summary.json.
   std::string brief_report() const;
   bool ok() const { return found_design(termination); }

@@ -1141,6 +1141,11 @@ Result optimize(const DesignProblem& problem, const OptimizeOptions& options,
   r.original = nlp.original_metrics();
   r.metrics = nlp.metrics(r.x);
   r.added_mass = nlp.added_mass(r.x);
+  // the four-bar's convexity test and mass-moment variables (optimize/nlp.hpp) are not yet
+  // carried over to the general linkage: its optimum is a local one
+  r.optimality =
+      "not proven global: the general planar linkage's problems are solved in the "
+      "counterweights' positions, without the convexity test of the four-bar's";
   if (!r.ok()) return r;  // no design: nothing to verify
   // the design simulated by the engine, against the regressor's evaluation; in a free scene by
   // the other route (dae), against the reduced route's evaluations

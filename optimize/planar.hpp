@@ -170,6 +170,10 @@ struct Result {
   /// body's centre of mass (the balance layer, kinematics alone) against the engine's (its
   /// support forces): the largest difference relative to the largest value; NaN when not run.
   double inertial_error = std::numeric_limits<double>::quiet_NaN();
+  /// True when the optimum is proven global (as OptimizeResult::global); `optimality` says why,
+  /// or why that is not proven.
+  bool global{};
+  std::string optimality;
   bool ok() const { return found_design(termination); }
   /// One line: algorithm, termination, iterations, evaluations, seconds, objective, constraint
   /// violation, verification.

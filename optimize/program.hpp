@@ -34,6 +34,15 @@ class Program {
   /// c_in(x) (size n_ineq) and, when `jac` is not null, its Jacobian (n_ineq x n).
   virtual void inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
                             Eigen::MatrixXd* jac) const = 0;
+  /// The inequalities as the first-order check (optimize/first_order.hpp) reads them, given the
+  /// objective's gradient g at x: by default inequalities(x, c, jac). A program whose
+  /// constraint function loses its gradient where the set it bounds has a corner (a cone
+  /// |p|² <= m² d² at its apex) gives there the rows of an equivalent convex function
+  /// (|p| - m d), with the subgradient that faces -g, so that the check sees the constraint.
+  virtual void first_order_inequalities(const Eigen::VectorXd& x, const Eigen::VectorXd& /*g*/,
+                                        Eigen::VectorXd& c, Eigen::MatrixXd& jac) const {
+    inequalities(x, c, &jac);
+  }
   /// Sets the variables that only bound others (a peak's bound variable t >= |y_s|) to their
   /// tightest feasible values at x, in place: a solver may return them a little loose (the
   /// objective then overstates), a little tight (their rows then look violated although the

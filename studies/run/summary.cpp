@@ -281,6 +281,9 @@ void add_solver_fields(Json& j, const Result& r, const OptimizedRun& o) {
   const bool found = o.found();
   j["objective"] = found ? Json(r.objective) : Json(nullptr);
   j["constraint_violation"] = found ? Json(r.constraint_violation) : Json(nullptr);
+  // whether the optimum is proven global, and why (or why that is not proven)
+  j["global"] = found && r.global;
+  j["optimality"] = r.optimality;
   Json variables = Json::array();
   if (static_cast<std::size_t>(r.x.size()) == o.variable_names.size()) {
     for (std::size_t k = 0; k < o.variable_names.size(); ++k) {
