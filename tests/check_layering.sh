@@ -4,7 +4,7 @@
 # four-bar's own files in core/fourbar/ and never include them; core's internals (core/detail/,
 # core/fourbar/detail/) are included by core's sources, tests and benchmarks only, never by a
 # public header or a higher layer. Third-party headers stay behind their one door (yaml-cpp in
-# studies/, CLI11 in cli/, NLopt and Ipopt in optimize/*.cpp).
+# studies/, CLI11 in cli/, NLopt and Ipopt in optimize/*.cpp, pybind11 in python/).
 cd "$(dirname "$0")/.." || exit 1
 fail=0
 forbid() {  # forbid DESCRIPTION REGEX PATH...
@@ -46,5 +46,8 @@ forbid "yaml-cpp outside studies/" 'yaml-cpp/' core balance optimize cli
 forbid "CLI11 outside cli/" 'CLI/' core balance optimize studies
 forbid "NLopt or Ipopt outside optimize/*.cpp" '(nlopt|coin/|coin-or/|IpIpopt)' \
   core balance studies cli $(ls optimize/*.hpp 2>/dev/null)
+# the Python module (python/) sits on top, beside cli/: no library includes it or pybind11
+forbid "a library includes the Python module" 'python/' core balance optimize studies cli
+forbid "pybind11 outside python/" 'pybind11/' core balance optimize studies cli
 [ $fail -eq 0 ] && echo "layering ok"
 exit $fail

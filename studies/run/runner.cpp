@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
+#include <string_view>
 #include <system_error>
 #include <utility>
 #include <variant>
@@ -119,19 +120,35 @@ void write_table(const core::Series& table, const fs::path& file) {
   out.commit();  // a failed write shows here, as the file's error state
 }
 
-void write_timeseries(const core::Trajectory& trajectory, const fs::path& file) {
-  AtomicFile out(file);
-  std::FILE* f = out.get();
-  std::fputs(kTimeseriesHeader, f);
-  std::fputc('\n', f);
+core::Series timeseries_table(const core::Trajectory& trajectory) {
+  core::Series table;
+  for (std::string_view names = kTimeseriesHeader; !names.empty();) {
+    const std::size_t comma = std::min(names.find(','), names.size());
+    table.columns.emplace_back(names.substr(0, comma));
+    names.remove_prefix(std::min(comma + 1, names.size()));
+  }
+  table.values.reserve(trajectory.samples.size() * table.width());
   for (std::size_t i = 0; i < trajectory.samples.size(); ++i) {
     const core::DynamicsSample& d = trajectory.samples[i];
     const core::FourBarState& s = d.state;
     const double t = i < trajectory.t.size() ? trajectory.t[i] : std::nan("");
-    const double row[] = {t,         s.theta1,  s.theta2,  s.theta3,  s.omega1,  s.omega2,
-                          s.omega3,  s.alpha1,  s.alpha2,  s.alpha3,  d.RA0.x(), d.RA0.y(),
-                          d.RA3.x(), d.RA3.y(), d.Fsh.x(), d.Fsh.y(), d.Msh,     d.tau};
-    for (std::size_t k = 0; k < std::size(row); ++k) {
+    table.values.insert(
+        table.values.end(),
+        {t, s.theta1, s.theta2, s.theta3, s.omega1, s.omega2, s.omega3, s.alpha1, s.alpha2,
+         s.alpha3, d.RA0.x(), d.RA0.y(), d.RA3.x(), d.RA3.y(), d.Fsh.x(), d.Fsh.y(), d.Msh, d.tau});
+  }
+  return table;
+}
+
+void write_timeseries(const core::Trajectory& trajectory, const fs::path& file) {
+  const core::Series table = timeseries_table(trajectory);
+  AtomicFile out(file);
+  std::FILE* f = out.get();
+  std::fputs(kTimeseriesHeader, f);
+  std::fputc('\n', f);
+  for (std::size_t i = 0; i < table.rows(); ++i) {
+    const std::span<const double> row = table.row(i);
+    for (std::size_t k = 0; k < row.size(); ++k) {
       std::fprintf(f, k == 0 ? "%.17g" : ",%.17g", row[k]);
     }
     std::fputc('\n', f);
@@ -439,8 +456,8 @@ BalancedRun planar_balanced_run(const Study& study, const RunResult& original) {
   const auto* driven = std::get_if<core::planar::DrivenScene>(&study.scene);
   const bool revolution = driven && driven->duration == 0 && driven->revolutions >= 1 &&
                           !driven->speeds.empty() && driven->speeds[0] != 0;
-  const std::string shown = revolution ? std::string()
-                                       : with_every_condition(study.planar(), model, *k);
+  const std::string shown =
+      revolution ? std::string() : with_every_condition(study.planar(), model, *k);
   b.design = bp::force_balance(study.planar(), *k, ask.counterweights, ask.balancing_factor);
   if (!shown.empty()) b.design->message += (b.design->message.empty() ? "" : "; ") + shown;
   if (ask.shafts) {

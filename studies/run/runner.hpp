@@ -194,6 +194,10 @@ void write_run(const Study& study, RunResult& result, const std::filesystem::pat
 /// @throws std::runtime_error if the file cannot be written.
 void write_table(const core::Series& table, const std::filesystem::path& file);
 
+/// A four-bar's samples as a table with timeseries.csv's columns (kTimeseriesHeader), one row per
+/// sample: what write_timeseries() writes, and what the Python module hands out.
+core::Series timeseries_table(const core::Trajectory& trajectory);
+
 /// Writes the samples as timeseries.csv content (header, one row per sample, "%.17g").
 /// @throws std::runtime_error if the file cannot be written.
 void write_timeseries(const core::Trajectory& trajectory, const std::filesystem::path& file);
