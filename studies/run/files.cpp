@@ -98,7 +98,8 @@ std::string csv_line_field(std::string text) {
   return quote(text);
 }
 
-std::string csv_number(double v) { return std::isnan(v) ? std::string() : text::exact(v); }
+// NaN and infinities are no data: an empty field (issue 17)
+std::string csv_number(double v) { return std::isfinite(v) ? text::exact(v) : std::string(); }
 
 std::vector<std::string> csv_fields(const std::string& line) {
   std::vector<std::string> out(1);

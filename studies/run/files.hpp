@@ -43,7 +43,8 @@ std::string csv_field(const std::string& text);
 /// in the last column of a row, so that every row is one line of the file).
 std::string csv_line_field(std::string text);
 
-/// `v` as a CSV number: its exact text ("%.17g"), an empty field for NaN (no value).
+/// `v` as a CSV number: its exact text ("%.17g"), an empty field for NaN or an infinity (no
+/// value).
 std::string csv_number(double v);
 
 /// The fields of one CSV line (RFC 4180 quoting; a trailing '\r' is dropped).

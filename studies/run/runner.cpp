@@ -27,6 +27,17 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// A solver's "found" design whose objective is not a finite number (a bound so wide that a
+// metric overflows) is no design: failed, with the reason (issue 17: it "converged" at inf).
+template <class Result>
+void refuse_non_finite(Result& r) {
+  if (!optimize::found_design(r.termination) || std::isfinite(r.objective)) return;
+  r.termination = optimize::Termination::kFailed;
+  r.message = "the objective at the solver's design is " + text::shortest(r.objective) +
+              ", not a finite number: a design variable's bounds reach beyond the range the "
+              "metrics can be computed in; narrow them";
+}
+
 // solves an optimize study's problem and simulates the optimum; not run when the original's
 // simulation stopped early (its metrics are the normalisers)
 OptimizedRun optimize_study(const Study& study, const RunResult& original) {
@@ -39,6 +50,7 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original) {
   const OptimizeRequest& req = *study.optimize;
   const optimize::DesignProblem problem = design_problem(study);
   o.result = optimize::optimize(problem, req.options);
+  refuse_non_finite(o.result);
   {
     const optimize::Nlp nlp(problem);
     o.variable_names = nlp.variable_names();
@@ -73,6 +85,7 @@ OptimizedRun planar_optimize_study(const Study& study, const RunResult& original
   }
   o.planar_result =
       optimize::planar::optimize(planar_design_problem(study), study.planar_optimize->options);
+  refuse_non_finite(o.planar_result);
   o.variable_names = o.planar_result.variable_names;
   o.design_variables = o.planar_result.design_variables;
   if (!o.found()) return o;
