@@ -29,6 +29,12 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+/// Removes from `dir` the temporaries of AtomicFiles ('.<name>.<pid>.<n>.tmp') whose process is
+/// gone: a run killed (SIGKILL, a second Ctrl-C) before its commit leaves them, up to a whole
+/// timeseries in size. Those of running processes (a sweep's other points) are kept. Quiet: a
+/// temporary that cannot be removed stays.
+void remove_stale_temporaries(const std::filesystem::path& dir);
+
 /// Writes `text` to `file` through an AtomicFile.
 /// @throws std::runtime_error if the file cannot be written (the message names it).
 void write_text_file(const std::string& text, const std::filesystem::path& file);

@@ -524,9 +524,14 @@ void write_run(const Study& study, RunResult& result, const fs::path& out_dir) {
     throw std::runtime_error("cannot create the output directory " + out_dir.string() + ": " +
                              ec.message());
   }
+  remove_stale_temporaries(out_dir);  // of a run killed here before
   // an earlier run's files in the folder would be read as this run's (a report listing the
   // Pareto front of another design)
-  for (const char* name : kRunFiles) {
+  // and its page: a run that fails midway (a full disk) must not leave the old report beside
+  // the new data files (issue 17)
+  std::vector<std::string> names(std::begin(kRunFiles), std::end(kRunFiles));
+  names.emplace_back("report.html");
+  for (const std::string& name : names) {
     if (fs::remove(out_dir / name, ec); ec) {
       throw std::runtime_error("cannot remove the earlier run's " + (out_dir / name).string() +
                                ": " + ec.message());

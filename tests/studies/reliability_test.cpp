@@ -3,11 +3,17 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
+#include <sstream>
+
+#include <unistd.h>
 #include <string>
 
 #include "core/fourbar/model.hpp"
 #include "core/metrics.hpp"
+#include "studies/run/files.hpp"
 #include "studies/run/simulation.hpp"
 #include "studies/study/load_study.hpp"
 #include "tests/support/study_errors.hpp"
@@ -155,6 +161,52 @@ TEST(HostileNumbers, ANonFiniteSampleStopsTheRunThere) {
     ASSERT_TRUE(std::isfinite(s.Fsh.x()) && std::isfinite(s.Fsh.y()) && std::isfinite(s.Msh));
   }
   EXPECT_NE(sim.status().message.find("not finite"), std::string::npos) << sim.status().message;
+}
+
+// Finding 10: a run killed before its commit left '.timeseries.csv.<pid>.0.tmp' (up to 477 MB)
+// that no later run removed. A run into the folder removes those of processes that are gone.
+TEST(FaultLeftovers, TemporariesOfDeadProcessesAreRemovedOthersKept) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("bd-stale-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  auto touch = [&](const std::string& name) { std::ofstream(dir / name) << "x"; };
+  const std::string dead = ".timeseries.csv.999999999.0.tmp";  // above any pid_max
+  const std::string alive = ".timeseries.csv." + std::to_string(::getpid()) + ".3.tmp";
+  touch(dead);
+  touch(alive);
+  touch("timeseries.csv");
+  touch(".notes.tmp");
+  remove_stale_temporaries(dir);
+  EXPECT_FALSE(std::filesystem::exists(dir / dead));
+  EXPECT_TRUE(std::filesystem::exists(dir / alive));
+  EXPECT_TRUE(std::filesystem::exists(dir / "timeseries.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / ".notes.tmp"));
+  std::filesystem::remove_all(dir);
+}
+
+// Deliverable 1: every input of the fuzz corpus (tests/fuzz/corpus/: each regression the fuzzer
+// or the findings turned up) is run by the ordinary suite too, so the sanitizer job sees them:
+// it loads, or it is one StudyError, located, on one line.
+TEST(FuzzCorpus, EveryInputLoadsOrIsOneLocatedLine) {
+  int inputs = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(std::string(BD_SOURCE_DIR) + "/tests/fuzz/corpus")) {
+    std::ifstream in(entry.path(), std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    ++inputs;
+    try {
+      (void)parse_study(text.str(), "fuzz.yaml");
+    } catch (const StudyError& e) {
+      const std::string what = e.what();
+      EXPECT_GE(e.line(), 1) << entry.path() << ": " << what;
+      EXPECT_GE(e.column(), 1) << entry.path() << ": " << what;
+      for (const char c : what) {
+        EXPECT_GE(static_cast<unsigned char>(c), 0x20) << entry.path() << ": " << what;
+      }
+    }
+  }
+  EXPECT_GE(inputs, 4);
 }
 
 }  // namespace
