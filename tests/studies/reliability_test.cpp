@@ -93,7 +93,7 @@ void expect_error_at_line(const std::string& text, int line, const std::string& 
 TEST(HostileStudyNumbers, NumbersBeyondTheComputableRangeAreRefusedWhereTheyAre) {
   const std::string range = "must be 0 or of magnitude 1e-100 to 1e15";
   expect_error_at_line(edited(kDriven, "length: 1,", "length: 1e308,"), 6,
-                       "linkage.crank.length " + range + " in m, got '1e308'");
+                       "linkage.crank.length " + range + " in m");
   expect_error_at_line(edited(kDriven, "omega1: 6.283185307179586", "omega1: 4.9e-324"), 9,
                        "scene.omega1 " + range + " in rad/s");
   expect_error_at_line(edited(kDriven, "f: 0.1,", "f: -1e-300,"), 6, "linkage.crank.f " + range);
@@ -160,7 +160,8 @@ TEST(HostileNumbers, ANonFiniteSampleStopsTheRunThere) {
   for (const core::DynamicsSample& s : sim.fourbar.samples) {
     ASSERT_TRUE(std::isfinite(s.Fsh.x()) && std::isfinite(s.Fsh.y()) && std::isfinite(s.Msh));
   }
-  EXPECT_NE(sim.status().message.find("not finite"), std::string::npos) << sim.status().message;
+  // the engine's own check or the run's guard (studies/run/simulation.cpp) says it
+  EXPECT_NE(sim.status().message.find("finite"), std::string::npos) << sim.status().message;
 }
 
 // Finding 10: a run killed before its commit left '.timeseries.csv.<pid>.0.tmp' (up to 477 MB)
