@@ -19,6 +19,7 @@
 #include "cli/sweep_display.hpp"
 #include "core/fourbar/metrics.hpp"
 #include "core/number_text.hpp"
+#include "core/printable.hpp"
 #include "studies/report/report.hpp"
 #include "studies/studies.hpp"
 #include "studies/study/load_study.hpp"
@@ -98,6 +99,11 @@ Exit codes:
 The study-file format is described in docs/study-format.md; examples are in studies/examples/.
 )";
 
+// one line on stderr: control characters in `text` (from a file, a key, a message) escaped
+void say_error(const std::string& text) {
+  std::fprintf(stderr, "%s\n", bd::text::printable(text).c_str());
+}
+
 // a sweep's design: how many points, and each parameter's values or range
 void print_sweep_design(const st::SweepRequest& sweep) {
   const std::size_t points = st::sweep_points(sweep).size();
@@ -132,7 +138,7 @@ std::optional<st::Study> load_or_say(const std::string& file) {
   try {
     return st::load_study(file);
   } catch (const bd::InputError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
+    say_error(e.what());
     return std::nullopt;
   }
 }
@@ -146,7 +152,7 @@ int validate(const std::string& file) {
     if (study.sweep) print_sweep_design(*study.sweep);
     return kExitOk;
   } catch (const bd::InputError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
+    say_error(e.what());
     return kExitBadInput;
   }
 }
@@ -550,7 +556,7 @@ int run_sweep_study(const st::Study& study, const RunArgs& args, const fs::path&
   try {
     r = st::run_sweep(study, out, options);
   } catch (const bd::InputError& e) {
-    std::fprintf(stderr, "%s: %s\n", args.study.c_str(), e.what());
+    say_error(args.study + ": " + e.what());
     return kExitBadInput;
   }
   const double seconds =
@@ -593,7 +599,7 @@ int run(const RunArgs& args) {
   try {
     result = st::run_study(study, out);
   } catch (const bd::InputError& e) {
-    std::fprintf(stderr, "%s: %s\n", args.study.c_str(), e.what());
+    say_error(args.study + ": " + e.what());
     return kExitBadInput;
   }
 
@@ -602,29 +608,30 @@ int run(const RunArgs& args) {
   print_summary(study, result);
   std::fflush(stdout);
   if (result.stopped_early()) {
-    // one line per run that stopped
-    if (const st::RunStatus status = result.status(); !status.ok()) {
-      std::fprintf(stderr, "%s: simulation stopped early: %s\n", args.study.c_str(),
-                   status.message.c_str());
-    }
+    // one line, naming each run that stopped (the original's, the balanced or optimised
+    // design's)
+    std::string line;
+    auto add = [&line](const char* what, const std::string& message) {
+      line += (line.empty() ? "" : "; ") + std::string(what) + message;
+    };
+    if (const st::RunStatus status = result.status(); !status.ok()) add("", status.message);
     const bool balanced_ran =
         result.balanced && (!result.balanced->is_planar || result.balanced->design);
     if (balanced_ran && !result.balanced->ok()) {
-      std::fprintf(stderr, "%s: simulation of the balanced design stopped early: %s\n",
-                   args.study.c_str(), result.balanced->status().message.c_str());
+      add("the balanced design's: ", result.balanced->status().message);
     }
     if (result.optimized && result.optimized->found() && !result.optimized->status().ok()) {
-      std::fprintf(stderr, "%s: simulation of the optimised design stopped early: %s\n",
-                   args.study.c_str(), result.optimized->status().message.c_str());
+      add("the optimised design's: ", result.optimized->status().message);
     }
+    say_error(args.study + ": simulation stopped early: " + line);
     return kExitStoppedEarly;
   }
   if (result.optimized && result.optimized->failed()) {
     // one line: the optimiser's message names the binding constraint
     std::string message = result.optimized->message();
     std::replace(message.begin(), message.end(), '\n', ' ');
-    std::fprintf(stderr, "%s: no optimum (%s): %s\n", args.study.c_str(),
-                 bd::optimize::to_string(result.optimized->termination()), message.c_str());
+    say_error(args.study + ": no optimum (" +
+              bd::optimize::to_string(result.optimized->termination()) + "): " + message);
     return kExitNoOptimum;
   }
   return kExitOk;
@@ -682,7 +689,7 @@ int bench(const BenchArgs& args) {
   try {
     result = st::run_bench(study, out, options);
   } catch (const bd::InputError& e) {
-    std::fprintf(stderr, "%s: %s\n", args.study.c_str(), e.what());
+    say_error(args.study + ": " + e.what());
     return kExitBadInput;
   }
   print_warnings(result.run.warnings);
@@ -818,7 +825,7 @@ int main(int argc, char** argv) {
     if (bench_cmd->parsed()) return bench(bench_args);
     return run(args);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "balance-design: error: %s\n", e.what());
+    say_error(std::string("balance-design: error: ") + e.what());
     return kExitInternal;
   } catch (...) {
     std::fprintf(stderr, "balance-design: unexpected internal error\n");

@@ -3,12 +3,54 @@
 /// four-bar, core/planar/metrics.hpp for general planar linkages): each metric summarises one
 /// magnitude over a run's samples, as its RMS or its peak. Every table lists, per quantity, the
 /// RMS and then the peak.
+#include <cmath>
+#include <cstddef>
+
 namespace bd::core {
 
 /// How the samples' magnitudes become one number.
 enum class Statistic {
   kRms,  // sqrt(Σ x² / n)
   kMax,  // max x
+};
+
+/// |(a, b)|: sqrt(a² + b²) where that is exact to round-off, std::hypot where a square leaves
+/// double's range (a force of 1e200 N has the magnitude 1e200, not inf; issue 17). The common
+/// case keeps its bits: results stay identical to the plain formula.
+inline double magnitude(double a, double b) {
+  const double r = std::sqrt(a * a + b * b);
+  if (std::isnormal(r) || (a == 0 && b == 0)) return r;
+  return std::hypot(a, b);
+}
+
+/// RMS of magnitudes x_i: sqrt(Σ x² / n), the plain sum while it stays finite and, when a square
+/// overflows, the sum scaled by the largest |x| (as LAPACK's dnrm2), so an RMS of 1e200 N is
+/// 1e200, not inf. A NaN among the x stays NaN.
+class RmsAccumulator {
+ public:
+  void add(double x) {
+    ++n_;
+    plain_ += x * x;
+    x = std::abs(x);
+    if (x > scale_) {
+      scaled_ = 1.0 + scaled_ * (scale_ / x) * (scale_ / x);
+      scale_ = x;
+    } else if (x > 0 || x != x) {
+      scaled_ += (x / scale_) * (x / scale_);
+    }
+  }
+  double rms() const {
+    if (n_ == 0) return 0.0;
+    const double n = static_cast<double>(n_);
+    if (std::isfinite(plain_) && (plain_ > 0 || scale_ == 0)) return std::sqrt(plain_ / n);
+    return scale_ * std::sqrt(scaled_ / n);
+  }
+
+ private:
+  std::size_t n_ = 0;
+  double plain_ = 0.0;
+  double scale_ = 0.0;   // the largest |x| so far
+  double scaled_ = 0.0;  // Σ (x / scale_)²
 };
 
 }  // namespace bd::core

@@ -16,15 +16,15 @@ const MetricInfo* metric_info(std::string_view name) {
 double magnitude(const DynamicsSample& s, Quantity quantity) {
   switch (quantity) {
     case Quantity::kShakingForce:
-      return s.Fsh.norm();
+      return core::magnitude(s.Fsh.x(), s.Fsh.y());
     case Quantity::kShakingMoment:
       return std::abs(s.Msh);
     case Quantity::kDriveTorque:
       return std::abs(s.tau);
     case Quantity::kReactionA0:
-      return s.RA0.norm();
+      return core::magnitude(s.RA0.x(), s.RA0.y());
     case Quantity::kReactionA3:
-      return s.RA3.norm();
+      return core::magnitude(s.RA3.x(), s.RA3.y());
   }
   return 0.0;
 }
@@ -33,18 +33,22 @@ Metrics metrics(const Trajectory& trajectory) {
   Metrics m;
   const auto& samples = trajectory.samples;
   if (samples.empty()) return m;
-  // per row of the table: the sum of squares (RMS) or the running maximum (peak)
-  std::array<double, kMetricCount> acc{};
+  // per row of the table: the RMS (without overflow) or the running maximum (peak)
+  std::array<RmsAccumulator, kMetricCount> rms{};
+  std::array<double, kMetricCount> peak{};
   for (const DynamicsSample& s : samples) {
     for (std::size_t k = 0; k < kMetricCount; ++k) {
       const double x = magnitude(s, kMetricTable[k].quantity);
-      acc[k] = kMetricTable[k].statistic == Statistic::kRms ? acc[k] + x * x : std::max(acc[k], x);
+      if (kMetricTable[k].statistic == Statistic::kRms) {
+        rms[k].add(x);
+      } else {
+        peak[k] = std::max(peak[k], x);
+      }
     }
   }
-  const double n = static_cast<double>(samples.size());
   for (std::size_t k = 0; k < kMetricCount; ++k) {
     const MetricInfo& info = kMetricTable[k];
-    m.*info.field = info.statistic == Statistic::kRms ? std::sqrt(acc[k] / n) : acc[k];
+    m.*info.field = info.statistic == Statistic::kRms ? rms[k].rms() : peak[k];
   }
   return m;
 }

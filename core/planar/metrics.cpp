@@ -61,19 +61,23 @@ std::vector<double> metric_values(const std::vector<ColumnMetric>& metrics, cons
     const ColumnMetric& m = metrics[k];
     std::vector<int> c;
     for (const std::string& name : m.columns) c.push_back(table.column(name));
-    double acc = 0;
+    RmsAccumulator rms;
+    double peak = 0;
     for (std::size_t i = 0; i < rows; ++i) {
       double x = 0;
       if (c.size() == 1) {
         x = std::abs(table.at(i, static_cast<std::size_t>(c[0])));
       } else {
-        const double a = table.at(i, static_cast<std::size_t>(c[0])),
-                     b = table.at(i, static_cast<std::size_t>(c[1]));
-        x = std::sqrt(a * a + b * b);
+        x = magnitude(table.at(i, static_cast<std::size_t>(c[0])),
+                      table.at(i, static_cast<std::size_t>(c[1])));
       }
-      acc = m.statistic == Statistic::kRms ? acc + x * x : std::max(acc, x);
+      if (m.statistic == Statistic::kRms) {
+        rms.add(x);
+      } else {
+        peak = std::max(peak, x);
+      }
     }
-    out[k] = m.statistic == Statistic::kRms ? std::sqrt(acc / static_cast<double>(rows)) : acc;
+    out[k] = m.statistic == Statistic::kRms ? rms.rms() : peak;
   }
   return out;
 }

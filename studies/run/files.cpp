@@ -1,5 +1,6 @@
 #include "studies/run/files.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -70,6 +71,32 @@ void AtomicFile::commit() {
   committed_ = true;
 }
 
+void remove_stale_temporaries(const fs::path& dir) {
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    // .<target>.<pid>.<counter>.tmp
+    if (name.size() < 8 || name[0] != '.' || !name.ends_with(".tmp")) continue;
+    const std::string stem = name.substr(0, name.size() - 4);
+    const std::size_t counter = stem.rfind('.');
+    if (counter == std::string::npos || counter == 0) continue;
+    const std::size_t pid_at = stem.rfind('.', counter - 1);
+    if (pid_at == std::string::npos || pid_at == 0) continue;
+    const std::string pid_text = stem.substr(pid_at + 1, counter - pid_at - 1);
+    const std::string counter_text = stem.substr(counter + 1);
+    auto digits = [](const std::string& t) {
+      return !t.empty() && t.size() < 10 &&
+             std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+    };
+    if (!digits(pid_text) || !digits(counter_text)) continue;
+    const auto pid = static_cast<pid_t>(std::stol(pid_text));
+    if (pid == ::getpid() || pid <= 0) continue;
+    if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge
+    std::error_code rm;
+    fs::remove(it->path(), rm);
+  }
+}
+
 void write_text_file(const std::string& text, const fs::path& file) {
   AtomicFile out(file);
   if (std::fwrite(text.data(), 1, text.size(), out.get()) != text.size()) {
@@ -98,7 +125,8 @@ std::string csv_line_field(std::string text) {
   return quote(text);
 }
 
-std::string csv_number(double v) { return std::isnan(v) ? std::string() : text::exact(v); }
+// NaN and infinities are no data: an empty field (issue 17)
+std::string csv_number(double v) { return std::isfinite(v) ? text::exact(v) : std::string(); }
 
 std::vector<std::string> csv_fields(const std::string& line) {
   std::vector<std::string> out(1);

@@ -29,6 +29,12 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+/// Removes from `dir` the temporaries of AtomicFiles ('.<name>.<pid>.<n>.tmp') whose process is
+/// gone: a run killed (SIGKILL, a second Ctrl-C) before its commit leaves them, up to a whole
+/// timeseries in size. Those of running processes (a sweep's other points) are kept. Quiet: a
+/// temporary that cannot be removed stays.
+void remove_stale_temporaries(const std::filesystem::path& dir);
+
 /// Writes `text` to `file` through an AtomicFile.
 /// @throws std::runtime_error if the file cannot be written (the message names it).
 void write_text_file(const std::string& text, const std::filesystem::path& file);
@@ -43,7 +49,8 @@ std::string csv_field(const std::string& text);
 /// in the last column of a row, so that every row is one line of the file).
 std::string csv_line_field(std::string text);
 
-/// `v` as a CSV number: its exact text ("%.17g"), an empty field for NaN (no value).
+/// `v` as a CSV number: its exact text ("%.17g"), an empty field for NaN or an infinity (no
+/// value).
 std::string csv_number(double v);
 
 /// The fields of one CSV line (RFC 4180 quoting; a trailing '\r' is dropped).

@@ -28,6 +28,17 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// A solver's "found" design whose objective is not a finite number (a bound so wide that a
+// metric overflows) is no design: failed, with the reason (issue 17: it "converged" at inf).
+template <class Result>
+void refuse_non_finite(Result& r) {
+  if (!optimize::found_design(r.termination) || std::isfinite(r.objective)) return;
+  r.termination = optimize::Termination::kFailed;
+  r.message = "the objective at the solver's design is " + text::shortest(r.objective) +
+              ", not a finite number: a design variable's bounds reach beyond the range the "
+              "metrics can be computed in; narrow them";
+}
+
 // solves an optimize study's problem and simulates the optimum; not run when the original's
 // simulation stopped early (its metrics are the normalisers)
 OptimizedRun optimize_study(const Study& study, const RunResult& original) {
@@ -40,6 +51,7 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original) {
   const OptimizeRequest& req = *study.optimize;
   const optimize::DesignProblem problem = design_problem(study);
   o.result = optimize::optimize(problem, req.options);
+  refuse_non_finite(o.result);
   {
     const optimize::Nlp nlp(problem);
     o.variable_names = nlp.variable_names();
@@ -74,6 +86,7 @@ OptimizedRun planar_optimize_study(const Study& study, const RunResult& original
   }
   o.planar_result =
       optimize::planar::optimize(planar_design_problem(study), study.planar_optimize->options);
+  refuse_non_finite(o.planar_result);
   o.variable_names = o.planar_result.variable_names;
   o.design_variables = o.planar_result.design_variables;
   if (!o.found()) return o;
@@ -528,9 +541,14 @@ void write_run(const Study& study, RunResult& result, const fs::path& out_dir) {
     throw std::runtime_error("cannot create the output directory " + out_dir.string() + ": " +
                              ec.message());
   }
+  remove_stale_temporaries(out_dir);  // of a run killed here before
   // an earlier run's files in the folder would be read as this run's (a report listing the
   // Pareto front of another design)
-  for (const char* name : kRunFiles) {
+  // and its page: a run that fails midway (a full disk) must not leave the old report beside
+  // the new data files (issue 17)
+  std::vector<std::string> names(std::begin(kRunFiles), std::end(kRunFiles));
+  names.emplace_back("report.html");
+  for (const std::string& name : names) {
     if (fs::remove(out_dir / name, ec); ec) {
       throw std::runtime_error("cannot remove the earlier run's " + (out_dir / name).string() +
                                ": " + ec.message());

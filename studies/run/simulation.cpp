@@ -1,6 +1,11 @@
 #include "studies/run/simulation.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <utility>
 #include <variant>
+
+#include "core/number_text.hpp"
 
 #include "core/planar/from_fourbar.hpp"
 #include "core/planar/metrics.hpp"
@@ -44,6 +49,67 @@ Scene planar_scene(const Scene& scene) {
   return core::planar::DrivenScene{{d.theta1}, {d.omega1}, d.revolutions, 0, d.samples};
 }
 
+Simulation simulate_unchecked(const Study& study, const MethodChoice& method,
+                              const Tolerances& tolerances);
+
+// "the run stopped at a value that is not finite", naming the instant and the value
+std::string non_finite_message(double t, const std::string& where, const std::string& column,
+                               double value) {
+  return "a computed value is not finite at t = " + text::digits(t, 10) + " s" + where + " (" +
+         column + " = " + text::shortest(value) +
+         "): the linkage's numbers leave the range of double precision; the samples before it "
+         "are kept";
+}
+
+// No NaN or infinity is ever data (issue 17): a run whose sample holds one stops at that
+// sample, as at a singular position, keeping the samples before it. The engines check their
+// own results; this is the one guard every run (original, balanced, optimised, a sweep's point)
+// passes before its numbers reach a file.
+void stop_at_non_finite(core::Trajectory& r) {
+  for (std::size_t i = 0; i < r.samples.size(); ++i) {
+    const core::DynamicsSample& s = r.samples[i];
+    const core::FourBarState& q = s.state;
+    const std::pair<const char*, double> values[] = {
+        {"t", i < r.t.size() ? r.t[i] : 0.0},
+        {"theta1", q.theta1}, {"theta2", q.theta2}, {"theta3", q.theta3},
+        {"omega1", q.omega1}, {"omega2", q.omega2}, {"omega3", q.omega3},
+        {"alpha1", q.alpha1}, {"alpha2", q.alpha2}, {"alpha3", q.alpha3},
+        {"RA0x", s.RA0.x()},  {"RA0y", s.RA0.y()},  {"RA3x", s.RA3.x()},
+        {"RA3y", s.RA3.y()},  {"RC1x", s.RC1.x()},  {"RC1y", s.RC1.y()},
+        {"RC3x", s.RC3.x()},  {"RC3y", s.RC3.y()},  {"Fshx", s.Fsh.x()},
+        {"Fshy", s.Fsh.y()},  {"Msh", s.Msh},       {"tau", s.tau}};
+    for (const auto& [name, v] : values) {
+      if (std::isfinite(v)) continue;
+      const double t = i < r.t.size() ? r.t[i] : 0.0;
+      const std::string where = std::isfinite(q.theta1)
+                                    ? ", theta1 = " + text::digits(q.theta1, 10) + " rad"
+                                    : std::string();
+      r.message = non_finite_message(t, where, name, v);
+      r.status = core::SimulationStatus::kIntegratorFailed;
+      r.samples.resize(i);
+      r.t.resize(std::min(r.t.size(), i));
+      return;
+    }
+  }
+}
+
+void stop_at_non_finite(core::planar::Trajectory& r) {
+  core::Series& table = r.table;
+  const std::size_t width = table.width();
+  const int tc = table.column("t");
+  for (std::size_t i = 0; i < table.rows(); ++i) {
+    for (std::size_t k = 0; k < width; ++k) {
+      const double v = table.at(i, k);
+      if (std::isfinite(v)) continue;
+      const double t = tc >= 0 ? table.at(i, static_cast<std::size_t>(tc)) : 0.0;
+      r.message = non_finite_message(t, "", table.columns[k], v);
+      r.status = core::SimulationStatus::kIntegratorFailed;
+      table.values.resize(i * width);
+      return;
+    }
+  }
+}
+
 }  // namespace
 
 RunStatus run_status(const core::Trajectory& t) {
@@ -65,6 +131,19 @@ Simulation simulate(const Study& study, const MethodChoice& method) {
 }
 
 Simulation simulate(const Study& study, const MethodChoice& method, const Tolerances& tolerances) {
+  Simulation s = simulate_unchecked(study, method, tolerances);
+  if (s.is_planar) {
+    stop_at_non_finite(s.planar);
+  } else {
+    stop_at_non_finite(s.fourbar);
+  }
+  return s;
+}
+
+namespace {
+
+Simulation simulate_unchecked(const Study& study, const MethodChoice& method,
+                              const Tolerances& tolerances) {
   Simulation s;
   s.method = method;
   if (study.is_fourbar()) {
@@ -96,6 +175,8 @@ Simulation simulate(const Study& study, const MethodChoice& method, const Tolera
   }
   return s;
 }
+
+}  // namespace
 
 MetricList metric_list(const core::Metrics& metrics) {
   MetricList list;

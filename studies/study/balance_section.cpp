@@ -77,6 +77,11 @@ class BalanceReader {
         r_.fail(moment_mark, std::string("balance.moment: full is not possible: ") + err.what());
       }
       r_.fail(force_mark, std::string("balance.force: full is not possible: ") + err.what());
+    } catch (const InputError& err) {
+      // the balanced design checked as a linkage (a counterweight out of range): the run would
+      // refuse it, so validation does
+      r_.fail(force_mark, std::string("balance: the balanced design is not a valid linkage: ") +
+                              err.what());
     }
   }
 

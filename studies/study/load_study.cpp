@@ -1,5 +1,6 @@
 #include "studies/study/load_study.hpp"
 
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -14,19 +15,21 @@
 #include <vector>
 
 #include "core/number_text.hpp"
+#include "core/printable.hpp"
 #include "studies/study/load_study_internal.hpp"
 #include "studies/study/sections.hpp"
 
 namespace bd::studies {
 
+// control characters (a key holding a newline or a NUL) are escaped: what() is one line
 StudyError::StudyError(std::string file, int line, int column, std::string message)
-    : InputError(line > 0 ? file + ":" + std::to_string(line) + ":" + std::to_string(column) +
-                                ": " + message
-                          : file + ": " + message),
+    : InputError(line > 0 ? text::printable(file) + ":" + std::to_string(line) + ":" +
+                                std::to_string(column) + ": " + text::printable(message)
+                          : text::printable(file) + ": " + text::printable(message)),
       file_(std::move(file)),
       line_(line),
       column_(column),
-      message_(std::move(message)) {}
+      message_(text::printable(message)) {}
 
 namespace {
 
@@ -36,6 +39,8 @@ using namespace detail;
 constexpr std::size_t kMaxName = 100;
 constexpr std::string_view kBalancedSuffix = "-balanced";
 constexpr std::string_view kOptimizedSuffix = "-optimized";
+// the tightest relative tolerance a study may ask of the integrator
+constexpr double kMinTolerance = 1e-14;
 
 class StudyParser {
  public:
@@ -179,6 +184,11 @@ class StudyParser {
     if (!(tol > 0 && tol < 1)) {
       r_.fail(m, "tolerance must be > 0 and < 1 (a relative tolerance), got " + text::exact(tol));
     }
+    if (tol < kMinTolerance) {
+      // double precision carries about 16 digits: the integrator cannot meet a tighter one
+      r_.fail(m, "tolerance must be >= 1e-14 (a relative tolerance; double precision carries "
+                 "about 16 digits), got " + text::shortest(tol));
+    }
     core::SimulateOptions options;
     options.tolerance = tol;
     if (const auto problem = options.validate()) r_.fail(m, "tolerance: " + problem->text());
@@ -246,19 +256,65 @@ YAML::Node node_at(YAML::Node root, const std::vector<PathStep>& steps) {
 
 }  // namespace internal
 
-Study parse_study(const std::string& yaml_text, const std::string& source_name) {
-  const Reporter r(source_name);
-  std::vector<YAML::Node> docs;
+namespace {
+
+// Counts the documents of a YAML text without building them (yaml-cpp's event interface).
+class DocumentMarks : public YAML::EventHandler {
+ public:
+  std::vector<YAML::Mark> starts;
+  void OnDocumentStart(const YAML::Mark& mark) override { starts.push_back(mark); }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+};
+
+// The text's one YAML document. Not YAML::LoadAll: yaml-cpp 0.7 never consumes a token that can
+// start no node (a ',' outside brackets, as in a file holding only ","), so LoadAll returns an
+// endless list of empty documents at that token and fills the memory. Here the parser is asked
+// for at most two documents: a second one that starts with '---' (or a '%' directive) is a
+// second document; one that starts anywhere else starts at text the first document could not
+// take, which is reported there.
+YAML::Node one_document(const std::string& text, const Reporter& r) {
+  DocumentMarks marks;
   try {
-    docs = YAML::LoadAll(yaml_text);
+    std::istringstream in(text);
+    YAML::Parser parser(in);
+    for (int i = 0; i < 2 && parser.HandleNextDocument(marks); ++i) {
+    }
   } catch (const YAML::Exception& e) {
     r.fail(e.mark, e.msg);
   }
-  if (docs.size() > 1) {
-    r.fail(mark_of(docs[1], YAML::Mark()),
-           "a study file holds one YAML document; found a second one (after '---')");
+  if (marks.starts.size() > 1) {
+    const YAML::Mark& at = marks.starts[1];
+    const std::size_t pos = at.pos >= 0 ? static_cast<std::size_t>(at.pos) : text.size();
+    if (text.compare(pos, 3, "---") == 0 || text.compare(pos, 1, "%") == 0) {
+      r.fail(at, "a study file holds one YAML document; found a second one (after '---')");
+    }
+    r.fail(at, "unexpected " + (pos < text.size() ? text::quoted_char(text[pos]) : "end") +
+                   ": the study's YAML document cannot go on here (a study file is one map "
+                   "of keys: name, linkage, scene, ...)");
   }
-  Study study = internal::parse_study_tree(docs.empty() ? YAML::Node() : docs[0], source_name);
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    r.fail(e.mark, e.msg);
+  }
+}
+
+}  // namespace
+
+Study parse_study(const std::string& yaml_text, const std::string& source_name) {
+  const Reporter r(source_name);
+  const YAML::Node root = one_document(yaml_text, r);
+  Study study = internal::parse_study_tree(root, source_name);
   // each point of a sweep is this text with its values set (point_study())
   if (study.sweep) study.sweep->study_text = yaml_text;
   return study;

@@ -135,7 +135,7 @@ class SweepReader {
 
   // sweep.seed: a whole number that reads back exactly
   std::uint64_t read_seed(const MapReader::Entry& e) {
-    const double v = read_number(r_, e, "sweep.seed", "");
+    const double v = read_number(r_, e, "sweep.seed", "", false);
     if (v != std::floor(v) || v < 0 || v >= kSeedLimit) {
       r_.fail(mark_of(e.value, e.key_mark),
               "sweep.seed must be a whole number from 0 to 2^53 - 1 (9007199254740991), got " +

@@ -135,9 +135,20 @@ class MapReader {
   std::vector<Entry> entries_;
 };
 
-// a finite number; `unit` in words for messages ("m", "kg", "rad/s", "" for none)
+// The range of every number in a study file (but the sweep's seed): 0, or a magnitude from
+// kMinMagnitude to kMaxMagnitude. The tool forms products of a few inputs (a counterweight's
+// inertia m d^2, a force m l omega^2, its square in an RMS, a disc's radius from its mass and
+// thickness); within this range they stay far inside double's range (1e-308 to 1e308), beyond
+// it they overflowed to inf or divided by an underflowed 0, and the run failed after `validate`
+// said ok (issue 17). 1e15 is beyond any linkage in SI units (a 1e12 kg mass runs); 1e-100 lets
+// a script's round-off residue (1.2e-16 for sin(pi)) through and stops subnormals.
+inline constexpr double kMaxMagnitude = 1e15;
+inline constexpr double kMinMagnitude = 1e-100;
+
+// a finite number in the range above; `unit` in words for messages ("m", "kg", "rad/s", "" for
+// none); `bounded` false takes any finite number (the sweep's seed, an integer up to 2^53)
 inline double read_number(const Reporter& r, const YAML::Node& node, const YAML::Mark& fallback,
-                          const std::string& path, const std::string& unit) {
+                          const std::string& path, const std::string& unit, bool bounded = true) {
   const std::string in_unit = unit.empty() ? "" : " in " + unit;
   double value = 0.0;
   if (!node.IsScalar() || !YAML::convert<double>::decode(node, value)) {
@@ -148,12 +159,18 @@ inline double read_number(const Reporter& r, const YAML::Node& node, const YAML:
     r.fail(mark_of(node, fallback),
            path + " must be a finite number" + in_unit + ", got " + describe(node));
   }
+  const double magnitude = std::fabs(value);
+  if (bounded && (magnitude > kMaxMagnitude || (magnitude != 0 && magnitude < kMinMagnitude))) {
+    r.fail(mark_of(node, fallback),
+           path + " must be 0 or of magnitude 1e-100 to 1e15" + in_unit +
+               " (the range the tool computes in), got " + describe(node));
+  }
   return value;
 }
 
 inline double read_number(const Reporter& r, const MapReader::Entry& e, const std::string& path,
-                          const std::string& unit) {
-  return read_number(r, e.value, e.key_mark, path, unit);
+                          const std::string& unit, bool bounded = true) {
+  return read_number(r, e.value, e.key_mark, path, unit, bounded);
 }
 
 // a finite number > 0

@@ -432,6 +432,7 @@ void start_files(const Study& study, const fs::path& out_dir, const SweepResult&
     throw std::runtime_error("cannot create the output directory " + out_dir.string() + ": " +
                              ec.message());
   }
+  remove_stale_temporaries(out_dir);  // of a sweep killed here before
   write_text_file(sweep_json(study, result.points, counts), result.summary);
   if (options.resume && existing.csv.has_header) {  // checked: this sweep's header and rows
     if (existing.csv.complete_size != existing.csv_text.size()) {
