@@ -112,6 +112,11 @@ Solved solve(const Program& program, const Eigen::VectorXd& x0, const OptimizeOp
 Solved solve_from(const Program& program, const std::vector<Eigen::VectorXd>& starts,
                   const OptimizeOptions& options);
 
+/// The feasibility of the point r.x, whatever the solver said: r.constraint_violation, and the
+/// termination and message when they disagree with it (`solver` is the solver's message).
+void check_feasibility(const Program& program, const OptimizeOptions& options,
+                       const std::string& solver, Solved& r);
+
 DriverOutcome solve_with_nlopt(const Program& nlp, const Eigen::VectorXd& x0,
                                const OptimizeOptions& options);
 

@@ -78,27 +78,6 @@ namespace detail {
 class NlpProgram;
 }
 
-/// How a counterweight enters as variables.
-enum class CounterweightVariablesAs {
-  /// Its mass m and its centre r = (x, y) from the pivot: [kg], [m], [m] (the default; the
-  /// envelope (x² + y²)/distance_max² - 1 <= 0).
-  kPositions,
-  /// Its mass m and its mass moment p = m r about the pivot: [kg], [kg m], [kg m], each moment in
-  /// [-mass_max distance_max, mass_max distance_max]. The links' masses and first moments are
-  /// then affine in the variables, and the envelope is the convex cone |p| <= m distance_max,
-  /// smoothed where it meets its apex (m = 0, p = 0) as
-  ///   (sqrt(|p|² + δ²) - δ) / (mass_max distance_max) - m / mass_max <= 0,  δ = kConeSmoothing
-  /// (relative to mass_max distance_max): the same cone up to δ, never tighter, with a gradient
-  /// everywhere (the plain |p|² <= m² distance_max² has none at the apex, where "no
-  /// counterweight" lies). The design at x takes r = p / m, within distance_max (the δ of slack
-  /// removed), and r = 0 where m = 0. Used for the problems that are convex in these variables
-  /// (Nlp::why_not_convex()).
-  kMassMoments,
-};
-/// δ of the smoothed cone, relative to mass_max distance_max: the design's mass moment moves by
-/// at most δ when its position is brought within distance_max, so the objective by ~1e-10.
-inline constexpr double kConeSmoothing = 1e-10;
-
 class Nlp final : public Program {
  public:
   /// Precomputes what the problem needs (the regressor for a driven scene, the original's

@@ -10,6 +10,7 @@
 
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
+#include "optimize/convex_solve.hpp"
 
 namespace bd::optimize::detail {
 
@@ -188,20 +189,6 @@ void NlpProgram::start_extra_variables(Eigen::VectorXd&) const {}
 
 // ---------------------------------------------------------------------------------------------
 // mass-moment variables
-
-namespace {
-
-// the counterweight's centre from its mass and mass moment p about the pivot: p / m within
-// distance_max (the smoothed cone's slack removed), the pivot without mass
-Vec2 position_of(double mass, const Vec2& moment, double distance_max) {
-  if (!(mass > 0)) return Vec2::Zero();
-  Vec2 r = moment / mass;
-  const double d = r.norm();
-  if (d > distance_max) r *= distance_max / d;
-  return r;
-}
-
-}  // namespace
 
 Eigen::VectorXd NlpProgram::from_positions(const Eigen::VectorXd& x) const {
   Eigen::VectorXd z = x;
@@ -552,18 +539,8 @@ void NlpProgram::first_order_inequalities(const Eigen::VectorXd& x, const Eigen:
     if (b.kind == Block::Kind::kEnvelope) {
       const auto i = static_cast<std::size_t>(b.counterweight);
       const int j = cw_var_[i];
-      const double mmax = problem_.counterweights[i].mass_max,
-                   d = problem_.counterweights[i].distance_max, pmax = mmax * d;
-      const Vec2 p(x(j + 1), x(j + 2));
-      // the unit direction of p, or at the apex the one facing -g
-      Vec2 u = p;
-      if (!(u.norm() > 1e-12 * pmax)) u = -Vec2(g(j + 1), g(j + 2));
-      if (u.norm() > 0) u.normalize();
-      c(row) = (p.norm() - x(j) * d) / pmax;
-      jac.row(row).setZero();
-      jac(row, j) = -1 / mmax;
-      jac(row, j + 1) = u.x() / pmax;
-      jac(row, j + 2) = u.y() / pmax;
+      cone_first_order_row(x, g, j, problem_.counterweights[i].mass_max,
+                           problem_.counterweights[i].distance_max, row, c, jac);
     }
     row += b.count;
   }

@@ -13,6 +13,7 @@
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
 #include "optimize/check_inputs.hpp"
+#include "optimize/convex_solve.hpp"
 #include "optimize/first_order.hpp"
 #include "optimize/ipopt_driver.hpp"
 #include "optimize/nlopt_driver.hpp"
@@ -270,12 +271,8 @@ std::string OptimizeResult::brief_report() const {
   return s;
 }
 
-namespace {
-
-// The feasibility of the point returned, whatever the solver said: r.constraint_violation, and
-// the termination and message when they disagree with it (`solver` is the solver's message).
-void check_feasibility(const Program& nlp, const OptimizeOptions& options,
-                       const std::string& solver, detail::Solved& r) {
+void detail::check_feasibility(const Program& nlp, const OptimizeOptions& options,
+                               const std::string& solver, detail::Solved& r) {
   int worst = -1;
   double worst_value = 0.0;
   r.constraint_violation = detail::constraint_violation(nlp, r.x, &worst, &worst_value);
@@ -297,6 +294,8 @@ void check_feasibility(const Program& nlp, const OptimizeOptions& options,
     r.message += " (the point returned is feasible)";
   }
 }
+
+namespace {
 
 // The optimum re-simulated with another formulation, compared metric by metric.
 void verify(const DesignProblem& problem, OptimizeResult& r) {
@@ -338,7 +337,7 @@ detail::Solved run_once(const Program& nlp, const VectorXd& x0, const OptimizeOp
   r.seconds = std::chrono::duration<double>(stopped - started).count();
   nlp.polish(r.x);
   r.objective = nlp.objective(r.x, nullptr);
-  check_feasibility(nlp, options, outcome.message, r);
+  detail::check_feasibility(nlp, options, outcome.message, r);
   return r;
 }
 
@@ -466,41 +465,11 @@ OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& opt
   detail::check_inputs(problem, options);
   const Nlp nlp(problem);
   throw_if(check_algorithm(problem, options));
-  // A problem convex in the counterweights' masses and mass moments is solved in those
-  // variables by the local gradient methods, where a first-order point is the global optimum;
-  // its design is then taken back to the position variables, the ones the results and the rest
-  // of the tool read. (MLSL's and the derivative-free methods' own steps are scaled for the
-  // positions: they keep them.)
-  const std::string why_not = nlp.why_not_convex();
   std::optional<Nlp> convex;
-  if (why_not.empty()) convex.emplace(problem, CounterweightVariablesAs::kMassMoments);
-  const bool in_moments = convex && uses_gradients(options.algorithm) &&
-                          options.algorithm != Algorithm::kMlsl;
-  const Nlp& program = in_moments ? *convex : nlp;
-  std::vector<VectorXd> starts;
-  for (const VectorXd& d : designs) starts.push_back(program.from_positions(d));
-  // the natural start, and where it does not fit (an added-mass budget), the same with lighter
-  // counterweights, then the original design (no counterweight: feasible for any budget >= 0)
-  for (double fraction = 1; fraction > 1e-3; fraction /= 4) {
-    starts.push_back(program.start_scaled(fraction));
-  }
-  starts.push_back(program.start(true));
-  detail::Solved solved = detail::solve_from(program, starts, options);
-  if (in_moments) {
-    solved.x = nlp.start_at(convex->to_positions(solved.x));
-    solved.objective = nlp.objective(solved.x, nullptr);
-    if (found_design(solved.termination)) {
-      check_feasibility(nlp, options, solved.message, solved);
-    }
-  }
-  // the certificate: the first-order conditions of the convex program at the design, whichever
-  // program found it
-  const detail::Optimality optimality = detail::optimality(
-      why_not, solved.termination == Termination::kConverged,
-      convex && found_design(solved.termination)
-          ? detail::stationarity_residual(*convex, convex->from_positions(solved.x))
-          : solved.stationarity,
-      options.relative_tolerance);
+  if (nlp.why_not_convex().empty()) convex.emplace(problem, CounterweightVariablesAs::kMassMoments);
+  const detail::ConvexAwareSolve solve = detail::solve_convex_aware(nlp, convex, designs, options);
+  const detail::Solved& solved = solve.solved;
+  const detail::Optimality& optimality = solve.optimality;
 
   OptimizeResult r;
   r.global = optimality.global && found_design(solved.termination);

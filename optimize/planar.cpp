@@ -8,11 +8,13 @@
 #include <map>
 #include <mutex>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
+#include "optimize/convex_solve.hpp"
 #include "optimize/epsilon_front.hpp"
 #include "optimize/nlopt_driver.hpp"
 
@@ -166,7 +168,8 @@ Problem DesignProblem::validate() const {
 
 struct PlanarNlp::Impl {
   DesignProblem p;
-  bool free{};  // a free scene: metrics by simulation, no regressor
+  bool free{};     // a free scene: metrics by simulation, no regressor
+  bool moments{};  // counterweights as (m, p = m r): CounterweightVariablesAs::kMassMoments
   // a free scene's last simulation: its x and metrics (table order; +inf when it failed)
   mutable std::mutex cache_mutex;
   mutable VectorXd cached_x;
@@ -210,7 +213,9 @@ struct PlanarNlp::Impl {
   void check_balance_reachable(const MatrixXd& Z, const VectorXd& z0,
                                const bp::Kinematics& k) const;
   void balance_conditions(const cp::Trajectory& base);
-  void q_of(const VectorXd& x, VectorXd& q, MatrixXd* J) const;
+  // q at x and its Jacobian; `positions`: the counterweights' variables read as positions
+  // whatever the program's (the start's force-balance step works in positions)
+  void q_of(const VectorXd& x, VectorXd& q, MatrixXd* J, bool positions = false) const;
   const cp::ColumnMetric& metric(int k) const { return table[static_cast<std::size_t>(k)]; }
   int metric_index(const std::string& name) const {
     for (std::size_t k = 0; k < table.size(); ++k)
@@ -431,6 +436,13 @@ void PlanarNlp::Impl::set_up_variables() {
     cw_away.push_back(-d.normalized());
     const std::string from = " from " + l.nodes[static_cast<std::size_t>(pv)].name;
     cw_var.push_back(add(0.0, c.mass_max, name + " counterweight mass [kg]"));
+    if (moments) {
+      const double pmax = c.mass_max * c.distance_max;
+      const std::string about = " about " + l.nodes[static_cast<std::size_t>(pv)].name;
+      add(-pmax, pmax, name + " counterweight mass moment x" + about + " in link axes [kg m]");
+      add(-pmax, pmax, name + " counterweight mass moment y" + about + " in link axes [kg m]");
+      continue;
+    }
     add(-c.distance_max, c.distance_max, name + " counterweight x" + from + " in link axes [m]");
     add(-c.distance_max, c.distance_max, name + " counterweight y" + from + " in link axes [m]");
   }
@@ -541,7 +553,7 @@ void PlanarNlp::Impl::set_up_constraints() {
   }
 }
 
-void PlanarNlp::Impl::q_of(const VectorXd& x, VectorXd& q, MatrixXd* J) const {
+void PlanarNlp::Impl::q_of(const VectorXd& x, VectorXd& q, MatrixXd* J, bool positions) const {
   const cp::Linkage& l = p.original;
   q = q0;
   if (J) J->setZero(nq, n);
@@ -575,8 +587,30 @@ void PlanarNlp::Impl::q_of(const VectorXd& x, VectorXd& q, MatrixXd* J) const {
   for (std::size_t c = 0; c < p.counterweights.size(); ++c) {
     const int k = p.counterweights[c].link, v = cw_var[c];
     const double mc = x[v];
-    const Vec2 r = cw_pivot_in_link[c] + Vec2(x[v + 1], x[v + 2]);
     const double a = disc_inertia_per_mass2(p.counterweights[c]);
+    if (moments && !positions) {
+      // the first moment about the link's first node, p + m (pivot), and J = |that|² / m
+      const Vec2 o = cw_pivot_in_link[c], M = Vec2(x[v + 1], x[v + 2]) + mc * o;
+      const double Jc = mc > 0 ? M.squaredNorm() / mc : 0.0;
+      q[P::link_mass(k)] += mc;
+      q[P::link_me(k)] += M.x();
+      q[P::link_mf(k)] += M.y();
+      q[P::link_J(k)] += Jc + a * mc * mc;
+      if (!J) continue;
+      (*J)(P::link_mass(k), v) += 1;
+      (*J)(P::link_me(k), v) += o.x();
+      (*J)(P::link_mf(k), v) += o.y();
+      (*J)(P::link_me(k), v + 1) += 1;
+      (*J)(P::link_mf(k), v + 2) += 1;
+      (*J)(P::link_J(k), v) += 2 * a * mc;
+      if (mc > 0) {
+        (*J)(P::link_J(k), v) += 2 * M.dot(o) / mc - Jc / mc;
+        (*J)(P::link_J(k), v + 1) += 2 * M.x() / mc;
+        (*J)(P::link_J(k), v + 2) += 2 * M.y() / mc;
+      }
+      continue;
+    }
+    const Vec2 r = cw_pivot_in_link[c] + Vec2(x[v + 1], x[v + 2]);
     q[P::link_mass(k)] += mc;
     q[P::link_me(k)] += mc * r.x();
     q[P::link_mf(k)] += mc * r.y();
@@ -593,9 +627,11 @@ void PlanarNlp::Impl::q_of(const VectorXd& x, VectorXd& q, MatrixXd* J) const {
   }
 }
 
-PlanarNlp::PlanarNlp(const DesignProblem& problem) : impl_(std::make_unique<Impl>()) {
+PlanarNlp::PlanarNlp(const DesignProblem& problem, CounterweightVariablesAs as)
+    : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.p = problem;
+  m.moments = as == CounterweightVariablesAs::kMassMoments;
   m.p.original = cp::make_linkage(problem.original);
   m.free = std::holds_alternative<cp::FreeScene>(problem.scene);
   if (const Problem e = m.p.validate()) throw InputError("invalid design problem: " + e->text());
@@ -754,6 +790,19 @@ void PlanarNlp::inequalities(const VectorXd& x, VectorXd& c, MatrixXd* jac) cons
       case Impl::Row::Kind::kEnvelope: {
         const int v = m.cw_var[static_cast<std::size_t>(row.index)];
         const double d = m.p.counterweights[static_cast<std::size_t>(row.index)].distance_max;
+        if (m.moments) {
+          // the smoothed cone (sqrt(|p|² + δ²) - δ) / (mass_max d) - m / mass_max
+          const double mmax = m.p.counterweights[static_cast<std::size_t>(row.index)].mass_max;
+          const double pmax = mmax * d, ux = x[v + 1] / pmax, uy = x[v + 2] / pmax;
+          const double norm = std::sqrt(ux * ux + uy * uy + kConeSmoothing * kConeSmoothing);
+          c[r] = norm - kConeSmoothing - x[v] / mmax;
+          if (jac) {
+            (*jac)(r, v) = -1 / mmax;
+            (*jac)(r, v + 1) = ux / norm / pmax;
+            (*jac)(r, v + 2) = uy / norm / pmax;
+          }
+          break;
+        }
         c[r] = (x[v + 1] * x[v + 1] + x[v + 2] * x[v + 2]) / (d * d) - 1;
         if (jac) {
           (*jac)(r, v + 1) = 2 * x[v + 1] / (d * d);
@@ -826,7 +875,10 @@ std::string PlanarNlp::constraint_text(int i, const VectorXd& x) const {
   switch (row.kind) {
     case Impl::Row::Kind::kEnvelope: {
       const int v = m.cw_var[static_cast<std::size_t>(row.index)];
-      return "the counterweight's centre is " + text::digits(x.segment<2>(v + 1).norm(), 6) +
+      const double distance =
+          m.moments ? (x[v] > 0 ? x.segment<2>(v + 1).norm() / x[v] : 0.0)
+                    : x.segment<2>(v + 1).norm();
+      return "the counterweight's centre is " + text::digits(distance, 6) +
              " m from its pivot, at most " +
              text::digits(m.p.counterweights[static_cast<std::size_t>(row.index)].distance_max, 6) +
              " m";
@@ -875,8 +927,116 @@ void PlanarNlp::polish(VectorXd& x) const {
 }
 
 VectorXd PlanarNlp::start(bool original) const {
+  VectorXd x = positions_start(original);
+  if (impl_->moments) {
+    for (int v : impl_->cw_var) x.segment<2>(v + 1) *= x[v];
+  }
+  set_bound_variables(x);
+  return x;
+}
+
+VectorXd PlanarNlp::start_scaled(double fraction) const {
+  VectorXd x = start();
+  for (int v : impl_->cw_var) {
+    x[v] *= fraction;
+    if (impl_->moments) x.segment<2>(v + 1) *= fraction;
+  }
+  set_bound_variables(x);
+  return x;
+}
+
+VectorXd PlanarNlp::from_positions(const VectorXd& x) const {
+  VectorXd z = x;
+  if (impl_->moments) {
+    for (int v : impl_->cw_var) {
+      if (v + 2 < z.size()) z.segment<2>(v + 1) *= z[v];
+    }
+  }
+  return start_at(z);
+}
+
+VectorXd PlanarNlp::to_positions(const VectorXd& x) const {
   const Impl& m = *impl_;
-  VectorXd x(m.n);
+  VectorXd out = x.head(m.design_n);
+  if (!m.moments) return out;
+  for (std::size_t c = 0; c < m.cw_var.size(); ++c) {
+    const int v = m.cw_var[c];
+    out.segment<2>(v + 1) = detail::position_of(x[v], Vec2(x[v + 1], x[v + 2]),
+                                                m.p.counterweights[c].distance_max);
+  }
+  return out;
+}
+
+void PlanarNlp::first_order_inequalities(const VectorXd& x, const VectorXd& g, VectorXd& c,
+                                         MatrixXd& jac) const {
+  const Impl& m = *impl_;
+  inequalities(x, c, &jac);
+  if (!m.moments) return;
+  for (std::size_t i = 0; i < m.rows.size(); ++i) {
+    const Impl::Row& row = m.rows[i];
+    if (row.kind != Impl::Row::Kind::kEnvelope) continue;
+    const CounterweightVariables& cw = m.p.counterweights[static_cast<std::size_t>(row.index)];
+    detail::cone_first_order_row(x, g, m.cw_var[static_cast<std::size_t>(row.index)],
+                                 cw.mass_max, cw.distance_max, static_cast<Eigen::Index>(i), c,
+                                 jac);
+  }
+}
+
+std::string PlanarNlp::why_not_convex() const {
+  const Impl& m = *impl_;
+  if (m.free) return "a free scene: the motion, and with it every reaction, depends on the design";
+  // the entries of q that are not affine in the variables, and why
+  std::vector<std::pair<int, std::string>> varying;
+  for (std::size_t k = 0; k < m.p.original.links.size(); ++k) {
+    const int link = static_cast<int>(k);
+    bool mass = false, offset = false, counterweight = false;
+    for (const LinkParameterVariable& v : m.p.link_parameters) {
+      if (v.link != link) continue;
+      mass = mass || v.parameter == Param::kMass;
+      offset = offset || v.parameter == Param::kE || v.parameter == Param::kF;
+    }
+    for (const CounterweightVariables& c : m.p.counterweights) {
+      counterweight = counterweight || c.link == link;
+    }
+    const std::string name = "the " + m.p.original.links[k].name + "'s ";
+    if (counterweight) {
+      varying.emplace_back(P::link_J(link),
+                           name + "inertia about its first node, which varies with the square of "
+                                  "its counterweight's position");
+    } else if (offset) {
+      varying.emplace_back(P::link_J(link), name + "inertia about its first node, which varies "
+                                                   "with the square of its e or f");
+    }
+    if (mass && offset) {
+      for (int i : {P::link_me(link), P::link_mf(link)}) {
+        varying.emplace_back(i, name + "first moments, its mass times e or f, both varied");
+      }
+    }
+  }
+  std::vector<int> used;
+  for (std::size_t k = 0; k < m.table.size(); ++k) {
+    if (m.weight[k] > 0) used.push_back(static_cast<int>(k));
+  }
+  for (const Limit& l : m.p.limits) {
+    if (l.metric != "added_mass") used.push_back(m.metric_index(l.metric));
+  }
+  for (int k : used) {
+    for (const std::string& column : m.metric(k).columns) {
+      const MatrixXd& B = m.outputs.at(column).second;
+      const double scale = B.cwiseAbs().maxCoeff();
+      for (const auto& [i, why] : varying) {
+        if (B.col(i).cwiseAbs().maxCoeff() > 1e-9 * scale) {
+          return m.metric(k).name + " depends on " + why;
+        }
+      }
+    }
+  }
+  return "";
+}
+
+VectorXd PlanarNlp::positions_start(bool original) const {
+  const Impl& m = *impl_;
+  VectorXd x = VectorXd::Zero(m.n);
   for (std::size_t c = 0; c < m.p.counterweights.size(); ++c) {
     const CounterweightVariables& cw = m.p.counterweights[c];
     const int v = m.cw_var[c];
@@ -899,9 +1059,12 @@ VectorXd PlanarNlp::start(bool original) const {
   // feasible design at all on some linkages.
   if (!original && n_eq() > 0 && !m.p.counterweights.empty()) {
     for (int pass = 0; pass < 4; ++pass) {
-      VectorXd c;
-      MatrixXd jac;
-      equalities(x, c, &jac);
+      // the balance conditions in the positions, whatever the program's variables
+      VectorXd q, c;
+      MatrixXd dq, jac;
+      m.q_of(x, q, &dq, true);
+      c = m.balance_rows * q + m.balance_offset;
+      jac = m.balance_rows * dq;
       MatrixXd J(jac.rows(), 2 * static_cast<Eigen::Index>(m.p.counterweights.size()));
       for (std::size_t k = 0; k < m.p.counterweights.size(); ++k)
         J.middleCols(2 * static_cast<Eigen::Index>(k), 2) = jac.middleCols(m.cw_var[k] + 1, 2);
@@ -924,7 +1087,6 @@ VectorXd PlanarNlp::start(bool original) const {
       if (!moved_mass) break;
     }
   }
-  set_bound_variables(x);
   return x;
 }
 
@@ -959,6 +1121,7 @@ std::vector<bp::LinkCounterweight> PlanarNlp::counterweights(const VectorXd& x) 
     balance::Counterweight w;
     w.mass = x[v];
     w.position = Vec2(x[v + 1], x[v + 2]);
+    if (m.moments) w.position = detail::position_of(w.mass, w.position, cw.distance_max);
     w.distance = w.position.norm();
     if (cw.shape == balance::CounterweightShape::kDisc) {
       w.thickness = cw.thickness;
@@ -1106,14 +1269,16 @@ Result optimize(const DesignProblem& problem, const OptimizeOptions& options,
   if (const Problem e = options.validate()) throw InputError("optimize options: " + e->text());
   if (const Problem e = check_algorithm(problem, options)) throw InputError(*e);
   const PlanarNlp nlp(problem);
-  // the original design itself (no counterweight mass) is the second start: it meets every
-  // limit of 1 or more and any added-mass limit >= 0, where the first may be far outside
-  std::vector<VectorXd> starts;
-  for (const VectorXd& d : designs) starts.push_back(nlp.start_at(d));
-  starts.push_back(nlp.start());
-  starts.push_back(nlp.start(true));
-  detail::Solved s = detail::solve_from(nlp, starts, options);
+  // a problem convex in the counterweights' masses and mass moments solved in those variables
+  // (optimize/convex_solve.hpp); the original design itself (no counterweight mass) is the last
+  // start: it meets every limit of 1 or more and any added-mass limit >= 0
+  std::optional<PlanarNlp> convex;
+  if (nlp.why_not_convex().empty()) convex.emplace(problem, CounterweightVariablesAs::kMassMoments);
+  const detail::ConvexAwareSolve solve = detail::solve_convex_aware(nlp, convex, designs, options);
+  const detail::Solved& s = solve.solved;
   Result r;
+  r.global = solve.optimality.global && found_design(s.termination);
+  r.optimality = solve.optimality.words;
   r.algorithm = options.algorithm;
   r.termination = s.termination;
   r.message = s.message;
@@ -1141,11 +1306,6 @@ Result optimize(const DesignProblem& problem, const OptimizeOptions& options,
   r.original = nlp.original_metrics();
   r.metrics = nlp.metrics(r.x);
   r.added_mass = nlp.added_mass(r.x);
-  // the four-bar's convexity test and mass-moment variables (optimize/nlp.hpp) are not yet
-  // carried over to the general linkage: its optimum is a local one
-  r.optimality =
-      "not proven global: the general planar linkage's problems are solved in the "
-      "counterweights' positions, without the convexity test of the four-bar's";
   if (!r.ok()) return r;  // no design: nothing to verify
   // the design simulated by the engine, against the regressor's evaluation; in a free scene by
   // the other route (dae), against the reduced route's evaluations

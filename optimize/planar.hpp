@@ -100,8 +100,14 @@ class PlanarNlp final : public Program {
  public:
   /// @throws bd::InputError for an invalid problem, an original that cannot run in the scene,
   ///         or a normaliser (the original's metric) that is zero.
-  explicit PlanarNlp(const DesignProblem& problem);
+  /// With CounterweightVariablesAs::kMassMoments each counterweight's (x, y) become its mass
+  /// moment p = m (x, y) about the pivot [kg m], in [-mass_max distance_max, mass_max
+  /// distance_max], its envelope the smoothed cone (optimize/program.hpp).
+  explicit PlanarNlp(const DesignProblem& problem,
+                     CounterweightVariablesAs as = CounterweightVariablesAs::kPositions);
   ~PlanarNlp() override;
+  PlanarNlp(const PlanarNlp&) = delete;
+  PlanarNlp& operator=(const PlanarNlp&) = delete;
 
   int n() const override;
   int n_eq() const override;
@@ -118,6 +124,23 @@ class PlanarNlp final : public Program {
                     Eigen::MatrixXd* jac) const override;
   std::string constraint_text(int i, const Eigen::VectorXd& x) const override;
   void polish(Eigen::VectorXd& x) const override;
+  /// With mass-moment variables, each envelope row as |p| - m distance_max, scaled (the four-bar
+  /// Nlp's, optimize/nlp.hpp).
+  void first_order_inequalities(const Eigen::VectorXd& x, const Eigen::VectorXd& g,
+                                Eigen::VectorXd& c, Eigen::MatrixXd& jac) const override;
+  /// Empty when the problem is convex in mass-moment variables, else why not, as the four-bar
+  /// Nlp's why_not_convex() decides it: a driven scene, and no metric of the objective or the
+  /// limits with a regressor column (to 1e-9 of its largest) on a link's inertia about its first
+  /// node where a counterweight's position or the link's e or f vary, or on its first moments
+  /// where its mass and e or f vary together.
+  std::string why_not_convex() const;
+  /// A design in position variables (results' x) in this program's variables, and back (the
+  /// design variables only; positions within distance_max, the pivot where m = 0), as the
+  /// four-bar Nlp's.
+  Eigen::VectorXd from_positions(const Eigen::VectorXd& x) const;
+  Eigen::VectorXd to_positions(const Eigen::VectorXd& x) const;
+  /// start() with each counterweight's mass (and mass moment) scaled by `fraction`.
+  Eigen::VectorXd start_scaled(double fraction) const;
 
   /// The design's own variables: the first ones of x (then one bound variable per peak of the
   /// objective, t >= the peak's magnitude at every sample).
@@ -144,6 +167,8 @@ class PlanarNlp final : public Program {
 
  private:
   std::vector<double> simulated(const Eigen::VectorXd& x) const;
+  /// start()'s design variables in positions (bound variables not set).
+  Eigen::VectorXd positions_start(bool original) const;
   void set_bound_variables(Eigen::VectorXd& x) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;

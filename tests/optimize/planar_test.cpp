@@ -12,6 +12,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -283,6 +286,153 @@ TEST(PlanarOptimize, ForceBalancedSixBarsWithTheLeastShakingMoment) {
         "six-bar #%d: Msh_rms original %.4g, force balanced by the balance layer %.4g, "
         "optimum %.4g (Fsh %.2e)\n",
         i, r.original[2], fbm[2], metric_of(r, "Msh_rms", true), metric_of(r, "Fsh_rms", true));
+  }
+}
+
+// Issue 15, item 1, on the general engine: six-bars with a counterweight on each grounded link
+// and slider-cranks with one on the crank, the least RMS shaking force under an added-mass budget
+// that binds (0.3, 0.7 of the force-balanced design's added mass; a slider-crank: of the
+// least-squares design's) or not (1.5). Convex in the counterweights' masses and mass moments z:
+// Fsh = -Σ m a is affine in z (a grounded link turns about a fixed pivot and the motion is
+// prescribed). The reference is the test's own: the quadratic Fsh_rms² = z'Hz + 2g'z + c from
+// engine simulations of unit counterweights, minimised over {Σ |z_c| / D_c <= M} by projected
+// gradient. Every gradient method reaches it to 1e-6 (of the reference where the budget binds,
+// of the original where it does not), says the optimum is global, and none ends infeasible.
+struct Quadratic {
+  MatrixXd H;
+  VectorXd g;
+  double c{};
+  double rms(const VectorXd& z) const {
+    return std::sqrt(std::max(0.0, z.dot(H * z) + 2 * g.dot(z) + c));
+  }
+};
+
+Quadratic assemble(const cp::Linkage& l, const std::vector<int>& links, double speed, int samples) {
+  auto fsh = [&](const cp::Linkage& m) {
+    const cp::Trajectory t = revolution(m, {speed}, samples);
+    EXPECT_TRUE(t.ok()) << t.message;
+    const int x = t.table.column("Fshx"), y = t.table.column("Fshy");
+    VectorXd f(2 * samples);
+    for (int i = 0; i < samples; ++i) {
+      f[2 * i] = t.table.at(static_cast<std::size_t>(i), static_cast<std::size_t>(x));
+      f[2 * i + 1] = t.table.at(static_cast<std::size_t>(i), static_cast<std::size_t>(y));
+    }
+    return f;
+  };
+  const VectorXd f0 = fsh(l);
+  MatrixXd A(2 * samples, 2 * static_cast<Eigen::Index>(links.size()));
+  for (std::size_t c = 0; c < links.size(); ++c) {
+    const int k = links[c], pivot = bp::counterweight_pivot(l, k);
+    const Vec2 at = bp::in_link_axes(l, k, l.nodes[static_cast<std::size_t>(pivot)].position);
+    for (int j = 0; j < 2; ++j) {
+      const Vec2 unit = j == 0 ? Vec2(1, 0) : Vec2(0, 1);
+      cp::Linkage m = l;
+      balance::Counterweight w;
+      w.mass = 1.0;
+      w.position = unit;
+      w.distance = 1.0;
+      m.links[static_cast<std::size_t>(k)] =
+          bp::merged(l.links[static_cast<std::size_t>(k)], w, at + unit);
+      A.col(2 * static_cast<Eigen::Index>(c) + j) = fsh(cp::make_linkage(m)) - f0;
+    }
+  }
+  Quadratic q;
+  q.H = A.transpose() * A / samples;
+  q.g = A.transpose() * f0 / samples;
+  q.c = f0.squaredNorm() / samples;
+  return q;
+}
+
+// the projection onto {Σ |z_c| / D_c <= M}: each pair's length shrunk by τ / D_c, τ by bisection
+VectorXd project_on_budget(const VectorXd& y, const VectorXd& D, double M) {
+  const Eigen::Index n = D.size();
+  auto used = [&](double tau) {
+    double u = 0;
+    for (Eigen::Index c = 0; c < n; ++c)
+      u += std::max(y.segment<2>(2 * c).norm() - tau / D[c], 0.0) / D[c];
+    return u;
+  };
+  if (used(0) <= M) return y;
+  double lo = 0, hi = 0;
+  for (Eigen::Index c = 0; c < n; ++c) hi = std::max(hi, y.segment<2>(2 * c).norm() * D[c]);
+  for (int k = 0; k < 200; ++k) (used(0.5 * (lo + hi)) > M ? lo : hi) = 0.5 * (lo + hi);
+  VectorXd z = y;
+  for (Eigen::Index c = 0; c < n; ++c) {
+    const double length = y.segment<2>(2 * c).norm();
+    z.segment<2>(2 * c) *= length > 0 ? std::max(length - hi / D[c], 0.0) / length : 0.0;
+  }
+  return z;
+}
+
+VectorXd budget_minimiser(const Quadratic& q, const VectorXd& D, double M) {
+  const double L = 2 * Eigen::SelfAdjointEigenSolver<MatrixXd>(q.H).eigenvalues().maxCoeff();
+  VectorXd z = VectorXd::Zero(q.g.size());
+  for (int k = 0; k < 2'000'000; ++k) {
+    const VectorXd next = project_on_budget(z - 2 * (q.H * z + q.g) / L, D, M);
+    const bool still = (next - z).norm() <= 1e-16 * (1 + z.norm());
+    z = next;
+    if (still) break;
+  }
+  return z;
+}
+
+TEST(PlanarOptimize, ConvexBudgetProblemsReachTheIndependentGlobalOptimum) {
+  Rng rng(507);
+  for (int i = 0; i < 4; ++i) {
+    const bool six = i % 2 == 0;
+    const cp::Linkage l = unloaded(six ? six_bar_or_retry(rng, i == 2) : slider_crank(rng, i == 1),
+                                   false);
+    const double speed = six ? uniform(rng, 4, 12) : uniform(rng, 50, 300);
+    const int samples = 72;
+    const cp::Trajectory tr = revolution(l, {speed}, samples);
+    ASSERT_TRUE(tr.ok());
+    std::vector<bp::LinkCounterweightSpec> asks = bp::grounded_links(l);
+    if (!six) asks = {bp::LinkCounterweightSpec{.link = 0, .spec = {}}};
+    const bp::ForceBalance fb = bp::force_balance(l, kinematics_of(l, tr), asks);
+    op::DesignProblem p;
+    p.original = l;
+    p.scene = scene_of(speed, samples);
+    std::vector<int> links;
+    VectorXd D(static_cast<Eigen::Index>(asks.size()));
+    for (std::size_t c = 0; c < asks.size(); ++c) {
+      double farthest = 0;
+      for (const bp::LinkCounterweight& a : fb.added)
+        if (a.link == asks[c].link) farthest = a.counterweight.distance;
+      op::CounterweightVariables v;
+      v.link = asks[c].link;
+      v.distance_max = std::max(1.5 * farthest, cp::element_length(l, v.link));
+      v.mass_max = 4 * fb.added_mass + 1;
+      p.counterweights.push_back(v);
+      links.push_back(v.link);
+      D[static_cast<Eigen::Index>(c)] = v.distance_max;
+    }
+    p.objective = {{"Fsh_rms", 1.0}};
+    const Quadratic q = assemble(l, links, speed, samples);
+    const double original = std::sqrt(q.c);
+    // the least added mass of the unbounded optimum (the full or least-squares balance) at
+    // distance_max
+    const VectorXd best = q.H.completeOrthogonalDecomposition().solve(-q.g);
+    double least = 0;
+    for (Eigen::Index c = 0; c < D.size(); ++c) least += best.segment<2>(2 * c).norm() / D[c];
+    for (double fraction : {0.3, 0.7, 1.5}) {
+      p.limits = {{"added_mass", fraction * least}};
+      const double reference =
+          q.rms(fraction < 1 ? budget_minimiser(q, D, fraction * least) : best);
+      const double tolerance = fraction < 1 ? 1e-6 * reference : 1e-6 * original;
+      for (optimize::Algorithm a : {optimize::Algorithm::kSlsqp, optimize::Algorithm::kMma,
+                                    optimize::Algorithm::kIpopt}) {
+        optimize::OptimizeOptions o;
+        o.algorithm = a;
+        const op::Result r = op::optimize(p, o);
+        SCOPED_TRACE(std::string(six ? "six-bar #" : "slider-crank #") + std::to_string(i) +
+                     ", budget " + std::to_string(fraction) + " | " + r.brief_report() + " | " +
+                     r.message + " | " + r.optimality);
+        ASSERT_TRUE(r.ok());
+        EXPECT_NEAR(metric_of(r, "Fsh_rms", true), reference, tolerance);
+        EXPECT_GE(metric_of(r, "Fsh_rms", true), reference - 1e-9 * original);
+        EXPECT_TRUE(r.global);
+      }
+    }
   }
 }
 
