@@ -206,7 +206,9 @@ Study parse_study_tree(const YAML::Node& root, const std::string& source_name) {
   const Reporter r(source_name);
   StudyParser parser(r);
   try {
-    return parser.parse(root);
+    Study study = parser.parse(root);
+    study.units_read = r.units_read();
+    return study;
   } catch (const YAML::Exception& e) {
     // conversions are checked before use, so this is unexpected; still report it in place
     r.fail(e.mark, e.msg);
@@ -290,6 +292,21 @@ YAML::Node one_document(const std::string& text, const Reporter& r) {
     for (int i = 0; i < 2 && parser.HandleNextDocument(marks); ++i) {
     }
   } catch (const YAML::Exception& e) {
+    // yaml-cpp's word for a tab in the indentation is "illegal map value" or the like: name it,
+    // at the first tab in a line's indentation up to the error
+    std::istringstream lines(yaml_text);
+    std::string line;
+    for (int row = 0; std::getline(lines, line) && (e.mark.line < 0 || row <= e.mark.line);
+         ++row) {
+      const std::size_t indent = line.find_first_not_of(" \t");
+      const std::size_t tab = line.find('\t');
+      if (tab != std::string::npos && tab < indent) {
+        YAML::Mark at;
+        at.line = row;
+        at.column = static_cast<int>(tab);
+        r.fail(at, "tabs are not allowed in YAML indentation; indent with spaces");
+      }
+    }
     r.fail(e.mark, e.msg);
   }
   if (marks.starts.size() > 1) {

@@ -1,6 +1,8 @@
 // The balance-design executable: exit codes, the one-line error on stderr, outputs where asked
 // and nothing written for bad input. Needs the executable built (target balance-design).
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -369,6 +371,42 @@ TEST_F(CliTest, HelpAndVersion) {
   EXPECT_NE(out_.find("--out"), std::string::npos) << out_;
   EXPECT_EQ(run("--version"), 0);
   EXPECT_EQ(out_.rfind("balance-design ", 0), 0u) << out_;
+}
+
+// each command's help says what that command does, not the outputs of run; `help` is help
+TEST_F(CliTest, HelpPerCommand) {
+  EXPECT_EQ(run("help"), 0) << err_;
+  const std::string top = out_;
+  EXPECT_NE(top.find("Exit codes"), std::string::npos) << top;
+  EXPECT_EQ(run("--help"), 0);
+  EXPECT_EQ(out_, top);
+  EXPECT_EQ(run("help run"), 0) << err_;
+  EXPECT_NE(out_.find("balanced-timeseries.csv"), std::string::npos) << out_;
+  for (const char* command : {"validate", "report", "bench"}) {
+    EXPECT_EQ(run(std::string(command) + " --help"), 0) << command;
+    EXPECT_EQ(out_.find("balanced-timeseries.csv"), std::string::npos) << command << "\n" << out_;
+    EXPECT_LT(std::count(out_.begin(), out_.end(), '\n'), 30) << command << "\n" << out_;
+    const std::string own = out_;
+    EXPECT_EQ(run(std::string("help ") + command), 0) << command;
+    EXPECT_EQ(out_, own) << command;
+  }
+}
+
+// the output folder holds its study: `report DIR` from another directory gives the same page,
+// even when the study was given by a relative path that does not lead there
+TEST_F(CliTest, ReportFromAnotherDirectoryGivesTheSamePage) {
+  fs::copy_file(kExamples + "/paper-fourbar-driven.yaml", dir_ / "mine.yaml");
+  EXPECT_EQ(run("run mine.yaml --out res"), 0) << err_;
+  ASSERT_TRUE(fs::exists(dir_ / "res" / "study.yaml"));
+  EXPECT_EQ(read(dir_ / "res" / "study.yaml"), read(dir_ / "mine.yaml"));
+  const std::string first = read(dir_ / "res" / "report.html");
+  fs::create_directories(dir_ / "elsewhere");
+  fs::remove(dir_ / "mine.yaml");  // even with the original gone
+  EXPECT_EQ(std::system(("cd " + quote((dir_ / "elsewhere").string()) + " && " + quote(kExe) +
+                         " report ../res >/dev/null 2>&1")
+                            .c_str()),
+            0);
+  EXPECT_EQ(read(dir_ / "res" / "report.html"), first);
 }
 
 }  // namespace
