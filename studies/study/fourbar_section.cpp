@@ -305,8 +305,8 @@ core::FourBar FourBarSection::read(const MapReader::Entry& linkage, const MapRea
 
 Scene FourBarSection::read_scene(const MapReader::Entry& scene, const core::FourBar& model) {
   Scene s = impl_->read_scene(scene);
-  impl_->check_turns(model, s, scene);
   impl_->check_assembly(model, s, scene.key_mark);
+  impl_->check_turns(model, s, scene);
   return s;
 }
 

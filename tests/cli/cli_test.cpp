@@ -120,10 +120,9 @@ TEST_F(CliTest, BadCommandLineExitsTwo) {
 }
 
 TEST_F(CliTest, SimulationStoppedEarlyExitsThreeAndKeepsResults) {
-  // the crank (2.5) of this linkage cannot turn fully: the driven run stops where the loop
-  // cannot close
-  write("stops.yaml",
-        "name: stops\n"
+  // a driven crank that cannot turn fully is refused before it runs (exit 2, at scene.type)
+  write("rocks.yaml",
+        "name: rocks\n"
         "linkage:\n"
         "  type: fourbar\n"
         "  frame: 3.2\n"
@@ -132,7 +131,32 @@ TEST_F(CliTest, SimulationStoppedEarlyExitsThreeAndKeepsResults) {
         "  coupler: {length: 3.0, mass: 3.0, s: 1.45, sigma: 0.4, inertia: 3.1}\n"
         "  rocker:  {length: 2.0, mass: 2.2, s: 1.66, sigma: -0.4, inertia: 2.1}\n"
         "scene: {type: driven, theta1: 1.5707963267948966, omega1: 6.283185307179586}\n");
+  EXPECT_EQ(run("validate rocks.yaml"), 2);
+  EXPECT_EQ(err_.rfind("rocks.yaml:9:15: scene.type: driven turns the crank through whole "
+                       "revolutions, but this linkage is rocker-crank",
+                       0),
+            0u)
+      << err_;
+  // a parallelogram (a change-point linkage): its crank turns fully, but at theta1 = pi the
+  // links fold flat, a dead centre where the driven run stops
+  write("stops.yaml",
+        "name: stops\n"
+        "linkage:\n"
+        "  type: fourbar\n"
+        "  frame: 3.0\n"
+        "  branch: 1\n"
+        "  crank:   {length: 1.0, mass: 2.1, s: 0.6, sigma: 0.3, inertia: 1.1}\n"
+        "  coupler: {length: 3.0, mass: 3.0, s: 1.45, sigma: 0.4, inertia: 3.1}\n"
+        "  rocker:  {length: 1.0, mass: 2.2, s: 0.66, sigma: -0.4, inertia: 2.1}\n"
+        "scene: {type: driven, theta1: 1.5707963267948966, omega1: 6.283185307179586}\n");
   EXPECT_EQ(run("stops.yaml --out res"), 3) << err_;
+  // its metrics say they cover part of the run only
+  EXPECT_NE(out_.find("  partial  the metrics below cover only the 90 samples before the run "
+                      "stopped"),
+            std::string::npos)
+      << out_;
+  EXPECT_NE(read(dir_ / "res" / "summary.json").find("\"metrics_partial\": true"),
+            std::string::npos);
   EXPECT_EQ(err_.rfind("stops.yaml: simulation stopped early: ", 0), 0u) << err_;
   EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
   EXPECT_NE(err_.find("theta1"), std::string::npos) << err_;
