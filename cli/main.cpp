@@ -43,13 +43,15 @@ constexpr int kExitInterrupted = 5;
 
 constexpr const char* kFooter = R"(
 Outputs (in DIR, default results/<name>/ with <name> the study's `name`):
-  timeseries.csv  one row per sample: t,theta1,theta2,theta3,omega1,omega2,omega3,
-                  alpha1,alpha2,alpha3,RA0x,RA0y,RA3x,RA3y,Fshx,Fshy,Msh,tau (SI units, %.17g)
-  summary.json    study name, method used and why, scene, samples, status, metrics
-                  (Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max, RA0_rms, RA0_max,
-                  RA3_rms, RA3_max); with a balance section also balance, balanced_run,
-                  balanced_metrics and reduction (balanced / original); in a driven scene
-                  the harmonic orders of the shaking force and moment (harmonics)
+  timeseries.csv  one row per sample: t, the link angles, rates and accelerations, the
+                  support reactions, the total shaking force and moment, the drive torque, their
+                  inertial and static parts, the shafts' forces and the pin forces (SI, %.17g)
+  summary.json    study name, method used and why, scene, samples, status, metrics (of the
+                  inertial shaking force and moment, torque, reactions; the total shaking force
+                  and moment; the pin forces' peaks) and where each peak lies; with a balance
+                  section also balance, balanced_run, balanced_metrics and reduction (the ratio
+                  balanced / original: below 1 a reduction); in a driven scene the harmonic
+                  orders of the shaking force and moment (harmonics)
   harmonics.csv   a driven scene: design,order, amplitude and phase of Fshx, Fshy, Msh, and
                   the force's parts turning with and against the input, orders 0 to 8
   A planar linkage's timeseries.csv and metrics name its links, nodes, joints and inputs
@@ -81,6 +83,10 @@ Outputs (in DIR, default results/<name>/ with <name> the study's `name`):
   Options of a sweep run: --resume, --threads N, --progress auto|bar|lines|none.
   Files are written under a temporary name and renamed, so none is ever half-written.
 
+The study-file format is described in docs/study-format.md; examples are in studies/examples/.
+)";
+
+constexpr const char* kExitCodes = R"(
 Exit codes:
   0  the study ran to the end
   1  unexpected internal error (or the output files could not be written)
@@ -95,8 +101,6 @@ Exit codes:
   5  sweep interrupted (Ctrl-C or SIGTERM): the rows of the points finished are kept in
      sweep.csv; run again with --resume to compute the rest. A sweep whose points fail still
      exits 0: each failure is its row's status
-
-The study-file format is described in docs/study-format.md; examples are in studies/examples/.
 )";
 
 // one line on stderr: control characters in `text` (from a file, a key, a message) escaped
@@ -186,7 +190,10 @@ int report(const std::string& dir) {
     std::fprintf(stderr, "%s: no summary.json here: not the output folder of a run\n", dir.c_str());
     return kExitBadInput;
   }
-  const std::string source = summary_source(summary);
+  // the study as the run read it: its copy in DIR (written by every run), else the file
+  // summary.json names
+  const fs::path copy = fs::path(dir) / "study.yaml";
+  const std::string source = fs::exists(copy) ? copy.string() : summary_source(summary);
   if (source.empty()) {
     std::fprintf(stderr,
                  "%s: summary.json names no study file (\"source\"), so the report "
@@ -224,13 +231,33 @@ struct RunArgs {
 };
 
 // before / after / ratio of the main metrics, added mass and inertia
+// true when the study has weights or applied loads, so that the total shaking force and moment
+// differ from their inertial parts (without, the terminal leaves the equal totals out)
+bool has_static_part(const st::Study& study) {
+  if (study.is_fourbar()) {
+    const bd::core::Loads& l = study.fourbar().loads;
+    for (const bd::core::LinkLoad* k : {&l.crank, &l.coupler, &l.rocker}) {
+      if (k->force != bd::Vec2(0, 0) || k->moment != 0) return true;
+    }
+    return l.gravity != bd::Vec2(0, 0);
+  }
+  const bd::core::planar::Loads& l = study.planar().loads;
+  return l.gravity != bd::Vec2(0, 0) || !l.node_forces.empty() || !l.link_loads.empty();
+}
+
+bool is_total(const std::string& metric) {
+  return metric.rfind("Fsh_total", 0) == 0 || metric.rfind("Msh_total", 0) == 0;
+}
+
 void print_comparison(const st::Study& study, const st::RunResult& r) {
   const std::vector<st::ComparisonRow> rows = st::comparison(study, r);
   int width = 14;  // the metric column, as wide as the longest name (a shaft's bearing force)
   for (const st::ComparisonRow& row : rows)
     width = std::max(width, static_cast<int>(row.metric.size()));
   std::printf("  %-*s %14s %14s %12s\n", width, "metric", "before", "after", "ratio");
+  const bool totals = has_static_part(study);
   for (const st::ComparisonRow& row : rows) {
+    if (!totals && is_total(row.metric)) continue;
     if (row.ratio) {
       std::printf("  %-*s %14.6g %14.6g %12.4g\n", width, row.metric.c_str(), row.before, row.after,
                   *row.ratio);
@@ -461,20 +488,26 @@ void print_scene(const st::Study& study) {
 }
 
 // the metrics in pairs (RMS, then peak, per quantity); a peak alone on its own line
-void print_metrics(const st::MetricList& metrics, bool driven) {
+void print_metrics(const st::MetricList& metrics, bool driven, bool totals) {
   for (std::size_t k = 0; k < metrics.size(); ++k) {
     const st::MetricValue& m = metrics[k];
-    const std::string symbol = m.name.substr(0, m.name.rfind('_'));
+    if (!totals && is_total(m.name)) continue;
+    std::string symbol = m.name.substr(0, m.name.rfind('_'));
     if (symbol.rfind("tau", 0) == 0 && !driven) continue;  // 0 in free motion without a drive
+    // Fsh, Msh: the inertial part; Fsh_total, Msh_total: weights and loads included
+    const bool total = symbol.ends_with("_total");
+    if (total) symbol.resize(symbol.size() - 6);
+    const char* what = total ? "total " : "";
     const bool pair = k + 1 < metrics.size() && m.name.size() > 4 &&
                       m.name.compare(m.name.size() - 4, 4, "_rms") == 0;
     if (pair) {
       const st::MetricValue& peak = metrics[k + 1];
-      std::printf("  %-8s rms %.6g %s, max %.6g %s\n", ("|" + symbol + "|").c_str(), m.value,
-                  m.unit.c_str(), peak.value, peak.unit.c_str());
+      std::printf("  %-8s %srms %.6g %s, max %.6g %s\n", ("|" + symbol + "|").c_str(), what,
+                  m.value, m.unit.c_str(), peak.value, peak.unit.c_str());
       ++k;
     } else {
-      std::printf("  %-8s max %.6g %s\n", ("|" + symbol + "|").c_str(), m.value, m.unit.c_str());
+      std::printf("  %-8s %smax %.6g %s\n", ("|" + symbol + "|").c_str(), what, m.value,
+                  m.unit.c_str());
     }
   }
 }
@@ -490,7 +523,11 @@ void print_summary(const st::Study& study, const st::RunResult& r) {
                 status.rhs_evaluations);
   }
   std::printf("\n");
-  print_metrics(r.metric_list, !st::is_free(study.scene));
+  if (!status.ok()) {
+    std::printf("  partial  the metrics below cover only the %zu samples before the run stopped\n",
+                status.samples);
+  }
+  print_metrics(r.metric_list, !st::is_free(study.scene), has_static_part(study));
   if (study.balance && r.balanced) print_balance(study, r);
   if (study.planar_balance && r.balanced) print_planar_balance(study, r);
   if (study.optimize && r.optimized) print_optimize(study, r);
@@ -717,6 +754,13 @@ int bench(const BenchArgs& args) {
 // `balance-design STUDY.yaml ...` is short for `balance-design run STUDY.yaml ...`
 std::vector<std::string> with_default_command(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
+  // `balance-design help` is --help; `balance-design help COMMAND` is COMMAND --help
+  if (!args.empty() && args.front() == "help") {
+    args.erase(args.begin());
+    if (args.size() > 1) args.resize(1);
+    args.push_back("--help");
+    if (args.front() == "--help") return args;
+  }
   if (!args.empty()) {
     const std::string& first = args.front();
     const bool top_level = first == "run" || first == "validate" || first == "report" ||
@@ -782,7 +826,8 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& bench_args) {
 int main(int argc, char** argv) {
   try {
     CLI::App app{std::string("balance-design ") + BD_VERSION + kDescription, "balance-design"};
-    app.footer(kFooter);
+    // each command's help says what that command does: the outputs belong to run's, the exit
+    // codes to the program's and run's (CLI11 copies a footer set now into every subcommand)
     app.set_version_flag("--version", std::string("balance-design ") + BD_VERSION);
     app.require_subcommand(1);
 
@@ -790,7 +835,7 @@ int main(int argc, char** argv) {
     CLI::App* run_cmd = app.add_subcommand(
         "run", "load STUDY.yaml, check it, simulate its scene and write the outputs into DIR");
     add_run_options(*run_cmd, args);
-    run_cmd->footer(kFooter);
+    run_cmd->footer(std::string(kFooter) + kExitCodes);
 
     std::string validate_file;
     CLI::App* validate_cmd = app.add_subcommand(
@@ -807,6 +852,13 @@ int main(int argc, char** argv) {
 
     BenchArgs bench_args;
     CLI::App* bench_cmd = add_bench_command(app, bench_args);
+    app.footer(std::string(kFooter) + kExitCodes +
+               "\nbalance-design COMMAND --help (or balance-design help COMMAND) says what one "
+               "command does.\n");
+    validate_cmd->footer("\nExit codes: 0 the study is valid (one ok line), 2 it is not (one "
+                         "line FILE:LINE:COLUMN: message on stderr).\n");
+    report_cmd->footer("\nDIR may be given from anywhere. Exit codes: 0 the page was written, "
+                       "1 it could not be, 2 DIR holds no run.\n");
 
     std::vector<std::string> argv_rest = with_default_command(argc, argv);
     if (argv_rest.empty()) {

@@ -3,6 +3,11 @@
 /// four-bar, core/planar/metrics.hpp for general planar linkages): each metric summarises one
 /// magnitude over a run's samples, as its RMS or its peak. Every table lists, per quantity, the
 /// RMS and then the peak.
+///
+/// The shaking force Fsh and moment Msh of every table are their inertial parts (-Σ m a and
+/// -dH/dt: what balancing acts on, zero for a balanced design whatever its weight and loads).
+/// What the frame feels in all, the weights and the applied loads included, follows every
+/// table's own metrics as the total metrics below.
 #include <cmath>
 #include <cstddef>
 
@@ -51,6 +56,26 @@ class RmsAccumulator {
   double plain_ = 0.0;
   double scale_ = 0.0;   // the largest |x| so far
   double scaled_ = 0.0;  // Σ (x / scale_)²
+};
+
+/// One of the total shaking force's and moment's metrics (inertial and static parts together).
+struct TotalMetricInfo {
+  const char* name;   // summary.json key, CSV column and row
+  const char* unit;   // "N" or "N m"
+  const char* words;  // for tables and help
+  bool force;         // the force |Fsh| (else the moment |Msh|)
+  Statistic statistic;
+};
+/// The total metrics, in the order every table lists them after its own.
+inline constexpr TotalMetricInfo kTotalMetrics[] = {
+    {"Fsh_total_rms", "N", "RMS of the total shaking force |Fsh|, weights and loads included",
+     true, Statistic::kRms},
+    {"Fsh_total_max", "N", "peak of the total shaking force |Fsh|, weights and loads included",
+     true, Statistic::kMax},
+    {"Msh_total_rms", "N m", "RMS of the total shaking moment |Msh|, weights and loads included",
+     false, Statistic::kRms},
+    {"Msh_total_max", "N m", "peak of the total shaking moment |Msh|, weights and loads included",
+     false, Statistic::kMax},
 };
 
 }  // namespace bd::core

@@ -21,14 +21,16 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-// Outputs of one sample: RA0x, RA0y, RA3x, RA3y, Fshx, Fshy, Msh, tau.
-constexpr int kOutputs = 8;
-using Vec8 = Eigen::Matrix<double, kOutputs, 1>;
+// Outputs of one sample: RA0x, RA0y, RA3x, RA3y, Fshx, Fshy, Msh (the inertial parts, which the
+// metrics take), tau, and the total Fshx, Fshy, Msh (weights and loads included).
+constexpr int kOutputs = 11;
+using VecOut = Eigen::Matrix<double, kOutputs, 1>;
 
-// Output groups of the metrics: their first row and row count.
-enum Group { kFsh, kMsh, kTau, kRA0, kRA3, kGroups };
-constexpr int kGroupFirst[kGroups] = {4, 6, 7, 0, 2};
-constexpr int kGroupRows[kGroups] = {2, 1, 1, 2, 2};
+// Output groups of the metrics, and of the total shaking force and moment: their first row and
+// row count.
+enum Group { kFsh, kMsh, kTau, kRA0, kRA3, kFshTotal, kMshTotal, kGroups };
+constexpr int kGroupFirst[kGroups] = {4, 6, 7, 0, 2, 8, 10};
+constexpr int kGroupRows[kGroups] = {2, 1, 1, 2, 2, 2, 1};
 
 // the output group of a reaction metric's quantity
 int group_of(Metric m) {
@@ -49,9 +51,10 @@ int group_of(Metric m) {
 }
 
 // The outputs of one dynamics sample.
-Vec8 outputs(const core::DynamicsSample& s) {
-  Vec8 y;
-  y << s.RA0.x(), s.RA0.y(), s.RA3.x(), s.RA3.y(), s.Fsh.x(), s.Fsh.y(), s.Msh, s.tau;
+VecOut outputs(const core::DynamicsSample& s) {
+  VecOut y;
+  y << s.RA0.x(), s.RA0.y(), s.RA3.x(), s.RA3.y(), s.Fsh_inertial.x(), s.Fsh_inertial.y(),
+      s.Msh_inertial, s.tau, s.Fsh.x(), s.Fsh.y(), s.Msh;
   return y;
 }
 
@@ -112,7 +115,7 @@ class DrivenNlp final : public NlpProgram {
   VecQ box_bounds() const;
   void bound_peaks();
   core::FourBar model_at(const VecQ& q, double th1, double th2, double th3) const;
-  Vec8 sample_outputs(const VecQ& q, double th1, double th2, double th3) const;
+  VecOut sample_outputs(const VecQ& q, double th1, double th2, double th3) const;
   core::Trajectory trajectory_of(const VecQ& q) const;
   double rms_squared(int g, const VecQ& q) const;
   double peak(int g, const VecQ& q) const;
@@ -243,12 +246,12 @@ void DrivenNlp::build_regressor() {
     const double th1 = theta1_[static_cast<std::size_t>(i)];
     const auto pose = core::solve_position(problem_.original, th1);
     if (!pose) throw InputError("the driven scene cannot be evaluated: " + pose.error().what());
-    const Vec8 y0 = sample_outputs(q0, th1, pose->theta2, pose->theta3);
-    Vec8 affine = y0;
+    const VecOut y0 = sample_outputs(q0, th1, pose->theta2, pose->theta3);
+    VecOut affine = y0;
     for (int j : columns) {
       VecQ qj = q0;
       qj(j) += 1.0;
-      const Vec8 yj = sample_outputs(qj, th1, pose->theta2, pose->theta3);
+      const VecOut yj = sample_outputs(qj, th1, pose->theta2, pose->theta3);
       Y.block<kOutputs, 1>(kOutputs * i, j) = yj - y0;
       affine -= (yj - y0) * q0(j);
     }
@@ -316,7 +319,7 @@ core::FourBar DrivenNlp::model_at(const VecQ& q, double th1, double th2, double 
 
 // The outputs for q at crank angle th1 with the sample's link angles th2, th3 (for moving the
 // applied forces to ρ).
-Vec8 DrivenNlp::sample_outputs(const VecQ& q, double th1, double th2, double th3) const {
+VecOut DrivenNlp::sample_outputs(const VecQ& q, double th1, double th2, double th3) const {
   const auto s = core::inverse_dynamics(model_at(q, th1, th2, th3), th1, scene().omega1, 0.0,
                                         problem_.formulation);
   if (!s) throw InputError("the driven scene cannot be evaluated: " + s.error().what());
@@ -434,8 +437,10 @@ core::Trajectory DrivenNlp::trajectory_of(const VecQ& q) const {
     s.state.omega1 = scene().omega1;
     s.RA0 = y[kRA0].segment<2>(2 * i);
     s.RA3 = y[kRA3].segment<2>(2 * i);
-    s.Fsh = y[kFsh].segment<2>(2 * i);
-    s.Msh = y[kMsh](i);
+    s.Fsh_inertial = y[kFsh].segment<2>(2 * i);
+    s.Msh_inertial = y[kMsh](i);
+    s.Fsh = y[kFshTotal].segment<2>(2 * i);
+    s.Msh = y[kMshTotal](i);
     s.tau = y[kTau](i);
   }
   t.status = core::SimulationStatus::kCompleted;

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "core/fourbar/complex_masses.hpp"
+#include "core/fourbar/kinematics.hpp"
 #include "core/fourbar/counter_rotation.hpp"
 #include "core/fourbar/detail/formulation_support.hpp"
 #include "core/fourbar/detail/instant_dynamics.hpp"
@@ -34,8 +35,46 @@ const char* to_string(Formulation f) {
   return "?";
 }
 
-Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model, double theta1,
-                                                         double omega1, Formulation f) {
+void set_derived_outputs(const FourBar& model, DynamicsSample& s) {
+  const Pose pose = pose_of(s.state);
+  s.Fsh_inertial = Vec2(0, 0);
+  s.Msh_inertial = 0.0;
+  s.Fsh_static = Vec2(0, 0);
+  s.Msh_static = 0.0;
+  const double alpha[] = {s.state.alpha1, s.state.alpha2, s.state.alpha3};
+  Vec2 net[3];  // per link: m a - (F + m g), what the joints, supports and gears must supply
+  for (int k = 1; k <= 3; ++k) {
+    const Link& l = link(model, k);
+    const LinkLoad& load = link_load(model, k);
+    const Vec2 c = centre_of_mass(model, k, pose);
+    const Vec2 ma = l.mass * centre_of_mass_acceleration(model, k, s.state);
+    // H about A0 = Σ (c × m v + I ω), so dH/dt = Σ (c × m a + I α)
+    s.Fsh_inertial -= ma;
+    s.Msh_inertial -= cross(c, ma) + l.inertia * alpha[k - 1];
+    const Vec2 f = load.force + l.mass * model.loads.gravity;
+    s.Fsh_static += f;
+    s.Msh_static += cross(c, f) + load.moment;
+    net[k - 1] = ma - f;
+  }
+  // the crank: net = -RA0 - RC1 - FA1 (its support, its gear, the coupler); the rocker:
+  // net = -RA3 - RC3 + FA2
+  s.FA1 = -net[0] - s.RA0 - s.RC1;
+  s.FA2 = net[2] + s.RA3 + s.RC3;
+  // a disc turns at minus its link's rate about a shaft fixed in the frame: -dH/dt = +J α_link
+  s.Msh_inertial += model.counter_rotations.crank.inertia * s.state.alpha1 +
+                    model.counter_rotations.rocker.inertia * s.state.alpha3;
+}
+
+namespace {
+
+Expected<DynamicsSample, DynamicsError> with_parts(const FourBar& model,
+                                                   Expected<DynamicsSample, DynamicsError> s) {
+  if (s) set_derived_outputs(model, *s);
+  return s;
+}
+
+Expected<DynamicsSample, DynamicsError> forward_of(const FourBar& model, double theta1,
+                                                   double omega1, Formulation f) {
   if (has_counter_rotations(model)) return forward_dynamics_with_discs(model, theta1, omega1, f);
   switch (f) {
     case Formulation::kOpenedLoop:
@@ -48,9 +87,8 @@ Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model, d
   return forward_dynamics_mass_matrix(model, theta1, omega1);
 }
 
-Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model, double theta1,
-                                                         double omega1, double alpha1,
-                                                         Formulation f) {
+Expected<DynamicsSample, DynamicsError> inverse_of(const FourBar& model, double theta1,
+                                                   double omega1, double alpha1, Formulation f) {
   if (has_counter_rotations(model)) {
     return inverse_dynamics_with_discs(model, theta1, omega1, alpha1, f);
   }
@@ -63,6 +101,19 @@ Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model, d
       break;
   }
   return inverse_dynamics_mass_matrix(model, theta1, omega1, alpha1);
+}
+
+}  // namespace
+
+Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model, double theta1,
+                                                         double omega1, Formulation f) {
+  return with_parts(model, forward_of(model, theta1, omega1, f));
+}
+
+Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model, double theta1,
+                                                         double omega1, double alpha1,
+                                                         Formulation f) {
+  return with_parts(model, inverse_of(model, theta1, omega1, alpha1, f));
 }
 
 namespace detail {

@@ -23,7 +23,26 @@ struct DynamicsSample {
   /// shaking moment on the frame about A0: l4·RA3y - tau + at1 × RC1 + at3 × RC3 [N m]
   double Msh{};
   double tau{};  // drive torque on the crank from the frame [N m] (0 in free motion)
+  /// The joint forces between moving links (set_derived_outputs()), each named after its joint:
+  /// the force of the first link on the second.
+  Vec2 FA1{0, 0};  // on the coupler at A1 from the crank [N]
+  Vec2 FA2{0, 0};  // on the rocker at A2 from the coupler [N]
+  /// The shaking force and moment split by their cause (set_derived_outputs(); Fsh = Fsh_inertial +
+  /// Fsh_static and Msh = Msh_inertial + Msh_static to round-off, by Newton's law on the moving
+  /// parts). The inertial part is what balancing acts on; the static part does not change with
+  /// the motion's speed.
+  Vec2 Fsh_inertial{0, 0};  // -Σ m a over the links' centres of mass [N]
+  double Msh_inertial{};    // -dH/dt about A0, counter-rotating discs included [N m]
+  Vec2 Fsh_static{0, 0};    // the weights and the applied forces [N]
+  double Msh_static{};      // their moment about A0 and the applied moments [N m]
 };
+
+/// Sets the outputs of s derived from its state (angles, rates, accelerations), its reactions
+/// and the model's masses and loads: the inertial and static parts of the shaking force and
+/// moment, and the joint forces FA1, FA2 (Newton's law on the crank and on the rocker).
+/// forward_dynamics(), inverse_dynamics() and the simulations call it on every sample they
+/// return.
+void set_derived_outputs(const FourBar& model, DynamicsSample& s);
 
 /// |sin(theta3 - theta2)| below this counts as a singular (dead-centre) position, and the dynamics
 /// returns kSingular instead of a number. Near a dead centre theta1 is an ill-conditioned input:

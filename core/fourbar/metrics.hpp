@@ -3,27 +3,36 @@
 /// summarises and how (RMS over the samples or the largest magnitude). Every layer that names,
 /// orders or computes a metric (the optimiser, the runner's files, sweeps, reports and the
 /// command line) reads this table, so all of them list the metrics in one order.
+#include <cmath>
 #include <cstddef>
 #include <string_view>
 
+#include <vector>
+
 #include "core/fourbar/simulate.hpp"
 #include "core/metrics.hpp"
+#include "core/peaks.hpp"
 
 namespace bd::core {
 
 /// RMS over samples and maximum of magnitudes.
 struct Metrics {
-  double Fsh_rms{}, Fsh_max{};  // |F̄sh| [N]
-  double Msh_rms{}, Msh_max{};  // |Msh| [N m]
+  double Fsh_rms{}, Fsh_max{};  // |F̄sh|, its inertial part [N]
+  double Msh_rms{}, Msh_max{};  // |Msh|, its inertial part [N m]
   double tau_rms{}, tau_max{};  // |tau| [N m]
   double RA0_rms{}, RA0_max{};  // |R̄A0| [N]
   double RA3_rms{}, RA3_max{};  // |R̄A3| [N]
+  /// Outputs that are not rows of the table (kOutputMetrics): the total shaking force and moment
+  /// (core::kTotalMetrics) and the joint forces' peaks.
+  double Fsh_total_rms{}, Fsh_total_max{};  // |F̄sh| [N]
+  double Msh_total_rms{}, Msh_total_max{};  // |Msh| [N m]
+  double FA1_max{}, FA2_max{};              // |F̄A1|, |F̄A2| [N]
 };
 
 /// The magnitude a metric summarises, one value per sample.
 enum class Quantity {
-  kShakingForce,   // |F̄sh| [N]
-  kShakingMoment,  // |Msh| [N m]
+  kShakingForce,   // |F̄sh|, its inertial part [N]
+  kShakingMoment,  // |Msh|, its inertial part [N m]
   kDriveTorque,    // |tau| [N m]
   kReactionA0,     // |R̄A0|, the crank's support [N]
   kReactionA3,     // |R̄A3|, the rocker's support [N]
@@ -42,13 +51,13 @@ struct MetricInfo {
 /// The metrics, in the one order every file and table uses: per quantity its RMS, then its
 /// peak.
 inline constexpr MetricInfo kMetricTable[] = {
-    {"Fsh_rms", "N", "RMS of the shaking force |Fsh|", Quantity::kShakingForce, Statistic::kRms,
-     &Metrics::Fsh_rms},
-    {"Fsh_max", "N", "peak of the shaking force |Fsh|", Quantity::kShakingForce, Statistic::kMax,
-     &Metrics::Fsh_max},
-    {"Msh_rms", "N m", "RMS of the shaking moment |Msh|", Quantity::kShakingMoment, Statistic::kRms,
-     &Metrics::Msh_rms},
-    {"Msh_max", "N m", "peak of the shaking moment |Msh|", Quantity::kShakingMoment,
+    {"Fsh_rms", "N", "RMS of the inertial shaking force |Fsh|", Quantity::kShakingForce,
+     Statistic::kRms, &Metrics::Fsh_rms},
+    {"Fsh_max", "N", "peak of the inertial shaking force |Fsh|", Quantity::kShakingForce,
+     Statistic::kMax, &Metrics::Fsh_max},
+    {"Msh_rms", "N m", "RMS of the inertial shaking moment |Msh|", Quantity::kShakingMoment,
+     Statistic::kRms, &Metrics::Msh_rms},
+    {"Msh_max", "N m", "peak of the inertial shaking moment |Msh|", Quantity::kShakingMoment,
      Statistic::kMax, &Metrics::Msh_max},
     {"tau_rms", "N m", "RMS of the drive torque |tau|", Quantity::kDriveTorque, Statistic::kRms,
      &Metrics::tau_rms},
@@ -71,7 +80,52 @@ const MetricInfo* metric_info(std::string_view name);
 /// The magnitude of `quantity` at one sample.
 double magnitude(const DynamicsSample& sample, Quantity quantity);
 
-/// Metrics over the trajectory's samples (all zero when it has none).
+/// A metric every output lists after the table's, which the optimiser does not take: the total
+/// shaking force and moment (core::kTotalMetrics, in its order), then the peaks of the joint
+/// forces between moving links.
+struct OutputMetricInfo {
+  const char* name;
+  const char* unit;
+  const char* words;
+  Statistic statistic;
+  double Metrics::*field;
+  double (*magnitude)(const DynamicsSample&);
+};
+inline constexpr OutputMetricInfo kOutputMetrics[] = {
+    {kTotalMetrics[0].name, kTotalMetrics[0].unit, kTotalMetrics[0].words, Statistic::kRms,
+     &Metrics::Fsh_total_rms, [](const DynamicsSample& s) { return magnitude(s.Fsh.x(), s.Fsh.y()); }},
+    {kTotalMetrics[1].name, kTotalMetrics[1].unit, kTotalMetrics[1].words, Statistic::kMax,
+     &Metrics::Fsh_total_max, [](const DynamicsSample& s) { return magnitude(s.Fsh.x(), s.Fsh.y()); }},
+    {kTotalMetrics[2].name, kTotalMetrics[2].unit, kTotalMetrics[2].words, Statistic::kRms,
+     &Metrics::Msh_total_rms, [](const DynamicsSample& s) { return std::abs(s.Msh); }},
+    {kTotalMetrics[3].name, kTotalMetrics[3].unit, kTotalMetrics[3].words, Statistic::kMax,
+     &Metrics::Msh_total_max, [](const DynamicsSample& s) { return std::abs(s.Msh); }},
+    {"FA1_max", "N", "peak of the joint force |FA1| (crank on coupler)", Statistic::kMax,
+     &Metrics::FA1_max, [](const DynamicsSample& s) { return magnitude(s.FA1.x(), s.FA1.y()); }},
+    {"FA2_max", "N", "peak of the joint force |FA2| (coupler on rocker)", Statistic::kMax,
+     &Metrics::FA2_max, [](const DynamicsSample& s) { return magnitude(s.FA2.x(), s.FA2.y()); }},
+};
+
+/// Where the peaks of a run lie: per row of kMetricTable (RMS rows: their value and t = 0),
+/// and per row of kOutputMetrics.
+struct PeakList {
+  std::vector<Peak> table, output;
+};
+
+/// Metrics over the trajectory's samples (all zero when it has none): peaks are the largest
+/// samples.
 Metrics metrics(const Trajectory& trajectory);
+
+/// The same, with the peaks' places: each the largest sample.
+Metrics metrics(const Trajectory& trajectory, PeakList* peaks);
+
+/// Metrics of a driven run of `model` in `scene` (the run's samples in `trajectory`, computed by
+/// `formulation`) with every peak resolved between the samples: maximised over time by the exact
+/// inverse dynamics at the refined crank angle (core/peaks.hpp), so that it no longer depends on
+/// the sample count. A run of whole revolutions is periodic (the last sample's neighbour is the
+/// first); a run that stopped early is resolved within its time span. `peaks`, when given,
+/// receives where each lies.
+Metrics metrics(const FourBar& model, const DrivenScene& scene, const Trajectory& trajectory,
+                Formulation formulation, PeakList* peaks = nullptr);
 
 }  // namespace bd::core

@@ -133,6 +133,7 @@ void fail(Trajectory& out, const DynamicsError& error, double t, double theta1) 
 // What the integrator's right-hand side needs, and what it saw when the dynamics failed.
 struct FreeMotion {
   const FourBar* model{};
+  DynamicsConstants constants;  // of *model
   Formulation formulation{};
   long evaluations{};     // forward_dynamics calls (right-hand side and samples)
   bool rhs_failed{};      // a right-hand side failed since the last reset
@@ -149,7 +150,8 @@ int free_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) {
   const double* x = N_VGetArrayPointer(y);
   const double theta1 = x[0], omega1 = x[1];
   ++motion.evaluations;
-  const auto sample = forward_dynamics(*motion.model, theta1, omega1, motion.formulation);
+  const auto sample =
+      detail::forward_dynamics(*motion.model, motion.constants, theta1, omega1, motion.formulation);
   if (!sample || at_dead_centre(*sample, 0.1 * kDeadCentreSin, motion.error)) {
     motion.rhs_failed = true;
     if (!sample) motion.error = sample.error();
@@ -280,7 +282,9 @@ Trajectory simulate_free_opened_loop(const FourBar& model, const FreeScene& scen
                                      const SimulateOptions& options) {
   const OpenedLoopDaeOptions dae = opened_loop_dae_options(options);
   if (!has_counter_rotations(model)) {
-    return simulate_opened_loop_dae(model, scene, dae).trajectory;
+    Trajectory out = simulate_opened_loop_dae(model, scene, dae).trajectory;
+    for (DynamicsSample& s : out.samples) set_derived_outputs(model, s);
+    return out;
   }
   // discs: the motion from the equations with I_k + J_k, then each sample's reactions from the
   // bare linkage loaded by the mesh forces at the sample's own state
@@ -298,6 +302,7 @@ Trajectory simulate_free_opened_loop(const FourBar& model, const FreeScene& scen
     }
     out.samples[i] = with_shaft_reactions(model, *bare, f);
   }
+  for (DynamicsSample& s : out.samples) set_derived_outputs(model, s);
   return out;
 }
 
@@ -392,6 +397,7 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
 
   FreeMotion motion;
   motion.model = &model;
+  motion.constants = dynamics_constants(model);
   motion.formulation = options.formulation;
 
   // the initial sample; a start outside the workspace or on a singular position stops here
@@ -498,6 +504,7 @@ Trajectory simulate_driven(const FourBar& model, const DrivenScene& scene,
       fail(out, *error, t, theta1);
       break;
     }
+    if (!constants.counter_rotations) set_derived_outputs(model, sample);
     FourBarState& state = sample.state;
     const double wrapped2 = state.theta2, wrapped3 = state.theta3;
     if (j > 0 && short_steps) {

@@ -105,6 +105,8 @@ void resize(Instant& in, const Model& m) {
   in.guide_reaction.assign(m.frame_guides().size(), Vec2(0, 0));
   in.joint_force.assign(m.joints().size(), Vec2(0, 0));
   in.shaft_reaction.assign(l.shafts.size(), Vec2(0, 0));
+  in.spring_reaction.assign(m.frame_springs().size(), Vec2(0, 0));
+  in.drive_reaction.assign(m.frame_drives().size(), Vec2(0, 0));
 }
 
 bool finite(const VectorXd& v) { return v.allFinite(); }
@@ -121,6 +123,17 @@ Model::Model(const Linkage& linkage) : system_(std::make_unique<System>(make_lin
   }
   for (std::size_t k = 0; k < l.sliders.size(); ++k) {
     if (l.sliders[k].link < 0) frame_guides_.push_back(static_cast<int>(k));
+  }
+  for (std::size_t k = 0; k < l.springs.size(); ++k) {
+    const Spring& sp = l.springs[k];
+    if (l.nodes[static_cast<std::size_t>(sp.a)].ground ||
+        l.nodes[static_cast<std::size_t>(sp.b)].ground)
+      frame_springs_.push_back(static_cast<int>(k));
+  }
+  for (std::size_t k = 0; k < l.inputs.size(); ++k) {
+    const Input& in = l.inputs[k];
+    if (in.kind == Input::Kind::kSlide && l.sliders[static_cast<std::size_t>(in.slider)].link < 0)
+      frame_drives_.push_back(static_cast<int>(k));
   }
   for (std::size_t i = 0; i < l.nodes.size(); ++i) {
     if (l.nodes[i].ground) continue;
@@ -156,6 +169,8 @@ Model::Model(const Model& other)
     : system_(std::make_unique<System>(*other.system_)),
       ground_nodes_(other.ground_nodes_),
       frame_guides_(other.frame_guides_),
+      frame_springs_(other.frame_springs_),
+      frame_drives_(other.frame_drives_),
       joints_(other.joints_),
       length_scale_(other.length_scale_) {}
 Model& Model::operator=(const Model& other) {
@@ -545,24 +560,26 @@ void frame_forces(const Model& model, Workspace& ws) {
     in.guide_reaction[i] = -ws.lambda[sl.row] * sl.normal;
     on_frame(in.guide_reaction[i], in.x[static_cast<std::size_t>(sl.node)]);
   }
+  std::size_t drive = 0;
   for (const System::InputRow& ir : s.inputs) {
     const double e = in.effort[static_cast<std::size_t>(ir.input)];
     if (ir.angle) {
       in.Msh -= e;  // the drive's stator reacts on the frame
     } else {
       const System::SliderRow& sl = s.sliders[static_cast<std::size_t>(ir.slider)];
-      if (!sl.on_link) on_frame(-e * sl.unit, in.x[static_cast<std::size_t>(sl.node)]);
+      if (!sl.on_link) {
+        in.drive_reaction[drive++] = -e * sl.unit;
+        on_frame(-e * sl.unit, in.x[static_cast<std::size_t>(sl.node)]);
+      }
     }
   }
-  for (std::size_t k = 0; k < l.springs.size(); ++k) {
-    const Spring& sp = l.springs[k];
-    const detail::SpringState st = detail::spring_state(s, static_cast<int>(k), in.x, in.v);
-    if (l.nodes[static_cast<std::size_t>(sp.a)].ground) {
-      on_frame(st.tension * st.unit, in.x[static_cast<std::size_t>(sp.a)]);
-    }
-    if (l.nodes[static_cast<std::size_t>(sp.b)].ground) {
-      on_frame(-st.tension * st.unit, in.x[static_cast<std::size_t>(sp.b)]);
-    }
+  for (std::size_t j = 0; j < model.frame_springs().size(); ++j) {
+    const int k = model.frame_springs()[j];
+    const Spring& sp = l.springs[static_cast<std::size_t>(k)];
+    const detail::SpringState st = detail::spring_state(s, k, in.x, in.v);
+    const bool at_a = l.nodes[static_cast<std::size_t>(sp.a)].ground;
+    in.spring_reaction[j] = (at_a ? st.tension : -st.tension) * st.unit;
+    on_frame(in.spring_reaction[j], in.x[static_cast<std::size_t>(at_a ? sp.a : sp.b)]);
   }
   for (std::size_t j = 0; j < model.joints().size(); ++j) {
     in.joint_force[j] = f(model.joints()[j].link, model.joints()[j].node);
@@ -570,34 +587,55 @@ void frame_forces(const Model& model, Workspace& ws) {
   shaft_forces(model, in, on_frame);
 }
 
-// the inertial part of the shaking force and moment: -Σ m a and -dH/dt about the origin
-void inertial_parts(const Model& model, Instant& in) {
+// the inertial part of the shaking force and moment, -Σ m a and -dH/dt about the origin, and
+// the static part, the weights and the applied loads with their moments about the origin
+void shaking_parts(const Model& model, Instant& in) {
   const System& s = model.system();
   const Linkage& l = s.linkage;
+  const Vec2 g = l.loads.gravity;
   in.Fsh_inertial = Vec2(0, 0);
   in.Msh_inertial = 0.0;
-  for (std::size_t k = 0; k < l.links.size(); ++k) {
+  in.Fsh_static = Vec2(0, 0);
+  in.Msh_static = 0.0;
+  // a mass m at c with acceleration a
+  auto mass_at = [&](double m, const Vec2& c, const Vec2& a) {
+    in.Fsh_inertial -= m * a;
+    in.Msh_inertial -= cross(c, m * a);
+    in.Fsh_static += m * g;
+    in.Msh_static += cross(c, m * g);
+  };
+  std::vector<Vec2>::size_type k = 0;
+  for (; k < l.links.size(); ++k) {
     const System::ElementRow& e = s.elements[k];
     const PointWeights& w = s.com_weights[k];
     const std::size_t p = static_cast<std::size_t>(e.p), q = static_cast<std::size_t>(e.q);
-    const Vec2 c = w.at_p * in.x[p] + w.at_q * in.x[q];
-    const Vec2 ac = w.at_p * in.a[p] + w.at_q * in.a[q];
-    const double m = l.links[k].mass;
-    in.Fsh_inertial -= m * ac;
-    in.Msh_inertial -= cross(c, m * ac) + l.links[k].inertia * in.alpha[k];
+    mass_at(l.links[k].mass, w.at_p * in.x[p] + w.at_q * in.x[q],
+            w.at_p * in.a[p] + w.at_q * in.a[q]);
+    in.Msh_inertial -= l.links[k].inertia * in.alpha[k];
   }
   for (const PointMass& pm : l.point_masses) {
     const std::size_t n = static_cast<std::size_t>(pm.node);
-    in.Fsh_inertial -= pm.mass * in.a[n];
-    in.Msh_inertial -= cross(in.x[n], pm.mass * in.a[n]);
+    mass_at(pm.mass, in.x[n], in.a[n]);
   }
-  for (std::size_t k = 0; k < l.shafts.size(); ++k) {
+  for (k = 0; k < l.shafts.size(); ++k) {
     const BalanceShaft& b = l.shafts[k];
     const std::size_t link = static_cast<std::size_t>(b.link);
     const detail::ShaftMotion m =
         detail::shaft_motion(s, static_cast<int>(k), in.x, in.omega[link], in.alpha[link]);
-    in.Fsh_inertial -= b.mass * m.a;
-    in.Msh_inertial -= b.inertia * m.alpha + cross(b.at + m.r, b.mass * m.a);
+    mass_at(b.mass, b.at + m.r, m.a);
+    in.Msh_inertial -= b.inertia * m.alpha;
+  }
+  for (const LinkLoad& load : l.loads.link_loads) {
+    const System::ElementRow& e = s.elements[static_cast<std::size_t>(load.link)];
+    const PointWeights& w = s.com_weights[static_cast<std::size_t>(load.link)];
+    const Vec2 c = w.at_p * in.x[static_cast<std::size_t>(e.p)] +
+                   w.at_q * in.x[static_cast<std::size_t>(e.q)];
+    in.Fsh_static += load.force;
+    in.Msh_static += cross(c, load.force) + load.moment;
+  }
+  for (const NodeForce& f : l.loads.node_forces) {
+    in.Fsh_static += f.force;
+    in.Msh_static += cross(in.x[static_cast<std::size_t>(f.node)], f.force);
   }
 }
 
@@ -605,7 +643,7 @@ void inertial_parts(const Model& model, Instant& in) {
 void forces(const Model& model, Workspace& ws) {
   link_node_forces(model, ws);
   frame_forces(model, ws);
-  inertial_parts(model, ws.instant);
+  shaking_parts(model, ws.instant);
 }
 
 // after the accelerations q̈: the multipliers from Gᵀ λ = M q̈ - F (efforts of the inputs

@@ -56,13 +56,19 @@ class Model {
   /// each link but the first, from the joint), or in one link and carrying a slider or a point
   /// mass (the force on that link).
   const std::vector<JointForce>& joints() const { return joints_; }
+  /// The springs with an end on the frame, in spring order (their pull on the frame at that
+  /// node, R<node>_<spring>, is an output: part of the shaking force, not of the pin's reaction).
+  const std::vector<int>& frame_springs() const { return frame_springs_; }
+  /// The inputs that drive a slider along a frame guide, in input order (the drive's reaction on
+  /// the frame, R<slider>_drive, is an output).
+  const std::vector<int>& frame_drives() const { return frame_drives_; }
   /// A length scale of the linkage: its longest element [m].
   double length_scale() const { return length_scale_; }
   const detail::System& system() const { return *system_; }
 
  private:
   std::unique_ptr<detail::System> system_;
-  std::vector<int> ground_nodes_, frame_guides_;
+  std::vector<int> ground_nodes_, frame_guides_, frame_springs_, frame_drives_;
   std::vector<JointForce> joints_;
   double length_scale_{};
 };
@@ -85,10 +91,20 @@ struct Instant {
   /// the reaction of its tooth force; the tooth force's action on the link reaches the frame
   /// through the link's pivot, in that ground node's reaction).
   std::vector<Vec2> shaft_reaction;
-  Vec2 Fsh{0, 0};           // shaking force: every force of the mechanism ON the frame [N]
+  std::vector<Vec2> spring_reaction;  // per frame spring: its pull ON the frame [N]
+  std::vector<Vec2> drive_reaction;   // per frame slide drive: its reaction ON the frame [N]
+  /// shaking force: every force of the mechanism ON the frame, the sum of ground_reaction,
+  /// guide_reaction, shaft_reaction, spring_reaction and drive_reaction [N]
+  Vec2 Fsh{0, 0};
   double Msh{};             // shaking moment about the origin, drives' reactions included [N m]
+  /// The shaking force and moment split by their cause: Fsh = Fsh_inertial + Fsh_static and
+  /// Msh = Msh_inertial + Msh_static to round-off (Newton's law on the moving parts; springs
+  /// and drives between the frame and the mechanism cancel out of the sum). The inertial part
+  /// is what balancing acts on.
   Vec2 Fsh_inertial{0, 0};  // -Σ m a [N]
   double Msh_inertial{};    // -dH/dt about the origin [N m]
+  Vec2 Fsh_static{0, 0};    // the weights and the applied forces (loads) [N]
+  double Msh_static{};      // their moment about the origin and the applied moments [N m]
 };
 
 /// Why an instant could not be evaluated.

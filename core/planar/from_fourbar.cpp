@@ -45,7 +45,8 @@ core::Trajectory fourbar_trajectory(const Trajectory& planar) {
                     th3 = col("theta_rocker"), om1 = col("omega_crank"), om2 = col("omega_coupler"),
                     om3 = col("omega_rocker"), al1 = col("alpha_crank"), al2 = col("alpha_coupler"),
                     al3 = col("alpha_rocker"), r0 = col("RA0x"), r3 = col("RA3x"), f = col("Fshx"),
-                    m = col("Msh"), tau = col("tau");
+                    m = col("Msh"), tau = col("tau"), fi = col("Fshx_inertial"),
+                    mi = col("Msh_inertial"), fs = col("Fshx_static"), ms = col("Msh_static");
   core::Trajectory out;
   out.t.reserve(t.rows());
   out.samples.reserve(t.rows());
@@ -58,6 +59,12 @@ core::Trajectory fourbar_trajectory(const Trajectory& planar) {
     d.Fsh = Vec2(t.at(i, f), t.at(i, f + 1));
     d.Msh = t.at(i, m);
     d.tau = t.at(i, tau);
+    d.Fsh_inertial = Vec2(t.at(i, fi), t.at(i, fi + 1));
+    d.Msh_inertial = t.at(i, mi);
+    d.Fsh_static = Vec2(t.at(i, fs), t.at(i, fs + 1));
+    d.Msh_static = t.at(i, ms);
+    if (t.column("FA1x") >= 0) d.FA1 = Vec2(t.at(i, col("FA1x")), t.at(i, col("FA1y")));
+    if (t.column("FA2x") >= 0) d.FA2 = Vec2(t.at(i, col("FA2x")), t.at(i, col("FA2y")));
     if (t.column("RC1x") >= 0) {
       d.RC1 = Vec2(t.at(i, col("RC1x")), t.at(i, col("RC1y")));
     }

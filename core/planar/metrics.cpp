@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace bd::core::planar {
 
@@ -13,8 +14,8 @@ std::vector<ColumnMetric> metric_table(const Model& model) {
     t.push_back({symbol + "_rms", unit, "RMS of " + what, Statistic::kRms, columns});
     t.push_back({symbol + "_max", unit, "peak of " + what, Statistic::kMax, columns});
   };
-  both("Fsh", "N", "the shaking force |Fsh|", {"Fshx", "Fshy"});
-  both("Msh", "N m", "the shaking moment |Msh|", {"Msh"});
+  both("Fsh", "N", "the inertial shaking force |Fsh|", {"Fshx_inertial", "Fshy_inertial"});
+  both("Msh", "N m", "the inertial shaking moment |Msh|", {"Msh_inertial"});
   for (const Input& in : l.inputs) {
     const bool one = l.inputs.size() == 1;
     const std::string column = one ? "tau" : "tau_" + in.name;
@@ -50,27 +51,47 @@ std::vector<ColumnMetric> metric_table(const Model& model) {
                  Statistic::kMax,
                  {name + "x", name + "y"}});
   }
+  for (const TotalMetricInfo& m : kTotalMetrics) {
+    t.push_back({m.name, m.unit, m.words, m.statistic,
+                 m.force ? std::vector<std::string>{"Fshx", "Fshy"}
+                         : std::vector<std::string>{"Msh"}});
+  }
   return t;
 }
+
+namespace {
+
+// the columns of each metric in `table`
+std::vector<std::vector<int>> metric_columns(const std::vector<ColumnMetric>& metrics,
+                                             const Series& table) {
+  std::vector<std::vector<int>> out;
+  for (const ColumnMetric& m : metrics) {
+    std::vector<int> c;
+    for (const std::string& name : m.columns) c.push_back(table.column(name));
+    out.push_back(c);
+  }
+  return out;
+}
+
+// the magnitude a metric summarises, in one row
+double magnitude(const std::vector<int>& c, std::span<const double> row) {
+  if (c.size() == 1) return std::abs(row[static_cast<std::size_t>(c[0])]);
+  return core::magnitude(row[static_cast<std::size_t>(c[0])], row[static_cast<std::size_t>(c[1])]);
+}
+
+}  // namespace
 
 std::vector<double> metric_values(const std::vector<ColumnMetric>& metrics, const Series& table) {
   std::vector<double> out(metrics.size(), 0.0);
   const std::size_t rows = table.rows();
   if (rows == 0) return out;
+  const std::vector<std::vector<int>> columns = metric_columns(metrics, table);
   for (std::size_t k = 0; k < metrics.size(); ++k) {
     const ColumnMetric& m = metrics[k];
-    std::vector<int> c;
-    for (const std::string& name : m.columns) c.push_back(table.column(name));
     RmsAccumulator rms;
     double peak = 0;
     for (std::size_t i = 0; i < rows; ++i) {
-      double x = 0;
-      if (c.size() == 1) {
-        x = std::abs(table.at(i, static_cast<std::size_t>(c[0])));
-      } else {
-        x = magnitude(table.at(i, static_cast<std::size_t>(c[0])),
-                      table.at(i, static_cast<std::size_t>(c[1])));
-      }
+      const double x = magnitude(columns[k], table.row(i));
       if (m.statistic == Statistic::kRms) {
         rms.add(x);
       } else {
@@ -78,6 +99,103 @@ std::vector<double> metric_values(const std::vector<ColumnMetric>& metrics, cons
       }
     }
     out[k] = m.statistic == Statistic::kRms ? rms.rms() : peak;
+  }
+  return out;
+}
+
+std::vector<Peak> sampled_peaks(const std::vector<ColumnMetric>& metrics, const Series& table) {
+  std::vector<Peak> out(metrics.size());
+  const std::vector<double> values = metric_values(metrics, table);
+  const std::vector<std::vector<int>> columns = metric_columns(metrics, table);
+  const int tc = table.column("t");
+  for (std::size_t k = 0; k < metrics.size(); ++k) {
+    out[k] = {values[k], 0.0};
+    if (metrics[k].statistic != Statistic::kMax) continue;
+    for (std::size_t i = 0; i < table.rows(); ++i) {
+      if (magnitude(columns[k], table.row(i)) == values[k]) {
+        out[k].t = tc >= 0 ? table.at(i, static_cast<std::size_t>(tc)) : 0.0;
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<double> metric_values(const Model& model, const DrivenScene& scene,
+                                  const std::vector<ColumnMetric>& metrics, const Trajectory& run,
+                                  std::vector<Peak>* peaks) {
+  std::vector<double> out = metric_values(metrics, run.table);
+  if (peaks) peaks->assign(metrics.size(), Peak{});
+  const Series& table = run.table;
+  const std::size_t rows = table.rows();
+  if (rows == 0) return out;
+  const Linkage& l = model.linkage();
+  const std::vector<double> t = table.column_values("t");
+  const std::vector<double> start = scene.start.empty() ? drawn_inputs(model) : scene.start;
+  // periodic: whole revolutions of the one input that moves, run to the end
+  double period = 0;
+  int moving = 0;
+  for (std::size_t k = 0; k < l.inputs.size() && k < scene.speeds.size(); ++k) {
+    if (scene.speeds[k] == 0) continue;
+    ++moving;
+    if (l.inputs[k].kind == Input::Kind::kAngle)
+      period = 2 * std::numbers::pi / std::abs(scene.speeds[k]) * scene.revolutions;
+  }
+  if (moving != 1 || scene.duration > 0 || !run.ok()) period = 0;
+  // the positions of row i, every node (the guess of a position solve)
+  std::vector<std::pair<int, int>> xy(l.nodes.size(), {-1, -1});
+  for (std::size_t n = 0; n < l.nodes.size(); ++n) {
+    if (!l.nodes[n].ground)
+      xy[n] = {table.column("x_" + l.nodes[n].name), table.column("y_" + l.nodes[n].name)};
+  }
+  auto positions = [&](std::size_t i) {
+    std::vector<Vec2> x(l.nodes.size());
+    for (std::size_t n = 0; n < l.nodes.size(); ++n) {
+      x[n] = l.nodes[n].ground ? l.nodes[n].position
+                               : Vec2(table.at(i, static_cast<std::size_t>(xy[n].first)),
+                                      table.at(i, static_cast<std::size_t>(xy[n].second)));
+    }
+    return x;
+  };
+  Workspace ws(model);
+  Series row;
+  row.columns = table.columns;
+  std::vector<double> z(start.size());
+  const std::vector<double> zero(start.size(), 0.0);
+  const std::vector<std::vector<int>> columns = metric_columns(metrics, table);
+  const double h = rows > 1 ? t[1] - t[0] : 0.0;
+  // the whole row at time s, by the inverse dynamics from the nearest sample's positions; empty
+  // where it cannot be evaluated or lands away from the samples' branch
+  double cached_t = std::nan("");
+  auto row_at = [&](double s) -> bool {
+    if (s == cached_t) return !row.values.empty();
+    cached_t = s;
+    row.values.clear();
+    const double u = period > 0 ? std::fmod(s - t[0] + period, period) + t[0] : s;
+    const auto i = static_cast<std::size_t>(
+        std::clamp(std::round((u - t[0]) / (h > 0 ? h : 1.0)), 0.0, static_cast<double>(rows - 1)));
+    const std::vector<Vec2> guess = positions(i);
+    for (std::size_t k = 0; k < z.size(); ++k) z[k] = start[k] + scene.speeds[k] * s;
+    if (!solve_position(model, ws, guess, z)) return false;
+    for (std::size_t n = 0; n < guess.size(); ++n) {
+      if ((ws.instant.x[n] - guess[n]).norm() > 0.25 * model.length_scale()) return false;
+    }
+    if (!inverse_dynamics(model, ws, s, scene.speeds, zero)) return false;
+    append_row(model, ws.instant, row);
+    return true;
+  };
+  for (std::size_t k = 0; k < metrics.size(); ++k) {
+    if (metrics[k].statistic != Statistic::kMax) {
+      if (peaks) (*peaks)[k] = {out[k], 0.0};
+      continue;
+    }
+    std::vector<double> x(rows);
+    for (std::size_t i = 0; i < rows; ++i) x[i] = magnitude(columns[k], table.row(i));
+    const Peak p = resolved_peak(t, x, period, [&](double s) {
+      return row_at(s) ? magnitude(columns[k], row.row(0)) : std::nan("");
+    });
+    out[k] = p.value;
+    if (peaks) (*peaks)[k] = p;
   }
   return out;
 }

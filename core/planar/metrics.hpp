@@ -2,13 +2,17 @@
 /// The metrics of a planar linkage's run, built for its model as the four-bar's table is
 /// (core/metrics.hpp): per quantity its RMS over the samples, then its peak, in this order:
 /// Fsh, Msh, the drive efforts (tau, or tau_<input> with several inputs), the reaction of every
-/// ground node and frame guide (R<name>); then the peak of every joint force (F<joint>_max).
+/// ground node and frame guide (R<name>); then the peak of every joint force (F<joint>_max);
+/// then the total shaking force and moment (core::kTotalMetrics). Fsh and Msh are their inertial
+/// parts (the columns Fshx_inertial, Fshy_inertial, Msh_inertial); the totals are Fshx, Fshy, Msh.
 /// Each is the magnitude of one column (Msh, tau) or of an x, y pair of columns.
 #include <string>
 #include <vector>
 
 #include "core/metrics.hpp"
+#include "core/peaks.hpp"
 #include "core/planar/dynamics.hpp"
+#include "core/planar/simulate.hpp"
 #include "core/series.hpp"
 
 namespace bd::core::planar {
@@ -24,7 +28,21 @@ struct ColumnMetric {
 /// The model's metric table.
 std::vector<ColumnMetric> metric_table(const Model& model);
 
-/// The table's values over the rows of `table` (0 for a table without rows).
+/// The table's values over the rows of `table` (0 for a table without rows): peaks are the
+/// largest samples.
 std::vector<double> metric_values(const std::vector<ColumnMetric>& metrics, const Series& table);
+
+/// Where each metric's largest sample lies (RMS rows: their value and t = 0).
+std::vector<Peak> sampled_peaks(const std::vector<ColumnMetric>& metrics, const Series& table);
+
+/// The table's values over a driven run of `model` in `scene` (the run's samples in
+/// `run.table`), with every peak resolved between the samples: maximised over time by the exact
+/// inverse dynamics at the refined instant (core/peaks.hpp), so that it no longer depends on the
+/// sample count. A run of whole revolutions of one moving input is periodic (the last sample's
+/// neighbour is the first); any other run is resolved within its time span. `peaks`, when given,
+/// receives per metric where its peak lies (RMS rows: the value and t = 0).
+std::vector<double> metric_values(const Model& model, const DrivenScene& scene,
+                                  const std::vector<ColumnMetric>& metrics, const Trajectory& run,
+                                  std::vector<Peak>* peaks = nullptr);
 
 }  // namespace bd::core::planar

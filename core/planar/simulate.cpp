@@ -116,6 +116,15 @@ std::vector<std::string> columns(const Model& model) {
   for (int g : model.ground_nodes()) pair("R" + l.nodes[static_cast<std::size_t>(g)].name);
   for (int s : model.frame_guides()) pair("R" + l.sliders[static_cast<std::size_t>(s)].name);
   for (const BalanceShaft& b : l.shafts) pair("R" + b.name);
+  for (int k : model.frame_springs()) {
+    const Spring& sp = l.springs[static_cast<std::size_t>(k)];
+    const int anchor = l.nodes[static_cast<std::size_t>(sp.a)].ground ? sp.a : sp.b;
+    pair("R" + l.nodes[static_cast<std::size_t>(anchor)].name + "_" + sp.name);
+  }
+  for (int k : model.frame_drives()) {
+    const Input& in = l.inputs[static_cast<std::size_t>(k)];
+    pair("R" + l.sliders[static_cast<std::size_t>(in.slider)].name + "_drive");
+  }
   for (const JointForce& j : model.joints()) pair("F" + j.name);
   c.insert(c.end(), {"Fshx", "Fshy", "Msh"});
   if (l.inputs.size() == 1) {
@@ -123,7 +132,8 @@ std::vector<std::string> columns(const Model& model) {
   } else {
     for (const Input& in : l.inputs) c.push_back("tau_" + in.name);
   }
-  c.insert(c.end(), {"Fshx_inertial", "Fshy_inertial", "Msh_inertial"});
+  c.insert(c.end(), {"Fshx_inertial", "Fshy_inertial", "Msh_inertial", "Fshx_static",
+                     "Fshy_static", "Msh_static"});
   return c;
 }
 
@@ -142,10 +152,13 @@ void append_row(const Model& model, const Instant& in, Series& table) {
   for (const Vec2& r : in.ground_reaction) v.insert(v.end(), {r.x(), r.y()});
   for (const Vec2& r : in.guide_reaction) v.insert(v.end(), {r.x(), r.y()});
   for (const Vec2& r : in.shaft_reaction) v.insert(v.end(), {r.x(), r.y()});
+  for (const Vec2& r : in.spring_reaction) v.insert(v.end(), {r.x(), r.y()});
+  for (const Vec2& r : in.drive_reaction) v.insert(v.end(), {r.x(), r.y()});
   for (const Vec2& f : in.joint_force) v.insert(v.end(), {f.x(), f.y()});
   v.insert(v.end(), {in.Fsh.x(), in.Fsh.y(), in.Msh});
   v.insert(v.end(), in.effort.begin(), in.effort.end());
-  v.insert(v.end(), {in.Fsh_inertial.x(), in.Fsh_inertial.y(), in.Msh_inertial});
+  v.insert(v.end(), {in.Fsh_inertial.x(), in.Fsh_inertial.y(), in.Msh_inertial,
+                     in.Fsh_static.x(), in.Fsh_static.y(), in.Msh_static});
 }
 
 // ---------------------------------------------------------------------------------------------

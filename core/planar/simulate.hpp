@@ -76,9 +76,14 @@ struct Trajectory {
 ///   t; per link theta_<link>, omega_<link>, alpha_<link> [rad, rad/s, rad/s^2]; per slider
 ///   s_<slider>, v_<slider>, a_<slider> [m, m/s, m/s^2] (along its guide); per moving node
 ///   x_<node>, y_<node> [m]; per ground node R<node>x, R<node>y and per frame guide
-///   R<slider>x, R<slider>y [N] (forces on the frame); per joint F<joint>x, F<joint>y [N] (on
+///   R<slider>x, R<slider>y, per balance shaft R<shaft>x, R<shaft>y, per spring anchored on the
+///   frame R<node>_<spring>x, R<node>_<spring>y (its pull at that ground node), per slide drive
+///   on a frame guide R<slider>_drivex, R<slider>_drivey [N] (forces on the frame: Fsh is
+///   their sum); per joint F<joint>x, F<joint>y [N] (on
 ///   the joint's link); Fshx, Fshy [N], Msh [N m]; the drives' efforts: tau for a single input,
-///   else tau_<input> [N m or N]; Fshx_inertial, Fshy_inertial [N], Msh_inertial [N m].
+///   else tau_<input> [N m or N]; Fshx_inertial, Fshy_inertial [N], Msh_inertial [N m] (the
+///   inertial part, -Σ m a and -dH/dt); Fshx_static, Fshy_static [N], Msh_static [N m] (the
+///   weights and applied loads): Fsh = inertial + static.
 std::vector<std::string> columns(const Model& model);
 /// Appends `in` as a row of those columns.
 void append_row(const Model& model, const Instant& in, Series& table);

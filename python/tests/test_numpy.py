@@ -21,7 +21,10 @@ def test_rms_of_the_shaking_force_from_the_arrays(driven):
     # the shaking force is the sum of the support reactions (no counter-rotations here)
     assert np.array_equal(ts["Fshx"], ts["RA0x"] + ts["RA3x"])
     magnitude = np.hypot(ts["Fshx"], ts["Fshy"])
-    assert np.max(magnitude) == pytest.approx(r.metrics["Fsh_max"], rel=1e-15)
+    # the peak is resolved between the samples: at least the largest sample, and within the
+    # parabola's reach of it at 360 samples per revolution
+    assert np.max(magnitude) <= r.metrics["Fsh_max"]
+    assert np.max(magnitude) == pytest.approx(r.metrics["Fsh_max"], rel=1e-3)
     # RMS over the revolution, as the metric is defined (the samples of one period)
     assert np.sqrt(np.mean(magnitude ** 2)) == pytest.approx(r.metrics["Fsh_rms"], rel=1e-12)
     assert r.array.shape == (len(ts["t"]), len(r.columns))

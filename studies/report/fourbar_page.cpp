@@ -326,16 +326,22 @@ FourBarCharts fourbar_charts(const Study& study, const fs::path& dir, const Seco
     std::string msh = "set title 'Shaking moment about A0'\nset xlabel " + gp_string(drive_x) +
                       "\nset ylabel 'Msh [N m]'\nplot " + ts_file +
                       " skip 1 using 1:17 with lines lw 2 title 'original'";
-    std::string drive = "set title 'Drive torque and bearing loads'\nset xlabel " +
-                        gp_string(drive_x) +
-                        "\nset ylabel 'bearing load [N]'\n"
-                        "set y2label 'drive torque τ [N m]'\nset ytics nomirror\nset y2tics\n"
-                        "plot " +
-                        ts_file +
+    // a free scene has no drive: its chart is the bearing loads alone (a torque of 0 on a right
+    // axis of its own would read as a constant load)
+    const bool driven = !is_free(study.scene);
+    std::string drive = std::string("set title '") +
+                        (driven ? "Drive torque and bearing loads" : "Bearing loads") +
+                        "'\nset xlabel " + gp_string(drive_x) +
+                        "\nset ylabel 'bearing load [N]'\n" +
+                        (driven ? "set y2label 'drive torque τ [N m]'\nset ytics nomirror\n"
+                                  "set y2tics\n"
+                                : "") +
+                        "plot " + ts_file +
                         " skip 1 using 1:(sqrt($11**2+$12**2)) with lines lw 2 "
                         "lt 1 title '|RA0|', '' skip 1 using 1:(sqrt($13**2+$14**2)) with lines "
-                        "lw 2 lt 2 title '|RA3|', '' skip 1 using 1:18 axes x1y2 with lines lw 2 "
-                        "lt 3 title 'τ'";
+                        "lw 2 lt 2 title '|RA3|'" +
+                        (driven ? ", '' skip 1 using 1:18 axes x1y2 with lines lw 2 lt 3 title 'τ'"
+                                : "");
     if (!second.empty()) {
       hodo += ", " + ts2_file + " skip 1 using 15:16 with linespoints lw 2 dt 2 pt 6 pi 25 title " +
               gp_string(second_label);
@@ -348,9 +354,10 @@ FourBarCharts fourbar_charts(const Study& study, const fs::path& dir, const Seco
                "', '' skip 1 using 1:(sqrt($13**2+$14**2)) with "
                "lines lw 2 lt 2 dt 2 title '|RA3| " +
                second_label +
-               "', '' skip 1 using 1:18 "
-               "axes x1y2 with lines lw 2 lt 3 dt 2 title 'τ " +
-               second_label + "'";
+               "'" +
+               (driven ? ", '' skip 1 using 1:18 axes x1y2 with lines lw 2 lt 3 dt 2 title 'τ " +
+                             second_label + "'"
+                       : std::string());
     }
     const std::string overlay =
         second.empty() ? "" : " The " + second_label + " design is dashed (" + second_file + ").";
@@ -360,11 +367,13 @@ FourBarCharts fourbar_charts(const Study& study, const fs::path& dir, const Seco
          true});
     charts.push_back({"shaking-moment", "Shaking moment",
                       "Shaking moment on the frame about A0 over the run." + overlay, msh});
-    charts.push_back({"drive", "Drive torque and bearing loads",
-                      "Magnitudes of the bearing forces at A0 and A3 (left axis) and the drive "
-                      "torque (right axis; zero in free motion)." +
-                          overlay,
-                      drive});
+    charts.push_back(
+        {"drive", driven ? "Drive torque and bearing loads" : "Bearing loads",
+         driven ? "Magnitudes of the bearing forces at A0 and A3 (left axis) and the drive "
+                  "torque (right axis)." + overlay
+                : "Magnitudes of the bearing forces at A0 and A3 (free motion: no drive)." +
+                      overlay,
+         drive});
   }
   // one scale of marker size for the links' masses of both designs
   double mass_ref = std::max(

@@ -21,17 +21,18 @@ std::vector<double> revolution(const std::vector<double>& values, std::size_t n,
 
 Harmonics analysed(std::string input, double speed, double theta0, std::size_t n,
                    const std::vector<double>& fx, const std::vector<double>& fy,
-                   const std::vector<double>& msh) {
+                   const std::vector<double>& msh, const std::vector<double>& tau) {
   Harmonics h{std::move(input), speed, static_cast<int>(n), {}};
   const std::vector<double> x = revolution(fx, n, speed), y = revolution(fy, n, speed),
-                            m = revolution(msh, n, speed);
+                            m = revolution(msh, n, speed), d = revolution(tau, n, speed);
   const std::vector<core::Harmonic> hx = core::harmonic_orders(x, theta0, kHarmonicOrders);
   const std::vector<core::Harmonic> hy = core::harmonic_orders(y, theta0, kHarmonicOrders);
   const std::vector<core::Harmonic> hm = core::harmonic_orders(m, theta0, kHarmonicOrders);
+  const std::vector<core::Harmonic> ht = core::harmonic_orders(d, theta0, kHarmonicOrders);
   const std::vector<core::RotatingHarmonic> hr =
       core::rotating_orders(x, y, theta0, kHarmonicOrders);
   for (std::size_t k = 0; k < hx.size(); ++k) {
-    HarmonicOrder o{static_cast<int>(k), hx[k], hy[k], hm[k], {}};
+    HarmonicOrder o{static_cast<int>(k), hx[k], hy[k], hm[k], ht[k], {}};
     if (k > 0) o.Fsh = hr[k - 1];
     h.orders.push_back(o);
   }
@@ -42,13 +43,14 @@ std::optional<Harmonics> fourbar_harmonics(const core::DrivenScene& scene,
                                            const core::Trajectory& t) {
   const std::size_t n = static_cast<std::size_t>(scene.samples);
   if (n < 4 || t.samples.size() < n) return std::nullopt;
-  std::vector<double> fx, fy, msh;
+  std::vector<double> fx, fy, msh, tau;
   for (std::size_t i = 0; i < n; ++i) {
     fx.push_back(t.samples[i].Fsh.x());
     fy.push_back(t.samples[i].Fsh.y());
     msh.push_back(t.samples[i].Msh);
+    tau.push_back(t.samples[i].tau);
   }
-  return analysed("crank", scene.omega1, scene.theta1, n, fx, fy, msh);
+  return analysed("crank", scene.omega1, scene.theta1, n, fx, fy, msh, tau);
 }
 
 std::optional<Harmonics> planar_harmonics(const core::planar::Linkage& l,
@@ -70,7 +72,8 @@ std::optional<Harmonics> planar_harmonics(const core::planar::Linkage& l,
   const double theta0 = t.table.column_values("theta_" + link).front();
   return analysed(input.name, scene.speeds[static_cast<std::size_t>(moving)], theta0, n,
                   t.table.column_values("Fshx"), t.table.column_values("Fshy"),
-                  t.table.column_values("Msh"));
+                  t.table.column_values("Msh"),
+                  t.table.column_values(l.inputs.size() == 1 ? "tau" : "tau_" + input.name));
 }
 
 }  // namespace
@@ -92,7 +95,7 @@ std::string harmonics_rows(const std::string& design, const Harmonics& h) {
     text += design + "," + std::to_string(o.order);
     for (double v : {o.Fshx.amplitude, o.Fshx.phase, o.Fshy.amplitude, o.Fshy.phase, o.Fsh.forward,
                      o.Fsh.forward_phase, o.Fsh.backward, o.Fsh.backward_phase, o.Msh.amplitude,
-                     o.Msh.phase}) {
+                     o.Msh.phase, o.tau.amplitude, o.tau.phase}) {
       text += "," + text::exact(v);
     }
     text += "\n";

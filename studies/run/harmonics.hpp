@@ -1,6 +1,7 @@
 #pragma once
-/// The harmonic orders of a driven run: the shaking force and moment over the first revolution of
-/// the input that turns, by the FFT of the run's exact samples (core/harmonics.hpp).
+/// The harmonic orders of a driven run: the shaking force and moment and the drive torque over
+/// the first revolution of the input that turns, by the FFT of the run's exact samples
+/// (core/harmonics.hpp, which the engine balancing's shafts use too).
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@ inline constexpr int kHarmonicOrders = 8;
 struct HarmonicOrder {
   int order{};
   core::Harmonic Fshx, Fshy, Msh;
+  core::Harmonic tau;  // the drive's torque (or force) on the turning input
   core::RotatingHarmonic Fsh;  // order 0: zero
 };
 
@@ -41,7 +43,8 @@ std::optional<Harmonics> harmonics(const Study& study, const core::Trajectory& f
 /// The header line of harmonics.csv (without the newline).
 inline constexpr const char* kHarmonicsHeader =
     "design,order,Fshx_amplitude,Fshx_phase,Fshy_amplitude,Fshy_phase,Fsh_forward,"
-    "Fsh_forward_phase,Fsh_backward,Fsh_backward_phase,Msh_amplitude,Msh_phase";
+    "Fsh_forward_phase,Fsh_backward,Fsh_backward_phase,Msh_amplitude,Msh_phase,tau_amplitude,"
+    "tau_phase";
 
 /// The rows of harmonics.csv for one design (`design`: "original", "balanced"), "%.17g".
 std::string harmonics_rows(const std::string& design, const Harmonics& h);

@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string_view>
 #include <system_error>
@@ -64,8 +66,9 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original) {
   const Simulation sim = simulate(best);
   o.method = sim.method;
   o.trajectory = sim.fourbar;
-  o.metrics = core::metrics(o.trajectory);
-  o.metric_list = metric_list(o.metrics);
+  core::PeakList peaks;
+  o.metrics = fourbar_metrics(best, sim, &peaks);
+  o.metric_list = metric_list(o.metrics, &peaks);
   o.harmonics = harmonics(best, o.trajectory, o.planar);
   if (req.pareto) {
     o.pareto = optimize::pareto_front(problem, req.pareto->first, req.pareto->second,
@@ -148,7 +151,10 @@ core::Series timeseries_table(const core::Trajectory& trajectory) {
     table.values.insert(
         table.values.end(),
         {t, s.theta1, s.theta2, s.theta3, s.omega1, s.omega2, s.omega3, s.alpha1, s.alpha2,
-         s.alpha3, d.RA0.x(), d.RA0.y(), d.RA3.x(), d.RA3.y(), d.Fsh.x(), d.Fsh.y(), d.Msh, d.tau});
+         s.alpha3, d.RA0.x(), d.RA0.y(), d.RA3.x(), d.RA3.y(), d.Fsh.x(), d.Fsh.y(), d.Msh, d.tau,
+         d.Fsh_inertial.x(), d.Fsh_inertial.y(), d.Msh_inertial, d.Fsh_static.x(), d.Fsh_static.y(),
+         d.Msh_static, d.RC1.x(), d.RC1.y(), d.RC3.x(), d.RC3.y(), d.FA1.x(), d.FA1.y(), d.FA2.x(),
+         d.FA2.y()});
   }
   return table;
 }
@@ -511,10 +517,15 @@ RunResult compute_study(const Study& study) {
   RunResult result;
   Simulation sim = simulate(study);
   result.method = sim.method;
-  result.metric_list = metric_list(study, sim);
+  if (study.is_fourbar()) {
+    core::PeakList peaks;
+    result.metrics = fourbar_metrics(study, sim, &peaks);
+    result.metric_list = metric_list(result.metrics, &peaks);
+  } else {
+    result.metric_list = metric_list(study, sim);
+  }
   result.trajectory = std::move(sim.fourbar);
   result.planar = std::move(sim.planar);
-  if (study.is_fourbar()) result.metrics = core::metrics(result.trajectory);
   result.harmonics = harmonics(study, result.trajectory, result.planar);
   if (study.balance) {
     const Study design = balanced_study(study);
@@ -522,8 +533,9 @@ RunResult compute_study(const Study& study) {
     BalancedRun b;
     b.method = balanced.method;
     b.trajectory = balanced.fourbar;
-    b.metrics = core::metrics(b.trajectory);
-    b.metric_list = metric_list(b.metrics);
+    core::PeakList peaks;
+    b.metrics = fourbar_metrics(design, balanced, &peaks);
+    b.metric_list = metric_list(b.metrics, &peaks);
     b.harmonics = harmonics(design, b.trajectory, b.planar);
     result.balanced = std::move(b);
   }
@@ -553,6 +565,14 @@ void write_run(const Study& study, RunResult& result, const fs::path& out_dir) {
       throw std::runtime_error("cannot remove the earlier run's " + (out_dir / name).string() +
                                ": " + ec.message());
     }
+  }
+  // the study file itself, so that the folder holds everything its report is built from
+  // (`balance-design report DIR` reads it from there, wherever it is run from)
+  if (!study.source.empty()) {
+    std::ifstream in(study.source, std::ios::binary);
+    std::ostringstream text;
+    if (in) text << in.rdbuf();
+    if (in && !in.bad()) write_text_file(text.str(), out_dir / "study.yaml");
   }
   result.timeseries = out_dir / "timeseries.csv";
   result.summary = out_dir / "summary.json";

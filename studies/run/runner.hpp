@@ -25,12 +25,14 @@ namespace bd::studies {
 /// The header line of timeseries.csv (without the newline).
 inline constexpr const char* kTimeseriesHeader =
     "t,theta1,theta2,theta3,omega1,omega2,omega3,alpha1,alpha2,alpha3,RA0x,RA0y,RA3x,RA3y,Fshx,"
-    "Fshy,Msh,tau";
+    "Fshy,Msh,tau,Fshx_inertial,Fshy_inertial,Msh_inertial,Fshx_static,Fshy_static,Msh_static,"
+    "RC1x,RC1y,RC3x,RC3y,FA1x,FA1y,FA2x,FA2y";
 
 /// Every file write_run() may write into a run's folder, in the order the report lists them.
 /// write_run() removes those of an earlier run first, so no file of another study or design is
 /// left beside the new ones.
-inline constexpr const char* kRunFiles[] = {"timeseries.csv",
+inline constexpr const char* kRunFiles[] = {"study.yaml",
+                                            "timeseries.csv",
                                             "summary.json",
                                             "balanced-timeseries.csv",
                                             "balanced.yaml",

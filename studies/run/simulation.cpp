@@ -178,18 +178,40 @@ Simulation simulate_unchecked(const Study& study, const MethodChoice& method,
 
 }  // namespace
 
-MetricList metric_list(const core::Metrics& metrics) {
+MetricList metric_list(const core::Metrics& metrics, const core::PeakList* peaks) {
   MetricList list;
-  for (const core::MetricInfo& info : core::kMetricTable) {
-    list.push_back({info.name, info.unit, metrics.*info.field});
+  auto peak_t = [](const std::vector<core::Peak>* p, std::size_t k, core::Statistic s) {
+    return p && k < p->size() && s == core::Statistic::kMax ? std::optional<double>((*p)[k].t)
+                                                             : std::nullopt;
+  };
+  for (std::size_t k = 0; k < core::kMetricCount; ++k) {
+    const core::MetricInfo& info = core::kMetricTable[k];
+    list.push_back({info.name, info.unit, metrics.*info.field,
+                    peak_t(peaks ? &peaks->table : nullptr, k, info.statistic)});
+  }
+  for (std::size_t k = 0; k < std::size(core::kOutputMetrics); ++k) {
+    const core::OutputMetricInfo& info = core::kOutputMetrics[k];
+    list.push_back({info.name, info.unit, metrics.*info.field,
+                    peak_t(peaks ? &peaks->output : nullptr, k, info.statistic)});
   }
   return list;
+}
+
+core::Metrics fourbar_metrics(const Study& study, const Simulation& simulation,
+                              core::PeakList* peaks) {
+  const auto* driven = std::get_if<core::DrivenScene>(&study.scene);
+  if (!driven) return core::metrics(simulation.fourbar, peaks);
+  const core::Formulation f = simulation.method.general_engine()
+                                  ? core::Formulation::kMassMatrix
+                                  : simulation.method.formulation;
+  return core::metrics(study.fourbar(), *driven, simulation.fourbar, f, peaks);
 }
 
 std::vector<std::string> metric_names(const Study& study) {
   std::vector<std::string> names;
   if (study.is_fourbar()) {
     for (const core::MetricInfo& info : core::kMetricTable) names.emplace_back(info.name);
+    for (const core::OutputMetricInfo& info : core::kOutputMetrics) names.emplace_back(info.name);
   } else {
     for (const auto& m : core::planar::metric_table(core::planar::Model(study.planar()))) {
       names.push_back(m.name);
@@ -199,13 +221,27 @@ std::vector<std::string> metric_names(const Study& study) {
 }
 
 MetricList metric_list(const Study& study, const Simulation& simulation) {
-  if (!simulation.is_planar) return metric_list(core::metrics(simulation.fourbar));
+  if (!simulation.is_planar) {
+    core::PeakList peaks;
+    const core::Metrics m = fourbar_metrics(study, simulation, &peaks);
+    return metric_list(m, &peaks);
+  }
   const core::planar::Model model(study.planar());
   const std::vector<core::planar::ColumnMetric> table = core::planar::metric_table(model);
-  const std::vector<double> values = core::planar::metric_values(table, simulation.planar.table);
+  std::vector<core::Peak> peaks;
+  std::vector<double> values;
+  if (const auto* driven = std::get_if<core::planar::DrivenScene>(&study.scene)) {
+    values = core::planar::metric_values(model, *driven, table, simulation.planar, &peaks);
+  } else {
+    values = core::planar::metric_values(table, simulation.planar.table);
+    peaks = core::planar::sampled_peaks(table, simulation.planar.table);
+  }
   MetricList list;
-  for (std::size_t k = 0; k < table.size(); ++k)
-    list.push_back({table[k].name, table[k].unit, values[k]});
+  for (std::size_t k = 0; k < table.size(); ++k) {
+    const bool peak = table[k].statistic == core::Statistic::kMax && k < peaks.size();
+    list.push_back({table[k].name, table[k].unit, values[k],
+                    peak ? std::optional<double>(peaks[k].t) : std::nullopt});
+  }
   return list;
 }
 

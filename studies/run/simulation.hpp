@@ -3,6 +3,7 @@
 /// the four-bar's closed form, by the general engine on a four-bar (its samples mapped back to
 /// the four-bar's, so every four-bar output reads the same), or by the general engine on a
 /// planar linkage; and the run's metrics, from the four-bar's table or the planar linkage's.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,7 @@ namespace bd::studies {
 struct MetricValue {
   std::string name, unit;
   double value{};
+  std::optional<double> t;  // a peak: the time where it lies [s]
 };
 using MetricList = std::vector<MetricValue>;
 
@@ -65,11 +67,17 @@ struct Tolerances {
 /// tolerance and the integrators' default absolute tolerance, 1e-12). Driven scenes ignore them.
 Simulation simulate(const Study& study, const MethodChoice& method, const Tolerances& tolerances);
 
-/// The run's metrics in its table's order: a four-bar's (core::kMetricTable) or a planar
-/// linkage's (core::planar::metric_table()).
+/// The run's metrics in its table's order: a four-bar's (core::kMetricTable, then
+/// core::kTotalMetrics) or a planar linkage's (core::planar::metric_table()). In a driven scene
+/// every peak is resolved between the samples by the exact inverse dynamics (core/peaks.hpp; a
+/// four-bar's by its closed form, the mass matrix's when the run took the general engine); in a
+/// free scene a peak is the largest sample.
 MetricList metric_list(const Study& study, const Simulation& simulation);
-/// A four-bar's metrics in the table's order.
-MetricList metric_list(const core::Metrics& metrics);
+/// A four-bar's run's metrics, as metric_list() computes them, with where their peaks lie.
+core::Metrics fourbar_metrics(const Study& study, const Simulation& simulation,
+                              core::PeakList* peaks = nullptr);
+/// A four-bar's metrics in the table's order (with the peaks' times when given).
+MetricList metric_list(const core::Metrics& metrics, const core::PeakList* peaks = nullptr);
 /// The names of the metrics a run of the study has, in its table's order.
 std::vector<std::string> metric_names(const Study& study);
 

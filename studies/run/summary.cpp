@@ -22,6 +22,28 @@ Json metrics_json(const MetricList& metrics) {
   return j;
 }
 
+// where each peak lies: its time, and in a driven scene the crank angle (a four-bar) or the
+// inputs' values (a planar linkage) there
+Json peaks_json(const Study& study, const MetricList& metrics) {
+  Json j = Json::object();
+  for (const MetricValue& m : metrics) {
+    if (!m.t) continue;
+    Json p = {{"value", m.value}, {"t", *m.t}};
+    if (const auto* d = std::get_if<core::DrivenScene>(&study.scene)) {
+      p["theta1"] = d->theta1 + d->omega1 * *m.t;
+    } else if (const auto* pd = std::get_if<core::planar::DrivenScene>(&study.scene)) {
+      std::vector<double> start =
+          pd->start.empty() ? core::planar::drawn_inputs(core::planar::Model(study.planar()))
+                            : pd->start;
+      for (std::size_t k = 0; k < start.size() && k < pd->speeds.size(); ++k)
+        start[k] += pd->speeds[k] * *m.t;
+      p["inputs"] = start;
+    }
+    j[m.name] = p;
+  }
+  return j;
+}
+
 // after / before per metric; null where before is 0
 Json reduction_json(const MetricList& before, const MetricList& after) {
   Json j = Json::object();
@@ -89,7 +111,8 @@ Json harmonics_json(const Harmonics& h) {
          {"Fshy", real(o.Fshy)},
          {"Fsh_forward", {{"amplitude", o.Fsh.forward}, {"phase", o.Fsh.forward_phase}}},
          {"Fsh_backward", {{"amplitude", o.Fsh.backward}, {"phase", o.Fsh.backward_phase}}},
-         {"Msh", real(o.Msh)}});
+         {"Msh", real(o.Msh)},
+         {"tau", real(o.tau)}});
   }
   return {{"input", h.input}, {"speed", h.speed}, {"samples", h.samples}, {"orders", orders}};
 }
@@ -374,7 +397,9 @@ void add_second_run(Json& j, const Study& study, const std::string& what,
   Json run = {{"study", study.name + "-" + what}, {"method", method_json(study, method)}};
   add_run_fields(run, status);
   j[what + "_run"] = run;
+  j[what + "_metrics_partial"] = !status.ok();
   j[what + "_metrics"] = metrics_json(second);
+  j[what + "_peaks"] = peaks_json(study, second);
   j["reduction"] = reduction_json(original, second);
 }
 
@@ -386,9 +411,13 @@ std::string summary_json(const Study& study, const RunResult& result) {
             {"source", study.source},
             {"method", method_json(study, result.method)},
             {"scene", scene_json(study.scene)},
-            {"tolerance", study.tolerance}};
+            {"tolerance", study.tolerance},
+            {"units_read", study.units_read}};
   add_run_fields(j, result.status());
+  // a run that stopped early: its metrics cover the samples before the stop only
+  j["metrics_partial"] = !result.status().ok();
   j["metrics"] = metrics_json(result.metric_list);
+  j["peaks"] = peaks_json(study, result.metric_list);
   if (result.harmonics) j["harmonics"] = harmonics_json(*result.harmonics);
   if (study.balance && result.balanced) {
     const BalancedRun& b = *result.balanced;

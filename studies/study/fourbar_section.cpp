@@ -260,6 +260,31 @@ class FourBarSection::Impl {
             "the linkage cannot be assembled at the initial crank angle: " + pose.error().what());
   }
 
+  // a driven scene turns the crank through whole revolutions: refused at scene.type when the
+  // loop cannot close at every crank angle (the run would stop at the first limit position)
+  void check_turns(const core::FourBar& model, const Scene& scene, const MapReader::Entry& e) {
+    if (!std::holds_alternative<core::DrivenScene>(scene) || core::crank_turns_fully(model)) return;
+    const YAML::Node type = e.value["type"];
+    const YAML::Mark where = type ? mark_of(type, e.key_mark) : e.key_mark;
+    // the crank angles where the loop just closes: |A1 - A3| = l2 + l3 or |l2 - l3|
+    const double l1 = model.crank.length, l4 = model.frame_length;
+    std::string limits;
+    for (double d : {model.coupler.length + model.rocker.length,
+                     std::abs(model.coupler.length - model.rocker.length)}) {
+      const double c = (l1 * l1 + l4 * l4 - d * d) / (2 * l1 * l4);
+      if (std::abs(c) <= 1) {
+        limits += (limits.empty() ? "" : ", ") + std::string("±") + text::digits(std::acos(c), 6);
+      }
+    }
+    r_.fail(where, std::string("scene.type: driven turns the crank through whole revolutions, but "
+                               "this linkage is ") +
+                       core::to_string(core::classify_grashof(model)) +
+                       ": its loop cannot close at every crank angle" +
+                       (limits.empty() ? "" : " (limit positions at theta1 = " + limits + " rad)") +
+                       ", so the run would stop at the first limit position; simulate it with "
+                       "type: free, which passes through them, or change the link lengths");
+  }
+
   Vec2 read_shaft(const MapReader::Entry& at, const std::string& path, int side, double frame) {
     return detail::read_shaft(r_, at, path, side, frame);
   }
@@ -281,6 +306,7 @@ core::FourBar FourBarSection::read(const MapReader::Entry& linkage, const MapRea
 Scene FourBarSection::read_scene(const MapReader::Entry& scene, const core::FourBar& model) {
   Scene s = impl_->read_scene(scene);
   impl_->check_assembly(model, s, scene.key_mark);
+  impl_->check_turns(model, s, scene);
   return s;
 }
 

@@ -206,7 +206,9 @@ Study parse_study_tree(const YAML::Node& root, const std::string& source_name) {
   const Reporter r(source_name);
   StudyParser parser(r);
   try {
-    return parser.parse(root);
+    Study study = parser.parse(root);
+    study.units_read = r.units_read();
+    return study;
   } catch (const YAML::Exception& e) {
     // conversions are checked before use, so this is unexpected; still report it in place
     r.fail(e.mark, e.msg);
@@ -276,6 +278,25 @@ class DocumentMarks : public YAML::EventHandler {
   void OnMapEnd() override {}
 };
 
+// A YAML error at its place; yaml-cpp's words for a tab in the indentation ("illegal map value"
+// and the like) are replaced by what it is, at the first tab in a line's indentation up to the
+// error.
+[[noreturn]] void fail_yaml(const std::string& text, const YAML::Exception& e, const Reporter& r) {
+  std::istringstream lines(text);
+  std::string line;
+  for (int row = 0; std::getline(lines, line) && (e.mark.line < 0 || row <= e.mark.line); ++row) {
+    const std::size_t indent = line.find_first_not_of(" \t");
+    const std::size_t tab = line.find('\t');
+    if (tab != std::string::npos && tab < indent) {
+      YAML::Mark at;
+      at.line = row;
+      at.column = static_cast<int>(tab);
+      r.fail(at, "tabs are not allowed in YAML indentation; indent with spaces");
+    }
+  }
+  r.fail(e.mark, e.msg);
+}
+
 // The text's one YAML document. Not YAML::LoadAll: yaml-cpp 0.7 never consumes a token that can
 // start no node (a ',' outside brackets, as in a file holding only ","), so LoadAll returns an
 // endless list of empty documents at that token and fills the memory. Here the parser is asked
@@ -290,7 +311,7 @@ YAML::Node one_document(const std::string& text, const Reporter& r) {
     for (int i = 0; i < 2 && parser.HandleNextDocument(marks); ++i) {
     }
   } catch (const YAML::Exception& e) {
-    r.fail(e.mark, e.msg);
+    fail_yaml(text, e, r);
   }
   if (marks.starts.size() > 1) {
     const YAML::Mark& at = marks.starts[1];
@@ -305,7 +326,7 @@ YAML::Node one_document(const std::string& text, const Reporter& r) {
   try {
     return YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    r.fail(e.mark, e.msg);
+    fail_yaml(text, e, r);
   }
 }
 

@@ -61,9 +61,9 @@ class PlanarSection::Impl {
                     " in scene (type: driven)");
       core::planar::DrivenScene d;
       d.speeds = read_values(sc.require("speeds", "the constant speed of each input, rad/s or m/s"),
-                             "scene.speeds", dof);
+                             "scene.speeds", dof, l, true);
       if (const MapReader::Entry* x = sc.find("start"))
-        d.start = read_values(*x, "scene.start", dof);
+        d.start = read_values(*x, "scene.start", dof, l, false);
       const MapReader::Entry* rev = sc.find("revolutions");
       const MapReader::Entry* dur = sc.find("duration");
       if (rev && dur) r_.fail(dur->key_mark, "scene: give revolutions or duration, not both");
@@ -79,9 +79,9 @@ class PlanarSection::Impl {
       sc.check_keys({"type", "rates", "duration", "samples", "start"}, " in scene (type: free)");
       core::planar::FreeScene f;
       if (const MapReader::Entry* x = sc.find("rates"))
-        f.rates = read_values(*x, "scene.rates", dof);
+        f.rates = read_values(*x, "scene.rates", dof, l, true);
       if (const MapReader::Entry* x = sc.find("start"))
-        f.start = read_values(*x, "scene.start", dof);
+        f.start = read_values(*x, "scene.start", dof, l, false);
       f.duration =
           positive(sc.require("duration", "the simulated time in s"), "scene.duration", "s");
       if (const MapReader::Entry* n = sc.find("samples")) {
@@ -512,9 +512,15 @@ class PlanarSection::Impl {
   // ---- the scene
 
   // a list with one value per input (a plain number for a single input)
+  // one value per input, each in its input's unit (an angle's or a slide's, or their rates')
   std::vector<double> read_values(const MapReader::Entry& x, const std::string& path,
-                                  std::size_t n) {
-    if (x.value.IsScalar() && n == 1) return {read_number(r_, x, path, "")};
+                                  std::size_t n, const core::planar::Linkage& l, bool rate) {
+    auto unit = [&](std::size_t i) -> std::string {
+      const bool angle =
+          i >= l.inputs.size() || l.inputs[i].kind == core::planar::Input::Kind::kAngle;
+      return angle ? (rate ? "rad/s" : "rad") : (rate ? "m/s" : "m");
+    };
+    if (x.value.IsScalar() && n == 1) return {read_number(r_, x, path, unit(0))};
     const YAML::Mark m = mark_of(x.value, x.key_mark);
     if (!x.value.IsSequence() || x.value.size() != n) {
       r_.fail(m, path + " must be a list of " + std::to_string(n) + " number" +
@@ -523,7 +529,7 @@ class PlanarSection::Impl {
     }
     std::vector<double> v;
     for (std::size_t i = 0; i < n; ++i) {
-      v.push_back(read_number(r_, x.value[i], m, path + "[" + std::to_string(i) + "]", ""));
+      v.push_back(read_number(r_, x.value[i], m, path + "[" + std::to_string(i) + "]", unit(i)));
     }
     return v;
   }

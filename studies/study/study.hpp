@@ -60,6 +60,9 @@ struct Study {
   Method method = Method::kAuto;  // auto: the runner picks, and says why
   double tolerance = 1e-10;       // integrator relative tolerance (free scenes) [-]
   std::string source;             // the study file as named by the user ("" when built in code)
+  /// The values the file gives with a unit of their own, as read and in SI, e.g. "scene.theta1:
+  /// 90 deg = 1.5707963267948966 rad" (a plain number is SI and is not listed).
+  std::vector<std::string> units_read;
   /// A four-bar study's `balance:` section, synthesised at load time; empty when absent.
   std::optional<balance::BalancedDesign> balance;
   /// A planar study's `balance:` section, checked at load time; the runner synthesises the design

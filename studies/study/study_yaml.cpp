@@ -11,39 +11,39 @@ namespace bd::studies {
 namespace {
 
 std::string vec(const Vec2& v) {
-  return "[" + text::exact(v.x()) + ", " + text::exact(v.y()) + "]";
+  return "[" + text::shortest(v.x()) + ", " + text::shortest(v.y()) + "]";
 }
 
 // the paper's polar form s, sigma (what people read and write); reading it
 // back reproduces e, f to within a few ulps (s e^{i sigma} rounds), which the comment records
 std::string link_line(const char* name, const core::Link& l) {
-  return std::string("  ") + name + ": {length: " + text::exact(l.length) +
-         ", mass: " + text::exact(l.mass) + ", s: " + text::exact(l.s()) +
-         ", sigma: " + text::exact(l.sigma()) + ", inertia: " + text::exact(l.inertia) + "}\n" +
-         "    # e = " + text::exact(l.e) + " m, f = " + text::exact(l.f) + " m\n";
+  return std::string("  ") + name + ": {length: " + text::shortest(l.length) +
+         ", mass: " + text::shortest(l.mass) + ", s: " + text::shortest(l.s()) +
+         ", sigma: " + text::shortest(l.sigma()) + ", inertia: " + text::shortest(l.inertia) + "}\n" +
+         "    # e = " + text::shortest(l.e) + " m, f = " + text::shortest(l.f) + " m\n";
 }
 
 std::string load_line(const char* name, const core::LinkLoad& l) {
   return std::string("  ") + name + ": {force: " + vec(l.force) +
-         ", moment: " + text::exact(l.moment) + "}\n";
+         ", moment: " + text::shortest(l.moment) + "}\n";
 }
 
 std::string list(const std::vector<double>& v) {
   std::string s = "[";
-  for (std::size_t k = 0; k < v.size(); ++k) s += (k ? ", " : "") + text::exact(v[k]);
+  for (std::size_t k = 0; k < v.size(); ++k) s += (k ? ", " : "") + text::shortest(v[k]);
   return s + "]";
 }
 
 std::string effort(const core::planar::TimeFunction& f) {
   using K = core::planar::TimeFunction::Kind;
-  if (f.kind == K::kConstant) return text::exact(f.value);
+  if (f.kind == K::kConstant) return text::shortest(f.value);
   if (f.kind == K::kHarmonic) {
-    return "{mean: " + text::exact(f.mean) + ", amplitude: " + text::exact(f.amplitude) +
-           ", frequency: " + text::exact(f.frequency) + ", phase: " + text::exact(f.phase) + "}";
+    return "{mean: " + text::shortest(f.mean) + ", amplitude: " + text::shortest(f.amplitude) +
+           ", frequency: " + text::shortest(f.frequency) + ", phase: " + text::shortest(f.phase) + "}";
   }
   std::string s = "{table: [";
   for (std::size_t k = 0; k < f.times.size(); ++k) {
-    s += (k ? ", [" : "[") + text::exact(f.times[k]) + ", " + text::exact(f.values[k]) + "]";
+    s += (k ? ", [" : "[") + text::shortest(f.times[k]) + ", " + text::shortest(f.values[k]) + "]";
   }
   return s + "]}";
 }
@@ -59,14 +59,14 @@ std::string planar_linkage_yaml(const core::planar::Linkage& l) {
   for (const core::planar::Link& k : l.links) {
     std::string nodes;
     for (int i : k.nodes) nodes += (nodes.empty() ? "" : ", ") + node(i);
-    y += "    " + k.name + ": {nodes: [" + nodes + "], mass: " + text::exact(k.mass) +
-         ", e: " + text::exact(k.e) + ", f: " + text::exact(k.f) +
-         ", inertia: " + text::exact(k.inertia) + "}\n";
+    y += "    " + k.name + ": {nodes: [" + nodes + "], mass: " + text::shortest(k.mass) +
+         ", e: " + text::shortest(k.e) + ", f: " + text::shortest(k.f) +
+         ", inertia: " + text::shortest(k.inertia) + "}\n";
   }
   if (!l.point_masses.empty()) {
     y += "  point_masses:\n";
     for (const core::planar::PointMass& p : l.point_masses) {
-      y += "    " + node(p.node) + ": " + text::exact(p.mass) + "\n";
+      y += "    " + node(p.node) + ": " + text::shortest(p.mass) + "\n";
     }
   }
   if (!l.sliders.empty()) {
@@ -83,9 +83,9 @@ std::string planar_linkage_yaml(const core::planar::Linkage& l) {
     y += "  springs:\n";
     for (const core::planar::Spring& sp : l.springs) {
       y += "    " + sp.name + ": {between: [" + node(sp.a) + ", " + node(sp.b) +
-           "], stiffness: " + text::exact(sp.stiffness) +
-           ", free_length: " + text::exact(sp.free_length) +
-           ", damping: " + text::exact(sp.damping) + "}\n";
+           "], stiffness: " + text::shortest(sp.stiffness) +
+           ", free_length: " + text::shortest(sp.free_length) +
+           ", damping: " + text::shortest(sp.damping) + "}\n";
     }
   }
   if (!l.shafts.empty()) {
@@ -93,8 +93,8 @@ std::string planar_linkage_yaml(const core::planar::Linkage& l) {
     for (const core::planar::BalanceShaft& b : l.shafts) {
       y += "    " + b.name + ": {link: " + l.links[static_cast<std::size_t>(b.link)].name +
            ", ratio: " + std::to_string(b.ratio) + ", at: " + vec(b.at) +
-           ", mass: " + text::exact(b.mass) + ", eccentricity: " + vec(b.eccentricity) +
-           ", inertia: " + text::exact(b.inertia) + "}\n";
+           ", mass: " + text::shortest(b.mass) + ", eccentricity: " + vec(b.eccentricity) +
+           ", inertia: " + text::shortest(b.inertia) + "}\n";
     }
   }
   y += "  inputs:\n";
@@ -112,7 +112,7 @@ std::string planar_linkage_yaml(const core::planar::Linkage& l) {
     y += "  links:\n";
     for (const core::planar::LinkLoad& ld : l.loads.link_loads) {
       y += "    " + l.links[static_cast<std::size_t>(ld.link)].name + ": {force: " + vec(ld.force) +
-           ", moment: " + text::exact(ld.moment) + "}\n";
+           ", moment: " + text::shortest(ld.moment) + "}\n";
     }
   }
   if (!l.loads.node_forces.empty()) {
@@ -130,7 +130,7 @@ std::string planar_scene_yaml(const Scene& scene) {
     y += "  type: free\n";
     if (!f->start.empty()) y += "  start: " + list(f->start) + "\n";
     if (!f->rates.empty()) y += "  rates: " + list(f->rates) + "\n";
-    y += "  duration: " + text::exact(f->duration) + "\n";
+    y += "  duration: " + text::shortest(f->duration) + "\n";
     return y + "  samples: " + std::to_string(f->samples) + "\n";
   }
   const auto& d = std::get<core::planar::DrivenScene>(scene);
@@ -138,7 +138,7 @@ std::string planar_scene_yaml(const Scene& scene) {
   if (!d.start.empty()) y += "  start: " + list(d.start) + "\n";
   y += "  speeds: " + list(d.speeds) + "\n";
   if (d.duration > 0) {
-    y += "  duration: " + text::exact(d.duration) + "\n";
+    y += "  duration: " + text::shortest(d.duration) + "\n";
   } else {
     y += "  revolutions: " + std::to_string(d.revolutions) + "\n";
   }
@@ -159,14 +159,14 @@ std::string study_yaml(const Study& study, const std::string& header) {
   if (!study.is_fourbar()) {
     y += planar_linkage_yaml(study.planar()) + planar_scene_yaml(study.scene);
     y += "\nmethod: " + study.method_name() + "\n";
-    return y + "tolerance: " + text::exact(study.tolerance) + "\n";
+    return y + "tolerance: " + text::shortest(study.tolerance) + "\n";
   }
 
   // linkage: links in the paper's polar form (see link_line)
   const core::FourBar& m = study.fourbar();
   y += "linkage:\n";
   y += "  type: fourbar\n";
-  y += "  frame: " + text::exact(m.frame_length) + "\n";
+  y += "  frame: " + text::shortest(m.frame_length) + "\n";
   y += std::string("  branch: ") + (m.branch == core::Branch::kPlus ? "1" : "-1") + "\n";
   y += link_line("crank", m.crank);
   y += link_line("coupler", m.coupler);
@@ -177,7 +177,7 @@ std::string study_yaml(const Study& study, const std::string& header) {
     y += "  counter_rotations:\n";
     for (int i = 0; i < 2; ++i) {
       if (discs[i]->inertia <= 0) continue;
-      y += std::string("    ") + disc_names[i] + ": {inertia: " + text::exact(discs[i]->inertia) +
+      y += std::string("    ") + disc_names[i] + ": {inertia: " + text::shortest(discs[i]->inertia) +
            ", at: " + vec(discs[i]->at) + "}\n";
     }
   }
@@ -193,20 +193,20 @@ std::string study_yaml(const Study& study, const std::string& header) {
   y += "\nscene:\n";
   if (const auto* free = std::get_if<core::FreeScene>(&study.scene)) {
     y += "  type: free\n";
-    y += "  theta1: " + text::exact(free->theta1) + "\n";
-    y += "  omega1: " + text::exact(free->omega1) + "\n";
-    y += "  duration: " + text::exact(free->duration) + "\n";
+    y += "  theta1: " + text::shortest(free->theta1) + "\n";
+    y += "  omega1: " + text::shortest(free->omega1) + "\n";
+    y += "  duration: " + text::shortest(free->duration) + "\n";
     y += "  samples: " + std::to_string(free->samples) + "\n";
   } else {
     const auto& driven = std::get<core::DrivenScene>(study.scene);
     y += "  type: driven\n";
-    y += "  theta1: " + text::exact(driven.theta1) + "\n";
-    y += "  omega1: " + text::exact(driven.omega1) + "\n";
+    y += "  theta1: " + text::shortest(driven.theta1) + "\n";
+    y += "  omega1: " + text::shortest(driven.omega1) + "\n";
     y += "  revolutions: " + std::to_string(driven.revolutions) + "\n";
     y += "  samples: " + std::to_string(driven.samples) + "\n";
   }
   y += "\nmethod: " + study.method_name() + "\n";
-  y += "tolerance: " + text::exact(study.tolerance) + "\n";
+  y += "tolerance: " + text::shortest(study.tolerance) + "\n";
   return y;
 }
 

@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <string>
 #include <utility>
 #include <vector>
@@ -40,6 +41,10 @@ class Reporter {
  public:
   explicit Reporter(std::string source) : source_(std::move(source)) {}
   const std::string& source() const { return source_; }
+  /// Every value read with a unit of its own, as read and in SI ("scene.theta1: 90 deg =
+  /// 1.5707963267948966 rad"), in reading order.
+  const std::vector<std::string>& units_read() const { return units_read_; }
+  void note_unit(const std::string& line) const { units_read_.push_back(line); }
 
   [[noreturn]] void fail(const YAML::Mark& mark, const std::string& message) const {
     if (mark.is_null()) throw StudyError(source_, 1, 1, message);
@@ -48,6 +53,7 @@ class Reporter {
 
  private:
   std::string source_;
+  mutable std::vector<std::string> units_read_;  // a log of the reading, not its state
 };
 
 // where a value is: its own mark, else its key's (an empty value is marked at the next token,
@@ -135,6 +141,63 @@ class MapReader {
   std::vector<Entry> entries_;
 };
 
+// The units a value whose SI unit is `si` may be written in, with their factors to SI; a plain
+// number is SI. "2 g" is 2 grams for a mass, two standard gravities for an acceleration.
+struct UnitFactor {
+  const char* name;
+  double factor;
+  double divisor;  // SI = number · factor / divisor (divided last: 90 deg is π/2 exactly)
+};
+inline std::vector<UnitFactor> units_for(const std::string& si) {
+  constexpr double kPi = 3.14159265358979323846;
+  if (si == "rad") return {{"rad", 1, 1}, {"deg", kPi, 180}, {"°", kPi, 180}, {"rev", 2 * kPi, 1}};
+  if (si == "rad/s") {
+    return {{"rad/s", 1, 1}, {"rpm", 2 * kPi, 60}, {"rev/s", 2 * kPi, 1}, {"deg/s", kPi, 180}};
+  }
+  if (si == "m") return {{"m", 1, 1}, {"mm", 1, 1e3}, {"cm", 1, 1e2}, {"in", 0.0254, 1}};
+  if (si == "kg") return {{"kg", 1, 1}, {"g", 1, 1e3}, {"lb", 0.45359237, 1}};
+  if (si == "kg m^2") {
+    return {{"kg m^2", 1, 1},       {"kg m²", 1, 1},       {"kg mm^2", 1, 1e6}, {"kg mm²", 1, 1e6},
+            {"g cm^2", 1, 1e7}, {"g cm²", 1, 1e7}, {"g mm^2", 1, 1e9},  {"g mm²", 1, 1e9}};
+  }
+  if (si == "N") return {{"N", 1, 1}, {"kN", 1e3, 1}, {"mN", 1, 1e3}};
+  if (si == "N m") return {{"N m", 1, 1}, {"Nm", 1, 1}, {"N mm", 1, 1e3}, {"kN m", 1e3, 1}};
+  if (si == "s") return {{"s", 1, 1}, {"ms", 1, 1e3}, {"min", 60, 1}};
+  if (si == "m/s") return {{"m/s", 1, 1}, {"mm/s", 1, 1e3}};
+  if (si == "m/s^2") return {{"m/s^2", 1, 1}, {"m/s²", 1, 1}, {"g", 9.80665, 1}};
+  if (si == "Hz") return {{"Hz", 1, 1}, {"rpm", 1, 60}};
+  if (si == "N/m") return {{"N/m", 1, 1}, {"N/mm", 1e3, 1}, {"kN/m", 1e3, 1}};
+  if (si == "N s/m") return {{"N s/m", 1, 1}, {"N s/mm", 1e3, 1}};
+  return {};
+}
+
+// a scalar "<number> <unit>" (the space optional) in SI, or false when it is not one; fails at
+// the value for a unit the quantity cannot take
+inline bool read_with_unit(const Reporter& r, const YAML::Node& node, const YAML::Mark& fallback,
+                           const std::string& path, const std::string& si, double& value) {
+  if (!node.IsScalar() || si.empty()) return false;
+  const std::string& text = node.Scalar();
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  const double number = std::strtod(begin, &end);
+  if (end == begin) return false;
+  std::string unit(end);
+  unit.erase(0, unit.find_first_not_of(' '));
+  unit.erase(unit.find_last_not_of(' ') + 1);
+  if (unit.empty()) return false;
+  std::string known;
+  for (const UnitFactor& u : units_for(si)) {
+    if (unit == u.name) {
+      value = number * u.factor / u.divisor;
+      r.note_unit(path + ": " + text + " = " + text::exact(value) + " " + si);
+      return true;
+    }
+    known += (known.empty() ? "" : ", ") + std::string(u.name);
+  }
+  r.fail(mark_of(node, fallback), path + ": unit '" + unit + "' is not one of " + known +
+                                      " (a plain number is in " + si + ")");
+}
+
 // The range of every number in a study file (but the sweep's seed): 0, or a magnitude from
 // kMinMagnitude to kMaxMagnitude. The tool forms products of a few inputs (a counterweight's
 // inertia m d^2, a force m l omega^2, its square in an RMS, a disc's radius from its mass and
@@ -151,7 +214,8 @@ inline double read_number(const Reporter& r, const YAML::Node& node, const YAML:
                           const std::string& path, const std::string& unit, bool bounded = true) {
   const std::string in_unit = unit.empty() ? "" : " in " + unit;
   double value = 0.0;
-  if (!node.IsScalar() || !YAML::convert<double>::decode(node, value)) {
+  if (!node.IsScalar() || (!YAML::convert<double>::decode(node, value) &&
+                           !read_with_unit(r, node, fallback, path, unit, value))) {
     r.fail(mark_of(node, fallback),
            path + " must be a number" + in_unit + ", got " + describe(node));
   }

@@ -110,7 +110,7 @@ std::pair<double, double> added(const Study& study, const RunResult& r) {
 PointRow point_row(const Study& base, int index, std::span<const double> values,
                    std::size_t cells) {
   std::string head = std::to_string(index);
-  for (double v : values) head += "," + text::exact(v);
+  for (double v : values) head += "," + text::shortest(v);  // the swept values as a person wrote them
   std::string status = "ok", message;
   std::string body;
   try {
@@ -276,9 +276,10 @@ std::string row_problem(const std::string& line, std::size_t i, std::size_t colu
   }
   if (f[0] != std::to_string(i)) return "its point is '" + f[0] + "'";
   for (std::size_t j = 0; j < values.size(); ++j) {
-    if (f[1 + j] != text::exact(values[j])) {
+    // compared as numbers: a row written by an earlier version has %.17g text
+    if (std::strtod(f[1 + j].c_str(), nullptr) != values[j]) {
       return "its parameter " + std::to_string(j + 1) + " is " + f[1 + j] + ", the design's " +
-             text::exact(values[j]);
+             text::shortest(values[j]);
     }
   }
   const std::string& status = f[columns - 2];
@@ -433,6 +434,8 @@ void start_files(const Study& study, const fs::path& out_dir, const SweepResult&
                              ec.message());
   }
   remove_stale_temporaries(out_dir);  // of a sweep killed here before
+  // the study itself, which `balance-design report DIR` reads from the folder
+  if (study.sweep) write_text_file(study.sweep->study_text, out_dir / "study.yaml");
   write_text_file(sweep_json(study, result.points, counts), result.summary);
   if (options.resume && existing.csv.has_header) {  // checked: this sweep's header and rows
     if (existing.csv.complete_size != existing.csv_text.size()) {

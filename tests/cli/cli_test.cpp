@@ -1,6 +1,8 @@
 // The balance-design executable: exit codes, the one-line error on stderr, outputs where asked
 // and nothing written for bad input. Needs the executable built (target balance-design).
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -118,10 +120,9 @@ TEST_F(CliTest, BadCommandLineExitsTwo) {
 }
 
 TEST_F(CliTest, SimulationStoppedEarlyExitsThreeAndKeepsResults) {
-  // the crank (2.5) of this linkage cannot turn fully: the driven run stops where the loop
-  // cannot close
-  write("stops.yaml",
-        "name: stops\n"
+  // a driven crank that cannot turn fully is refused before it runs (exit 2, at scene.type)
+  write("rocks.yaml",
+        "name: rocks\n"
         "linkage:\n"
         "  type: fourbar\n"
         "  frame: 3.2\n"
@@ -130,7 +131,32 @@ TEST_F(CliTest, SimulationStoppedEarlyExitsThreeAndKeepsResults) {
         "  coupler: {length: 3.0, mass: 3.0, s: 1.45, sigma: 0.4, inertia: 3.1}\n"
         "  rocker:  {length: 2.0, mass: 2.2, s: 1.66, sigma: -0.4, inertia: 2.1}\n"
         "scene: {type: driven, theta1: 1.5707963267948966, omega1: 6.283185307179586}\n");
+  EXPECT_EQ(run("validate rocks.yaml"), 2);
+  EXPECT_EQ(err_.rfind("rocks.yaml:9:15: scene.type: driven turns the crank through whole "
+                       "revolutions, but this linkage is rocker-crank",
+                       0),
+            0u)
+      << err_;
+  // a parallelogram (a change-point linkage): its crank turns fully, but at theta1 = pi the
+  // links fold flat, a dead centre where the driven run stops
+  write("stops.yaml",
+        "name: stops\n"
+        "linkage:\n"
+        "  type: fourbar\n"
+        "  frame: 3.0\n"
+        "  branch: 1\n"
+        "  crank:   {length: 1.0, mass: 2.1, s: 0.6, sigma: 0.3, inertia: 1.1}\n"
+        "  coupler: {length: 3.0, mass: 3.0, s: 1.45, sigma: 0.4, inertia: 3.1}\n"
+        "  rocker:  {length: 1.0, mass: 2.2, s: 0.66, sigma: -0.4, inertia: 2.1}\n"
+        "scene: {type: driven, theta1: 1.5707963267948966, omega1: 6.283185307179586}\n");
   EXPECT_EQ(run("stops.yaml --out res"), 3) << err_;
+  // its metrics say they cover part of the run only
+  EXPECT_NE(out_.find("  partial  the metrics below cover only the 90 samples before the run "
+                      "stopped"),
+            std::string::npos)
+      << out_;
+  EXPECT_NE(read(dir_ / "res" / "summary.json").find("\"metrics_partial\": true"),
+            std::string::npos);
   EXPECT_EQ(err_.rfind("stops.yaml: simulation stopped early: ", 0), 0u) << err_;
   EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
   EXPECT_NE(err_.find("theta1"), std::string::npos) << err_;
@@ -369,6 +395,42 @@ TEST_F(CliTest, HelpAndVersion) {
   EXPECT_NE(out_.find("--out"), std::string::npos) << out_;
   EXPECT_EQ(run("--version"), 0);
   EXPECT_EQ(out_.rfind("balance-design ", 0), 0u) << out_;
+}
+
+// each command's help says what that command does, not the outputs of run; `help` is help
+TEST_F(CliTest, HelpPerCommand) {
+  EXPECT_EQ(run("help"), 0) << err_;
+  const std::string top = out_;
+  EXPECT_NE(top.find("Exit codes"), std::string::npos) << top;
+  EXPECT_EQ(run("--help"), 0);
+  EXPECT_EQ(out_, top);
+  EXPECT_EQ(run("help run"), 0) << err_;
+  EXPECT_NE(out_.find("balanced-timeseries.csv"), std::string::npos) << out_;
+  for (const char* command : {"validate", "report", "bench"}) {
+    EXPECT_EQ(run(std::string(command) + " --help"), 0) << command;
+    EXPECT_EQ(out_.find("balanced-timeseries.csv"), std::string::npos) << command << "\n" << out_;
+    EXPECT_LT(std::count(out_.begin(), out_.end(), '\n'), 30) << command << "\n" << out_;
+    const std::string own = out_;
+    EXPECT_EQ(run(std::string("help ") + command), 0) << command;
+    EXPECT_EQ(out_, own) << command;
+  }
+}
+
+// the output folder holds its study: `report DIR` from another directory gives the same page,
+// even when the study was given by a relative path that does not lead there
+TEST_F(CliTest, ReportFromAnotherDirectoryGivesTheSamePage) {
+  fs::copy_file(kExamples + "/paper-fourbar-driven.yaml", dir_ / "mine.yaml");
+  EXPECT_EQ(run("run mine.yaml --out res"), 0) << err_;
+  ASSERT_TRUE(fs::exists(dir_ / "res" / "study.yaml"));
+  EXPECT_EQ(read(dir_ / "res" / "study.yaml"), read(dir_ / "mine.yaml"));
+  const std::string first = read(dir_ / "res" / "report.html");
+  fs::create_directories(dir_ / "elsewhere");
+  fs::remove(dir_ / "mine.yaml");  // even with the original gone
+  EXPECT_EQ(std::system(("cd " + quote((dir_ / "elsewhere").string()) + " && " + quote(kExe) +
+                         " report ../res >/dev/null 2>&1")
+                            .c_str()),
+            0);
+  EXPECT_EQ(read(dir_ / "res" / "report.html"), first);
 }
 
 }  // namespace

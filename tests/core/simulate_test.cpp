@@ -390,10 +390,14 @@ TEST(Simulate, StatusNames) {
 TEST(Metrics, MatchHandComputation) {
   Trajectory trajectory;
   DynamicsSample a, b, c;
-  a.Fsh = Vec2(3, 4);   // |Fsh| = 5
-  b.Fsh = Vec2(0, 0);   // 0
-  c.Fsh = Vec2(-1, 0);  // 1
-  a.Msh = -2, b.Msh = 1, c.Msh = 2;
+  // the table's Fsh and Msh are the inertial parts; the totals (weights, loads) come after
+  a.Fsh_inertial = Vec2(3, 4);   // |Fsh| = 5
+  b.Fsh_inertial = Vec2(0, 0);   // 0
+  c.Fsh_inertial = Vec2(-1, 0);  // 1
+  a.Msh_inertial = -2, b.Msh_inertial = 1, c.Msh_inertial = 2;
+  a.Fsh = Vec2(3, -6), b.Fsh = Vec2(0, -10), c.Fsh = Vec2(-1, -10);
+  a.Msh = 0, b.Msh = 4, c.Msh = -1;
+  a.FA1 = Vec2(0, 2), b.FA2 = Vec2(-4, 0);
   a.tau = 0, b.tau = -3, c.tau = 0;
   a.RA0 = Vec2(1, 0), b.RA0 = Vec2(0, -6), c.RA0 = Vec2(2, 2);
   a.RA3 = Vec2(0, 7), b.RA3 = Vec2(-5, 0), c.RA3 = Vec2(1, 1);
@@ -408,6 +412,12 @@ TEST(Metrics, MatchHandComputation) {
   EXPECT_DOUBLE_EQ(m.tau_max, 3.0);
   EXPECT_DOUBLE_EQ(m.RA0_max, 6.0);
   EXPECT_DOUBLE_EQ(m.RA3_max, 7.0);
+  EXPECT_DOUBLE_EQ(m.Fsh_total_rms, std::sqrt((45.0 + 100.0 + 101.0) / 3.0));
+  EXPECT_DOUBLE_EQ(m.Fsh_total_max, std::sqrt(101.0));
+  EXPECT_DOUBLE_EQ(m.Msh_total_rms, std::sqrt((0.0 + 16.0 + 1.0) / 3.0));
+  EXPECT_DOUBLE_EQ(m.Msh_total_max, 4.0);
+  EXPECT_DOUBLE_EQ(m.FA1_max, 2.0);
+  EXPECT_DOUBLE_EQ(m.FA2_max, 4.0);
 
   const Metrics none = metrics(Trajectory{});
   EXPECT_EQ(none.Fsh_rms, 0.0);

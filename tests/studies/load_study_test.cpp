@@ -755,9 +755,12 @@ TEST(LoadStudy, OptimizeNeedsOriginalMetricsToNormaliseBy) {
            "  type: driven\n  theta1: 1.5707963267948966\n  omega1: 6.283185307179586\n");
   const std::string text = stuck.substr(0, stuck.find("    length: 1.0\n")) + "    length: 2.5\n" +
                            stuck.substr(stuck.find("    length: 1.0\n") + 16);
-  EXPECT_NO_THROW(parse_study(text, "study.yaml"));  // runs, and stops early (exit code 3)
-  expect_error(text + kMinimal, 18, 1,
-               "optimize: the original design cannot be evaluated in the driven scene");
+  // refused before the optimize section is read: a driven scene needs a crank that turns fully
+  // (it used to load, run to the first limit position and stop with exit code 3)
+  expect_error(text, 15, 9,
+               "scene.type: driven turns the crank through whole revolutions, but this linkage is "
+               "rocker-crank");
+  expect_error(text + kMinimal, 15, 9, "scene.type: driven turns the crank");
   // the paper's force-balanced linkage, driven: no shaking force to normalise by
   std::string balanced = driven();
   for (const auto& [from, to] :

@@ -77,13 +77,17 @@ void expect_rows_match(const std::vector<std::string>& lines, const core::Trajec
   ASSERT_EQ(lines.size(), tr.samples.size() + 1);
   for (std::size_t i = 0; i < tr.samples.size(); ++i) {
     const std::vector<double> row = fields_of(lines[i + 1]);
-    ASSERT_EQ(row.size(), 18u) << "row " << i;
+    ASSERT_EQ(row.size(), 32u) << "row " << i;
     const core::DynamicsSample& d = tr.samples[i];
     const core::FourBarState& s = d.state;
     const double expected[] = {tr.t[i],   s.theta1,  s.theta2,  s.theta3,  s.omega1,  s.omega2,
                                s.omega3,  s.alpha1,  s.alpha2,  s.alpha3,  d.RA0.x(), d.RA0.y(),
-                               d.RA3.x(), d.RA3.y(), d.Fsh.x(), d.Fsh.y(), d.Msh,     d.tau};
-    for (std::size_t k = 0; k < 18; ++k) {
+                               d.RA3.x(), d.RA3.y(), d.Fsh.x(), d.Fsh.y(), d.Msh,     d.tau,
+                               d.Fsh_inertial.x(), d.Fsh_inertial.y(), d.Msh_inertial,
+                               d.Fsh_static.x(), d.Fsh_static.y(), d.Msh_static,
+                               d.RC1.x(), d.RC1.y(), d.RC3.x(), d.RC3.y(),
+                               d.FA1.x(), d.FA1.y(), d.FA2.x(), d.FA2.y()};
+    for (std::size_t k = 0; k < std::size(expected); ++k) {
       EXPECT_EQ(row[k], expected[k]) << "row " << i << " column " << k;
     }
   }
@@ -99,15 +103,17 @@ TEST_F(RunnerTest, FreeSceneWritesTheContractFiles) {
   EXPECT_EQ(r.method.formulation, choose_method(study).formulation);
   EXPECT_EQ(r.method.reason, choose_method(study).reason);
 
-  // nothing but the two final files: no temporary left behind
-  EXPECT_EQ(names_in(out),
-            (std::set<std::string>{"report.html", "summary.json", "timeseries.csv"}));
+  // nothing but the final files (the study's copy among them): no temporary left behind
+  EXPECT_EQ(names_in(out), (std::set<std::string>{"report.html", "study.yaml", "summary.json",
+                                                  "timeseries.csv"}));
+  EXPECT_EQ(read(out / "study.yaml"), read(BD_SOURCE_DIR "/studies/examples/paper-fourbar.yaml"));
 
   const std::vector<std::string> lines = lines_of(read(r.timeseries));
   ASSERT_FALSE(lines.empty());
   EXPECT_EQ(lines[0],
             "t,theta1,theta2,theta3,omega1,omega2,omega3,alpha1,alpha2,alpha3,RA0x,RA0y,RA3x,"
-            "RA3y,Fshx,Fshy,Msh,tau");
+            "RA3y,Fshx,Fshy,Msh,tau,Fshx_inertial,Fshy_inertial,Msh_inertial,Fshx_static,"
+            "Fshy_static,Msh_static,RC1x,RC1y,RC3x,RC3y,FA1x,FA1y,FA2x,FA2y");
   EXPECT_EQ(lines.size(), 502u);  // header + 501 samples
   expect_rows_match(lines, r.trajectory);
   EXPECT_EQ(fields_of(lines[1])[0], 0.0);
@@ -159,7 +165,8 @@ TEST_F(RunnerTest, DrivenSceneWritesOneRowPerSampleAndSaysWhyNoIntegrator) {
   EXPECT_NE(json.find("no integrator: kinetostatics per sample"), std::string::npos) << json;
   EXPECT_GT(r.metrics.tau_max, 0.0);
   EXPECT_EQ(names_in(dir_),
-            (std::set<std::string>{"harmonics.csv", "report.html", "summary.json", "timeseries.csv"}));
+            (std::set<std::string>{"harmonics.csv", "report.html", "study.yaml", "summary.json",
+                                   "timeseries.csv"}));
 }
 
 TEST_F(RunnerTest, RunningAgainReplacesTheFiles) {
@@ -169,7 +176,8 @@ TEST_F(RunnerTest, RunningAgainReplacesTheFiles) {
   run_study(study, dir_);
   EXPECT_EQ(read(dir_ / "timeseries.csv"), first);
   EXPECT_EQ(names_in(dir_),
-            (std::set<std::string>{"harmonics.csv", "report.html", "summary.json", "timeseries.csv"}));
+            (std::set<std::string>{"harmonics.csv", "report.html", "study.yaml", "summary.json",
+                                   "timeseries.csv"}));
 }
 
 TEST_F(RunnerTest, SimulationStoppedEarlyKeepsItsSamplesAndSaysWhy) {
@@ -190,7 +198,7 @@ TEST_F(RunnerTest, SimulationStoppedEarlyKeepsItsSamplesAndSaysWhy) {
   EXPECT_NE(json.find(std::string("\"status\": \"") + core::to_string(r.trajectory.status)),
             std::string::npos);
   EXPECT_EQ(names_in(dir_),
-            (std::set<std::string>{"report.html", "summary.json", "timeseries.csv"}));
+            (std::set<std::string>{"report.html", "study.yaml", "summary.json", "timeseries.csv"}));
 }
 
 TEST_F(RunnerTest, InvalidSceneCreatesNothing) {
@@ -206,7 +214,7 @@ TEST_F(RunnerTest, InvalidSceneCreatesNothing) {
 // (driven scenes: with the harmonic orders of both designs)
 const std::set<std::string> kBalanceFiles = {
     "balanced-timeseries.csv", "balanced.yaml", "comparison.csv", "harmonics.csv", "report.html",
-    "summary.json",            "timeseries.csv"};
+    "study.yaml",              "summary.json",  "timeseries.csv"};
 
 // the value of `"key": ` in the JSON text after `from` (a number or null)
 std::string json_value(const std::string& json, const std::string& key, std::size_t from = 0) {
@@ -251,27 +259,26 @@ TEST_F(RunnerTest, ComparisonCsvHasEveryMetricBeforeAfterAndRatio) {
   ASSERT_TRUE(r.ok()) << r.trajectory.message;
   EXPECT_EQ(names_in(dir_), kBalanceFiles);
   const std::vector<std::string> lines = lines_of(read(r.balanced->comparison));
-  ASSERT_EQ(lines.size(), 13u);
+  ASSERT_EQ(lines.size(), 19u);
   EXPECT_EQ(lines[0], "metric,before,after,ratio");
-  const char* names[] = {"Fsh_rms", "Fsh_max", "Msh_rms", "Msh_max", "tau_rms",    "tau_max",
-                         "RA0_rms", "RA0_max", "RA3_rms", "RA3_max", "added_mass", "added_inertia"};
+  const char* names[] = {"Fsh_rms",       "Fsh_max",       "Msh_rms",       "Msh_max",
+                         "tau_rms",       "tau_max",       "RA0_rms",       "RA0_max",
+                         "RA3_rms",       "RA3_max",       "Fsh_total_rms", "Fsh_total_max",
+                         "Msh_total_rms", "Msh_total_max", "FA1_max",       "FA2_max",
+                         "added_mass",    "added_inertia"};
+  auto values = [](const core::Metrics& m, double mass, double inertia) {
+    return std::vector<double>{m.Fsh_rms,       m.Fsh_max,       m.Msh_rms,       m.Msh_max,
+                               m.tau_rms,       m.tau_max,       m.RA0_rms,       m.RA0_max,
+                               m.RA3_rms,       m.RA3_max,       m.Fsh_total_rms, m.Fsh_total_max,
+                               m.Msh_total_rms, m.Msh_total_max, m.FA1_max,       m.FA2_max,
+                               mass,            inertia};
+  };
   const core::Metrics& a = r.metrics;
   const core::Metrics& z = r.balanced->metrics;
-  const double before[] = {a.Fsh_rms, a.Fsh_max, a.Msh_rms, a.Msh_max, a.tau_rms, a.tau_max,
-                           a.RA0_rms, a.RA0_max, a.RA3_rms, a.RA3_max, 0.0,       0.0};
-  const double after[] = {z.Fsh_rms,
-                          z.Fsh_max,
-                          z.Msh_rms,
-                          z.Msh_max,
-                          z.tau_rms,
-                          z.tau_max,
-                          z.RA0_rms,
-                          z.RA0_max,
-                          z.RA3_rms,
-                          z.RA3_max,
-                          study.balance->added_mass,
-                          study.balance->added_inertia};
-  for (std::size_t i = 0; i < 12; ++i) {
+  const std::vector<double> before = values(r.metrics, 0.0, 0.0);
+  const std::vector<double> after =
+      values(r.balanced->metrics, study.balance->added_mass, study.balance->added_inertia);
+  for (std::size_t i = 0; i < std::size(names); ++i) {
     const std::string& line = lines[i + 1];
     const auto comma = line.find(',');
     EXPECT_EQ(line.substr(0, comma), names[i]);
@@ -430,8 +437,8 @@ TEST_F(RunnerTest, BalanceStudyStoppedEarlyKeepsEveryFile) {
 
 // (driven scenes: with the original's harmonic orders)
 const std::set<std::string> kOptimizeFiles = {
-    "comparison.csv", "harmonics.csv",  "optimized-timeseries.csv", "optimized.yaml",
-    "report.html",    "summary.json",   "timeseries.csv"};
+    "comparison.csv", "harmonics.csv", "optimized-timeseries.csv", "optimized.yaml",
+    "report.html",    "study.yaml",    "summary.json",             "timeseries.csv"};
 
 // the driven paper linkage (paper-fourbar-driven.yaml) with an optimize section appended
 Study driven_with(const std::string& optimize_section, const std::string& name) {
@@ -480,21 +487,21 @@ TEST_F(RunnerTest, OptimizeStudyWritesTheOptimumAndTheComparison) {
 
   // comparison.csv: the same rows as a balance study's, for the optimum
   const std::vector<std::string> lines = lines_of(read(o.comparison));
-  ASSERT_EQ(lines.size(), 13u);
+  ASSERT_EQ(lines.size(), 19u);
   EXPECT_EQ(lines[0], "metric,before,after,ratio");
   const std::vector<ComparisonRow> cmp = comparison(study, r);
-  ASSERT_EQ(cmp.size(), 12u);
+  ASSERT_EQ(cmp.size(), 18u);
   EXPECT_EQ(cmp[2].metric, "Msh_rms");
   EXPECT_EQ(cmp[2].before, r.metrics.Msh_rms);
   EXPECT_EQ(cmp[2].after, o.metrics.Msh_rms);
-  EXPECT_EQ(cmp[10].metric, "added_mass");
-  EXPECT_EQ(cmp[10].after, added_mass(study.fourbar(), o.result.design));
-  EXPECT_EQ(cmp[11].metric, "added_inertia");
+  EXPECT_EQ(cmp[16].metric, "added_mass");
+  EXPECT_EQ(cmp[16].after, added_mass(study.fourbar(), o.result.design));
+  EXPECT_EQ(cmp[17].metric, "added_inertia");
   char buf[128];
   std::snprintf(buf, sizeof buf, "Msh_rms,%.17g,%.17g,%.17g", r.metrics.Msh_rms, o.metrics.Msh_rms,
                 o.metrics.Msh_rms / r.metrics.Msh_rms);
   EXPECT_EQ(lines[3], buf);
-  EXPECT_EQ(lines[11].rfind("added_mass,0,", 0), 0u) << lines[11];
+  EXPECT_EQ(lines[17].rfind("added_mass,0,", 0), 0u) << lines[17];
 }
 
 TEST_F(RunnerTest, OptimizeSummaryJsonExtendsTheContract) {
@@ -600,6 +607,7 @@ TEST_F(RunnerTest, ParetoFrontIsWrittenPointByPoint) {
   const OptimizedRun& o = *r.optimized;
   std::set<std::string> files = kOptimizeFiles;
   files.insert("pareto.csv");
+  files.erase("study.yaml");  // a study from text: no file to copy
   EXPECT_EQ(names_in(dir_), files);
   EXPECT_EQ(o.pareto_file, dir_ / "pareto.csv");
   ASSERT_EQ(o.pareto.size(), 3u);
@@ -649,7 +657,8 @@ TEST_F(RunnerTest, InfeasibleOptimizationKeepsTheOriginalAndSaysWhy) {
   EXPECT_NE(r.optimized->result.message.find("force balance"), std::string::npos)
       << r.optimized->result.message;
   EXPECT_EQ(names_in(dir_),
-            (std::set<std::string>{"harmonics.csv", "report.html", "summary.json", "timeseries.csv"}));
+            (std::set<std::string>{"harmonics.csv", "report.html", "summary.json",
+                                   "timeseries.csv"}));
   expect_rows_match(lines_of(read(r.timeseries)), r.trajectory);
   const std::string json = bd::testing::json_view(read(r.summary));
   EXPECT_NE(json.find("\"termination\": \"infeasible\""), std::string::npos) << json;

@@ -50,12 +50,16 @@ std::string g17(double v) {
 // ---------------------------------------------------------------------------------------------
 // a sweep folder as run_sweep() writes it (the spec's formats), from simulations at each point
 
-constexpr const char* kMetricNames[] = {"Fsh_rms", "Fsh_max", "Msh_rms", "Msh_max", "tau_rms",
-                                        "tau_max", "RA0_rms", "RA0_max", "RA3_rms", "RA3_max"};
+constexpr const char* kMetricNames[] = {
+    "Fsh_rms",       "Fsh_max",       "Msh_rms",       "Msh_max",       "tau_rms",  "tau_max",
+    "RA0_rms",       "RA0_max",       "RA3_rms",       "RA3_max",       "Fsh_total_rms",
+    "Fsh_total_max", "Msh_total_rms", "Msh_total_max", "FA1_max",       "FA2_max"};
 
 std::vector<double> metric_values(const core::Metrics& m) {
-  return {m.Fsh_rms, m.Fsh_max, m.Msh_rms, m.Msh_max, m.tau_rms,
-          m.tau_max, m.RA0_rms, m.RA0_max, m.RA3_rms, m.RA3_max};
+  return {m.Fsh_rms,       m.Fsh_max,       m.Msh_rms,       m.Msh_max,       m.tau_rms,
+          m.tau_max,       m.RA0_rms,       m.RA0_max,       m.RA3_rms,       m.RA3_max,
+          m.Fsh_total_rms, m.Fsh_total_max, m.Msh_total_rms, m.Msh_total_max, m.FA1_max,
+          m.FA2_max};
 }
 
 std::string csv_quoted(const std::string& text) {

@@ -278,6 +278,21 @@ inline core::Series reference_table(const cp::Model& model, const Glue& g,
       const Vec2 r = -s.slider_forces[static_cast<std::size_t>(k)];
       v.insert(v.end(), {r.x(), r.y()});
     }
+    // a spring anchored on the frame pulls it towards the spring's other end with its tension
+    for (int k : model.frame_springs()) {
+      const cp::Spring& sp = l.springs[static_cast<std::size_t>(k)];
+      const bool at_a = l.nodes[static_cast<std::size_t>(sp.a)].ground;
+      const Vec2 anchor = node_motion(g, s, at_a ? sp.a : sp.b).p;
+      const Vec2 other = node_motion(g, s, at_a ? sp.b : sp.a).p;
+      const Vec2 r = s.spring_tensions[static_cast<std::size_t>(k)] * (other - anchor).normalized();
+      v.insert(v.end(), {r.x(), r.y()});
+    }
+    // a slide drive on a frame guide pushes the frame back along the guide
+    for (int k : model.frame_drives()) {
+      const int slider = l.inputs[static_cast<std::size_t>(k)].slider;
+      const Vec2 r = -s.input_efforts[static_cast<std::size_t>(k)] * guide_direction(g, s, slider);
+      v.insert(v.end(), {r.x(), r.y()});
+    }
     for (const cp::JointForce& j : model.joints()) {
       const Vec2 f = j.link == g.host[static_cast<std::size_t>(j.node)]
                          ? single_link_joint_force(g, s, j.node)
@@ -287,6 +302,9 @@ inline core::Series reference_table(const cp::Model& model, const Glue& g,
     v.insert(v.end(), {s.shaking_force.x(), s.shaking_force.y(), s.shaking_moment});
     v.insert(v.end(), s.input_efforts.begin(), s.input_efforts.end());
     v.insert(v.end(), {s.inertial_force.x(), s.inertial_force.y(), s.inertial_moment});
+    // the static part: what the referee's total has beyond its inertial part
+    const Vec2 f = s.shaking_force - s.inertial_force;
+    v.insert(v.end(), {f.x(), f.y(), s.shaking_moment - s.inertial_moment});
   }
   return out;
 }
@@ -371,8 +389,8 @@ inline const char* to_string(Family f) {
     case Family::kAcceleration: return "slide accelerations";
     case Family::kReaction: return "ground and guide reactions";
     case Family::kJointForce: return "joint forces";
-    case Family::kShakingForce: return "Fsh and its inertial part";
-    case Family::kShakingMoment: return "Msh and its inertial part";
+    case Family::kShakingForce: return "Fsh and its inertial and static parts";
+    case Family::kShakingMoment: return "Msh and its inertial and static parts";
     case Family::kEffort: return "drive efforts";
     case Family::kNodeVelocity: return "node velocities";
     case Family::kNodeAcceleration: return "node accelerations";
@@ -392,9 +410,10 @@ inline Family family_of(const std::string& c) {
   if (starts(c, "s_") || starts(c, "x_") || starts(c, "y_")) return Family::kLength;
   if (starts(c, "v_")) return Family::kRate;
   if (starts(c, "a_")) return Family::kAcceleration;
-  if (c == "Fshx" || c == "Fshy" || c == "Fshx_inertial" || c == "Fshy_inertial")
+  if (c == "Fshx" || c == "Fshy" || c == "Fshx_inertial" || c == "Fshy_inertial" ||
+      c == "Fshx_static" || c == "Fshy_static")
     return Family::kShakingForce;
-  if (c == "Msh" || c == "Msh_inertial") return Family::kShakingMoment;
+  if (c == "Msh" || c == "Msh_inertial" || c == "Msh_static") return Family::kShakingMoment;
   if (starts(c, "tau")) return Family::kEffort;
   if (starts(c, "R")) return Family::kReaction;
   if (starts(c, "F")) return Family::kJointForce;
@@ -407,6 +426,7 @@ inline std::string partner(const std::string& c) {
   if (starts(c, "vx_")) return "vy_" + c.substr(3);
   if (starts(c, "ax_")) return "ay_" + c.substr(3);
   if (c == "Fshx_inertial") return "Fshy_inertial";
+  if (c == "Fshx_static") return "Fshy_static";
   const Family f = family_of(c);
   if ((f == Family::kReaction || f == Family::kJointForce || f == Family::kShakingForce) &&
       c.back() == 'x')
@@ -415,7 +435,7 @@ inline std::string partner(const std::string& c) {
 }
 inline bool is_y_of_vector(const std::string& c) {
   if (starts(c, "y_") || starts(c, "vy_") || starts(c, "ay_")) return true;
-  if (c == "Fshy_inertial") return true;
+  if (c == "Fshy_inertial" || c == "Fshy_static") return true;
   const Family f = family_of(c);
   return (f == Family::kReaction || f == Family::kJointForce || f == Family::kShakingForce) &&
          c.back() == 'y';

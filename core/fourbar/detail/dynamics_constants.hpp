@@ -80,7 +80,8 @@ DynamicsConstants dynamics_constants(const FourBar& model);
 /// forward_dynamics() and inverse_dynamics() (core/fourbar/dynamics.hpp) with the model's
 /// constants computed once by dynamics_constants(model): what a loop over many instants of one
 /// model calls (a simulation's right-hand side, a sweep). The results are those of the public
-/// calls bit for bit, at less cost (docs/performance.md).
+/// calls bit for bit, at less cost (docs/performance.md), but for the shaking force's and
+/// moment's inertial and static parts, which they leave zero (set_derived_outputs() adds them).
 /// `constants` must come from this `model`. Models with counter-rotations take the one-instant
 /// route.
 Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model,

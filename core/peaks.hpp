@@ -1,0 +1,33 @@
+#pragma once
+/// Peaks resolved between samples: the largest value of a smooth quantity over a motion, located
+/// by maximising the quantity itself (evaluated exactly at any instant by the caller) inside the
+/// bracket of each sampled local maximum, so that the sample count no longer decides a peak.
+/// Shared by every linkage type's metrics (core/fourbar/metrics.hpp, core/planar/metrics.hpp).
+#include <functional>
+#include <span>
+
+namespace bd::core {
+
+/// Where a quantity is largest, and its value there.
+struct Peak {
+  double value{};  // the largest value found, never below the largest sample
+  double t{};      // its time [s]
+};
+
+/// The quantity at time t, or NaN where it cannot be evaluated (that instant is then skipped).
+using QuantityAt = std::function<double(double t)>;
+
+/// Relative tolerance to which a bracket's maximiser is located in time; the peak's value, whose
+/// error goes with the square of the time's, is then good to round-off.
+inline constexpr double kPeakTimeTolerance = 1e-10;
+
+/// The peak of x over the samples x[i] = f(t[i]) (t increasing). Every sampled local maximum whose
+/// parabola through it and its neighbours could reach the largest sample is refined by Brent's
+/// maximisation of f on the interval between its neighbours; the largest value found wins.
+/// `period` > 0: the samples cover one period of a periodic motion, the end excluded, so the
+/// first and last samples are neighbours across it (a driven revolution); 0: an open interval
+/// (the ends are brackets of their own). With fewer than 3 samples: the largest sample.
+Peak resolved_peak(std::span<const double> t, std::span<const double> x, double period,
+                   const QuantityAt& f);
+
+}  // namespace bd::core
