@@ -18,7 +18,8 @@ install(TARGETS balance-design RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 
 # Public headers only: not core's internals (detail/ folders, and core/integrators.hpp, which
 # holds SUNDIALS' types), not the study reader's (yaml-cpp's types), the report's pages or the
-# solver drivers (NLopt, Ipopt), which their own .cpp files include. tests/install_test.cmake
+# solver drivers (NLopt, Ipopt) and the solve built on them (optimize/convex_solve.hpp), which
+# their own .cpp files include. tests/install_test.cmake
 # checks that every installed header finds every project header it includes.
 foreach(layer core balance optimize studies)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${layer}/ DESTINATION ${BD_INSTALL_INCLUDEDIR}/${layer}
@@ -32,7 +33,8 @@ foreach(layer core balance optimize studies)
           PATTERN "pages.hpp" EXCLUDE
           PATTERN "study_parts.hpp" EXCLUDE
           PATTERN "nlopt_driver.hpp" EXCLUDE
-          PATTERN "ipopt_driver.hpp" EXCLUDE)
+          PATTERN "ipopt_driver.hpp" EXCLUDE
+          PATTERN "convex_solve.hpp" EXCLUDE)
 endforeach()
 
 install(EXPORT balance_designTargets NAMESPACE balance_design::
