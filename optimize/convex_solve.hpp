@@ -59,12 +59,15 @@ struct ConvexAwareSolve {
 /// Solves `nlp` (position variables) from `designs` (its variables: results' x), then its
 /// natural start with each counterweight's mass scaled by 1, 1/4, ..., 1/256 (the first that
 /// fits an added-mass budget), then the original design (no counterweight: feasible for any
-/// budget >= 0). `convex` is the same problem in mass-moment variables, made only where
-/// nlp.why_not_convex() is empty.
-template <class Nlp>
-ConvexAwareSolve solve_convex_aware(const Nlp& nlp, const std::optional<Nlp>& convex,
+/// budget >= 0). `problem` is nlp's; where nlp.why_not_convex() is empty the same problem is
+/// also set up in mass-moment variables (Nlp(problem, CounterweightVariablesAs::kMassMoments)).
+template <class Nlp, class Problem>
+ConvexAwareSolve solve_convex_aware(const Nlp& nlp, const Problem& problem,
                                     const std::vector<Eigen::VectorXd>& designs,
                                     const OptimizeOptions& options) {
+  const std::string why_not = nlp.why_not_convex();
+  std::optional<Nlp> convex;
+  if (why_not.empty()) convex.emplace(problem, CounterweightVariablesAs::kMassMoments);
   const bool in_moments =
       convex && uses_gradients(options.algorithm) && options.algorithm != Algorithm::kMlsl;
   const Nlp& program = in_moments ? *convex : nlp;
@@ -93,7 +96,7 @@ ConvexAwareSolve solve_convex_aware(const Nlp& nlp, const std::optional<Nlp>& co
   }
   const bool found = found_design(solved.termination);
   out.optimality = optimality(
-      convex ? std::string() : nlp.why_not_convex(), solved.termination == Termination::kConverged,
+      why_not, solved.termination == Termination::kConverged,
       convex && found ? stationarity_residual(*convex, convex->from_positions(solved.x))
                       : solved.stationarity,
       options.relative_tolerance);

@@ -465,9 +465,7 @@ OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& opt
   detail::check_inputs(problem, options);
   const Nlp nlp(problem);
   throw_if(check_algorithm(problem, options));
-  std::optional<Nlp> convex;
-  if (nlp.why_not_convex().empty()) convex.emplace(problem, CounterweightVariablesAs::kMassMoments);
-  const detail::ConvexAwareSolve solve = detail::solve_convex_aware(nlp, convex, designs, options);
+  const detail::ConvexAwareSolve solve = detail::solve_convex_aware(nlp, problem, designs, options);
   const detail::Solved& solved = solve.solved;
   const detail::Optimality& optimality = solve.optimality;
 

@@ -1272,9 +1272,7 @@ Result optimize(const DesignProblem& problem, const OptimizeOptions& options,
   // a problem convex in the counterweights' masses and mass moments solved in those variables
   // (optimize/convex_solve.hpp); the original design itself (no counterweight mass) is the last
   // start: it meets every limit of 1 or more and any added-mass limit >= 0
-  std::optional<PlanarNlp> convex;
-  if (nlp.why_not_convex().empty()) convex.emplace(problem, CounterweightVariablesAs::kMassMoments);
-  const detail::ConvexAwareSolve solve = detail::solve_convex_aware(nlp, convex, designs, options);
+  const detail::ConvexAwareSolve solve = detail::solve_convex_aware(nlp, problem, designs, options);
   const detail::Solved& s = solve.solved;
   Result r;
   r.global = solve.optimality.global && found_design(s.termination);
