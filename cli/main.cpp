@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <exception>
@@ -389,6 +390,17 @@ void print_planar_balance(const st::Study& study, const st::RunResult& r) {
   print_comparison(study, r);
 }
 
+// the lower bound of the objective and the optimum's gap above it, or why there is none
+void print_lower_bound(double objective, double bound, const std::string& source) {
+  if (source.empty()) return;
+  if (!std::isfinite(bound)) {
+    std::printf("           %s\n", source.c_str());
+    return;
+  }
+  std::printf("           lower bound %.6g (the optimum is %.3g above it), %s\n", bound,
+              objective - bound, source.c_str());
+}
+
 // the optimum: how the solver ended, what it added, and before / after / ratio
 void print_optimize(const st::Study& study, const st::RunResult& r) {
   const st::OptimizeRequest& req = *study.optimize;
@@ -400,6 +412,7 @@ void print_optimize(const st::Study& study, const st::RunResult& r) {
   std::printf("           %s\n", o.brief_report().c_str());
   if (!run.found()) return;
   std::printf("           %s\n", o.optimality.c_str());
+  print_lower_bound(o.objective, o.lower_bound, o.lower_bound_source);
   for (const bd::optimize::PlacedCounterweight& p : o.counterweights) {
     const bd::balance::Counterweight& c = p.counterweight;
     std::printf("  %-7s  counterweight %.6g kg at [%.6g, %.6g] m from %s (%.6g m)",
@@ -436,6 +449,7 @@ void print_planar_optimize(const st::Study& study, const st::RunResult& r) {
                                      : o.brief_report().c_str());
   if (!run.found()) return;
   std::printf("           %s\n", o.optimality.c_str());
+  print_lower_bound(o.objective, o.lower_bound, o.lower_bound_source);
   int width = 7;
   for (const bd::core::planar::Link& k : study.planar().links)
     width = std::max(width, static_cast<int>(k.name.size()));

@@ -11,10 +11,13 @@
 /// `Nlp` is a linkage type's program (Nlp, planar::PlanarNlp) with start(bool),
 /// start_scaled(double), start_at(), from_positions(), to_positions() and why_not_convex().
 #include <Eigen/Core>
+#include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "core/number_text.hpp"
 #include "core/types.hpp"
 #include "optimize/first_order.hpp"
 #include "optimize/nlopt_driver.hpp"
@@ -51,10 +54,91 @@ inline void cone_first_order_row(const Eigen::VectorXd& x, const Eigen::VectorXd
   jac(row, j + 2) = u.y() / pmax;
 }
 
+/// A lower bound of the objective over every feasible design, and how it was found.
+struct LowerBound {
+  double value = std::numeric_limits<double>::quiet_NaN();  // NaN: none
+  std::string words;
+};
+
 struct ConvexAwareSolve {
   Solved solved;  // in the position variables
   Optimality optimality;
+  LowerBound bound;
 };
+
+/// The best Lagrangian bound (first_order()) of a convex program near x. The bound is as tight as
+/// the first-order conditions hold, and a solver's usual end, within sqrt(tolerance) of them,
+/// leaves it up to ~1e-4 of the objective below the optimum; so it is taken at x, at x without
+/// the counterweights below 1e-6 of their mass_max (a vanishing counterweight's mass moment has
+/// a direction of round-off, which the conditions cannot meet; on the apex the cone's
+/// subgradient can), at the ends of up to three SLSQP runs on from x to a relative tolerance of
+/// 1e-14 (each restart renews its Hessian), and, where these leave it more than 1e-7 of the
+/// objective's size below f(x), at the end of an Ipopt run to 1e-10 (its interior path reaches
+/// an optimum on the cone's apex, where SLSQP's steps turn with the round-off). Each is a bound;
+/// the largest is kept.
+template <class Nlp>
+double tight_bound(const Nlp& program, const Eigen::VectorXd& x, const OptimizeOptions& options) {
+  double bound = std::max(
+      first_order(program, x).lower_bound,
+      first_order(program, program.without_vanishing_counterweights(x, 1e-6)).lower_bound);
+  OptimizeOptions tight = options;
+  tight.algorithm = Algorithm::kSlsqp;
+  tight.relative_tolerance = 1e-14;
+  tight.check_gradients = false;
+  const double f = program.objective(x, nullptr), close = 1e-7 * std::max(std::abs(f), 1.0);
+  Eigen::VectorXd at = x;
+  for (int run = 0; run < 3 && f - bound > close; ++run) {
+    const Solved refined = solve(program, at, tight);
+    if (refined.x.size() != x.size()) break;
+    const double next = first_order(program, refined.x).lower_bound;
+    const bool gained = next > bound + 1e-12 * std::max(std::abs(bound), 1.0);
+    bound = std::max(bound, next);
+    at = refined.x;
+    if (!gained) break;
+  }
+  if (f - bound > close) {
+    tight.algorithm = Algorithm::kIpopt;
+    tight.relative_tolerance = 1e-10;
+    const Solved refined = solve(program, x, tight);
+    if (refined.x.size() == x.size()) {
+      bound = std::max(bound, first_order(program, refined.x).lower_bound);
+    }
+  }
+  return bound;
+}
+
+/// The lower bound of a problem that is not convex: the Lagrangian bound (first_order()) of its
+/// convex relaxation (CounterweightVariablesAs::kRelaxation) at the relaxation's own solve from
+/// its starts and from `best` (the best design found, in position variables), where the
+/// relaxation is convex; else none, with the reason.
+template <class Nlp, class Problem>
+LowerBound relaxation_bound(const Problem& problem, const Eigen::VectorXd& best,
+                            const OptimizeOptions& options) {
+  LowerBound out;
+  const Nlp relaxed(problem, CounterweightVariablesAs::kRelaxation);
+  if (const std::string why = relaxed.why_not_convex(); !why.empty()) {
+    out.words = "no lower bound: even with the counterweights' inertias relaxed, " + why;
+    return out;
+  }
+  OptimizeOptions local = options;
+  if (!uses_gradients(local.algorithm) || local.algorithm == Algorithm::kMlsl) {
+    local.algorithm = Algorithm::kSlsqp;
+  }
+  local.check_gradients = false;
+  std::vector<Eigen::VectorXd> starts;
+  if (best.size() > 0) starts.push_back(relaxed.start_at(relaxed.from_positions(best)));
+  for (double fraction = 1; fraction > 1e-3; fraction /= 4) {
+    starts.push_back(relaxed.start_scaled(fraction));
+  }
+  starts.push_back(relaxed.start(true));
+  const Solved solved = solve_from(relaxed, starts, local);
+  out.value = tight_bound(relaxed, solved.x, local);
+  out.words = "from the convex relaxation in which each counterweight's inertia about its pivot "
+              "(mass x distance², and a disc's own inertia) may take any value between its "
+              "least for the mass and mass moment and its largest within distance_max";
+  if (!std::isfinite(out.value)) out.words = "no lower bound: the relaxation's solve gave none";
+  return out;
+}
 
 /// Solves `nlp` (position variables) from `designs` (its variables: results' x), then its
 /// natural start with each counterweight's mass scaled by 1, 1/4, ..., 1/256 (the first that
@@ -95,11 +179,29 @@ ConvexAwareSolve solve_convex_aware(const Nlp& nlp, const Problem& problem,
     check_feasibility(nlp, options, solver, solved);
   }
   const bool found = found_design(solved.termination);
-  out.optimality = optimality(
-      why_not, solved.termination == Termination::kConverged,
-      convex && found ? stationarity_residual(*convex, convex->from_positions(solved.x))
-                      : solved.stationarity,
-      options.relative_tolerance);
+  double stationarity = solved.stationarity;
+  if (convex && found) {
+    // the certificate and the bound from the convex program's first-order conditions at the design
+    const Eigen::VectorXd at = convex->from_positions(solved.x);
+    stationarity = first_order(*convex, at).residual;
+    out.bound.value = tight_bound(*convex, at, options);
+    out.bound.words = "the first-order (Lagrangian) bound of the convex problem at the design";
+  } else if (!why_not.empty() && nlp.has_gradients()) {
+    out.bound = relaxation_bound<Nlp>(problem, found ? solved.x : Eigen::VectorXd(), options);
+  } else if (!why_not.empty()) {
+    out.bound.words = "no lower bound: " + why_not;
+  }
+  out.optimality = optimality(why_not, solved.termination == Termination::kConverged,
+                              stationarity, options.relative_tolerance);
+  // a design within kSameValue of a lower bound is a global optimum to that, convex or not
+  const double gap = solved.objective - out.bound.value;
+  if (!out.optimality.global && found && !why_not.empty() &&
+      gap <= kSameValue * std::max(std::abs(solved.objective), 1.0)) {
+    out.optimality = {true, "global to within " + (gap > 0 ? text::digits(gap, 2) : "round-off") +
+                                " of the objective: the problem is not convex (" + why_not +
+                                "), but no design can go below its convex relaxation's lower "
+                                "bound, which the design's objective meets to that"};
+  }
   return out;
 }
 

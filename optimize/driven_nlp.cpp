@@ -528,6 +528,7 @@ void DrivenNlp::metric_inequalities(const VectorXd& x, const Inertial& in, Vecto
         break;
       case Block::Kind::kEnvelope:
       case Block::Kind::kAddedMassLimit:
+      case Block::Kind::kRelaxation:
         break;
     }
     row += b.count;

@@ -14,6 +14,10 @@ using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
 double stationarity_residual(const Program& p, const VectorXd& x, double activity) {
+  return first_order(p, x, activity).residual;
+}
+
+FirstOrder first_order(const Program& p, const VectorXd& x, double activity) {
   const int n = p.n();
   VectorXd w = (p.upper() - p.lower()).cwiseAbs();
   for (int j = 0; j < n; ++j) {
@@ -23,8 +27,9 @@ double stationarity_residual(const Program& p, const VectorXd& x, double activit
   const double f = p.objective(x, &g);
   const VectorXd gw = w.cwiseProduct(g);
   // the columns of the active constraints' scaled gradients, with each multiplier's lower bound
+  // and the value its term adds to the Lagrangian at x (c_i, or l_j - x_j, x_j - u_j for bounds)
   std::vector<VectorXd> columns;
-  std::vector<double> floor;
+  std::vector<double> floor, term;
   const double inf = std::numeric_limits<double>::infinity();
   VectorXd c;
   MatrixXd jac;
@@ -33,6 +38,7 @@ double stationarity_residual(const Program& p, const VectorXd& x, double activit
     for (int i = 0; i < c.size(); ++i) {
       columns.emplace_back(w.cwiseProduct(jac.row(i).transpose()));
       floor.push_back(-inf);
+      term.push_back(c[i]);
     }
   }
   if (p.n_ineq() > 0) {
@@ -41,14 +47,17 @@ double stationarity_residual(const Program& p, const VectorXd& x, double activit
       if (!(c[i] >= -activity)) continue;
       columns.emplace_back(w.cwiseProduct(jac.row(i).transpose()));
       floor.push_back(0);
+      term.push_back(c[i]);
     }
   }
   for (int j = 0; j < n; ++j) {
     VectorXd e = VectorXd::Zero(n);
     if (x[j] - p.lower()[j] <= activity * w[j]) {
       e[j] = -w[j];  // -μ at a lower bound, in scaled units: the bound's gradient is -1
+      term.push_back(p.lower()[j] - x[j]);
     } else if (p.upper()[j] - x[j] <= activity * w[j]) {
       e[j] = w[j];
+      term.push_back(x[j] - p.upper()[j]);
     } else {
       continue;
     }
@@ -60,7 +69,15 @@ double stationarity_residual(const Program& p, const VectorXd& x, double activit
   // an optimum where the objective itself nearly vanishes (a force-balanced design's smoothed
   // Fsh, ~1e-6) the residual is still measured on the problem's own scale
   const double size = std::max({std::abs(f), gw.cwiseAbs().maxCoeff(), 1.0});
-  if (columns.empty()) return gw.cwiseAbs().maxCoeff() / size;
+  // L(y) >= L(x) + ∇L(x)·(y - x) >= L(x) - Σ_j |w_j ∂L/∂x_j| for y in the box, and L <= f on
+  // the feasible set (multipliers of the right sign): a lower bound where L is convex
+  const bool finite_box = ((p.upper() - p.lower()).array().isFinite()).all();
+  // (less 1e-12 of its size for the round-off of the sums: a bound must not overstate)
+  auto bound = [&](const VectorXd& r, double lagrangian) {
+    const double value = lagrangian - r.cwiseAbs().sum();
+    return finite_box ? value - 1e-12 * std::max(std::abs(value), 1.0) : -inf;
+  };
+  if (columns.empty()) return {gw.cwiseAbs().maxCoeff() / size, bound(gw, f)};
   MatrixXd A(n, static_cast<Eigen::Index>(columns.size()));
   VectorXd lower(A.cols());
   for (Eigen::Index k = 0; k < A.cols(); ++k) {
@@ -76,7 +93,11 @@ double stationarity_residual(const Program& p, const VectorXd& x, double activit
     if (z[k] < lower[k] - 1e-12 * scale) signs = false;
   }
   if (!signs) z = bounded_least_squares(A, -gw, lower, z.cwiseMax(lower));
-  return (gw + A * z).cwiseAbs().maxCoeff() / size;
+  z = z.cwiseMax(lower);  // a bounded solve's round-off below a floor would void the bound
+  const VectorXd r = gw + A * z;
+  double lagrangian = f;
+  for (Eigen::Index k = 0; k < z.size(); ++k) lagrangian += z[k] * term[static_cast<std::size_t>(k)];
+  return {r.cwiseAbs().maxCoeff() / size, bound(r, lagrangian)};
 }
 
 Optimality optimality(const std::string& why_not_convex, bool converged, double stationarity,

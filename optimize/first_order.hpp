@@ -37,6 +37,20 @@ inline double stationarity_tolerance(double relative_tolerance) {
 double stationarity_residual(const Program& program, const Eigen::VectorXd& x,
                              double activity = kActivity);
 
+/// The first-order conditions at x: the stationarity residual, and the Lagrangian bound
+///   L(x) - Σ_j |w_j ∂L/∂x_j(x)|,   L = f + Σ λ_i c_i + Σ μ (bound rows)
+/// with the fitted multipliers (λ >= 0 on inequalities and bounds). Where the program is convex
+/// (f and every inequality convex, the equalities linear) no feasible point of the box has a
+/// smaller objective: L <= f there, and L lies above its tangent at x, which cannot fall by more
+/// than that sum across the box (less 1e-12 of its size for round-off). It holds at any x, feasible or not, and tends to f(x) as x
+/// tends to a Karush-Kuhn-Tucker point; -infinity where a variable's box is unbounded.
+struct FirstOrder {
+  double residual{};
+  double lower_bound{};
+};
+FirstOrder first_order(const Program& program, const Eigen::VectorXd& x,
+                       double activity = kActivity);
+
 /// Whether a solved program's design is a proven global optimum, and why (or why that is not
 /// proven) in words for the result and summary.json.
 struct Optimality {

@@ -427,6 +427,7 @@ DriverOutcome multistart(const Program& nlp, const VectorXd& x0, const OptimizeO
   double best_f = HUGE_VAL, best_violation = HUGE_VAL;
   int best_start = 0, runs = 0, feasible_runs = 0;
   Run best_run;
+  std::vector<double> feasible_values;
   for (int s = 0; s < kStarts; ++s) {
     const int left = options.max_evaluations - tracked.evaluations();
     if (left <= 0) break;
@@ -448,6 +449,7 @@ DriverOutcome multistart(const Program& nlp, const VectorXd& x0, const OptimizeO
     if (feasible) {
       ++feasible_runs;
       run.f = nlp.objective(run.x, nullptr);
+      feasible_values.push_back(run.f);
     }
     // a feasible run beats an infeasible one; among feasible ones the lower objective wins,
     // among infeasible ones the smaller violation
@@ -470,9 +472,14 @@ DriverOutcome multistart(const Program& nlp, const VectorXd& x0, const OptimizeO
       tracked.evaluations() >= options.max_evaluations && runs < kStarts) {
     out.termination = Termination::kMaxEvaluations;
   }
+  out.starts = runs;
+  for (double f : feasible_values) {
+    if (f <= best_f + kSameValue * std::max(std::abs(best_f), 1.0)) ++out.starts_at_best;
+  }
   out.message = "multistart of NLopt LD_SLSQP (mlsl): " + std::to_string(runs) + " of " +
                 std::to_string(kStarts) + " local runs, " + std::to_string(feasible_runs) +
-                " feasible; best from start " + std::to_string(best_start) + ": " +
+                " feasible, " + std::to_string(out.starts_at_best) +
+                " reaching the best value; best from start " + std::to_string(best_start) + ": " +
                 describe(best_run.result);
   if (!best_run.error.empty()) out.message += ": " + best_run.error;
   return out;

@@ -20,7 +20,14 @@ struct DriverOutcome {
   Eigen::VectorXd x;    // the point returned (the solver's, or the best feasible one it saw)
   int iterations{};     // solver iterations (NLopt exposes none: its evaluations are reported)
   int evaluations{};    // objective evaluations
+  /// A multistart (mlsl): its local runs, and how many of them ended feasible within
+  /// kSameValue of the best objective (0 and 0 for a single run).
+  int starts{}, starts_at_best{};
 };
+
+/// Two local runs' objectives count as the same value within this, relative to the larger of
+/// the best objective's size and 1 (the objectives are normalised: 1 at the original design).
+inline constexpr double kSameValue = 1e-6;
 
 /// The Nlp as a solver sees it: every call is forwarded, objective evaluations are counted, and
 /// the best point at which the objective and all constraints were evaluated (in any order) with
@@ -99,6 +106,7 @@ struct Solved {
   /// gradients and a design found; NaN otherwise.
   double stationarity = std::numeric_limits<double>::quiet_NaN();
   bool gradient_check_failed{};
+  int starts{}, starts_at_best{};  // a multistart's local runs (DriverOutcome)
 };
 /// A converged end, in a program with gradients, where the first-order conditions do not hold
 /// to stationarity_tolerance() (optimize/first_order.hpp) is not taken as converged: the run goes on from there, by the same

@@ -42,6 +42,10 @@ Eigen::VectorXd Nlp::from_positions(const Eigen::VectorXd& x) const {
 Eigen::VectorXd Nlp::to_positions(const Eigen::VectorXd& x) const {
   return at(x).to_positions(x);
 }
+Eigen::VectorXd Nlp::without_vanishing_counterweights(const Eigen::VectorXd& x,
+                                                      double fraction) const {
+  return at(x).without_vanishing_counterweights(x, fraction);
+}
 Eigen::VectorXd Nlp::start(bool original) const { return program_->start(original); }
 Eigen::VectorXd Nlp::start_scaled(double fraction) const {
   return program_->start_scaled(fraction);

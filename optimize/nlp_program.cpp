@@ -32,7 +32,10 @@ double& parameter(core::Link& link, LinkParameterVariable::Parameter p) {
 // set-up
 
 NlpProgram::NlpProgram(const DesignProblem& p, CounterweightVariablesAs as)
-    : problem_(p), moments_(as == CounterweightVariablesAs::kMassMoments) {
+    : problem_(p),
+      moments_(as == CounterweightVariablesAs::kMassMoments ||
+               as == CounterweightVariablesAs::kRelaxation),
+      relaxed_(as == CounterweightVariablesAs::kRelaxation) {
   if (const Problem e = problem_.validate()) {
     throw InputError("invalid design problem: " + e->text());
   }
@@ -119,6 +122,27 @@ void NlpProgram::set_up_design_variables() {
                                           parameter_name(v.parameter) + " [" +
                                           parameter_unit(v.parameter) + "]"));
   }
+  if (!relaxed_) return;
+  for (std::size_t c = 0; c < problem_.counterweights.size(); ++c) {
+    const CounterweightVariables& cw = problem_.counterweights[c];
+    RelaxedCounterweight r;
+    r.mass = cw_var_[c];
+    r.mass_max = cw.mass_max;
+    r.distance_max = cw.distance_max;
+    const std::string name = std::string(core::link_name(cw.link)) + " counterweight ";
+    const char* pivot = cw.link == 1 ? "A0" : "A3";
+    r.w = add_variable(0.0, r.w_max(),
+                       name + "inertia of its mass about " + pivot + " (relaxed) [kg m^2]");
+    if (cw.shape == balance::CounterweightShape::kDisc) {
+      r.disc_a = 1 / (2 * cw.density * std::numbers::pi * cw.thickness);
+      r.s = add_variable(0.0, r.s_max(), name + "own inertia (relaxed) [kg m^2]");
+    }
+    relaxed_cw_.push_back(r);
+  }
+}
+
+void NlpProgram::set_relaxed_variables(Eigen::VectorXd& x) const {
+  for (const RelaxedCounterweight& r : relaxed_cw_) r.set_tight(x);
 }
 
 // force balance (eq. 57) in q, over the original total mass:
@@ -155,6 +179,12 @@ void NlpProgram::set_up_constraints() {
     add_block({Block::Kind::kEnvelope, static_cast<int>(c), Metric::kAddedMass, 0.0, -1, 1},
               {std::string(core::link_name(cw.link)) + " counterweight within distance_max = " +
                text::digits(cw.distance_max, 6) + " m of " + (cw.link == 1 ? "A0" : "A3")});
+    if (relaxed_) {
+      const RelaxedCounterweight& r = relaxed_cw_[c];
+      add_block({Block::Kind::kRelaxation, static_cast<int>(c), Metric::kAddedMass, 0.0, -1,
+                 r.rows()},
+                r.row_names(std::string(core::link_name(cw.link)) + " counterweight"));
+    }
   }
   // limits
   for (const Limit& l : problem_.limits) {
@@ -212,6 +242,17 @@ Eigen::VectorXd NlpProgram::to_positions(const Eigen::VectorXd& x) const {
   return out;
 }
 
+Eigen::VectorXd NlpProgram::without_vanishing_counterweights(const Eigen::VectorXd& x,
+                                                             double fraction) const {
+  Eigen::VectorXd out = x;
+  for (std::size_t c = 0; c < cw_var_.size(); ++c) {
+    const int j = cw_var_[c];
+    if (out(j) < fraction * problem_.counterweights[c].mass_max) out.segment<3>(j).setZero();
+  }
+  set_relaxed_variables(out);
+  return out;
+}
+
 std::string NlpProgram::why_not_convex() const {
   return "a free scene: the motion, and with it every reaction, depends on the design";
 }
@@ -232,7 +273,7 @@ std::vector<std::pair<int, std::string>> NlpProgram::non_affine_parameters() con
     }
     const int b = link_base(k), r = rho_base(k);
     const std::string joint = k == 3 ? "A3" : k == 1 ? "A0" : "A1";
-    if (counterweight) {
+    if (counterweight && !relaxed_) {
       out.emplace_back(b + 3, "the " + name + "'s inertia about " + joint +
                                   ", which varies with the square of its counterweight's position");
     } else if (offset) {
@@ -321,6 +362,22 @@ void NlpProgram::add_counterweight(int k, const core::Link& l, const Eigen::Vect
       out.q(b) += mc;
       out.q(b + 1) += Mx;
       out.q(b + 2) += My;
+      if (relaxed_) {
+        // |p + m o|² / m = w + 2 p·o + m |o|² with w >= |p|² / m relaxed, and s for a disc's Ic
+        const RelaxedCounterweight& r = relaxed_cw_[c];
+        out.q(b + 3) += x(r.w) + 2 * x(j + 1) * off + mc * off * off + (r.s >= 0 ? x(r.s) : 0.0);
+        if (with_jacobian) {
+          out.B(b, j) += 1;
+          out.B(b + 1, j) += off;
+          out.B(b + 1, j + 1) += 1;
+          out.B(b + 2, j + 2) += 1;
+          out.B(b + 3, r.w) += 1;
+          out.B(b + 3, j + 1) += 2 * off;
+          out.B(b + 3, j) += off * off;
+          if (r.s >= 0) out.B(b + 3, r.s) += 1;
+        }
+        continue;
+      }
       out.q(b + 3) += Ic + J;
       if (with_jacobian) {
         auto dM = out.B.row(b), dMx = out.B.row(b + 1), dMy = out.B.row(b + 2);
@@ -449,6 +506,7 @@ Eigen::VectorXd NlpProgram::start(bool original) const {
     core::Link l = core::link(problem_.original, v.link);
     x(param_var_[i]) = std::clamp(parameter(l, v.parameter), v.lower, v.upper);
   }
+  set_relaxed_variables(x);
   start_extra_variables(x);
   return x;
 }
@@ -459,6 +517,7 @@ Eigen::VectorXd NlpProgram::start_scaled(double fraction) const {
     x(j) *= fraction;
     if (moments_) x.segment<2>(j + 1) *= fraction;
   }
+  set_relaxed_variables(x);
   start_extra_variables(x);
   return x;
 }
@@ -468,6 +527,7 @@ Eigen::VectorXd NlpProgram::start_at(const Eigen::VectorXd& design) const {
   const int k = static_cast<int>(
       std::min<std::size_t>(3 * cw_var_.size() + param_var_.size(), std::size_t(design.size())));
   x.head(k) = design.head(k).cwiseMax(lower_.head(k)).cwiseMin(upper_.head(k));
+  set_relaxed_variables(x);
   start_extra_variables(x);
   return x;
 }
@@ -520,6 +580,8 @@ void NlpProgram::inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
         (*jac)(row, j + 1) = 2 * x(j + 1) / d2;
         (*jac)(row, j + 2) = 2 * x(j + 2) / d2;
       }
+    } else if (b.kind == Block::Kind::kRelaxation) {
+      relaxed_cw_[static_cast<std::size_t>(b.counterweight)].fill(x, row, c, jac);
     } else if (b.kind == Block::Kind::kAddedMassLimit) {
       c(row) = (added_mass(in.q) - b.value) / original_mass_;
       if (jac) {

@@ -20,6 +20,7 @@
 #include "optimize/nlp.hpp"
 #include "optimize/optimize.hpp"
 #include "optimize/problem.hpp"
+#include "optimize/relaxation.hpp"
 
 namespace bd::optimize::detail {
 
@@ -41,8 +42,15 @@ struct Inertial {
 
 /// A run of inequality constraints of one kind.
 struct Block {
-  enum class Kind { kEnvelope, kRmsLimit, kPeakLimit, kAddedMassLimit, kPeakBound } kind{};
-  int counterweight{-1};  // envelope: its counterweight
+  enum class Kind {
+    kEnvelope,
+    kRmsLimit,
+    kPeakLimit,
+    kAddedMassLimit,
+    kPeakBound,
+    kRelaxation  // a counterweight's relaxed inertia (CounterweightVariablesAs::kRelaxation)
+  } kind{};
+  int counterweight{-1};  // envelope, relaxation: its counterweight
   Metric metric{};        // limits and peak bounds
   double value{};         // a limit's value
   int bound_var{-1};      // peak bound: the variable t
@@ -73,6 +81,7 @@ class NlpProgram {
   virtual std::string why_not_convex() const;
   Eigen::VectorXd from_positions(const Eigen::VectorXd& x) const;
   Eigen::VectorXd to_positions(const Eigen::VectorXd& x) const;
+  Eigen::VectorXd without_vanishing_counterweights(const Eigen::VectorXd& x, double fraction) const;
 
   // Nlp's functions of the same names; x has n() entries (Nlp checks)
   Eigen::VectorXd start(bool original = false) const;
@@ -140,6 +149,7 @@ class NlpProgram {
 
   DesignProblem problem_;  // the original made consistent (core::make_fourbar)
   bool moments_{};         // counterweights as (m, p = m r): CounterweightVariablesAs::kMassMoments
+  bool relaxed_{};         // and their inertias relaxed: CounterweightVariablesAs::kRelaxation
   core::Metrics original_metrics_;
   double original_mass_{};
   bool linear_{};                                     // ObjectiveForm::kLinear
@@ -150,6 +160,7 @@ class NlpProgram {
   std::vector<std::string> variable_names_, constraint_names_;
   std::vector<int> cw_var_;     // first variable (the mass) of each counterweight
   std::vector<int> param_var_;  // the variable of each link parameter
+  std::vector<RelaxedCounterweight> relaxed_cw_;  // kRelaxation: each counterweight's variables
   int n_eq_{}, n_ineq_{};
   std::vector<Block> blocks_;
   Eigen::Matrix<double, 4, kQ> balance_ = Eigen::Matrix<double, 4, kQ>::Zero();
@@ -157,6 +168,8 @@ class NlpProgram {
  private:
   void check_normalisers() const;
   void set_up_design_variables();
+  /// kRelaxation: each counterweight's relaxed inertias at their real values for x's design.
+  void set_relaxed_variables(Eigen::VectorXd& x) const;
   void set_up_force_balance();
   core::Link add_link(int k, const Eigen::VectorXd& x, Inertial& out, bool with_jacobian) const;
   void add_counterweight(int k, const core::Link& l, const Eigen::VectorXd& x, Inertial& out,

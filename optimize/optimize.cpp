@@ -334,6 +334,8 @@ detail::Solved run_once(const Program& nlp, const VectorXd& x0, const OptimizeOp
   r.x = outcome.x;
   r.iterations = outcome.iterations;
   r.evaluations = outcome.evaluations;
+  r.starts = outcome.starts;
+  r.starts_at_best = outcome.starts_at_best;
   r.seconds = std::chrono::duration<double>(stopped - started).count();
   nlp.polish(r.x);
   r.objective = nlp.objective(r.x, nullptr);
@@ -472,6 +474,10 @@ OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& opt
   OptimizeResult r;
   r.global = optimality.global && found_design(solved.termination);
   r.optimality = optimality.words;
+  r.lower_bound = solve.bound.value;
+  r.lower_bound_source = solve.bound.words;
+  r.starts = solved.starts;
+  r.starts_at_best = solved.starts_at_best;
   r.algorithm = options.algorithm;
   r.termination = solved.termination;
   r.message = solved.message;

@@ -2,6 +2,7 @@
 /// Solving a DesignProblem with NLopt or Ipopt (Ceres-style: options in, result out). The
 /// solvers' headers appear only in optimize/nlopt_driver.cpp and optimize/ipopt_driver.cpp.
 #include <Eigen/Core>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -113,6 +114,15 @@ struct OptimizeResult {
   /// to the tolerance; `optimality` says why, or why that is not proven.
   bool global{};
   std::string optimality;
+  /// A lower bound of the objective over every feasible design (NaN: none), so that the gap to
+  /// `objective` shows what a better design could still gain; `lower_bound_source` says how it
+  /// was found (the convex problem's first-order bound, or its convex relaxation's where the
+  /// counterweights' inertias make it non-convex) or why there is none.
+  double lower_bound = std::numeric_limits<double>::quiet_NaN();
+  std::string lower_bound_source;
+  /// mlsl: its local runs, and how many ended feasible at the best value (to 1e-6 of the
+  /// objective's size); 0 and 0 for the single-start methods.
+  int starts{}, starts_at_best{};
   /// One line for the console and summary.json.
   std::string brief_report() const;
   bool ok() const { return found_design(termination); }

@@ -15,6 +15,7 @@
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
 #include "optimize/convex_solve.hpp"
+#include "optimize/relaxation.hpp"
 #include "optimize/epsilon_front.hpp"
 #include "optimize/nlopt_driver.hpp"
 
@@ -170,6 +171,8 @@ struct PlanarNlp::Impl {
   DesignProblem p;
   bool free{};     // a free scene: metrics by simulation, no regressor
   bool moments{};  // counterweights as (m, p = m r): CounterweightVariablesAs::kMassMoments
+  bool relaxed{};  // and their inertias relaxed: CounterweightVariablesAs::kRelaxation
+  std::vector<detail::RelaxedCounterweight> relaxed_cw;  // kRelaxation: their variables
   // a free scene's last simulation: its x and metrics (table order; +inf when it failed)
   mutable std::mutex cache_mutex;
   mutable VectorXd cached_x;
@@ -200,7 +203,7 @@ struct PlanarNlp::Impl {
   MatrixXd balance_rows;  // r x nq: U_rᵀ Z / (M0 L)
   VectorXd balance_offset;
   struct Row {
-    enum class Kind { kEnvelope, kRmsLimit, kPeakLimit, kPeakBound, kAddedMass } kind{};
+    enum class Kind { kEnvelope, kRmsLimit, kPeakLimit, kPeakBound, kAddedMass, kRelaxation } kind{};
     int index{};   // counterweight, or metric
     int sample{};  // peak limits
     double value{};
@@ -457,6 +460,21 @@ void PlanarNlp::Impl::set_up_variables() {
     it->second[static_cast<std::size_t>(v.parameter)] = param_var.back();
   }
   design_n = n;
+  // kRelaxation: each counterweight's inertia about its pivot (and a disc's own), relaxed
+  for (std::size_t c = 0; relaxed && c < p.counterweights.size(); ++c) {
+    const CounterweightVariables& cw = p.counterweights[c];
+    const std::string name = l.links[static_cast<std::size_t>(cw.link)].name + " counterweight ";
+    detail::RelaxedCounterweight r;
+    r.mass = cw_var[c];
+    r.mass_max = cw.mass_max;
+    r.distance_max = cw.distance_max;
+    r.w = add(0.0, r.w_max(), name + "inertia of its mass about its pivot (relaxed) [kg m^2]");
+    if (cw.shape == balance::CounterweightShape::kDisc) {
+      r.disc_a = disc_inertia_per_mass2(cw);
+      r.s = add(0.0, r.s_max(), name + "own inertia (relaxed) [kg m^2]");
+    }
+    relaxed_cw.push_back(r);
+  }
   // a bound variable t per peak of the objective, |y_s| <= t at every sample. Boxed in
   // [-t_max, t_max], t_max above the peak of any design in the box (the regressor's rows
   // against the spread of the parameters): with a lower bound at 0, SLSQP's subproblems put t on
@@ -529,6 +547,14 @@ void PlanarNlp::Impl::set_up_constraints() {
         p.original.links[static_cast<std::size_t>(p.counterweights[c].link)].name +
         " counterweight within distance_max = " +
         text::digits(p.counterweights[c].distance_max, 6) + " m of its pivot");
+    if (!relaxed) continue;
+    const detail::RelaxedCounterweight& r = relaxed_cw[c];
+    for (std::string& name : r.row_names(
+             p.original.links[static_cast<std::size_t>(p.counterweights[c].link)].name +
+             " counterweight")) {
+      rows.push_back({Row::Kind::kRelaxation, static_cast<int>(c), 0, 0.0});
+      constraint_names.push_back(std::move(name));
+    }
   }
   for (const Limit& lim : p.limits) {
     const std::string what = lim.metric + " <= " + text::digits(lim.value, 6);
@@ -595,13 +621,30 @@ void PlanarNlp::Impl::q_of(const VectorXd& x, VectorXd& q, MatrixXd* J, bool pos
       q[P::link_mass(k)] += mc;
       q[P::link_me(k)] += M.x();
       q[P::link_mf(k)] += M.y();
+      if (J) {
+        (*J)(P::link_mass(k), v) += 1;
+        (*J)(P::link_me(k), v) += o.x();
+        (*J)(P::link_mf(k), v) += o.y();
+        (*J)(P::link_me(k), v + 1) += 1;
+        (*J)(P::link_mf(k), v + 2) += 1;
+      }
+      if (relaxed) {
+        // |p + m o|² / m = w + 2 p·o + m |o|² with w >= |p|² / m relaxed, and s for a disc's
+        // own inertia
+        const detail::RelaxedCounterweight& rc = relaxed_cw[c];
+        const Vec2 pc(x[v + 1], x[v + 2]);
+        q[P::link_J(k)] += x[rc.w] + 2 * pc.dot(o) + mc * o.squaredNorm() +
+                           (rc.s >= 0 ? x[rc.s] : 0.0);
+        if (!J) continue;
+        (*J)(P::link_J(k), rc.w) += 1;
+        (*J)(P::link_J(k), v) += o.squaredNorm();
+        (*J)(P::link_J(k), v + 1) += 2 * o.x();
+        (*J)(P::link_J(k), v + 2) += 2 * o.y();
+        if (rc.s >= 0) (*J)(P::link_J(k), rc.s) += 1;
+        continue;
+      }
       q[P::link_J(k)] += Jc + a * mc * mc;
       if (!J) continue;
-      (*J)(P::link_mass(k), v) += 1;
-      (*J)(P::link_me(k), v) += o.x();
-      (*J)(P::link_mf(k), v) += o.y();
-      (*J)(P::link_me(k), v + 1) += 1;
-      (*J)(P::link_mf(k), v + 2) += 1;
       (*J)(P::link_J(k), v) += 2 * a * mc;
       if (mc > 0) {
         (*J)(P::link_J(k), v) += 2 * M.dot(o) / mc - Jc / mc;
@@ -631,7 +674,9 @@ PlanarNlp::PlanarNlp(const DesignProblem& problem, CounterweightVariablesAs as)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.p = problem;
-  m.moments = as == CounterweightVariablesAs::kMassMoments;
+  m.moments = as == CounterweightVariablesAs::kMassMoments ||
+              as == CounterweightVariablesAs::kRelaxation;
+  m.relaxed = as == CounterweightVariablesAs::kRelaxation;
   m.p.original = cp::make_linkage(problem.original);
   m.free = std::holds_alternative<cp::FreeScene>(problem.scene);
   if (const Problem e = m.p.validate()) throw InputError("invalid design problem: " + e->text());
@@ -810,6 +855,12 @@ void PlanarNlp::inequalities(const VectorXd& x, VectorXd& c, MatrixXd* jac) cons
         }
         break;
       }
+      case Impl::Row::Kind::kRelaxation:
+        // the counterweight's rows, filled at its first
+        if (i == 0 || m.rows[i - 1].kind != row.kind || m.rows[i - 1].index != row.index) {
+          m.relaxed_cw[static_cast<std::size_t>(row.index)].fill(x, r, c, jac);
+        }
+        break;
       case Impl::Row::Kind::kAddedMass:
         c[r] = (m.added(q, jac ? &J : nullptr, jac ? &g : nullptr) - row.value) / m.mass0;
         if (jac) jac->row(r) = g.transpose() / m.mass0;
@@ -910,6 +961,7 @@ std::string PlanarNlp::constraint_text(int i, const VectorXd& x) const {
              " x the original's peak, at most " + text::digits(row.value, 6) + " x";
     }
     case Impl::Row::Kind::kPeakBound:
+    case Impl::Row::Kind::kRelaxation:
       break;
   }
   return {};
@@ -967,6 +1019,17 @@ VectorXd PlanarNlp::to_positions(const VectorXd& x) const {
   return out;
 }
 
+VectorXd PlanarNlp::without_vanishing_counterweights(const VectorXd& x, double fraction) const {
+  const Impl& m = *impl_;
+  VectorXd out = x;
+  for (std::size_t c = 0; c < m.cw_var.size(); ++c) {
+    const int v = m.cw_var[c];
+    if (out[v] < fraction * m.p.counterweights[c].mass_max) out.segment<3>(v).setZero();
+  }
+  for (const detail::RelaxedCounterweight& r : m.relaxed_cw) r.set_tight(out);
+  return out;
+}
+
 void PlanarNlp::first_order_inequalities(const VectorXd& x, const VectorXd& g, VectorXd& c,
                                          MatrixXd& jac) const {
   const Impl& m = *impl_;
@@ -999,7 +1062,7 @@ std::string PlanarNlp::why_not_convex() const {
       counterweight = counterweight || c.link == link;
     }
     const std::string name = "the " + m.p.original.links[k].name + "'s ";
-    if (counterweight) {
+    if (counterweight && !m.relaxed) {
       varying.emplace_back(P::link_J(link),
                            name + "inertia about its first node, which varies with the square of "
                                   "its counterweight's position");
@@ -1093,6 +1156,7 @@ VectorXd PlanarNlp::positions_start(bool original) const {
 // each bound variable a hair above its smoothed peak at the design of x
 void PlanarNlp::set_bound_variables(VectorXd& x) const {
   const Impl& m = *impl_;
+  for (const detail::RelaxedCounterweight& r : m.relaxed_cw) r.set_tight(x);
   VectorXd q;
   m.q_of(x, q, nullptr);
   for (std::size_t k = 0; k < m.table.size(); ++k) {
@@ -1277,6 +1341,10 @@ Result optimize(const DesignProblem& problem, const OptimizeOptions& options,
   Result r;
   r.global = solve.optimality.global && found_design(s.termination);
   r.optimality = solve.optimality.words;
+  r.lower_bound = solve.bound.value;
+  r.lower_bound_source = solve.bound.words;
+  r.starts = s.starts;
+  r.starts_at_best = s.starts_at_best;
   r.algorithm = options.algorithm;
   r.termination = s.termination;
   r.message = s.message;

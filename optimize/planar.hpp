@@ -139,6 +139,11 @@ class PlanarNlp final : public Program {
   /// four-bar Nlp's.
   Eigen::VectorXd from_positions(const Eigen::VectorXd& x) const;
   Eigen::VectorXd to_positions(const Eigen::VectorXd& x) const;
+  /// (As Nlp's.) x with each counterweight whose mass is below `fraction` of its mass_max taken away
+  /// (mass and mass moment or position 0): a solver's end near the cone's apex, where the
+  /// direction of a vanishing mass moment is round-off, put on the apex itself.
+  Eigen::VectorXd without_vanishing_counterweights(const Eigen::VectorXd& x,
+                                                   double fraction) const;
   /// start() with each counterweight's mass (and mass moment) scaled by `fraction`.
   Eigen::VectorXd start_scaled(double fraction) const;
 
@@ -199,6 +204,11 @@ struct Result {
   /// or why that is not proven.
   bool global{};
   std::string optimality;
+  /// A lower bound of the objective over every feasible design (NaN: none) and how it was found
+  /// (as OptimizeResult::lower_bound).
+  double lower_bound = std::numeric_limits<double>::quiet_NaN();
+  std::string lower_bound_source;
+  int starts{}, starts_at_best{};  // mlsl's local runs (as OptimizeResult's)
   bool ok() const { return found_design(termination); }
   /// One line: algorithm, termination, iterations, evaluations, seconds, objective, constraint
   /// violation, verification.

@@ -27,6 +27,12 @@ enum class CounterweightVariablesAs {
   /// removed), and r = 0 where m = 0. Used for the problems that are convex in these variables
   /// (Nlp::why_not_convex(), planar::PlanarNlp::why_not_convex()).
   kMassMoments,
+  /// As kMassMoments, and each counterweight's inertia about its pivot (m |r|², and a disc's own
+  /// inertia) a variable of its own within a convex set that holds every real counterweight
+  /// (optimize/relaxation.hpp): the convex relaxation of a problem whose metrics read those
+  /// inertias (the shaking moment, the drive torque). Its minimum is a lower bound of the real
+  /// problem's; its designs are not real ones (solve_convex_aware() reports the bound only).
+  kRelaxation,
 };
 /// δ of the smoothed cone, relative to mass_max distance_max: the design's mass moment moves by
 /// at most δ when its position is brought within distance_max, so the objective by ~1e-10.

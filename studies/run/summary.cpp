@@ -1,6 +1,7 @@
 // summary.json: what a run computed, as one JSON document written by nlohmann-json (keys in the
 // order below, numbers in their shortest exact text, a number that is not finite as null).
 #include <cassert>
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <variant>
@@ -307,6 +308,14 @@ void add_solver_fields(Json& j, const Result& r, const OptimizedRun& o) {
   // whether the optimum is proven global, and why (or why that is not proven)
   j["global"] = found && r.global;
   j["optimality"] = r.optimality;
+  // a lower bound of the objective over every feasible design, and the optimum's gap above it
+  const bool bounded = found && std::isfinite(r.lower_bound);
+  j["lower_bound"] = bounded ? Json(r.lower_bound) : Json(nullptr);
+  j["gap"] = bounded ? Json(r.objective - r.lower_bound) : Json(nullptr);
+  j["lower_bound_source"] = r.lower_bound_source;
+  // a multistart's local runs and how many reached the best value
+  j["multistart"] = r.starts > 0 ? Json{{"starts", r.starts}, {"reaching_best", r.starts_at_best}}
+                                 : Json(nullptr);
   Json variables = Json::array();
   if (static_cast<std::size_t>(r.x.size()) == o.variable_names.size()) {
     for (std::size_t k = 0; k < o.variable_names.size(); ++k) {
