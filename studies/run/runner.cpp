@@ -305,6 +305,21 @@ const char* where_written(const Study& design) {
   return design.parts ? "linkage.counterweights below" : "merged into the link below";
 }
 
+// a planar design's counterweight in the header comment: 6 digits, a component that is
+// round-off of the position's size (1e-12 of it) written as 0
+std::string counterweight_line(const core::planar::Linkage& l,
+                               const balance::planar::LinkCounterweight& c, const Study& written) {
+  const balance::Counterweight& w = c.counterweight;
+  const double size = w.position.norm();
+  auto shown = [&](double v) { return std::abs(v) <= 1e-12 * size ? 0.0 : v; };
+  return fmt::format(
+      "Link {} carries a counterweight of {:.6g} kg at ({:.6g}, {:.6g}) m from node {} in the "
+      "link's axes ({}).\n",
+      l.links[static_cast<std::size_t>(c.link)].name, w.mass, shown(w.position.x()),
+      shown(w.position.y()), l.nodes[static_cast<std::size_t>(c.pivot)].name,
+      where_written(written));
+}
+
 }  // namespace
 
 std::string balanced_yaml(const Study& study) {
@@ -360,14 +375,8 @@ std::string balanced_yaml(const Study& study, const balance::planar::ForceBalanc
   header += design.full ? "It is fully force balanced over the motion.\n"
                         : (design.balancing_factor ? "" : "Full force balance is not reached: ") +
                               design.message + "\n";
-  for (const balance::planar::LinkCounterweight& c : design.added) {
-    const balance::Counterweight& w = c.counterweight;
-    header += fmt::format(
-        "Link {} carries a counterweight of {:.6g} kg at ({:.6g}, {:.6g}) m from node {} in the "
-        "link's axes ({}).\n",
-        l.links[static_cast<std::size_t>(c.link)].name, w.mass, w.position.x(), w.position.y(),
-        l.nodes[static_cast<std::size_t>(c.pivot)].name, where_written(written));
-  }
+  for (const balance::planar::LinkCounterweight& c : design.added)
+    header += counterweight_line(l, c, written);
   for (const core::planar::BalanceShaft& s : design.linkage.shafts) {
     bool had = false;
     for (const core::planar::BalanceShaft& o : l.shafts) had = had || o.name == s.name;
@@ -411,15 +420,8 @@ std::string planar_optimized_yaml(const Study& study, const OptimizedRun& run) {
       "relative difference {:.3g}).\n",
       optimize::to_string(req.options.algorithm), optimize::to_string(r.termination), r.evaluations,
       r.objective, r.verification_error);
-  for (const balance::planar::LinkCounterweight& c : r.counterweights) {
-    const balance::Counterweight& w = c.counterweight;
-    if (w.mass <= 0) continue;
-    header += fmt::format(
-        "Link {} carries a counterweight of {:.6g} kg at ({:.6g}, {:.6g}) m from node {} in the "
-        "link's axes ({}).\n",
-        l.links[static_cast<std::size_t>(c.link)].name, w.mass, w.position.x(), w.position.y(),
-        l.nodes[static_cast<std::size_t>(c.pivot)].name, where_written(written));
-  }
+  for (const balance::planar::LinkCounterweight& c : r.counterweights)
+    if (c.counterweight.mass > 0) header += counterweight_line(l, c, written);
   for (int k = 3 * static_cast<int>(req.counterweights.size()); k < r.design_variables; ++k) {
     header += fmt::format("Link parameter {} = {:.6g} (a variable).\n",
                           r.variable_names[static_cast<std::size_t>(k)], r.x[k]);
