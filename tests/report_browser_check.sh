@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Renders the report.html of every example study in headless Chromium and fails on a console
-# error, a missing image, an empty chart or a page that does not render. A sweep example's page
+# error, a missing image, an empty chart or a page that does not render; a single run's page
+# must have its linkage animation, moving (two moments of the virtual clock, two pictures), and,
+# where the run has harmonic orders, their bar chart. A sweep example's page
 # is the sweep's (heat maps and tables from sweep.csv); it is also checked as an interrupted
 # sweep leaves it: its rows cut to the first few and a last line cut short, the page rebuilt by
 # `balance-design report DIR`.
@@ -25,6 +27,34 @@ fail() {
   failures=$((failures + 1))
 }
 
+# check_animating NAME PAGE: the first linkage animation of PAGE, alone on a page, rendered at
+# two moments of Chromium's virtual clock gives two different pictures
+check_animating() {
+  local name=$1 page=$2
+  local alone="$work/$name.animation.html"
+  {
+    echo '<!DOCTYPE html><html><body style="margin:0">'
+    awk '/<svg class="animation"/ { on = 1 } on { print } on && /<\/svg>/ { exit }' "$page"
+    echo '</body></html>'
+  } >"$alone"
+  local shots=()
+  for ms in 100 1700; do
+    local profile shot="$work/$name.animation-$ms.png"
+    profile=$(mktemp -d)
+    timeout 120 "$chromium" --headless --no-sandbox --disable-gpu --disable-background-networking \
+      --disable-component-update --disable-sync --no-first-run --user-data-dir="$profile" \
+      --virtual-time-budget="$ms" --screenshot="$shot" --window-size=900,700 \
+      "file://$alone" >/dev/null 2>&1 || fail "$name: chromium failed on the animation"
+    rm -rf "$profile"
+    shots+=("$shot")
+  done
+  if [ ! -s "${shots[0]}" ] || [ ! -s "${shots[1]}" ]; then
+    fail "$name: no picture of the animation"
+  elif cmp -s "${shots[0]}" "${shots[1]}"; then
+    fail "$name: the linkage animation does not move (the same picture at 0.1 s and 1.7 s)"
+  fi
+}
+
 # check_page NAME OUT: the checks of OUT/report.html
 check_page() {
   local name=$1 out=$2
@@ -34,16 +64,34 @@ check_page() {
     return
   fi
 
-  # every chart has drawn something: each <svg> ... </svg> holds path elements
+  # every chart has drawn something: each gnuplot <svg> ... </svg> holds path elements (the
+  # linkage animations, drawn by the page itself, are checked below)
   awk -v name="$name" '
-    /<svg/ { inside = 1; paths = 0; charts++ }
+    /<svg/ && !/class="animation"/ { inside = 1; paths = 0; charts++ }
     inside && /<path/ { paths++ }
     inside && /<\/svg>/ { inside = 0; if (paths < 3) { print name ": chart " charts " is empty"; bad = 1 } }
     END { exit bad }' "$page" >&2 || fail "$name: an empty chart"
+  local animations
+  animations=$(grep -c '<svg class="animation"' "$page" || true)
   # one drawing per chart, none left out
   if command -v gnuplot >/dev/null &&
-    [ "$(grep -c '<figure class="chart"' "$page")" -ne "$(grep -c '<svg' "$page")" ]; then
+    [ "$(grep -c '<figure class="chart"' "$page")" -ne "$(($(grep -c '<svg' "$page") - animations))" ]; then
     fail "$name: a chart without its drawing"
+  fi
+  # a single run's page: the linkage animated (its shapes move by SMIL), and, where the run has
+  # harmonic orders, a bar chart of them per design
+  if [ -f "$out/timeseries.csv" ]; then
+    if [ "$animations" -lt 1 ]; then
+      fail "$name: no linkage animation"
+    elif ! grep -q '<animate attributeName="points"' "$page"; then
+      fail "$name: the linkage animation has nothing that moves"
+    else
+      check_animating "$name" "$page"
+    fi
+    if [ -f "$out/harmonics.csv" ] && command -v gnuplot >/dev/null &&
+      ! grep -q 'id="chart-harmonics-original"' "$page"; then
+      fail "$name: no harmonic bar chart"
+    fi
   fi
   if grep -qiE '[^a-z]nan[^a-z]' "$page"; then
     fail "$name: NaN on the page: $(grep -oiE '.{30}[^a-z]nan[^a-z].{10}' "$page" | head -1)"
@@ -77,7 +125,7 @@ check_page() {
   if [ ! -s "$shot" ]; then
     fail "$name: no screenshot"
   fi
-  echo "report_browser_check: $name ok ($(grep -c '<svg' "$page") charts)"
+  echo "report_browser_check: $name ok ($(grep -c '<svg' "$page") charts and animations)"
 }
 
 for study in "$src"/studies/examples/*.yaml; do

@@ -29,14 +29,13 @@ extract_chart "$tmp/driven-balanced/report.html" hodograph "$out/report-hodograp
 # report.html
 extract_chart "$tmp/sweep/report.html" sweep-Msh "$out/sweep-shaking-moment.svg"
 # general planar linkages: the engine's slider-crank at 3000 rpm and the Watt six-bar
-extract_chart "$tmp/engine/report.html" linkage "$out/engine-slider-crank-linkage.svg"
+extract_animation "$tmp/engine/report.html" original "$out/engine-slider-crank-linkage.svg"
 extract_chart "$tmp/engine/report.html" hodograph "$out/engine-slider-crank-hodograph.svg"
-extract_chart "$tmp/watt/report.html" linkage "$out/watt-sixbar-linkage.svg"
+extract_animation "$tmp/watt/report.html" original "$out/watt-sixbar-linkage.svg"
 extract_chart "$tmp/watt/report.html" joints "$out/watt-sixbar-joints.svg"
 # balancing them: the Watt six-bar with its three counterweights, and the engine's shaking force
 # before and after its crank counterweight
-extract_chart "$tmp/watt-balanced/report.html" linkage-balanced \
-  "$out/watt-sixbar-balanced-linkage.svg"
+extract_animation "$tmp/watt-balanced/report.html" balanced "$out/watt-sixbar-balanced-linkage.svg"
 extract_chart "$tmp/engine-balanced/report.html" hodograph \
   "$out/engine-slider-crank-balanced-hodograph.svg"
 # the six-bar's least shaking moment among force-balanced designs against the added mass

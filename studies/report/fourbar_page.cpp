@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <numbers>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -90,117 +91,15 @@ Drawing drawing(const core::FourBar& model, const Csv& timeseries) {
   return d;
 }
 
-// The linkage chart of one design: joints and link lines per sample, the links' centres of mass
-// G1, G2, G3 (marker area in proportion to the link's mass, `mass_ref` [kg] drawn at a fixed
-// size so two designs compare) on thin lines from the joint they are measured from (A0, A1, A2),
-// the opened-loop principal points P1, P2, P3, the system centre of mass S and its path, and any
-// counter-rotation shafts. Each sample's markers are drawn in that sample's colour and each kind
-// has its own legend entry per sample, so the legend shows every marker as drawn (a filled
-// circle of the legend's own size for G). Data blocks are named $<tag>...
-Chart linkage_chart(const core::FourBar& model, const Drawing& d, const std::string& tag,
-                    double mass_ref, std::string& datablocks) {
-  const std::vector<PoseSample>& poses = d.poses;
-  const std::string b = "$" + tag;
-  datablocks += b + "links << EOD\n";
-  for (const PoseSample& p : poses) {
-    const core::Joints& j = p.joints;
-    for (const Vec2* q : {&j.A0, &j.A1, &j.A2, &j.A3}) datablocks += xy(*q) + "\n";
-    datablocks += "\n\n";  // a new data set per pose (index k)
-  }
-  datablocks += "EOD\n" + b + "principal << EOD\n";
-  for (const PoseSample& p : poses) {
-    for (const Vec2* q : {&p.principal.P1, &p.principal.P2, &p.principal.P3})
-      datablocks += xy(*q) + "\n";
-    datablocks += "\n\n";
-  }
-  datablocks += "EOD\n" + b + "S << EOD\n";
-  for (const PoseSample& p : poses) datablocks += xy(p.S) + "\n\n\n";
-  datablocks += "EOD\n" + b + "G << EOD\n";
-  const double m[3] = {model.crank.mass, model.coupler.mass, model.rocker.mass};
-  for (const PoseSample& p : poses) {
-    for (int k = 0; k < 3; ++k) {
-      datablocks +=
-          xy(p.G[k]) + "," + fmt(std::max(0.4, 2.6 * std::sqrt(m[k] / mass_ref)), "%.4g") + "\n";
-    }
-    datablocks += "\n\n";
-  }
-  // s̄k: from the joint each centre of mass is measured from to the centre of mass
-  datablocks += "EOD\n" + b + "arms << EOD\n";
-  for (const PoseSample& p : poses) {
-    const Vec2* from[3] = {&p.joints.A0, &p.joints.A1, &p.joints.A2};
-    for (int k = 0; k < 3; ++k) datablocks += xy(*from[k]) + "\n" + xy(p.G[k]) + "\n\n";
-    datablocks += "\n";
-  }
-  datablocks += "EOD\n" + b + "Spath << EOD\n";
-  for (const Vec2& v : d.s_path) datablocks += xy(v) + "\n";
-  datablocks +=
-      "EOD\n" + b + "frame << EOD\n0,0\n" + fmt(model.frame_length, "%.10g") + ",0\nEOD\n";
-  const bool shafts = core::has_counter_rotations(model);
-  if (shafts) {
-    datablocks += b + "shafts << EOD\n";
-    for (const core::CounterRotation* c :
-         {&model.counter_rotations.crank, &model.counter_rotations.rocker})
-      if (c->inertia > 0) datablocks += xy(c->at) + "\n";
-    datablocks += "EOD\n";
-  }
-
-  std::string cmd =
-      "set size ratio -1\nset xlabel 'x [m]'\nset ylabel 'y [m]'\n"
-      "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n"
-      "set key outside right top vertical Left reverse\n";
-  const core::Joints& j0 = poses.front().joints;
-  const char* jn[] = {"A0", "A1", "A2", "A3"};
-  const Vec2* jp[] = {&j0.A0, &j0.A1, &j0.A2, &j0.A3};
-  for (int i = 0; i < 4; ++i) {
-    cmd += "set label " + gp_string(jn[i]) + " at " + xy(*jp[i]) + " offset 0.6,0.6\n";
-  }
-  const core::PrincipalPoints& p0 = poses.front().principal;
-  const char* pn[] = {"P1", "P2", "P3"};
-  const Vec2* pp[] = {&p0.P1, &p0.P2, &p0.P3};
-  for (int i = 0; i < 3; ++i) {
-    cmd += "set label " + gp_string(pn[i]) + " at " + xy(*pp[i]) + " offset 0.6,-0.8 tc lt 1\n";
-  }
-  // the legend: per sample its links, P, S, G; then the one-off entries
-  std::string entries, arms;
-  for (std::size_t k = 0; k < poses.size(); ++k) {
-    const std::string index = " index " + std::to_string(k);
-    const std::string lt = " lt " + std::to_string(k + 1);
-    entries += b + "links" + index + " using 1:2 with linespoints lw 2 pt 7 ps 0.6" + lt +
-               " title " +
-               gp_string("θ1 = " + fmt(poses[k].pose.theta1, "%.3g") +
-                         " rad, t = " + fmt(poses[k].t, "%.3g") + " s") +
-               ", ";
-    arms += b + "arms" + index + " using 1:2 with lines lw 1 dt 3" + lt + " notitle, ";
-    entries += b + "principal" + index + " using 1:2 with points pt 6 ps 1.4" + lt +
-               " title '  P1 P2 P3', ";
-    entries += b + "S" + index + " using 1:2 with points pt 5 ps 1.2" + lt + " title '  S', ";
-    entries += b + "G" + index + " using 1:2:3 with points pt 7 ps variable" + lt +
-               " title '  G1 G2 G3', ";
-  }
-  cmd += "plot " + arms + entries + b +
-         "frame using 1:2 with lines lw 3 lc 'gray40' title 'frame A0-A3', " + b +
-         "Spath using 1:2 with lines lw 1.5 lc 'black' dt 3 title 'path of S'";
-  if (shafts) {
-    cmd += ", " + b +
-           "shafts using 1:2 with points pt 4 ps 2.2 lw 2 lc 'black' "
-           "title 'counter-rotation shafts'";
-  }
-  Chart c;
-  c.commands = cmd;
-  c.square = true;
-  return c;
-}
-
 // the drawn samples of a design as a table
 std::string poses_table(const Drawing& d) {
   std::string h =
-      "<table><tr><th>sample</th><th>t [s]</th><th>&theta;1 [rad]</th><th>A1</th>"
-      "<th>A2</th><th>G1</th><th>G2</th><th>G3</th><th>P1</th><th>P2</th>"
-      "<th>P3</th><th>S</th></tr>";
+      "<table><tr><th>t [s]</th><th>&theta;1 [rad]</th><th>A1 [m]</th>"
+      "<th>A2 [m]</th><th>G1 [m]</th><th>G2 [m]</th><th>G3 [m]</th><th>P1 [m]</th><th>P2 [m]</th>"
+      "<th>P3 [m]</th><th>S [m]</th></tr>";
   for (const PoseSample& p : d.poses) {
-    h += "<tr><td class=\"n\">" + std::to_string(p.index + 1) + "</td><td class=\"n\">" + fmt(p.t) +
-         "</td><td class=\"n\">" + fmt(p.pose.theta1) + "</td><td>" + vec_text(p.joints.A1) +
-         "</td><td>" + vec_text(p.joints.A2) + "</td>";
+    h += "<tr><td class=\"n\">" + fmt(p.t) + "</td><td class=\"n\">" + fmt(p.pose.theta1) +
+         "</td><td>" + vec_text(p.joints.A1) + "</td><td>" + vec_text(p.joints.A2) + "</td>";
     for (const Vec2& g : p.G) h += "<td>" + vec_text(g) + "</td>";
     h += "<td>" + vec_text(p.principal.P1) + "</td><td>" + vec_text(p.principal.P2) + "</td><td>" +
          vec_text(p.principal.P3) + "</td><td>" + vec_text(p.S) + "</td></tr>";
@@ -221,11 +120,12 @@ std::string fourbar_linkage_tables(const core::FourBar& m) {
       "<th>inertia I [kg m&sup2;]</th></tr>";
   for (int k = 1; k <= 3; ++k) {
     const core::Link& l = core::link(m, k);
+    // e, f, s: round-off of the link's length shows as 0; sigma of a full turn
     h += "<tr><th>" + std::to_string(k) + " " + core::link_name(k) + "</th><td class=\"n\">" +
          fmt(l.length) + "</td><td class=\"n\">" + fmt(l.mass) + "</td><td class=\"n\">" +
-         fmt(l.s()) + "</td><td class=\"n\">" + fmt(l.sigma()) + "</td><td class=\"n\">" +
-         fmt(l.e) + "</td><td class=\"n\">" + fmt(l.f) + "</td><td class=\"n\">" + fmt(l.inertia) +
-         "</td></tr>";
+         fmt_scaled(l.s(), l.length) + "</td><td class=\"n\">" + fmt_scaled(l.sigma(), 1) +
+         "</td><td class=\"n\">" + fmt_scaled(l.e, l.length) + "</td><td class=\"n\">" +
+         fmt_scaled(l.f, l.length) + "</td><td class=\"n\">" + fmt(l.inertia) + "</td></tr>";
   }
   h += "<tr><th>4 frame</th><td class=\"n\">" + fmt(m.frame_length) +
        "</td><td colspan=\"6\">A0 at the origin, A3 at (l4, 0)</td></tr></table>";
@@ -258,113 +158,225 @@ std::string fourbar_linkage_tables(const core::FourBar& m) {
 namespace {
 
 // the four-bar's charts: its angles, reactions, shaking force and moment, drive torque and
-// bearing loads over the run, the linkage drawn at a few samples, and the Pareto front; the
-// second design's dashed over the original's. Returns the drawings of both designs too.
+// bearing loads over the run (over the crank angle in a driven scene), and the linkage animated;
+// the second design's dashed over the original's. Returns the drawings of both designs too.
 struct FourBarCharts {
   std::vector<Chart> charts;
   std::string datablocks;
+  std::vector<AnimationFigure> animations;
   Drawing original, second;
 };
 
+// the counterweights a design's model carries as parts: a balance study's synthesis (`balanced`:
+// the balanced design's), or the parts its study file gives
+std::vector<CounterweightPart> fourbar_parts(const Study& design, bool balanced) {
+  if (balanced && design.balance) {
+    std::vector<CounterweightPart> parts;
+    if (design.balance->crank_counterweight)
+      parts.push_back({1, -1, *design.balance->crank_counterweight});
+    if (design.balance->rocker_counterweight)
+      parts.push_back({3, -1, *design.balance->rocker_counterweight});
+    return parts;
+  }
+  return design.parts ? design.parts->counterweights : std::vector<CounterweightPart>{};
+}
+
+// the linkage animated over the first revolution (driven) or the run (free), from the samples
+// `ts` (decimated), with its counterweights as parts on their links and the centre of mass S
+AnimationFigure fourbar_animation(const core::FourBar& model,
+                                  const std::vector<CounterweightPart>& parts, const Csv& ts,
+                                  const Scene& scene, const std::string& id,
+                                  const std::string& what) {
+  std::vector<std::vector<double>> rows;
+  for (const auto& r : ts.rows) {
+    std::vector<double> x = numbers(r);
+    if (x.size() >= 18) rows.push_back(std::move(x));
+  }
+  AnimationFigure fig;
+  fig.animation.id = id;
+  if (rows.empty()) return fig;
+  const auto* driven = std::get_if<core::DrivenScene>(&scene);
+  std::size_t last = rows.size() - 1;
+  if (driven && driven->omega1 != 0) {  // the first revolution
+    const double period = 2 * std::numbers::pi / std::abs(driven->omega1);
+    while (last > 0 && rows[last][0] - rows[0][0] >= period * (1 - 1e-12)) --last;
+  }
+  std::vector<std::size_t> picks = frame_indices(0, last, 120);
+  const bool loop = driven && std::abs(rows[last][0] - rows[0][0]) > 0;
+  if (loop) picks.push_back(0);  // the periodic end: the first pose again
+  fig.animation.seconds = driven ? 4.0 : 8.0;
+
+  using K = AnimatedShape::Kind;
+  AnimatedShape frame{K::kLine, "#909090", 3, false, true, "frame A0-A3",
+                      {{Vec2(0, 0), Vec2(model.frame_length, 0)}}};
+  AnimatedShape links[3] = {{K::kLine, "#1f4e99", 6, false, false, "crank A0-A1", {}},
+                            {K::kLine, "#d0731c", 6, false, false, "coupler A1-A2", {}},
+                            {K::kLine, "#2e8b3d", 6, false, false, "rocker A2-A3", {}}};
+  AnimatedShape joints{K::kDot, "white", 4.5, false, false, "joints A1, A2", {}};
+  AnimatedShape joint2 = joints;
+  AnimatedShape S{K::kDot, "#000000", 5, false, false,
+                  "S, the centre of mass of the moving links", {}};
+  AnimatedShape s_path{K::kLine, "#606060", 1.2, false, true, "path of S", {{}}};
+  std::vector<AnimatedShape> arms, weights;
+  double heaviest = 0;
+  for (const CounterweightPart& p : parts) heaviest = std::max(heaviest, p.counterweight.mass);
+  for (const CounterweightPart& p : parts) {
+    const char* link = p.link == 1 ? "crank" : "rocker";
+    const std::string colour = p.link == 1 ? "#1f4e99" : "#2e8b3d";
+    arms.push_back({K::kLine, colour, 2, false, true, "", {}});
+    weights.push_back({K::kDot, colour, 7 + 9 * std::sqrt(p.counterweight.mass / heaviest),
+                       false, false,
+                       std::string("counterweight on the ") + link + ": " +
+                           fmt(p.counterweight.mass, "%.4g") + " kg at " +
+                           fmt(p.counterweight.distance, "%.4g") + " m from " +
+                           (p.link == 1 ? "A0" : "A3"),
+                       {}});
+  }
+  for (const auto& row : rows) s_path.frames[0].push_back(pose_sample(model, row, 0).S);
+  for (std::size_t i : picks) {
+    const PoseSample p = pose_sample(model, rows[i], i);
+    const core::Joints& j = p.joints;
+    links[0].frames.push_back({j.A0, j.A1});
+    links[1].frames.push_back({j.A1, j.A2});
+    links[2].frames.push_back({j.A2, j.A3});
+    joints.frames.push_back({j.A1});
+    joint2.frames.push_back({j.A2});
+    S.frames.push_back({p.S});
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      const bool crank = parts[k].link == 1;
+      const double angle = crank ? p.pose.theta1 : p.pose.theta3;
+      const Vec2 pivot = crank ? j.A0 : j.A3;
+      const Vec2 u(std::cos(angle), std::sin(angle)), n(-u.y(), u.x());
+      const Vec2& at = parts[k].counterweight.position;
+      const Vec2 w = pivot + at.x() * u + at.y() * n;
+      arms[k].frames.push_back({pivot, w});
+      weights[k].frames.push_back({w});
+    }
+  }
+  std::vector<AnimatedShape>& shapes = fig.animation.shapes;
+  shapes.push_back(frame);
+  shapes.push_back(s_path);
+  for (const AnimatedShape& a : arms) shapes.push_back(a);
+  for (const AnimatedShape& l : links) shapes.push_back(l);
+  for (const AnimatedShape& w : weights) shapes.push_back(w);
+  shapes.push_back(joints);
+  shapes.push_back(joint2);
+  for (const core::CounterRotation* c :
+       {&model.counter_rotations.crank, &model.counter_rotations.rocker}) {
+    if (c->inertia > 0) {
+      shapes.push_back({K::kDot, "#b0b0b0", 9, false, false,
+                        "counter-rotating disc, J = " + fmt(c->inertia, "%.4g") + " kg m²",
+                        {{c->at}}});
+    }
+  }
+  shapes.push_back({K::kGround, "", 11, false, false, "A0", {{Vec2(0, 0)}}});
+  shapes.push_back({K::kGround, "", 11, false, false, "A3", {{Vec2(model.frame_length, 0)}}});
+  shapes.push_back(S);
+  fig.animation.labels = {{Vec2(0, 0), "A0"}, {Vec2(model.frame_length, 0), "A3"}};
+  fig.heading = "The " + what + " linkage in motion";
+  fig.caption =
+      std::string(driven ? "One revolution of the crank, slowed to 4 s and looping"
+                         : "The run, shown in 8 s and looping") +
+      " (" + std::to_string(picks.size() - (loop ? 1 : 0)) +
+      " samples of the run; printed, the first pose): crank blue, coupler orange, rocker green" +
+      (parts.empty() ? std::string()
+                     : ", each counterweight as a disc on its link (area in proportion to its "
+                       "mass; hover for its values) on a dashed arm from the pivot") +
+      "; S, the centre of mass of the moving links, black, with its path dashed (where the "
+      "shaking force is balanced, S stays in one place).";
+  return fig;
+}
+
 FourBarCharts fourbar_charts(const Study& study, const fs::path& dir, const SecondDesign& sd,
-                             const Csv& ts) {
+                             const Csv& ts, const Json& summary) {
   FourBarCharts out;
   const std::string second = sd.key, second_label = sd.label, second_file = sd.file;
   std::vector<Chart>& charts = out.charts;
   std::string& datablocks = out.datablocks;
-  // the linkage at four samples evenly spread over the run, and the path of S; the second
-  // design's alike, from its own model (counterweights merged into its links) and samples
   out.original = drawing(study.fourbar(), ts);
-  const Drawing& original = out.original;
-  const std::vector<PoseSample>& poses = original.poses;
-  std::optional<core::FourBar> second_model;
+  // the second design's model (counterweights merged into its links) and its parts
+  std::optional<Study> second_study;
   if (second == "balanced" && study.balance) {
-    second_model = study.balance->model;
+    second_study = balanced_study(study);
+    second_study->balance = study.balance;  // its counterweights, for the drawing
   } else if (second == "optimized" && fs::exists(dir / "optimized.yaml")) {
     try {
-      second_model = load_study((dir / "optimized.yaml").string()).fourbar();
+      second_study = load_study((dir / "optimized.yaml").string());
     } catch (const std::exception& e) {
       throw std::runtime_error("cannot draw the optimised design: " + std::string(e.what()));
     }
   }
-  if (second_model) out.second = drawing(*second_model, read_csv(dir / second_file));
-  const Drawing& second_drawing = out.second;
+  Csv ts2;
+  if (second_study) {
+    ts2 = read_csv_decimated(dir / second_file, kChartRows, nullptr);
+    out.second = drawing(second_study->fourbar(), ts2);
+  }
 
-  // charts
-  const fs::path abs_dir = fs::absolute(dir);
-  const std::string ts_file = gp_string((abs_dir / "timeseries.csv").string());
-  const std::string ts2_file = second.empty() ? "" : gp_string((abs_dir / second_file).string());
-  const std::string drive_x = time_axis(study.scene);
   if (!ts.rows.empty()) {
-    charts.push_back(
-        {"angles", "Link angles",
-         "theta1, theta2, theta3 over the run (cf. paper Fig. 7), from timeseries.csv.",
-         "set title 'Link angles'\nset xlabel " + gp_string(drive_x) +
-             "\nset ylabel 'angle [rad]'\n"
-             "plot " +
-             ts_file +
-             " skip 1 using 1:2 with lines lw 2 title 'θ1 crank', "
-             "'' skip 1 using 1:3 with lines lw 2 title 'θ2 coupler', "
-             "'' skip 1 using 1:4 with lines lw 2 title 'θ3 rocker'"});
+    // the samples as data blocks (at most kChartRows rows each: the page stays small)
+    datablocks += datablock("ts", ts);
+    if (second_study) datablocks += datablock("ts2", ts2);
+    const bool closed = periodic_run(study.scene, summary);
+    datablocks += xy_block("hodo", ts, 15, 16, closed);
+    if (second_study) datablocks += xy_block("hodo2", ts2, 15, 16, closed);
+    const RunAxis axis = run_axis(study.scene, 2);
+    const std::string u = " skip 1 using " + axis.x + ":";
+    const std::string xl = "\nset xlabel " + gp_string(axis.label) + "\n";
+    charts.push_back({"angles", "Link angles",
+                      "theta1, theta2, theta3 over the run (cf. paper Fig. 7), from timeseries.csv.",
+                      "set title 'Link angles'" + xl + "set ylabel 'angle [rad]'\nplot $ts" + u +
+                          "2 with lines lw 2 title 'θ1 crank', ''" + u +
+                          "3 with lines lw 2 title 'θ2 coupler', ''" + u +
+                          "4 with lines lw 2 title 'θ3 rocker'"});
     charts.push_back({"reactions", "Support reactions",
                       "Forces of the mechanism on the ground at A0 and A3 (cf. paper Fig. 8), "
                       "original design.",
-                      "set title 'Support reactions (original design)'\nset xlabel " +
-                          gp_string(drive_x) +
-                          "\nset ylabel 'force on the ground [N]'\n"
-                          "plot " +
-                          ts_file +
-                          " skip 1 using 1:11 with lines lw 2 title 'RA0x', "
-                          "'' skip 1 using 1:12 with lines lw 2 title 'RA0y', "
-                          "'' skip 1 using 1:13 with lines lw 2 title 'RA3x', "
-                          "'' skip 1 using 1:14 with lines lw 2 title 'RA3y'"});
+                      "set title 'Support reactions (original design)'" + xl +
+                          "set ylabel 'force on the ground [N]'\nplot $ts" + u +
+                          "11 with lines lw 2 title 'RA0x', ''" + u +
+                          "12 with lines lw 2 title 'RA0y', ''" + u +
+                          "13 with lines lw 2 title 'RA3x', ''" + u +
+                          "14 with lines lw 2 title 'RA3y'"});
     std::string hodo =
         "set title 'Shaking-force hodograph'\nset size ratio -1\n"
         "set xlabel 'Fshx [N]'\nset ylabel 'Fshy [N]'\n"
-        "plot " +
-        ts_file + " skip 1 using 15:16 with lines lw 2 title 'original'";
-    std::string msh = "set title 'Shaking moment about A0'\nset xlabel " + gp_string(drive_x) +
-                      "\nset ylabel 'Msh [N m]'\nplot " + ts_file +
-                      " skip 1 using 1:17 with lines lw 2 title 'original'";
+        "plot $hodo skip 1 using 1:2 with lines lw 2 title 'original'";
+    std::string msh = "set title 'Shaking moment about A0'" + xl + "set ylabel 'Msh [N m]'\nplot $ts" +
+                      u + "17 with lines lw 2 title 'original'";
     // a free scene has no drive: its chart is the bearing loads alone (a torque of 0 on a right
     // axis of its own would read as a constant load)
     const bool driven = !is_free(study.scene);
     std::string drive = std::string("set title '") +
-                        (driven ? "Drive torque and bearing loads" : "Bearing loads") +
-                        "'\nset xlabel " + gp_string(drive_x) +
-                        "\nset ylabel 'bearing load [N]'\n" +
+                        (driven ? "Drive torque and bearing loads" : "Bearing loads") + "'" + xl +
+                        "set ylabel 'bearing load [N]'\n" +
                         (driven ? "set y2label 'drive torque τ [N m]'\nset ytics nomirror\n"
                                   "set y2tics\n"
                                 : "") +
-                        "plot " + ts_file +
-                        " skip 1 using 1:(sqrt($11**2+$12**2)) with lines lw 2 "
-                        "lt 1 title '|RA0|', '' skip 1 using 1:(sqrt($13**2+$14**2)) with lines "
-                        "lw 2 lt 2 title '|RA3|'" +
-                        (driven ? ", '' skip 1 using 1:18 axes x1y2 with lines lw 2 lt 3 title 'τ'"
-                                : "");
-    if (!second.empty()) {
-      hodo += ", " + ts2_file + " skip 1 using 15:16 with linespoints lw 2 dt 2 pt 6 pi 25 title " +
+                        "plot $ts" + u + "(sqrt($11**2+$12**2)) with lines lw 2 lt 1 title "
+                        "'|RA0|', ''" + u + "(sqrt($13**2+$14**2)) with lines lw 2 lt 2 title "
+                        "'|RA3|'" +
+                        (driven ? ", ''" + u + "18 axes x1y2 with lines lw 2 lt 3 title 'τ'" : "");
+    if (second_study) {
+      hodo += ", $hodo2 skip 1 using 1:2 with linespoints lw 2 dt 2 pt 6 pi 25 title " +
               gp_string(second_label);
-      msh += ", " + ts2_file + " skip 1 using 1:17 with lines lw 2 dt 2 title " +
-             gp_string(second_label);
-      drive += ", " + ts2_file +
-               " skip 1 using 1:(sqrt($11**2+$12**2)) with lines lw 2 lt 1 dt 2 "
-               "title '|RA0| " +
-               second_label +
-               "', '' skip 1 using 1:(sqrt($13**2+$14**2)) with "
-               "lines lw 2 lt 2 dt 2 title '|RA3| " +
-               second_label +
+      msh += ", $ts2" + u + "17 with lines lw 2 dt 2 title " + gp_string(second_label);
+      drive += ", $ts2" + u + "(sqrt($11**2+$12**2)) with lines lw 2 lt 1 dt 2 title '|RA0| " +
+               second_label + "', ''" + u +
+               "(sqrt($13**2+$14**2)) with lines lw 2 lt 2 dt 2 title '|RA3| " + second_label +
                "'" +
-               (driven ? ", '' skip 1 using 1:18 axes x1y2 with lines lw 2 lt 3 dt 2 title 'τ " +
+               (driven ? ", ''" + u + "18 axes x1y2 with lines lw 2 lt 3 dt 2 title 'τ " +
                              second_label + "'"
                        : std::string());
     }
     const std::string overlay =
-        second.empty() ? "" : " The " + second_label + " design is dashed (" + second_file + ").";
-    charts.push_back(
-        {"hodograph", "Shaking-force hodograph",
-         "The tip of the shaking force F̄sh = R̄A0 + R̄A3 over the run, equal axes." + overlay, hodo,
-         true});
+        second_study ? " The " + second_label + " design is dashed (" + second_file + ")." : "";
+    charts.push_back({"hodograph", "Shaking-force hodograph",
+                      "The tip of the shaking force F̄sh = R̄A0 + R̄A3 over the run, equal axes" +
+                          std::string(closed ? ", closed by the periodic end (the first sample "
+                                               "again)."
+                                             : ".") +
+                          overlay,
+                      hodo, true});
     charts.push_back({"shaking-moment", "Shaking moment",
                       "Shaking moment on the frame about A0 over the run." + overlay, msh});
     charts.push_back(
@@ -374,49 +386,15 @@ FourBarCharts fourbar_charts(const Study& study, const fs::path& dir, const Seco
                 : "Magnitudes of the bearing forces at A0 and A3 (free motion: no drive)." +
                       overlay,
          drive});
-  }
-  // one scale of marker size for the links' masses of both designs
-  double mass_ref = std::max(
-      {study.fourbar().crank.mass, study.fourbar().coupler.mass, study.fourbar().rocker.mass});
-  if (second_model) {
-    mass_ref = std::max({mass_ref, second_model->crank.mass, second_model->coupler.mass,
-                         second_model->rocker.mass});
-  }
-  const std::string masses_caption =
-      ", the links' centres of mass G1, G2, G3 (filled circles, area in proportion to the "
-      "link's mass, on dotted lines from the joint each is measured from: A0, A1, A2), the "
-      "opened-loop principal points P1, P2, P3 (open circles) and the system centre of mass S "
-      "(filled squares), with the path S traces over all ";
-  if (!poses.empty()) {
-    Chart c = linkage_chart(study.fourbar(), original, "o", mass_ref, datablocks);
-    c.id = "linkage";
-    c.heading = "The linkage";
-    c.commands = "set title 'The linkage at " + std::to_string(poses.size()) +
-                 " samples: joints, centres of mass, principal points and S'\n" + c.commands;
-    c.caption = "Joints and link lines at " + std::to_string(poses.size()) +
-                " samples spread evenly over the run (one colour per sample)" + masses_caption +
-                std::to_string(original.s_path.size()) +
-                " samples; computed from the model and timeseries.csv (original design).";
-    charts.push_back(c);
-  }
-  if (!second_drawing.poses.empty()) {
-    const std::string what = second == "balanced" ? "balanced" : "optimised";
-    Chart c = linkage_chart(*second_model, second_drawing, "s", mass_ref, datablocks);
-    c.id = "linkage-" + second;
-    c.heading = "The " + what + " linkage";
-    c.commands =
-        "set title " +
-        gp_string("The " + what + " design at " + std::to_string(second_drawing.poses.size()) +
-                  (second == "balanced" ? " samples: its counterweights merged into its links"
-                                        : " samples: counterweights and link changes merged")) +
-        "\n" + c.commands;
-    c.caption = "The " + what + " design drawn as the original above, from " + second_file +
-                ": joints and link lines at " + std::to_string(second_drawing.poses.size()) +
-                " samples" + masses_caption + std::to_string(second_drawing.s_path.size()) +
-                " samples. A counterweight shows as its link's centre of mass moved towards or "
-                "past the pivot and grown with the added mass; where the shaking force is "
-                "balanced, S stays in one place.";
-    charts.push_back(c);
+    out.animations.push_back(fourbar_animation(study.fourbar(), fourbar_parts(study, false), ts,
+                                               study.scene, "animation-original", "original"));
+    if (second_study && !ts2.rows.empty()) {
+      out.animations.push_back(fourbar_animation(second_study->fourbar(),
+                                                 fourbar_parts(*second_study, second == "balanced"),
+                                                 ts2, study.scene,
+                                                 "animation-" + second,
+                                                 second == "balanced" ? "balanced" : "optimised"));
+    }
   }
   return out;
 }
@@ -425,26 +403,29 @@ FourBarCharts fourbar_charts(const Study& study, const fs::path& dir, const Seco
 
 std::string fourbar_report_html(const Study& study, const fs::path& dir, const std::string& gnuplot,
                                 const Json& summary) {
-  const Csv ts = read_csv(dir / "timeseries.csv");
+  std::size_t samples = 0;
+  const Csv ts = read_csv_decimated(dir / "timeseries.csv", kChartRows, &samples);
   const SecondDesign second = second_design(summary, dir);
   std::string h = page_start(study, summary) + simulation_section(summary);
   h += "<h2>Linkage</h2>\n" + fourbar_linkage_tables(study.fourbar());
   h +=
       metrics_section(summary, second,
-                      "Fsh, Msh: shaking force [N] and moment about A0 [N m] on the frame; tau: "
-                      "drive torque [N m]; RA0, RA3: forces on the ground at the bearings [N]. RMS "
-                      "over the samples, max of magnitudes.");
+                      "Fsh, Msh: shaking force and moment about A0 on the frame; tau: drive "
+                      "torque; RA0, RA3: forces on the ground at the bearings. RMS over the "
+                      "samples, max of magnitudes.");
   h += comparison_section(dir, second);
   h += harmonics_section(dir);
-  FourBarCharts c = fourbar_charts(study, dir, second, ts);
-  for (Chart& chart : pareto_charts(dir)) c.charts.push_back(std::move(chart));
-  h += charts_section(gnuplot, c.datablocks, c.charts);
+  FourBarCharts c = fourbar_charts(study, dir, second, ts, summary);
+  h += animations_section(c.animations);
+  for (Chart& chart : harmonic_charts(dir, c.datablocks)) c.charts.push_back(std::move(chart));
+  for (Chart& chart : pareto_charts(dir, c.datablocks)) c.charts.push_back(std::move(chart));
+  h += charts_section(gnuplot, c.datablocks, c.charts, samples, ts.rows.size());
   if (!c.original.poses.empty()) {
-    h += "<h3>The linkage at the drawn samples</h3>" + poses_table(c.original);
+    h += "<h3>The linkage at four samples</h3>" + poses_table(c.original);
   }
   if (!c.second.poses.empty()) {
     h += "<h3>The " + std::string(second.key == "balanced" ? "balanced" : "optimised") +
-         " linkage at the drawn samples</h3>" + poses_table(c.second);
+         " linkage at four samples</h3>" + poses_table(c.second);
   }
   h += second_design_section(summary, second);
   h += pareto_section(dir);

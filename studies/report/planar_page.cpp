@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -45,14 +46,14 @@ int gp_column(const Csv& ts, const std::string& name) {
   return it == ts.header.end() ? 0 : static_cast<int>(it - ts.header.begin()) + 1;
 }
 
-// one line per column over t, `expr` the gnuplot expression of a column index (magnitude or value)
-std::string lines_over_t(const std::string& file,
-                         const std::vector<std::pair<std::string, std::string>>& items) {
+// one line per column over the run's axis `x` (a gnuplot using expression), `expr` the gnuplot
+// expression of a column index (magnitude or value)
+std::string lines_over(const std::string& file, const std::string& x,
+                       const std::vector<std::pair<std::string, std::string>>& items) {
   std::string plot;
   for (std::size_t k = 0; k < items.size(); ++k) {
-    plot += (k ? ", " : "") + (k ? std::string("''") : file) +
-            " skip 1 using 1:" + items[k].second + " with lines lw 2 title " +
-            gp_string(items[k].first);
+    plot += (k ? ", " : "") + (k ? std::string("''") : file) + " skip 1 using " + x + ":" +
+            items[k].second + " with lines lw 2 title " + gp_string(items[k].first);
   }
   return plot;
 }
@@ -63,14 +64,8 @@ std::string magnitude(const Csv& ts, const std::string& name) {
   return "(sqrt($" + std::to_string(cx) + "**2+$" + std::to_string(cy) + "**2))";
 }
 
-// a counterweight drawn on its link: where it sits in the link's axes from its pivot node
-struct CounterweightPart {
-  int link{}, pivot{};
-  Vec2 position{0, 0};
-};
-
 // the counterweights of a balanced or optimised design, from summary.json's balance or
-// optimize section
+// optimize section (mass, place in the link's axes from its pivot node)
 std::vector<CounterweightPart> counterweight_parts(const Linkage& l, const Json& summary) {
   std::vector<CounterweightPart> parts;
   const Json* b = member(summary, "balance");
@@ -81,192 +76,220 @@ std::vector<CounterweightPart> counterweight_parts(const Linkage& l, const Json&
     const int link = core::planar::link_index(l, text(c, "link"));
     const int pivot = core::planar::node_index(l, text(c, "from_node"));
     const Json* at = member(c, "position");
+    const Json* mass = member(c, "mass");
     if (link < 0 || pivot < 0 || !at || !at->is_array() || at->size() != 2) continue;
-    if (!(*at)[0].is_number() || !(*at)[1].is_number()) continue;
-    parts.push_back({link, pivot, Vec2((*at)[0].get<double>(), (*at)[1].get<double>())});
+    if (!(*at)[0].is_number() || !(*at)[1].is_number() || !mass || !mass->is_number()) continue;
+    if (!(mass->get<double>() > 0)) continue;  // an optimum's unused counterweight
+    CounterweightPart part;
+    part.link = link;
+    part.pivot = pivot;
+    part.counterweight.mass = mass->get<double>();
+    part.counterweight.position = Vec2((*at)[0].get<double>(), (*at)[1].get<double>());
+    part.counterweight.distance = part.counterweight.position.norm();
+    parts.push_back(part);
   }
   return parts;
 }
 
-// the linkage at four samples evenly spread over the run: links through their nodes, the ground
-// nodes, the frame guides, and the counterweights `parts` (a balanced design's); `tag` names the
-// chart's data blocks apart from another linkage's on the page
-Chart linkage_chart(const Linkage& l, const Csv& ts, std::string& datablocks,
-                    const std::string& what = "linkage", const std::string& tag = "p",
-                    const std::vector<CounterweightPart>& parts = {}) {
-  const std::size_t n = ts.rows.size();
-  std::vector<std::size_t> picks;
-  for (std::size_t k = 0; k < 4 && k < n; ++k) picks.push_back(k * n / std::min<std::size_t>(4, n));
+// the linkage animated over the first revolution of its driven input (a driven scene given in
+// revolutions) or over the run: links through their nodes (a ternary link as a closed outline),
+// ground nodes, frame guides, the counterweights `parts` as discs on arms from their pivots,
+// balance shafts with their eccentric masses
+AnimationFigure planar_animation(const Linkage& l, const Csv& ts, const Scene& scene,
+                                 const std::vector<CounterweightPart>& parts, const std::string& id,
+                                 const std::string& what) {
+  AnimationFigure fig;
+  fig.animation.id = id;
+  std::vector<std::vector<double>> rows;
+  for (const auto& r : ts.rows) {
+    std::vector<double> x = numbers(r);
+    if (x.size() == ts.header.size()) rows.push_back(std::move(x));
+  }
+  if (rows.empty()) return fig;
   auto node_at = [&](const std::vector<double>& row, int i) {
     const core::planar::Node& node = l.nodes[static_cast<std::size_t>(i)];
     if (node.ground) return node.position;
     return Vec2(row[static_cast<std::size_t>(gp_column(ts, "x_" + node.name) - 1)],
                 row[static_cast<std::size_t>(gp_column(ts, "y_" + node.name) - 1)]);
   };
-  // where a counterweight sits at a sample: pivot + R(theta) position
-  auto weight_at = [&](const std::vector<double>& row, const CounterweightPart& part) {
-    const int column = gp_column(ts, "theta_" + l.links[static_cast<std::size_t>(part.link)].name);
-    const double theta = column ? row[static_cast<std::size_t>(column - 1)] : 0.0;
-    const Vec2 u(std::cos(theta), std::sin(theta)), v(-u.y(), u.x());
-    return Vec2(node_at(row, part.pivot) + part.position.x() * u + part.position.y() * v);
+  auto link_angle = [&](const std::vector<double>& row, int link) {
+    const int column = gp_column(ts, "theta_" + l.links[static_cast<std::size_t>(link)].name);
+    return column ? row[static_cast<std::size_t>(column - 1)] : 0.0;
   };
-  datablocks += "$" + tag + "links << EOD\n";
-  std::string entries;
-  for (std::size_t k = 0; k < picks.size(); ++k) {
-    const std::vector<double> row = numbers(ts.rows[picks[k]]);
-    for (const core::planar::Link& link : l.links) {
-      for (int i : link.nodes) datablocks += xy(node_at(row, i)) + "\n";
-      if (link.nodes.size() > 2) datablocks += xy(node_at(row, link.nodes[0])) + "\n";
-      datablocks += "\n";
-    }
-    for (const CounterweightPart& part : parts) {  // its arm from the pivot
-      datablocks += xy(node_at(row, part.pivot)) + "\n" + xy(weight_at(row, part)) + "\n\n";
-    }
-    datablocks += "\n";  // a new data set per sample (index k)
-    entries += std::string(k ? ", " : "") + "$" + tag + "links index " + std::to_string(k) +
-               " using 1:2 with linespoints lw 2 pt 7 ps 0.6 lt " + std::to_string(k + 1) +
-               " title " + gp_string("t = " + fmt(row[0], "%.3g") + " s");
+  // the first revolution of a driven input, or the run
+  const auto* driven = std::get_if<core::planar::DrivenScene>(&scene);
+  const bool revolution = driven && driven->duration == 0 && driven->revolutions >= 1 &&
+                          driven->speeds.size() == 1 && driven->speeds[0] != 0;
+  std::size_t last = rows.size() - 1;
+  if (revolution) {
+    const double period = 2 * std::numbers::pi / std::abs(driven->speeds[0]);
+    while (last > 0 && rows[last][0] - rows[0][0] >= period * (1 - 1e-12)) --last;
   }
-  // each counterweight where its link carries it, in its sample's colour
-  datablocks += "EOD\n$" + tag + "weights << EOD\n";
-  for (std::size_t k = 0; k < picks.size(); ++k) {
-    const std::vector<double> row = numbers(ts.rows[picks[k]]);
-    for (const CounterweightPart& part : parts) {
-      datablocks += xy(weight_at(row, part)) + "," + std::to_string(k + 1) + "\n";
+  std::vector<std::size_t> picks = frame_indices(0, last, 120);
+  if (revolution && last > 0) picks.push_back(0);  // the periodic end: the first pose again
+  fig.animation.seconds = revolution ? 4.0 : 8.0;
+
+  using K = AnimatedShape::Kind;
+  const char* colours[] = {"#1f4e99", "#d0731c", "#2e8b3d", "#8e3b9e",
+                           "#b8860b", "#c03030", "#2a9d9d", "#555555"};
+  std::vector<AnimatedShape>& shapes = fig.animation.shapes;
+  // frame guides: the stretch each slider's node travels, and a little more
+  for (const core::planar::Slider& sl : l.sliders) {
+    if (sl.link >= 0) continue;
+    const Vec2 u = (sl.to - sl.from).normalized();
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const auto& row : rows) {
+      const double along = u.dot(node_at(row, sl.node) - sl.from);
+      lo = std::min(lo, along);
+      hi = std::max(hi, along);
     }
+    const double margin = std::max(0.25 * (hi - lo), 1e-3);
+    shapes.push_back({K::kLine,
+                      "#909090",
+                      2,
+                      false,
+                      true,
+                      "guide of slider " + sl.name,
+                      {{sl.from + (lo - margin) * u, sl.from + (hi + margin) * u}}});
   }
-  // balance shafts: each shaft on the frame, its drive from its link's pivot, and its
-  // eccentric mass where it is at each sample, in that sample's colour
-  datablocks += "EOD\n$" + tag + "shafts << EOD\n";
-  for (const core::planar::BalanceShaft& b : l.shafts) datablocks += xy(b.at) + "\n";
-  datablocks += "EOD\n$" + tag + "drives << EOD\n";
+  // balance shafts' drives, counterweights' arms, links, weights, shafts
+  std::vector<AnimatedShape> links, arms, weights, eccentrics;
+  for (std::size_t k = 0; k < l.links.size(); ++k) {
+    const core::planar::Link& link = l.links[k];
+    links.push_back(
+        {K::kLine, colours[k % 8], 6, link.nodes.size() > 2, false, "link " + link.name, {}});
+  }
+  double heaviest = 0;
+  for (const CounterweightPart& p : parts) heaviest = std::max(heaviest, p.counterweight.mass);
+  for (const CounterweightPart& p : parts) {
+    const std::string colour = colours[static_cast<std::size_t>(p.link) % 8];
+    arms.push_back({K::kLine, colour, 2, false, true, "", {}});
+    weights.push_back({K::kDot,
+                       colour,
+                       7 + 9 * std::sqrt(p.counterweight.mass / heaviest),
+                       false,
+                       false,
+                       "counterweight on " + l.links[static_cast<std::size_t>(p.link)].name + ": " +
+                           fmt(p.counterweight.mass, "%.4g") + " kg at " +
+                           fmt(p.counterweight.distance, "%.4g") + " m from " +
+                           l.nodes[static_cast<std::size_t>(p.pivot)].name,
+                       {}});
+  }
   for (const core::planar::BalanceShaft& b : l.shafts) {
-    datablocks +=
-        xy(l.nodes[static_cast<std::size_t>(core::planar::pivot_of(l, b.link))].position) + "\n" +
-        xy(b.at) + "\n\n";
+    if (b.mass == 0 || b.eccentricity.norm() == 0) continue;
+    eccentrics.push_back({K::kDot, "#606060", 6, false, false, "eccentric mass of " + b.name, {}});
   }
-  datablocks += "EOD\n$" + tag + "eccentrics << EOD\n";
-  bool eccentric = false;
-  for (std::size_t k = 0; k < picks.size(); ++k) {
-    const std::vector<double> row = numbers(ts.rows[picks[k]]);
+  for (std::size_t i : picks) {
+    const std::vector<double>& row = rows[i];
+    for (std::size_t k = 0; k < l.links.size(); ++k) {
+      std::vector<Vec2> pts;
+      for (int n : l.links[k].nodes) pts.push_back(node_at(row, n));
+      links[k].frames.push_back(pts);
+    }
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      const double theta = link_angle(row, parts[k].link);
+      const Vec2 u(std::cos(theta), std::sin(theta)), n(-u.y(), u.x());
+      const Vec2 pivot = node_at(row, parts[k].pivot);
+      const Vec2& at = parts[k].counterweight.position;
+      const Vec2 w = pivot + at.x() * u + at.y() * n;
+      arms[k].frames.push_back({pivot, w});
+      weights[k].frames.push_back({w});
+    }
+    std::size_t e = 0;
     for (const core::planar::BalanceShaft& b : l.shafts) {
       if (b.mass == 0 || b.eccentricity.norm() == 0) continue;
       const core::planar::Link& link = l.links[static_cast<std::size_t>(b.link)];
       const Vec2 d = l.nodes[static_cast<std::size_t>(link.nodes[1])].position -
                      l.nodes[static_cast<std::size_t>(link.nodes[0])].position;
-      const int column = gp_column(ts, "theta_" + link.name);
-      const double turn =
-          column ? row[static_cast<std::size_t>(column - 1)] - std::atan2(d.y(), d.x()) : 0.0;
-      datablocks +=
-          xy(b.at + core::planar::shaft_centre(b, turn)) + "," + std::to_string(k + 1) + "\n";
-      eccentric = true;
+      const double turn = link_angle(row, b.link) - std::atan2(d.y(), d.x());
+      eccentrics[e++].frames.push_back({b.at + core::planar::shaft_centre(b, turn)});
     }
   }
-  datablocks += "EOD\n$" + tag + "ground << EOD\n";
-  for (const core::planar::Node& node : l.nodes) {
-    if (node.ground) datablocks += xy(node.position) + "\n";
-  }
-  datablocks += "EOD\n$" + tag + "guides << EOD\n";
-  // a frame guide over the stretch its node travels, and a little more (the line the study
-  // gives may be far longer: a cylinder axis given as [0, 0] to [1, 0])
-  for (const core::planar::Slider& s : l.sliders) {
-    if (s.link >= 0) continue;
-    const Vec2 u = (s.to - s.from).normalized();
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const auto& text_row : ts.rows) {
-      const double along = u.dot(node_at(numbers(text_row), s.node) - s.from);
-      lo = std::min(lo, along);
-      hi = std::max(hi, along);
-    }
-    if (!(hi >= lo)) lo = hi = 0;
-    const double margin = std::max(0.25 * (hi - lo), 1e-3);
-    datablocks += xy(s.from + (lo - margin) * u) + "\n" + xy(s.from + (hi + margin) * u) + "\n\n";
-  }
-  datablocks += "EOD\n";
-  std::string cmd = "set title " +
-                    gp_string("The " + what + " at " + std::to_string(picks.size()) + " samples") +
-                    "\nset size ratio -1\nset xlabel 'x [m]'\nset ylabel 'y [m]'\n"
-                    "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n"
-                    "set key outside right top vertical Left reverse\n";
-  for (const core::planar::Node& node : l.nodes) {
-    if (node.ground)
-      cmd +=
-          "set label " + gp_string(node.name) + " at " + xy(node.position) + " offset 0.6,-0.8\n";
-  }
-  // one label per shaft position (a Lanchester pair may share one)
-  std::vector<std::pair<Vec2, std::string>> shaft_labels;
   for (const core::planar::BalanceShaft& b : l.shafts) {
-    auto same = std::find_if(shaft_labels.begin(), shaft_labels.end(),
-                             [&](const auto& x) { return x.first == b.at; });
-    if (same == shaft_labels.end()) {
-      shaft_labels.emplace_back(b.at, b.name);
-    } else {
-      same->second += ", " + b.name;
-    }
+    const Vec2 pivot =
+        l.nodes[static_cast<std::size_t>(core::planar::pivot_of(l, b.link))].position;
+    shapes.push_back({K::kLine, "#a0a0a0", 1.5, false, true, "", {{pivot, b.at}}});
   }
-  for (const auto& [at, names] : shaft_labels)
-    cmd += "set label " + gp_string(names) + " at " + xy(at) + " offset 0.8,0.6\n";
-  cmd += "plot " + entries + ", $" + tag +
-         "ground using 1:2 with points pt 9 ps 1.8 lc 'gray30' title 'ground nodes'";
-  const bool guides = std::any_of(l.sliders.begin(), l.sliders.end(),
-                                  [](const core::planar::Slider& s) { return s.link < 0; });
-  if (guides) {
-    cmd += ", $" + tag + "guides using 1:2 with lines lw 1 dt 2 lc 'gray30' title 'frame guides'";
+  for (const AnimatedShape& a : arms) shapes.push_back(a);
+  for (const AnimatedShape& k : links) shapes.push_back(k);
+  for (const AnimatedShape& w : weights) shapes.push_back(w);
+  for (const core::planar::BalanceShaft& b : l.shafts) {
+    shapes.push_back({K::kDot, "white", 9, false, false, "balance shaft " + b.name, {{b.at}}});
   }
-  if (!parts.empty()) {
-    cmd += ", $" + tag +
-           "weights using 1:2:3 with points pt 7 ps 2.2 lc variable title 'counterweights'";
+  for (const AnimatedShape& e : eccentrics) shapes.push_back(e);
+  for (const core::planar::Node& node : l.nodes) {
+    if (!node.ground) continue;
+    shapes.push_back({K::kGround, "", 11, false, false, node.name, {{node.position}}});
+    fig.animation.labels.push_back({node.position, node.name});
   }
-  if (!l.shafts.empty()) {
-    cmd += ", $" + tag + "drives using 1:2 with lines dt 3 lw 1 lc 'gray50' notitle, $" + tag +
-           "shafts using 1:2 with points pt 6 ps 2.4 lw 2 lc 'black' title 'balance shafts'";
-    if (eccentric) {
-      cmd += ", $" + tag +
-             "eccentrics using 1:2:3 with points pt 5 ps 1.2 lc variable title 'shaft masses'";
-    }
-  }
-  Chart c;
-  c.id = "linkage";
-  c.heading = "The linkage";
-  c.caption =
-      "Links through their nodes (a ternary link as a closed outline) at samples spread "
-      "evenly over the run, one colour per sample; ground nodes as triangles, guides fixed "
-      "in the frame dashed; balance shafts as open circles, dotted to the pivot of the link "
-      "that drives them, with their eccentric masses in each sample's colour. From the node "
-      "columns of timeseries.csv.";
-  c.commands = cmd;
-  c.square = true;
-  return c;
+  fig.heading = "The " + what + " linkage in motion";
+  fig.caption =
+      std::string(revolution ? "One revolution of the driven input, slowed to 4 s and looping"
+                             : "The run, shown in 8 s and looping") +
+      " (" + std::to_string(picks.size() - (revolution && last > 0 ? 1 : 0)) +
+      " samples of the run; printed, the first pose): each link through its nodes in a colour of "
+      "its own (a ternary link as a closed outline; hover for its name), ground nodes as "
+      "triangles, guides fixed in the frame dashed" +
+      (parts.empty() ? std::string()
+                     : ", each counterweight as a disc on its link (area in proportion to its "
+                       "mass; hover for its values) on a dashed arm from its pivot") +
+      (l.shafts.empty() ? std::string()
+                        : ", balance shafts as open circles with their eccentric masses") +
+      ". From the node columns of the samples.";
+  return fig;
 }
 
-// the balanced design beside the original: its samples' file, its linkage and counterweights
+// the balanced or optimised design beside the original: its samples, its linkage and
+// counterweights
 struct Second {
   SecondDesign design;
-  std::string file;  // its samples as a gnuplot string
+  std::string file;  // its samples as a gnuplot data block ("" when there is no second design)
   std::optional<Linkage> linkage;
   std::vector<CounterweightPart> parts;
-  Csv ts;
+  Csv ts;  // decimated
 };
 
-// one line of the original over t, and the second design's (dashed) when there is one
-std::string with_second(const std::string& file, const Second& second, const std::string& name,
-                        const std::string& expr) {
-  std::string plot = file + " skip 1 using 1:" + expr + " with lines lw 2 title " +
+// one line of the original over the run's axis, and the second design's (dashed) when there is
+// one
+std::string with_second(const std::string& file, const std::string& x, const Second& second,
+                        const std::string& name, const std::string& expr) {
+  std::string plot = file + " skip 1 using " + x + ":" + expr + " with lines lw 2 title " +
                      gp_string(second.file.empty() ? name : name + ", original");
   if (!second.file.empty()) {
-    plot += ", " + second.file + " skip 1 using 1:" + expr + " with lines lw 2 dt 2 title " +
-            gp_string(name + ", " + second.design.label);
+    plot += ", " + second.file + " skip 1 using " + x + ":" + expr +
+            " with lines lw 2 dt 2 title " + gp_string(name + ", " + second.design.label);
   }
   return plot;
 }
 
-std::vector<Chart> planar_charts(const Study& study, const fs::path& dir, const Csv& ts,
-                                 const Second& second, std::string& datablocks) {
+// the column of the driven input's angle, for the crank-angle axis (0: none, e.g. a slide input)
+int driven_angle_column(const Linkage& l, const Csv& ts) {
+  if (l.inputs.empty() || l.inputs[0].kind != core::planar::Input::Kind::kAngle) return 0;
+  return gp_column(ts, "theta_" + l.links[static_cast<std::size_t>(l.inputs[0].link)].name);
+}
+
+// a free scene whose drives push with nothing (every effort 0): it has no drive chart
+bool drives_act(const Linkage& l, const Scene& scene) {
+  if (!is_free(scene)) return true;
+  for (const core::planar::Input& in : l.inputs) {
+    const core::planar::TimeFunction& f = in.effort;
+    if (f.kind != core::planar::TimeFunction::Kind::kConstant || f.value != 0) return true;
+  }
+  return false;
+}
+
+std::vector<Chart> planar_charts(const Study& study, const Csv& ts, const Second& second,
+                                 const Json& summary, std::string& datablocks) {
   const Linkage& l = study.planar();
-  const std::string file = gp_string((fs::absolute(dir) / "timeseries.csv").string());
-  const std::string taxis = "\nset xlabel " + gp_string(time_axis(study.scene)) + "\n";
   std::vector<Chart> charts;
   if (ts.rows.empty()) return charts;
+  // the samples as data blocks (at most kChartRows rows each: the page stays small)
+  const std::string file = "$ts";
+  datablocks += datablock("ts", ts);
+  if (!second.file.empty()) datablocks += datablock("ts2", second.ts);
+  const RunAxis axis = run_axis(study.scene, driven_angle_column(l, ts));
+  const std::string x = axis.x;
+  const std::string taxis = "\nset xlabel " + gp_string(axis.label) + "\n";
   std::vector<std::pair<std::string, std::string>> angles, supports, drives, joints;
   for (const core::planar::Link& link : l.links) {
     angles.push_back({"θ " + link.name, std::to_string(gp_column(ts, "theta_" + link.name))});
@@ -284,59 +307,51 @@ std::vector<Chart> planar_charts(const Study& study, const fs::path& dir, const 
   }
   std::string drive_plot;
   for (const auto& [name, expr] : drives) {
-    drive_plot += (drive_plot.empty() ? "" : ", ") + with_second(file, second, name, expr);
+    drive_plot += (drive_plot.empty() ? "" : ", ") + with_second(file, x, second, name, expr);
   }
-  // the second design has the original's columns (the same links, nodes and joints)
-  const std::string fsh = " skip 1 using " + std::to_string(gp_column(ts, "Fshx")) + ":" +
-                          std::to_string(gp_column(ts, "Fshy"));
-  std::string hodograph = file + fsh + " with lines lw 2 title " +
+  // the hodograph, closed by the periodic end when the run is whole revolutions; the second
+  // design has the original's columns (the same links, nodes and joints)
+  const bool closed = periodic_run(study.scene, summary);
+  datablocks += xy_block("hodo", ts, gp_column(ts, "Fshx"), gp_column(ts, "Fshy"), closed);
+  std::string hodograph = "$hodo skip 1 using 1:2 with lines lw 2 title " +
                           gp_string(second.file.empty() ? "shaking force" : "original");
   if (!second.file.empty()) {
-    hodograph += ", " + second.file + fsh + " with linespoints lw 2 pt 7 ps 0.5 pi 10 title " +
+    datablocks += xy_block("hodo2", second.ts, gp_column(second.ts, "Fshx"),
+                           gp_column(second.ts, "Fshy"), closed);
+    hodograph += ", $hodo2 skip 1 using 1:2 with linespoints lw 2 pt 7 ps 0.5 pi 10 title " +
                  gp_string(second.design.label);
   }
   charts.push_back({"angles", "Link angles",
                     "Every link's angle (its first-to-second node direction) over the run.",
                     "set title 'Link angles'" + taxis + "set ylabel 'angle [rad]'\nplot " +
-                        lines_over_t(file, angles)});
+                        lines_over(file, x, angles)});
   charts.push_back({"reactions", "Support reactions",
                     "Magnitudes of the forces of the mechanism on the frame at each ground node "
                     "and frame guide.",
                     "set title 'Support reactions'" + taxis +
                         "set ylabel 'force on the frame [N]'\nplot " +
-                        lines_over_t(file, supports)});
-  charts.push_back(
-      {"hodograph", "Shaking-force hodograph",
-       "The tip of the shaking force over the run, equal axes.",
-       "set title 'Shaking-force hodograph'\nset size ratio -1\nset xlabel 'Fshx [N]'\n"
-       "set ylabel 'Fshy [N]'\nplot " +
-           hodograph,
-       true});
+                        lines_over(file, x, supports)});
+  charts.push_back({"hodograph", "Shaking-force hodograph",
+                    std::string("The tip of the shaking force over the run, equal axes") +
+                        (closed ? ", closed by the periodic end (the first sample again)." : "."),
+                    "set title 'Shaking-force hodograph'\nset size ratio -1\nset xlabel 'Fshx "
+                    "[N]'\nset ylabel 'Fshy [N]'\nplot " +
+                        hodograph,
+                    true});
   charts.push_back(
       {"shaking-moment", "Shaking moment", "Shaking moment on the frame about the origin.",
        "set title 'Shaking moment about the origin'" + taxis + "set ylabel 'Msh [N m]'\nplot " +
-           with_second(file, second, "Msh", std::to_string(gp_column(ts, "Msh")))});
-  charts.push_back({"drive", "Drive efforts",
-                    "The drives' torques [N m] or forces [N] on their inputs, from the frame.",
-                    "set title 'Drive efforts'" + taxis +
-                        "set ylabel 'torque [N m] or force [N]'\nplot " + drive_plot});
+           with_second(file, x, second, "Msh", std::to_string(gp_column(ts, "Msh")))});
+  if (!drives.empty() && drives_act(l, study.scene)) {
+    charts.push_back({"drive", "Drive efforts",
+                      "The drives' torques [N m] or forces [N] on their inputs, from the frame.",
+                      "set title 'Drive efforts'" + taxis +
+                          "set ylabel 'torque [N m] or force [N]'\nplot " + drive_plot});
+  }
   if (!joints.empty()) {
     charts.push_back({"joints", "Joint forces", "Magnitudes of the joint forces on their links.",
                       "set title 'Joint forces'" + taxis + "set ylabel 'joint force [N]'\nplot " +
-                          lines_over_t(file, joints)});
-  }
-  charts.push_back(linkage_chart(l, ts, datablocks));
-  if (second.linkage && !second.ts.rows.empty()) {
-    Chart c = linkage_chart(*second.linkage, second.ts, datablocks,
-                            second.design.label + " linkage", "b", second.parts);
-    c.id = "linkage-" + second.design.key;
-    c.heading = "The " + second.design.label + " linkage";
-    c.caption =
-        "The " + second.design.label + " design drawn as the original above, from " +
-        second.design.file +
-        ", with each counterweight as a filled circle on an arm from its link's pivot, in its "
-        "sample's colour; the links' masses include them.";
-    charts.push_back(c);
+                          lines_over(file, x, joints)});
   }
   return charts;
 }
@@ -352,10 +367,14 @@ std::string planar_linkage_tables(const Linkage& l) {
   h += "</table><table><tr><th>link</th><th>nodes</th><th>mass m [kg]</th><th>e [m]</th>"
        "<th>f [m]</th><th>inertia I [kg m&sup2;]</th></tr>";
   for (const core::planar::Link& k : l.links) {
+    // e, f: round-off of the link's length (its first two nodes, as drawn) shows as 0
+    const double length = (l.nodes[static_cast<std::size_t>(k.nodes[1])].position -
+                           l.nodes[static_cast<std::size_t>(k.nodes[0])].position)
+                              .norm();
     h += "<tr><th>" + esc(k.name) + "</th><td>" + esc(nodes_of(l, k.nodes)) +
-         "</td><td class=\"n\">" + fmt(k.mass) + "</td><td class=\"n\">" + fmt(k.e) +
-         "</td><td class=\"n\">" + fmt(k.f) + "</td><td class=\"n\">" + fmt(k.inertia) +
-         "</td></tr>";
+         "</td><td class=\"n\">" + fmt(k.mass) + "</td><td class=\"n\">" + fmt_scaled(k.e, length) +
+         "</td><td class=\"n\">" + fmt_scaled(k.f, length) + "</td><td class=\"n\">" +
+         fmt(k.inertia) + "</td></tr>";
   }
   h += "</table>";
   if (!l.point_masses.empty()) {
@@ -417,12 +436,13 @@ std::string planar_linkage_tables(const Linkage& l) {
 
 std::string planar_report_html(const Study& study, const fs::path& dir, const std::string& gnuplot,
                                const Json& summary) {
-  const Csv ts = read_csv(dir / "timeseries.csv");
+  std::size_t samples = 0;
+  const Csv ts = read_csv_decimated(dir / "timeseries.csv", kChartRows, &samples);
   Second second;
   second.design = second_design(summary, dir);
   if (second.design.present()) {
-    second.file = gp_string((fs::absolute(dir) / second.design.file).string());
-    second.ts = read_csv(dir / second.design.file);
+    second.file = "$ts2";
+    second.ts = read_csv_decimated(dir / second.design.file, kChartRows, nullptr);
     second.parts = counterweight_parts(study.planar(), summary);
     try {
       second.linkage = load_study((dir / (second.design.key + ".yaml")).string()).planar();
@@ -435,16 +455,27 @@ std::string planar_report_html(const Study& study, const fs::path& dir, const st
   h += "<h2>Linkage</h2>\n" + planar_linkage_tables(study.planar());
   h +=
       metrics_section(summary, second.design,
-                      "Fsh, Msh: shaking force [N] and moment about the origin [N m] on the frame; "
-                      "tau: drive torques [N m] or forces [N]; R&lt;name&gt;: forces on the frame "
-                      "at a ground node or guide [N]; F&lt;joint&gt;: joint forces on their links "
-                      "[N]. RMS over the samples, max of magnitudes.");
+                      "Fsh, Msh: shaking force and moment about the origin on the frame; tau: "
+                      "drive torques (a slide input's: a force in N); R&lt;name&gt;: forces on the "
+                      "frame at a ground node or guide; F&lt;joint&gt;: joint forces on their "
+                      "links. RMS over the samples, max of magnitudes.");
   h += comparison_section(dir, second.design);
   h += harmonics_section(dir);
+  std::vector<AnimationFigure> animations;
+  const std::vector<CounterweightPart> own =
+      study.parts ? study.parts->counterweights : std::vector<CounterweightPart>{};
+  animations.push_back(
+      planar_animation(study.planar(), ts, study.scene, own, "animation-original", "original"));
+  if (second.linkage && !second.ts.rows.empty()) {
+    animations.push_back(planar_animation(*second.linkage, second.ts, study.scene, second.parts,
+                                          "animation-" + second.design.key, second.design.label));
+  }
+  h += animations_section(animations);
   std::string datablocks;
-  std::vector<Chart> charts = planar_charts(study, dir, ts, second, datablocks);
-  for (Chart& chart : pareto_charts(dir)) charts.push_back(std::move(chart));
-  h += charts_section(gnuplot, datablocks, charts);
+  std::vector<Chart> charts = planar_charts(study, ts, second, summary, datablocks);
+  for (Chart& chart : harmonic_charts(dir, datablocks)) charts.push_back(std::move(chart));
+  for (Chart& chart : pareto_charts(dir, datablocks)) charts.push_back(std::move(chart));
+  h += charts_section(gnuplot, datablocks, charts, samples, ts.rows.size());
   h += second_design_section(summary, second.design);
   h += pareto_section(dir);
   // the measurements of `balance-design bench` when the folder has them (work_precision.hpp)

@@ -3,6 +3,8 @@
 #include <stdlib.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -57,6 +59,46 @@ Csv read_csv(const fs::path& p) {
   return csv;
 }
 
+Csv read_csv_decimated(const fs::path& p, std::size_t max_rows, std::size_t* total) {
+  // first the rows are counted, then every step-th is kept, and the last
+  std::size_t rows = 0;
+  {
+    std::ifstream in(p, std::ios::binary);
+    if (!in) throw std::runtime_error("cannot read " + p.string());
+    std::string line;
+    std::getline(in, line);  // the header
+    while (std::getline(in, line))
+      if (!line.empty()) ++rows;
+  }
+  if (total) *total = rows;
+  // rows 0, step, 2 step, ... and the last: at most max_rows
+  const std::size_t step =
+      max_rows > 2 && rows > max_rows ? (rows - 1 + max_rows - 3) / (max_rows - 2) : 1;
+  std::ifstream in(p, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + p.string());
+  Csv csv;
+  std::string line;
+  if (std::getline(in, line)) csv.header = csv_fields(line);
+  std::size_t i = 0;
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    if (i % step == 0 || i + 1 == rows) csv.rows.push_back(csv_fields(line));
+    ++i;
+  }
+  return csv;
+}
+
+std::string datablock(const std::string& name, const Csv& csv) {
+  std::string b = "$" + name + " << EOD\n";
+  for (std::size_t k = 0; k < csv.header.size(); ++k) b += (k ? "," : "") + csv.header[k];
+  b += "\n";
+  for (const auto& row : csv.rows) {
+    for (std::size_t k = 0; k < row.size(); ++k) b += (k ? "," : "") + row[k];
+    b += "\n";
+  }
+  return b + "EOD\n";
+}
+
 // the numbers of a timeseries.csv row (columns as kTimeseriesHeader)
 std::vector<double> numbers(const std::vector<std::string>& row) {
   std::vector<double> x;
@@ -100,25 +142,93 @@ std::string fmt(double v, const char* f) {
 
 std::string xy(const Vec2& v) { return fmt(v.x(), "%.10g") + "," + fmt(v.y(), "%.10g"); }
 
+std::string fmt_scaled(double v, double scale) {
+  if (std::isfinite(v) && std::isfinite(scale) && scale > 0 && std::abs(v) <= 1e-12 * scale) {
+    return "0";
+  }
+  return fmt(v);
+}
+
 std::string vec_text(const Vec2& v) {
-  return "(" + fmt(v.x(), "%.4g") + ", " + fmt(v.y(), "%.4g") + ")";
+  const double scale = std::max(std::abs(v.x()), std::abs(v.y()));
+  auto part = [&](double x) {
+    return std::abs(x) <= 1e-12 * scale && x != 0 ? std::string("0") : fmt(x, "%.4g");
+  };
+  return "(" + part(v.x()) + ", " + part(v.y()) + ")";
+}
+
+namespace {
+
+bool starts(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
+
+}  // namespace
+
+std::string unit_of(const std::string& name) {
+  static const std::pair<const char*, const char*> exact[] = {{"mass", "kg"},
+                                                              {"added_mass", "kg"},
+                                                              {"distance", "m"},
+                                                              {"radius", "m"},
+                                                              {"thickness", "m"},
+                                                              {"position", "m"},
+                                                              {"at", "m"},
+                                                              {"inertia", "kg m²"},
+                                                              {"added_inertia", "kg m²"},
+                                                              {"theta1", "rad"},
+                                                              {"omega1", "rad/s"},
+                                                              {"duration", "s"},
+                                                              {"density", "kg/m³"},
+                                                              {"eccentricity", "m"},
+                                                              {"speeds", "rad/s or m/s"},
+                                                              {"rates", "rad/s or m/s"},
+                                                              {"start", "rad or m"},
+                                                              {"mass_max", "kg"},
+                                                              {"distance_max", "m"},
+                                                              {"J", "kg m²"},
+                                                              {"Fsh_rms_before", "N"},
+                                                              {"Fsh_rms_after", "N"},
+                                                              {"t", "s"},
+                                                              {"tau", "N m"}};
+  for (const auto& [n, u] : exact)
+    if (name == n) return u;
+  if (starts(name, "Fsh")) return "N";
+  if (starts(name, "Msh")) return "N m";
+  if (starts(name, "tau")) return "N m";
+  // reactions and joint forces: R<joint>..., F<joint>...
+  if (name.size() > 1 && (name[0] == 'R' || name[0] == 'F') &&
+      (std::isupper(static_cast<unsigned char>(name[1])) ||
+       std::isdigit(static_cast<unsigned char>(name[1]))))
+    return "N";
+  return "";
+}
+
+std::string with_unit(const std::string& name) {
+  const std::string u = unit_of(name);
+  return u.empty() ? name : name + " [" + u + "]";
 }
 
 // a number as written in a data file: shown to 6 significant digits, the exact text on hover
-std::string num_cell(const std::string& written) {
+std::string num_cell(const std::string& written, double scale) {
   if (written.empty()) return "<td class=\"n\">&ndash;</td>";
   char* end = nullptr;
   const double v = std::strtod(written.c_str(), &end);
   if (end == written.c_str() || *end != '\0') return "<td>" + esc(written) + "</td>";
-  return "<td class=\"n\" title=\"" + esc(written) + "\">" + esc(fmt(v)) + "</td>";
+  return "<td class=\"n\" title=\"" + esc(written) + "\">" + esc(fmt_scaled(v, scale)) + "</td>";
 }
 
 // an object as a two-column table, an array of objects as a table with a column per key
 std::string json_table(const Json& v) {
   std::string h = "<table>";
+  // a point mass has no radius or thickness: 0 there means "not a disc"
+  auto left_out = [](const std::string& k, const Json& x) {
+    return (k == "radius" || k == "thickness") && x.is_number() && x.get<double>() == 0;
+  };
   if (v.is_object()) {
     for (const auto& [k, x] : v.items()) {
-      h += "<tr><th>" + esc(k) + "</th>" + json_cell(x) + "</tr>";
+      if (left_out(k, x)) continue;
+      // the momentum left relative to the original's: round-off of 1 shows as 0
+      const std::string cell =
+          k == "momentum_left" && x.is_number() ? num_cell(text(x), 1.0) : json_cell(x);
+      h += "<tr><th>" + esc(with_unit(k)) + "</th>" + cell + "</tr>";
     }
   } else {
     std::vector<std::string> keys;
@@ -126,17 +236,34 @@ std::string json_table(const Json& v) {
       for (const auto& [k, x] : item.items()) {
         bool seen = false;
         for (const std::string& s : keys) seen = seen || s == k;
-        if (!seen) keys.push_back(k);
+        if (!seen && !left_out(k, x)) keys.push_back(k);
       }
     }
+    // a column every row leaves out goes; one some rows have keeps them all
+    std::vector<std::string> shown;
+    for (const std::string& k : keys) {
+      bool any = false;
+      for (const Json& item : v) {
+        const Json* x = member(item, k);
+        any = any || (x && !left_out(k, *x));
+      }
+      if (any) shown.push_back(k);
+    }
+    keys = shown;
     h += "<tr>";
-    for (const std::string& k : keys) h += "<th>" + esc(k) + "</th>";
+    for (const std::string& k : keys) h += "<th>" + esc(with_unit(k)) + "</th>";
     h += "</tr>";
     for (const Json& item : v) {
       h += "<tr>";
+      // a residual beside its scale (a balance condition): round-off of the scale shows as 0
+      const Json* scale = member(item, "scale");
       for (const std::string& k : keys) {
         const Json* x = member(item, k);
-        h += x ? json_cell(*x) : "<td></td>";
+        if (x && k == "residual" && x->is_number() && scale && scale->is_number()) {
+          h += num_cell(text(*x), std::abs(scale->get<double>()));
+        } else {
+          h += x ? json_cell(*x) : "<td></td>";
+        }
       }
       h += "</tr>";
     }
@@ -153,10 +280,15 @@ std::string json_cell(const Json& v) {
   bool objects = true;
   for (const Json& x : v) objects = objects && x.is_object();
   if (objects) return "<td>" + json_table(v) + "</td>";
+  // a list of numbers: round-off of its largest shows as 0
+  double scale = 0;
+  for (const Json& x : v)
+    if (x.is_number()) scale = std::max(scale, std::abs(x.get<double>()));
   std::string s;
   for (const Json& x : v) {
     if (x.is_structured()) continue;
-    s += (s.empty() ? "" : ", ") + esc(x.is_number() ? fmt(x.get<double>()) : text(x));
+    s +=
+        (s.empty() ? "" : ", ") + esc(x.is_number() ? fmt_scaled(x.get<double>(), scale) : text(x));
   }
   return "<td>" + s + "</td>";
 }

@@ -31,22 +31,44 @@ struct Csv {
 };
 /// @throws std::runtime_error if the file cannot be read (read_file(), studies/run/files.hpp).
 Csv read_csv(const std::filesystem::path& p);
+/// At most `max_rows` rows of a CSV file for the charts: the first, the last and rows evenly
+/// spaced between, read line by line so that a run of 10^7 samples never sits in memory whole;
+/// `total` (when given) gets the file's row count.
+/// @throws std::runtime_error if the file cannot be read.
+Csv read_csv_decimated(const std::filesystem::path& p, std::size_t max_rows, std::size_t* total);
+/// The rows a chart draws of a run's samples (the page stays a few MB at most).
+inline constexpr std::size_t kChartRows = 2000;
+/// A CSV as a gnuplot data block `$name` (header line first, as the file has it).
+std::string datablock(const std::string& name, const Csv& csv);
+
 /// The numbers of a CSV row (an empty field is NaN).
 std::vector<double> numbers(const std::vector<std::string>& row);
 
 /// A point as gnuplot data, "x,y" (10 digits).
 std::string xy(const Vec2& v);
-/// A point for a table, "(x, y)" (4 digits).
+/// A point for a table, "(x, y)" (4 digits; a component below 1e-12 of the larger shown as 0).
 std::string vec_text(const Vec2& v);
+/// A number for a page: 6 significant digits, or "0" where it is round-off of the quantity's
+/// `scale` (|v| <= 1e-12 scale: 6.123e-17 for a centre of mass on a link of 0.5 m). A display
+/// rule only: data files keep every digit.
+std::string fmt_scaled(double v, double scale);
+/// The unit a value of this name has on the page ("N", "N m", "kg", ...), "" when none is known:
+/// metric names (Fsh_rms, Msh_total_max, RA0_max, tau_rms, added_mass), summary.json keys (mass,
+/// position, theta1, omega1, ...).
+std::string unit_of(const std::string& name);
+/// `name` with its unit in brackets when it has one ("mass [kg]").
+std::string with_unit(const std::string& name);
 
 /// `text` with & < > " escaped for HTML.
 std::string esc(const std::string& text);
 /// `v` formatted by printf format `f`.
 std::string fmt(double v, const char* f = "%.6g");
 /// A number as written in a data file as a table cell: 6 significant digits, the exact text on
-/// hover; a non-number as escaped text; an empty field as a dash.
-std::string num_cell(const std::string& written);
-/// An object as a two-column table, an array of objects as a table with a column per key.
+/// hover; a non-number as escaped text; an empty field as a dash. With a `scale`, round-off of
+/// it shows as 0 (fmt_scaled()).
+std::string num_cell(const std::string& written, double scale = 0);
+/// An object as a two-column table, an array of objects as a table with a column per key; keys
+/// with their units (with_unit()), a point mass's radius and thickness of 0 left out.
 std::string json_table(const Json& v);
 /// A JSON value as a table cell.
 std::string json_cell(const Json& v);

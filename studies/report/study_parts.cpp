@@ -1,9 +1,12 @@
 #include "studies/report/study_parts.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <iterator>
 #include <variant>
 
+#include "core/number_text.hpp"
 #include "studies/run/runner.hpp"
 
 namespace bd::studies::report_support {
@@ -68,6 +71,16 @@ std::string simulation_section(const Json& summary) {
     h += "<h3>Scene</h3>" + json_table(*scene);
     h += "<p>Integrator relative tolerance " + esc(text(summary, "tolerance")) + ".</p>\n";
   }
+  // the units: SI on the page; what the study file gave in units of its own
+  h += "<p>Units on this page and in the data files: SI (m, kg, s, rad, N, N m). ";
+  const Json* units = member(summary, "units_read");
+  if (units && units->is_array() && !units->empty()) {
+    h += "The study file gave these values in units of their own, converted on reading:</p><ul>";
+    for (const Json& u : *units) h += "<li>" + esc(text(u)) + "</li>";
+    h += "</ul>\n";
+  } else {
+    h += "The study file gave every value as a plain number, read as SI.</p>\n";
+  }
   return h;
 }
 
@@ -78,17 +91,21 @@ std::string metrics_section(const Json& summary, const SecondDesign& second,
   const Json* second_metrics =
       second.present() ? member(summary, second.key + "_metrics") : nullptr;
   const Json* reduction = member(summary, "reduction");
-  if (second_metrics) h += "<th>" + esc(second.label) + "</th><th>ratio</th>";
-  h += "</tr>";
+  if (second_metrics) h += "<th>" + esc(second.label) + "</th><th>ratio after/before</th>";
+  h += "<th>unit</th></tr>";
+  auto value = [](const Json* v) { return v && v->is_number() ? std::abs(v->get<double>()) : 0.0; };
   if (metrics) {
     for (const auto& [k, v] : metrics->items()) {
-      h += "<tr><th>" + esc(k) + "</th>" + json_cell(v);
+      const Json* s = second_metrics ? member(*second_metrics, k) : nullptr;
+      // round-off of the larger of the two designs' values shows as 0
+      const double scale = std::max(value(&v), value(s));
+      h += "<tr><th>" + esc(k) + "</th>" + num_cell(text(v), scale);
       if (second_metrics) {
-        const Json* s = member(*second_metrics, k);
         const Json* r = reduction ? member(*reduction, k) : nullptr;
-        h += (s ? json_cell(*s) : "<td></td>") + (r ? json_cell(*r) : "<td></td>");
+        h += (s ? num_cell(text(*s), scale) : "<td></td>") +
+             (r ? num_cell(text(*r), 1.0) : "<td></td>");
       }
-      h += "</tr>";
+      h += "<td>" + esc(unit_of(k)) + "</td></tr>";
     }
   }
   return h + "</table>\n<p>" + notes + "</p>\n";
@@ -96,10 +113,22 @@ std::string metrics_section(const Json& summary, const SecondDesign& second,
 
 std::string comparison_section(const fs::path& dir, const SecondDesign& second) {
   if (!second.present() || !fs::exists(dir / "comparison.csv")) return "";
-  return "<h2>Comparison</h2>\n<p>From <a href=\"comparison.csv\">comparison.csv</a>: the original "
-         "(before) and the " +
-         second.label + " design (after), ratio after/before.</p>" +
-         csv_table(read_csv(dir / "comparison.csv"));
+  const Csv csv = read_csv(dir / "comparison.csv");
+  std::string h =
+      "<h2>Comparison</h2>\n<p>From <a href=\"comparison.csv\">comparison.csv</a>: the "
+      "original (before) and the " +
+      second.label +
+      " design (after), ratio after/before.</p><table><tr><th>metric</th>"
+      "<th>before</th><th>after</th><th>ratio after/before</th><th>unit</th></tr>";
+  for (const auto& row : csv.rows) {
+    if (row.size() < 4) continue;
+    // before and after: round-off of the larger shows as 0
+    const double scale = std::max(std::abs(std::strtod(row[1].c_str(), nullptr)),
+                                  std::abs(std::strtod(row[2].c_str(), nullptr)));
+    h += "<tr><th>" + esc(row[0]) + "</th>" + num_cell(row[1], scale) + num_cell(row[2], scale) +
+         num_cell(row[3], 1.0) + "<td>" + esc(unit_of(row[0])) + "</td></tr>";
+  }
+  return h + "</table>\n";
 }
 
 std::string harmonics_section(const fs::path& dir) {
@@ -120,21 +149,35 @@ std::string harmonics_section(const fs::path& dir) {
       "transform of the exact samples; order k repeats k times per revolution. Amplitudes of Fshx, "
       "Fshy [N] and Msh [N m]; the force's parts turning with the input (forward: a counterweight "
       "on the input's link cancels order 1) and against it (backward) [N]. Phases are in the "
-      "file.</p><table><tr><th>design</th><th>order</th><th>Fshx</th><th>Fshy</th>"
-      "<th>forward</th><th>backward</th><th>Msh</th></tr>";
+      "file.</p><table><tr><th>design</th><th>order</th><th>Fshx [N]</th><th>Fshy [N]</th>"
+      "<th>forward [N]</th><th>backward [N]</th><th>Msh [N m]</th></tr>";
+  // each column's largest amplitude over every design and order: round-off of it shows as 0
+  std::vector<double> scale(at.size(), 0.0);
+  for (const std::vector<std::string>& row : csv.rows) {
+    if (row.size() < csv.header.size()) continue;
+    for (std::size_t k = 2; k < at.size(); ++k)
+      scale[k] = std::max(scale[k], std::abs(std::strtod(row[at[k]].c_str(), nullptr)));
+  }
   for (const std::vector<std::string>& row : csv.rows) {
     if (row.size() < csv.header.size() || row[at[1]] == "0") continue;  // the mean: in the file
     h += "<tr><td>" + esc(row[at[0]]) + "</td><td class=\"n\">" + esc(row[at[1]]) + "</td>";
-    for (std::size_t k = 2; k < at.size(); ++k)
-      h += "<td class=\"n\">" + num_cell(row[at[k]]) + "</td>";
+    for (std::size_t k = 2; k < at.size(); ++k) h += num_cell(row[at[k]], scale[k]);
     h += "</tr>";
   }
   return h + "</table>\n";
 }
 
 std::string charts_section(const std::string& gnuplot, const std::string& datablocks,
-                           const std::vector<Chart>& charts) {
+                           const std::vector<Chart>& charts, std::size_t samples,
+                           std::size_t drawn) {
   std::string h = "<h2>Charts</h2>\n";
+  if (samples > drawn && drawn > 0) {
+    h += "<p>The run has " + std::to_string(samples) + " samples; the charts over the run draw " +
+         std::to_string(drawn) +
+         " of them, evenly spread, the first and the last included, so that this page stays "
+         "small. The data files below hold every sample, and the metrics are computed from all "
+         "of them.</p>\n";
+  }
   if (gnuplot.empty()) {
     return h +
            "<p class=\"notice\">The charts need gnuplot, which was not found on this machine "
@@ -157,23 +200,203 @@ std::vector<std::string> data_files() {
   return names;
 }
 
-std::vector<Chart> pareto_charts(const fs::path& dir) {
+namespace {
+
+bool finite_number(const std::string& field, double& v) {
+  if (field.empty()) return false;
+  char* end = nullptr;
+  v = std::strtod(field.c_str(), &end);
+  return *end == '\0' && std::isfinite(v);
+}
+
+// the front's rows with a design: both metrics numbers
+std::size_t designs_on_front(const Csv& pareto) {
+  std::size_t n = 0;
+  double x = 0, y = 0;
+  for (const auto& row : pareto.rows)
+    n += row.size() > 2 && finite_number(row[1], x) && finite_number(row[2], y);
+  return n;
+}
+
+// before (the original) and after (the chosen optimum) of a metric in comparison.csv
+bool compared(const Csv& comparison, const std::string& metric, double& before, double& after) {
+  for (const auto& row : comparison.rows) {
+    if (row.size() >= 3 && row[0] == metric)
+      return finite_number(row[1], before) && finite_number(row[2], after);
+  }
+  return false;
+}
+
+}  // namespace
+
+std::vector<Chart> pareto_charts(const fs::path& dir, std::string& datablocks) {
   if (!fs::exists(dir / "pareto.csv")) return {};
   const Csv pareto = read_csv(dir / "pareto.csv");
   if (pareto.header.size() < 3) return {};
-  return {{"pareto", "Pareto front",
-           "Each point a design found by the epsilon-constraint method (pareto.csv); points "
-           "without a design are left out.",
-           "set title 'Pareto front'\nset xlabel " + gp_string(pareto.header[1]) + "\nset ylabel " +
-               gp_string(pareto.header[2]) + "\nplot " +
-               gp_string((fs::absolute(dir) / "pareto.csv").string()) +
-               " skip 1 using 2:3 with linespoints lw 2 pt 7 title 'front'"}};
+  const std::string& first = pareto.header[1];
+  const std::string& second = pareto.header[2];
+  const std::size_t found = designs_on_front(pareto);
+  // the original and the chosen optimum, from comparison.csv
+  Csv comparison;
+  if (fs::exists(dir / "comparison.csv")) comparison = read_csv(dir / "comparison.csv");
+  double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+  const bool marks = compared(comparison, first, x0, x1) && compared(comparison, second, y0, y1);
+  if (found == 0 && !marks) return {};  // nothing to draw: the section says why
+  std::string plot;
+  if (found > 0) {
+    datablocks += "$pareto << EOD\n";
+    double x = 0, y = 0;
+    for (const auto& row : pareto.rows) {
+      if (row.size() > 2 && finite_number(row[1], x) && finite_number(row[2], y))
+        datablocks += row[1] + "," + row[2] + "\n";
+    }
+    datablocks += "EOD\n";
+    plot += "$pareto using 1:2 with linespoints lw 2 pt 7 title 'front'";
+  }
+  if (marks) {
+    datablocks += "$pareto_marks << EOD\n" + text::exact(x0) + "," + text::exact(y0) + "\n" +
+                  text::exact(x1) + "," + text::exact(y1) + "\nEOD\n";
+    plot += std::string(plot.empty() ? "" : ", ") +
+            "$pareto_marks every ::0::0 using 1:2 with points pt 5 ps 1.8 lc 'black' title "
+            "'original design', $pareto_marks every ::1::1 using 1:2 with points pt 12 ps 2.4 "
+            "lw 2 lc 'red' title 'chosen optimum'";
+  }
+  const std::size_t dropped = pareto.rows.size() - found;
+  std::string caption = "Each point a design found by the epsilon-constraint method (pareto.csv)";
+  caption += marks ? "; the original design and the optimum the study chose (comparison.csv) "
+                     "marked."
+                   : ".";
+  if (dropped > 0) {
+    caption += " " + std::to_string(dropped) + " of the " + std::to_string(pareto.rows.size()) +
+               " points found no design (their rows in pareto.csv say why) and are not drawn.";
+  }
+  return {{"pareto", "Pareto front", caption,
+           "set title 'Pareto front'\nset xlabel " + gp_string(with_unit(first)) + "\nset ylabel " +
+               gp_string(with_unit(second)) + "\nplot " + plot}};
+}
+
+std::vector<Chart> harmonic_charts(const fs::path& dir, std::string& datablocks) {
+  if (!fs::exists(dir / "harmonics.csv")) return {};
+  const Csv csv = read_csv(dir / "harmonics.csv");
+  const char* columns[] = {"design",       "order",         "Fsh_forward",
+                           "Fsh_backward", "Msh_amplitude", "tau_amplitude"};
+  std::vector<std::size_t> at;
+  for (const char* c : columns) {
+    const auto it = std::find(csv.header.begin(), csv.header.end(), c);
+    if (it == csv.header.end()) return {};
+    at.push_back(static_cast<std::size_t>(it - csv.header.begin()));
+  }
+  std::vector<std::string> designs;
+  for (const auto& row : csv.rows) {
+    if (row.size() < csv.header.size()) continue;
+    if (std::find(designs.begin(), designs.end(), row[at[0]]) == designs.end())
+      designs.push_back(row[at[0]]);
+  }
+  // each quantity's largest amplitude over every design and order: a bar of round-off of it
+  // (a balanced design's shaking force) is drawn as 0, not as a chart of noise
+  double scale[6] = {0, 0, 0, 0, 0, 0};
+  for (const auto& row : csv.rows) {
+    if (row.size() < csv.header.size() || row[at[1]] == "0") continue;
+    for (std::size_t k = 2; k < 6; ++k)
+      scale[k] = std::max(scale[k], std::abs(std::strtod(row[at[k]].c_str(), nullptr)));
+  }
+  // Fsh forward and backward share one axis, as Msh and tau do
+  scale[2] = scale[3] = std::max(scale[2], scale[3]);
+  std::vector<Chart> charts;
+  for (const std::string& d : designs) {
+    // orders 1..N of this design, the numbers as harmonics.csv has them (round-off: 0)
+    const std::string block = "harmonics_" + d;
+    datablocks += "$" + block + " << EOD\norder,Fsh_forward,Fsh_backward,Msh,tau\n";
+    for (const auto& row : csv.rows) {
+      if (row.size() < csv.header.size() || row[at[0]] != d || row[at[1]] == "0") continue;
+      datablocks += row[at[1]];
+      for (std::size_t k = 2; k < 6; ++k) {
+        const double v = std::strtod(row[at[k]].c_str(), nullptr);
+        datablocks += "," + (std::abs(v) <= 1e-12 * scale[k] ? std::string("0") : row[at[k]]);
+      }
+      datablocks += "\n";
+    }
+    datablocks += "EOD\n";
+    const std::string b = "$" + block;
+    charts.push_back(
+        {"harmonics-" + d, "Harmonic orders, " + d + " design",
+         "Amplitudes of orders 1..N over a revolution of the driven input (harmonics.csv, " + d +
+             " design): left, the shaking force's parts turning with the input (forward) and "
+             "against it (backward) [N]; right, the shaking moment and the drive torque [N m]. "
+             "An amplitude below 1e-12 of the largest of its kind on this page is round-off and "
+             "drawn as 0.",
+         "set multiplot layout 1,2 title " + gp_string("Harmonic orders, " + d + " design") +
+             "\nset style data histogram\nset style histogram clustered gap 1\n"
+             "set style fill solid 0.85 border -1\nset boxwidth 0.9\nset yrange [0:*]\n"
+             "set key inside top right\nset xlabel 'order'\n"
+             "set ylabel 'amplitude [N]'\nplot " +
+             b +
+             " skip 1 using 2:xtic(1) title 'Fsh forward', '' skip 1 using 3 title "
+             "'Fsh backward'\nset ylabel 'amplitude [N m]'\nplot " +
+             b +
+             " skip 1 using 4:xtic(1) title 'Msh', '' skip 1 using 5 title 'τ'\n"
+             "unset multiplot"});
+  }
+  return charts;
+}
+
+bool periodic_run(const Scene& scene, const Json& summary) {
+  if (text(summary, "ok") != "true") return false;
+  if (std::holds_alternative<core::DrivenScene>(scene)) return true;
+  if (const auto* d = std::get_if<core::planar::DrivenScene>(&scene)) {
+    return d->duration == 0 && d->revolutions >= 1 && d->speeds.size() == 1;
+  }
+  return false;
+}
+
+RunAxis run_axis(const Scene& scene, int angle_column) {
+  if (!is_free(scene) && angle_column > 0) {
+    return {"($" + std::to_string(angle_column) + "*180/pi)", "crank angle [deg]"};
+  }
+  return {"1", time_axis(scene)};
+}
+
+std::string xy_block(const std::string& name, const Csv& csv, int cx, int cy, bool close) {
+  std::string b = "$" + name + " << EOD\nx,y\n";
+  const auto x = static_cast<std::size_t>(cx - 1), y = static_cast<std::size_t>(cy - 1);
+  std::string first;
+  for (const auto& row : csv.rows) {
+    if (row.size() <= std::max(x, y)) continue;
+    const std::string line = row[x] + "," + row[y] + "\n";
+    if (first.empty()) first = line;
+    b += line;
+  }
+  if (close) b += first;
+  return b + "EOD\n";
+}
+
+std::string animations_section(const std::vector<AnimationFigure>& figures) {
+  std::string h;
+  for (const AnimationFigure& f : figures) {
+    if (f.animation.shapes.empty()) continue;
+    if (h.empty()) h = "<h2>The linkage in motion</h2>\n";
+    h += "<h3>" + esc(f.heading) + "</h3>\n<figure class=\"animation\" id=\"figure-" +
+         esc(f.animation.id) + "\">\n" + animation_svg(f.animation) + "\n<figcaption>" +
+         esc(f.caption) + "</figcaption>\n</figure>\n";
+  }
+  return h;
 }
 
 std::string pareto_section(const fs::path& dir) {
   if (!fs::exists(dir / "pareto.csv")) return "";
-  return "<h2>Pareto front</h2>\n<p>From <a href=\"pareto.csv\">pareto.csv</a>.</p>" +
-         csv_table(read_csv(dir / "pareto.csv"));
+  const Csv pareto = read_csv(dir / "pareto.csv");
+  const std::size_t found = designs_on_front(pareto);
+  std::string h = "<h2>Pareto front</h2>\n<p>From <a href=\"pareto.csv\">pareto.csv</a>";
+  if (pareto.header.size() >= 3) {
+    h += ": " + esc(with_unit(pareto.header[1])) + " against " + esc(with_unit(pareto.header[2]));
+  }
+  h += ". " + std::to_string(found) + " of its " + std::to_string(pareto.rows.size()) +
+       " points found a design" +
+       (found < pareto.rows.size() ? "; a point without one has empty metric and variable cells "
+                                     "and its termination says why"
+                                   : "") +
+       ".</p>";
+  return h + csv_table(pareto);
 }
 
 std::string time_axis(const Scene& scene) {

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "studies/report/animation.hpp"
 #include "studies/report/report_support.hpp"
 #include "studies/study/study.hpp"
 
@@ -36,11 +37,44 @@ std::string harmonics_section(const std::filesystem::path& dir);
 /// notice that no optimum was found).
 std::string second_design_section(const Json& summary, const SecondDesign& second);
 /// "Charts": each chart drawn by gnuplot with its heading and caption, or the notice that the
-/// charts need gnuplot.
+/// charts need gnuplot; when the run's `samples` are more than the charts' `drawn`, a note that
+/// the charts show every so many of them and the data files hold all.
 std::string charts_section(const std::string& gnuplot, const std::string& datablocks,
-                           const std::vector<Chart>& charts);
-/// The Pareto front of pareto.csv, when the folder has it (no chart otherwise).
-std::vector<Chart> pareto_charts(const std::filesystem::path& dir);
+                           const std::vector<Chart>& charts, std::size_t samples = 0,
+                           std::size_t drawn = 0);
+/// The Pareto front of pareto.csv, when the folder has a design on it or an optimum to mark
+/// (no chart otherwise): the front's designs, the original design and the chosen optimum (from
+/// comparison.csv), axes with their units; the points without a design are counted in the
+/// caption. Its data go into `datablocks`.
+std::vector<Chart> pareto_charts(const std::filesystem::path& dir, std::string& datablocks);
+/// A bar chart per design of harmonics.csv (when the folder has it): the amplitudes of orders
+/// 1..N of the shaking force (its parts turning with the input and against it) [N], and of the
+/// shaking moment and the drive torque [N m]. Its data (the file's numbers as written) go into
+/// `datablocks` as $harmonics_<design>.
+std::vector<Chart> harmonic_charts(const std::filesystem::path& dir, std::string& datablocks);
+
+/// True when the run's samples are whole periods of a driven motion (a four-bar's revolutions;
+/// a planar linkage's revolutions of its one input) and it ran to the end: its hodograph closes
+/// with the first sample.
+bool periodic_run(const Scene& scene, const Json& summary);
+/// The x axis of the charts over the run: a gnuplot `using` expression and its label. A driven
+/// scene's is the driven crank's angle in degrees (1-based column `angle_column`, 0: none), a
+/// free scene's the time.
+struct RunAxis {
+  std::string x, label;
+};
+RunAxis run_axis(const Scene& scene, int angle_column);
+/// A data block `$name` (header "x,y") of columns `cx`, `cy` (1-based) of `csv`, and the first
+/// row again at the end when `close`.
+std::string xy_block(const std::string& name, const Csv& csv, int cx, int cy, bool close);
+
+/// A linkage animation with its heading and caption.
+struct AnimationFigure {
+  Animation animation;
+  std::string heading, caption;
+};
+/// "The linkage in motion": each animation (those with shapes) with its heading and caption.
+std::string animations_section(const std::vector<AnimationFigure>& figures);
 /// "Pareto front": pareto.csv as a table, when the folder has it.
 std::string pareto_section(const std::filesystem::path& dir);
 /// The data files a study's folder may hold, in the order the report lists them: the run's

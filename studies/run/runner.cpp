@@ -225,6 +225,103 @@ std::string comparison_csv(const Study& study, const RunResult& result) {
   return text;
 }
 
+namespace {
+
+// a link's mass and inertia properties, the ones a counterweight or a link parameter changes
+const core::Link& link_at(const core::FourBar& m, int k) {
+  return k == 1 ? m.crank : k == 2 ? m.coupler : m.rocker;
+}
+core::Link& link_at(core::FourBar& m, int k) {
+  return k == 1 ? m.crank : k == 2 ? m.coupler : m.rocker;
+}
+const core::planar::Link& link_at(const core::planar::Linkage& l, int k) {
+  return l.links[static_cast<std::size_t>(k)];
+}
+core::planar::Link& link_at(core::planar::Linkage& l, int k) {
+  return l.links[static_cast<std::size_t>(k)];
+}
+std::vector<int> link_indices(const core::FourBar&) { return {1, 2, 3}; }
+std::vector<int> link_indices(const core::planar::Linkage& l) {
+  std::vector<int> k(l.links.size());
+  for (std::size_t i = 0; i < k.size(); ++i) k[i] = static_cast<int>(i);
+  return k;
+}
+template <class L>
+bool same_link(const L& a, const L& b) {
+  return a.mass == b.mass && a.e == b.e && a.f == b.f && a.inertia == b.inertia;
+}
+template <class L>
+double& parameter_of(L& link, optimize::LinkParameterVariable::Parameter p) {
+  using P = optimize::LinkParameterVariable::Parameter;
+  return p == P::kMass ? link.mass : p == P::kE ? link.e : p == P::kF ? link.f : link.inertia;
+}
+
+// The design's counterweights as parts of its links, for its study file: the links each was
+// merged into (`base`: the study's links, with the link parameters an optimiser set) without
+// them, and the study's own parts kept on the links nothing else changed. Empty when there is
+// no part to write, or when the parts would not give back `design`'s links bit for bit (the file
+// then has the merged links, as a study without parts).
+template <class T>
+std::optional<LinkageParts> design_parts(const Study& study, const T& base,
+                                         const std::vector<CounterweightPart>& added,
+                                         const T& design) {
+  const T& study_model = std::get<T>(study.linkage);
+  const T* study_bare = study.parts ? &std::get<T>(study.parts->bare) : nullptr;
+  auto touched = [&](int k) {
+    for (const CounterweightPart& p : added)
+      if (p.link == k) return true;
+    return !same_link(link_at(base, k), link_at(study_model, k));
+  };
+  LinkageParts out{design, {}};
+  T& bare = std::get<T>(out.bare);
+  for (int k : link_indices(study_model)) {
+    if (touched(k)) {
+      link_at(bare, k) = link_at(base, k);
+    } else if (study_bare) {
+      link_at(bare, k) = link_at(*study_bare, k);
+    }
+  }
+  if (study.parts) {
+    for (const CounterweightPart& p : study.parts->counterweights)
+      if (!touched(p.link)) out.counterweights.push_back(p);
+  }
+  out.counterweights.insert(out.counterweights.end(), added.begin(), added.end());
+  if (out.counterweights.empty()) return std::nullopt;
+  const T merged = std::get<T>(with_counterweights(out));
+  for (int k : link_indices(merged)) {
+    if (!same_link(link_at(merged, k), link_at(design, k))) return std::nullopt;
+  }
+  return out;
+}
+
+// the study of a design with its counterweights as parts, when they reproduce it
+Study with_parts(Study design, std::optional<LinkageParts> parts) {
+  design.parts = std::move(parts);
+  return design;
+}
+
+// where the header says a counterweight is
+const char* where_written(const Study& design) {
+  return design.parts ? "linkage.counterweights below" : "merged into the link below";
+}
+
+// a planar design's counterweight in the header comment: 6 digits, a component that is
+// round-off of the position's size (1e-12 of it) written as 0
+std::string counterweight_line(const core::planar::Linkage& l,
+                               const balance::planar::LinkCounterweight& c, const Study& written) {
+  const balance::Counterweight& w = c.counterweight;
+  const double size = w.position.norm();
+  auto shown = [&](double v) { return std::abs(v) <= 1e-12 * size ? 0.0 : v; };
+  return fmt::format(
+      "Link {} carries a counterweight of {:.6g} kg at ({:.6g}, {:.6g}) m from node {} in the "
+      "link's axes ({}).\n",
+      l.links[static_cast<std::size_t>(c.link)].name, w.mass, shown(w.position.x()),
+      shown(w.position.y()), l.nodes[static_cast<std::size_t>(c.pivot)].name,
+      where_written(written));
+}
+
+}  // namespace
+
 std::string balanced_yaml(const Study& study) {
   assert(study.balance.has_value());
   const balance::BalancedDesign& b = *study.balance;
@@ -235,6 +332,12 @@ std::string balanced_yaml(const Study& study) {
   header += study.source.empty() ? std::string(".\n") : " in\n  " + study.source + "\n";
   const std::optional<balance::Counterweight>* cws[] = {&b.crank_counterweight,
                                                         &b.rocker_counterweight};
+  std::vector<CounterweightPart> added;
+  for (int i = 0; i < 2; ++i) {
+    if (cws[i]->has_value()) added.push_back({i == 0 ? 1 : 3, -1, **cws[i]});
+  }
+  const Study design =
+      with_parts(balanced_study(study), design_parts(study, study.fourbar(), added, b.model));
   const char* sides[] = {"crank", "rocker"};
   const char* pivots[] = {"A0", "A3"};
   for (int i = 0; i < 2; ++i) {
@@ -242,9 +345,8 @@ std::string balanced_yaml(const Study& study) {
     const balance::Counterweight& c = **cws[i];
     char line[256];
     std::snprintf(line, sizeof line,
-                  "The %s carries a counterweight of %.6g kg at %.6g m from %s (merged into the "
-                  "link below).\n",
-                  sides[i], c.mass, c.distance, pivots[i]);
+                  "The %s carries a counterweight of %.6g kg at %.6g m from %s (%s).\n",
+                  sides[i], c.mass, c.distance, pivots[i], where_written(design));
     header += line;
   }
   if (b.request.moment) {
@@ -253,14 +355,18 @@ std::string balanced_yaml(const Study& study) {
         "(linkage.counter_rotations).\n";
   }
   header +=
-      "Links are in the polar form {s, sigma} with every digit (%.17g; e, f as comments).\n"
+      "Every number is written exactly (links by e, f; s, sigma as comments).\n"
       "Run it with\n  balance-design balanced.yaml";
-  return study_yaml(balanced_study(study), header);
+  return study_yaml(design, header);
 }
 
 std::string balanced_yaml(const Study& study, const balance::planar::ForceBalance& design) {
   const core::planar::Linkage& l = study.planar();
-  std::string header = "The balanced design of study '" + study.name + "', synthesised by\n";
+  std::vector<CounterweightPart> added;
+  for (const balance::planar::LinkCounterweight& c : design.added)
+    added.push_back({c.link, c.pivot, c.counterweight});
+  const Study written = with_parts(planar_balanced_study(study, design.linkage),
+                                   design_parts(study, l, added, design.linkage));  std::string header = "The balanced design of study '" + study.name + "', synthesised by\n";
   header += design.balancing_factor
                 ? fmt::format("balance-design from its balance section (balancing factor {:g})",
                               *design.balancing_factor)
@@ -269,14 +375,8 @@ std::string balanced_yaml(const Study& study, const balance::planar::ForceBalanc
   header += design.full ? "It is fully force balanced over the motion.\n"
                         : (design.balancing_factor ? "" : "Full force balance is not reached: ") +
                               design.message + "\n";
-  for (const balance::planar::LinkCounterweight& c : design.added) {
-    const balance::Counterweight& w = c.counterweight;
-    header += fmt::format(
-        "Link {} carries a counterweight of {:.6g} kg at ({:.6g}, {:.6g}) m from node {} in the "
-        "link's axes (merged into the link below).\n",
-        l.links[static_cast<std::size_t>(c.link)].name, w.mass, w.position.x(), w.position.y(),
-        l.nodes[static_cast<std::size_t>(c.pivot)].name);
-  }
+  for (const balance::planar::LinkCounterweight& c : design.added)
+    header += counterweight_line(l, c, written);
   for (const core::planar::BalanceShaft& s : design.linkage.shafts) {
     bool had = false;
     for (const core::planar::BalanceShaft& o : l.shafts) had = had || o.name == s.name;
@@ -288,7 +388,7 @@ std::string balanced_yaml(const Study& study, const balance::planar::ForceBalanc
         s.eccentricity.norm());
   }
   header += "Run it with\n  balance-design balanced.yaml";
-  return study_yaml(planar_balanced_study(study, design.linkage), header);
+  return study_yaml(written, header);
 }
 
 namespace {
@@ -299,7 +399,18 @@ std::string planar_optimized_yaml(const Study& study, const OptimizedRun& run) {
   const PlanarOptimizeRequest& req = *study.planar_optimize;
   const optimize::planar::Result& r = run.planar_result;
   const core::planar::Linkage& l = study.planar();
-  std::string header = "The optimised design of study '" + study.name + "', found by\n";
+  // the links the counterweights were merged into: the study's, with the link parameters set
+  core::planar::Linkage base = l;
+  for (std::size_t i = 0; i < req.link_parameters.size(); ++i) {
+    const optimize::planar::LinkParameterVariable& v = req.link_parameters[i];
+    parameter_of(link_at(base, v.link), v.parameter) =
+        r.x[static_cast<Eigen::Index>(3 * req.counterweights.size() + i)];
+  }
+  std::vector<CounterweightPart> added;
+  for (const balance::planar::LinkCounterweight& c : r.counterweights)
+    if (c.counterweight.mass > 0) added.push_back({c.link, c.pivot, c.counterweight});
+  const Study written = with_parts(planar_optimized_study(study, r.design),
+                                   design_parts(study, base, added, r.design));  std::string header = "The optimised design of study '" + study.name + "', found by\n";
   header += "balance-design from its optimize section";
   header += study.source.empty() ? std::string(".\n") : " in\n  " + study.source + "\n";
   header += "Objective: minimise " + objective_text(req) + ".\n";
@@ -309,21 +420,14 @@ std::string planar_optimized_yaml(const Study& study, const OptimizedRun& run) {
       "relative difference {:.3g}).\n",
       optimize::to_string(req.options.algorithm), optimize::to_string(r.termination), r.evaluations,
       r.objective, r.verification_error);
-  for (const balance::planar::LinkCounterweight& c : r.counterweights) {
-    const balance::Counterweight& w = c.counterweight;
-    if (w.mass <= 0) continue;
-    header += fmt::format(
-        "Link {} carries a counterweight of {:.6g} kg at ({:.6g}, {:.6g}) m from node {} in the "
-        "link's axes (merged into the link below).\n",
-        l.links[static_cast<std::size_t>(c.link)].name, w.mass, w.position.x(), w.position.y(),
-        l.nodes[static_cast<std::size_t>(c.pivot)].name);
-  }
+  for (const balance::planar::LinkCounterweight& c : r.counterweights)
+    if (c.counterweight.mass > 0) header += counterweight_line(l, c, written);
   for (int k = 3 * static_cast<int>(req.counterweights.size()); k < r.design_variables; ++k) {
     header += fmt::format("Link parameter {} = {:.6g} (a variable).\n",
                           r.variable_names[static_cast<std::size_t>(k)], r.x[k]);
   }
   header += "Run it with\n  balance-design optimized.yaml";
-  return study_yaml(planar_optimized_study(study, r.design), header);
+  return study_yaml(written, header);
 }
 
 }  // namespace
@@ -333,7 +437,18 @@ std::string optimized_yaml(const Study& study, const OptimizedRun& run) {
   assert(study.optimize.has_value() && run.found());
   const OptimizeRequest& req = *study.optimize;
   const optimize::OptimizeResult& r = run.result;
-  std::string header = "The optimised design of study '" + study.name + "', found by\n";
+  // the links the counterweights were merged into: the study's, with the link parameters set
+  core::FourBar base = study.fourbar();
+  for (std::size_t i = 0; i < req.link_parameters.size(); ++i) {
+    const optimize::LinkParameterVariable& v = req.link_parameters[i];
+    parameter_of(link_at(base, v.link), v.parameter) =
+        r.x[static_cast<Eigen::Index>(3 * req.counterweights.size() + i)];
+  }
+  std::vector<CounterweightPart> added;
+  for (const optimize::PlacedCounterweight& p : r.counterweights)
+    added.push_back({p.link, -1, p.counterweight});
+  const Study written =
+      with_parts(optimized_study(study, r.design), design_parts(study, base, added, r.design));  std::string header = "The optimised design of study '" + study.name + "', found by\n";
   header += "balance-design from its optimize section";
   header += study.source.empty() ? std::string(".\n") : " in\n  " + study.source + "\n";
   header += "Objective: minimise " + objective_text(req) + ".\n";
@@ -349,16 +464,16 @@ std::string optimized_yaml(const Study& study, const OptimizedRun& run) {
   for (const optimize::PlacedCounterweight& p : r.counterweights) {
     const balance::Counterweight& c = p.counterweight;
     std::snprintf(line, sizeof line,
-                  "The %s carries a counterweight of %.6g kg at %.6g m from %s (merged into the "
-                  "link below).\n",
+                  "The %s carries a counterweight of %.6g kg at %.6g m from %s (%s).\n",
                   core::link_name(p.link), c.mass, c.distance,
-                  p.link == 1 || p.link == 3 ? pivots[p.link] : "its pivot");
+                  p.link == 1 || p.link == 3 ? pivots[p.link] : "its pivot",
+                  where_written(written));
     header += line;
   }
   header +=
-      "Links are in the polar form {s, sigma} with every digit (%.17g; e, f as comments).\n"
+      "Every number is written exactly (links by e, f; s, sigma as comments).\n"
       "Run it with\n  balance-design optimized.yaml";
-  return study_yaml(optimized_study(study, r.design), header);
+  return study_yaml(written, header);
 }
 
 namespace {
@@ -385,8 +500,9 @@ std::string planar_pareto_csv(const Study& study, const OptimizedRun& run) {
                    : std::string(",,");
     text += std::string(",") + optimize::to_string(r.termination) + "," +
             (r.ok() ? text::exact(r.verification_error) : std::string());
+    // a point without a design has no variables: empty cells, as its metrics
     for (std::size_t k = 0; k < n; ++k) {
-      text += "," + (static_cast<Eigen::Index>(k) < r.x.size()
+      text += "," + (r.ok() && static_cast<Eigen::Index>(k) < r.x.size()
                          ? text::exact(r.x[static_cast<Eigen::Index>(k)])
                          : std::string());
     }
@@ -419,8 +535,9 @@ std::string pareto_csv(const Study& study, const OptimizedRun& run) {
     }
     text += std::string(",") + optimize::to_string(r.termination) + "," +
             (r.ok() ? text::exact(r.verification_error) : std::string());
+    // a point without a design has no variables: empty cells, as its metrics
     for (int k = 0; k < n; ++k) {
-      text += "," + (k < r.x.size() ? text::exact(r.x[k]) : std::string());
+      text += "," + (r.ok() && k < r.x.size() ? text::exact(r.x[k]) : std::string());
     }
     text += "\n";
   }

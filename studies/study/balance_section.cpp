@@ -28,6 +28,30 @@ balance::CounterweightShape read_shape(const Reporter& r_, const MapReader::Entr
   return t == "disc" ? balance::CounterweightShape::kDisc : balance::CounterweightShape::kPoint;
 }
 
+balance::Counterweight read_counterweight_part(const Reporter& r_, const MapReader& m,
+                                              const std::string& path) {
+  balance::Counterweight cw;
+  const MapReader::Entry& mass = m.require("mass", "in kg");
+  cw.mass = read_number(r_, mass, path + ".mass", "kg");
+  if (!(cw.mass >= 0)) {  // 0 kg leaves the link as it is (an optimum may place none)
+    r_.fail(mark_of(mass.value, mass.key_mark),
+            path + ".mass must be >= 0 kg, got " + text::shortest(cw.mass));
+  }
+  YAML::Mark marks[2];
+  cw.position = read_vec2(
+      r_, m.require("at", "its centre [x, y] in m, in the link's axes from the pivot"),
+      path + ".at", "m", marks);
+  cw.distance = cw.position.norm();
+  if (const MapReader::Entry* j = m.find("inertia")) {
+    cw.inertia = read_number(r_, *j, path + ".inertia", "kg m^2");
+    if (!(cw.inertia >= 0)) {
+      r_.fail(mark_of(j->value, j->key_mark),
+              path + ".inertia must be >= 0 kg m^2, got " + text::shortest(cw.inertia));
+    }
+  }
+  return cw;
+}
+
 namespace {
 
 class BalanceReader {

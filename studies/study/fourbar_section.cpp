@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,7 +47,8 @@ class FourBarSection::Impl {
   core::FourBar read_linkage(const MapReader::Entry& e) {
     const MapReader lk(r_, e.value, "linkage", e.key_mark,
                        "(type, frame, branch, crank, coupler, rocker)");
-    lk.check_keys({"type", "frame", "branch", "crank", "coupler", "rocker", "counter_rotations"});
+    lk.check_keys({"type", "frame", "branch", "crank", "coupler", "rocker", "counter_rotations",
+                   "counterweights"});
 
     core::FourBar model;
     const MapReader::Entry& frame = lk.require("frame", "l4, the distance A0A3 in m");
@@ -68,7 +70,24 @@ class FourBarSection::Impl {
     if (const MapReader::Entry* cr = lk.find("counter_rotations")) {
       model.counter_rotations = read_counter_rotations(*cr, model.frame_length);
     }
+    if (const MapReader::Entry* cw = lk.find("counterweights")) read_counterweights(*cw);
     return model;
+  }
+
+  // linkage.counterweights: {crank: {mass, at, inertia}, rocker: {...}}, each optional; `at`
+  // in the link's axes from its pivot (A0 for the crank, A3 for the rocker)
+  void read_counterweights(const MapReader::Entry& e) {
+    if (e.value.IsNull()) return;
+    const MapReader cw(r_, e.value, "linkage.counterweights", e.key_mark, "(crank, rocker)");
+    cw.check_keys({"crank", "rocker"});
+    for (int i = 0; i < 2; ++i) {
+      const MapReader::Entry* x = cw.find(kSides[i]);
+      if (!x) continue;
+      const std::string path = "linkage.counterweights." + std::string(kSides[i]);
+      const MapReader m(r_, x->value, path, x->key_mark, "(mass, at, inertia)");
+      m.check_keys({"mass", "at", "inertia"});
+      parts_.push_back({i == 0 ? 1 : 3, -1, read_counterweight_part(r_, m, path)});
+    }
   }
 
   // linkage.counter_rotations: {crank: {inertia, at}, rocker: {inertia, at}}, each optional
@@ -292,6 +311,9 @@ class FourBarSection::Impl {
   const Reporter& r_;
   std::vector<Place> places_;        // linkage and loads values, for make_fourbar()'s messages
   std::vector<Place> scene_places_;  // scene.theta1 when given
+ public:
+  std::vector<CounterweightPart> parts_;  // linkage.counterweights, in file order
+  std::optional<LinkageParts> parts;      // set by FourBarSection::read() when there are any
 };
 
 FourBarSection::FourBarSection(const Reporter& r) : impl_(std::make_unique<Impl>(r)) {}
@@ -300,8 +322,14 @@ FourBarSection::~FourBarSection() = default;
 core::FourBar FourBarSection::read(const MapReader::Entry& linkage, const MapReader::Entry* loads) {
   core::FourBar model = impl_->read_linkage(linkage);
   if (loads) model.loads = impl_->read_loads(*loads);
-  return impl_->checked_model(model, linkage.key_mark);
+  if (impl_->parts_.empty()) return impl_->checked_model(model, linkage.key_mark);
+  // the links carry their counterweights: the model is the bare links with each merged in
+  impl_->parts = LinkageParts{model, impl_->parts_};
+  return impl_->checked_model(std::get<core::FourBar>(with_counterweights(*impl_->parts)),
+                              linkage.key_mark);
 }
+
+std::optional<LinkageParts> FourBarSection::parts() const { return impl_->parts; }
 
 Scene FourBarSection::read_scene(const MapReader::Entry& scene, const core::FourBar& model) {
   Scene s = impl_->read_scene(scene);

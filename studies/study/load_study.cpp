@@ -85,11 +85,13 @@ class StudyParser {
       FourBarSection section(r_);
       const core::FourBar model = section.read(linkage, top.find("loads"));
       study.linkage = model;
+      study.parts = section.parts();
       study.scene = section.read_scene(scene, model);
     } else if (t == "planar") {
       PlanarSection section(r_);
       const core::planar::Linkage model = section.read(linkage, top.find("loads"));
       study.linkage = model;
+      study.parts = section.parts();
       study.scene = section.read_scene(scene, model);
     } else {
       r_.fail(mark_of(type.value, type.key_mark),

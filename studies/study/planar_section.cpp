@@ -34,7 +34,7 @@ class PlanarSection::Impl {
                        "(type, nodes, links, point_masses, sliders, springs, balance_shafts, "
                        "inputs)");
     lk.check_keys({"type", "nodes", "links", "point_masses", "sliders", "springs", "balance_shafts",
-                   "inputs"});
+                   "inputs", "counterweights"});
     linkage_mark_ = e.key_mark;
     core::planar::Linkage l;
     read_nodes(lk.require("nodes", "the joint points, each [x, y] in m or {at, ground}"), l);
@@ -47,7 +47,44 @@ class PlanarSection::Impl {
         lk.require("inputs", "the degrees of freedom: link angles or slider positions");
     read_inputs(inputs, l);
     if (loads) read_loads(*loads, l);
-    return checked(l, inputs);
+    if (const MapReader::Entry* x = lk.find("counterweights")) read_counterweights(*x, l);
+    if (parts_.empty()) return checked(l, inputs);
+    // the links carry their counterweights: the linkage is the bare links with each merged in
+    parts = LinkageParts{l, parts_};
+    return checked(std::get<core::planar::Linkage>(with_counterweights(*parts)), inputs);
+  }
+
+  // counterweights: {crank: {from: A0, mass, at: [x, y], inertia}, ...}: at most one per link,
+  // `at` in the link's axes from `from` (default: its ground node, else its first node)
+  void read_counterweights(const MapReader::Entry& e, const core::planar::Linkage& l) {
+    if (e.value.IsNull()) return;
+    const MapReader m(r_, e.value, "linkage.counterweights", e.key_mark,
+                      "of link: {from, mass, at, inertia}");
+    for (const MapReader::Entry& x : m.entries()) {
+      const std::string path = "linkage.counterweights." + x.key;
+      CounterweightPart part;
+      part.link = link_named(YAML::Node(x.key), x.key_mark, "linkage.counterweights", l);
+      const MapReader cm(r_, x.value, path, x.key_mark, "(from, mass, at, inertia)");
+      cm.check_keys({"from", "mass", "at", "inertia"});
+      const core::planar::Link& link = l.links[static_cast<std::size_t>(part.link)];
+      part.pivot = balance::planar::counterweight_pivot(l, part.link);
+      if (const MapReader::Entry* from = cm.find("from")) {
+        part.pivot = node_named(from->value, from->key_mark, path + ".from", l);
+        if (std::find(link.nodes.begin(), link.nodes.end(), part.pivot) == link.nodes.end()) {
+          r_.fail(mark_of(from->value, from->key_mark),
+                  path + ".from must be a node of link " + link.name + " (" +
+                      nodes_text(l, link.nodes) + "), got " + from->value.Scalar());
+        }
+      }
+      part.counterweight = read_counterweight_part(r_, cm, path);
+      parts_.push_back(part);
+    }
+  }
+
+  static std::string nodes_text(const core::planar::Linkage& l, const std::vector<int>& nodes) {
+    std::string s;
+    for (int n : nodes) s += (s.empty() ? "" : ", ") + l.nodes[static_cast<std::size_t>(n)].name;
+    return s;
   }
 
   Scene read_scene(const MapReader::Entry& e, const core::planar::Linkage& l) {
@@ -552,6 +589,10 @@ class PlanarSection::Impl {
   const Reporter& r_;
   YAML::Mark linkage_mark_;
   std::map<std::string, Place> places_;  // "links[2]" -> linkage.links.coupler and its key
+
+ public:
+  std::vector<CounterweightPart> parts_;  // linkage.counterweights, in file order
+  std::optional<LinkageParts> parts;      // set by read() when there are any
 };
 
 PlanarSection::PlanarSection(const Reporter& r) : impl_(std::make_unique<Impl>(r)) {}
@@ -561,6 +602,8 @@ core::planar::Linkage PlanarSection::read(const MapReader::Entry& linkage,
                                           const MapReader::Entry* loads) {
   return impl_->read(linkage, loads);
 }
+
+std::optional<LinkageParts> PlanarSection::parts() const { return impl_->parts; }
 
 Scene PlanarSection::read_scene(const MapReader::Entry& scene,
                                 const core::planar::Linkage& linkage) {

@@ -7,6 +7,7 @@
 /// - optimize_section.cpp: the optimize section (a four-bar's or a planar linkage's);
 /// - sweep_section.cpp: the sweep section, its paths checked against the file's tree.
 #include <memory>
+#include <optional>
 
 #include "studies/study/study.hpp"
 #include "studies/study/yaml_reader.hpp"
@@ -26,6 +27,9 @@ class FourBarSection {
   core::FourBar read(const MapReader::Entry& linkage, const MapReader::Entry* loads);
   /// The scene, and the linkage assembled at its initial crank angle.
   Scene read_scene(const MapReader::Entry& scene, const core::FourBar& model);
+  /// The counterweight parts read() merged into the links, and the linkage without them; empty
+  /// when linkage.counterweights is absent.
+  std::optional<LinkageParts> parts() const;
 
  private:
   class Impl;
@@ -43,6 +47,8 @@ class PlanarSection {
   core::planar::Linkage read(const MapReader::Entry& linkage, const MapReader::Entry* loads);
   /// The scene, checked against the linkage's inputs.
   Scene read_scene(const MapReader::Entry& scene, const core::planar::Linkage& linkage);
+  /// As FourBarSection::parts().
+  std::optional<LinkageParts> parts() const;
 
  private:
   class Impl;
@@ -56,6 +62,12 @@ Vec2 read_shaft(const Reporter& r, const MapReader::Entry& at, const std::string
 /// `shape: point | disc` of a counterweight at `path`.
 balance::CounterweightShape read_shape(const Reporter& r, const MapReader::Entry& shape,
                                        const std::string& path);
+
+/// A counterweight given as a part of its link (linkage.counterweights.<link> at `path`, the map
+/// `m`, its keys checked by the caller): mass >= 0 [kg], at [x, y] [m] in the link's axes from
+/// its pivot, inertia >= 0 about its own centre [kg m^2] (default 0, a point mass).
+balance::Counterweight read_counterweight_part(const Reporter& r, const MapReader& m,
+                                              const std::string& path);
 
 /// The balance section, synthesised (a synthesis that is not possible is reported at the key
 /// that asked for it).

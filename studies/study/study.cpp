@@ -58,6 +58,25 @@ std::optional<core::Formulation> formulation_of(Method method) {
   }
 }
 
+Linkage with_counterweights(const LinkageParts& parts) {
+  Linkage out = parts.bare;
+  if (auto* m = std::get_if<core::FourBar>(&out)) {
+    for (const CounterweightPart& p : parts.counterweights) {
+      core::Link& l = p.link == 1 ? m->crank : m->rocker;
+      l = balance::merged(l, p.counterweight, p.link == 3);
+    }
+    return out;
+  }
+  auto& l = std::get<core::planar::Linkage>(out);
+  for (const CounterweightPart& p : parts.counterweights) {
+    core::planar::Link& link = l.links[static_cast<std::size_t>(p.link)];
+    const Vec2 pivot = balance::planar::in_link_axes(
+        l, p.link, l.nodes[static_cast<std::size_t>(p.pivot)].position);
+    link = balance::planar::merged(link, p.counterweight, pivot + p.counterweight.position);
+  }
+  return out;
+}
+
 namespace {
 
 // the study of another design of the same linkage type: its name, scene, method and tolerance

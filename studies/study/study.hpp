@@ -53,6 +53,28 @@ std::optional<Method> method_named(const std::string& name);
 /// The four-bar formulation of a method (mass-matrix, opened-loop, complex-masses), else nothing.
 std::optional<core::Formulation> formulation_of(Method method);
 
+/// A counterweight carried by a link as a part of its own (`linkage.counterweights` in a study
+/// file, as balanced.yaml and optimized.yaml write the designs' counterweights).
+struct CounterweightPart {
+  int link{};   // a four-bar's: 1 crank or 3 rocker; a planar linkage's: its index in links
+  int pivot{};  // a planar linkage's node its position is measured from (a four-bar's: unused,
+                // the crank's is A0 and the rocker's A3)
+  balance::Counterweight counterweight;  // mass [kg], position [m] in link axes from the pivot,
+                                         // inertia about its own centre [kg m^2]
+};
+
+/// The linkage without its counterweight parts, and the parts; the study's linkage is `bare`
+/// with each part merged into its link in order (with_counterweights()).
+struct LinkageParts {
+  Linkage bare;
+  std::vector<CounterweightPart> counterweights;
+};
+
+/// `parts.bare` with each counterweight merged into its link in order (parallel axes,
+/// balance::merged(), the same arithmetic as the balance synthesis and the optimisers use), not
+/// yet checked by make_fourbar() or make_linkage().
+Linkage with_counterweights(const LinkageParts& parts);
+
 struct Study {
   std::string name;  // used in output names: [A-Za-z0-9._-], not starting with '.'
   Linkage linkage;   // with its loads, checked by core::make_fourbar() or make_linkage()
@@ -63,6 +85,9 @@ struct Study {
   /// The values the file gives with a unit of their own, as read and in SI, e.g. "scene.theta1:
   /// 90 deg = 1.5707963267948966 rad" (a plain number is SI and is not listed).
   std::vector<std::string> units_read;
+  /// The counterweights the file gives as parts of their links (linkage.counterweights), and
+  /// the linkage without them; empty when it gives none. `linkage` has them merged in.
+  std::optional<LinkageParts> parts;
   /// A four-bar study's `balance:` section, synthesised at load time; empty when absent.
   std::optional<balance::BalancedDesign> balance;
   /// A planar study's `balance:` section, checked at load time; the runner synthesises the design

@@ -14,13 +14,31 @@ std::string vec(const Vec2& v) {
   return "[" + text::shortest(v.x()) + ", " + text::shortest(v.y()) + "]";
 }
 
-// the paper's polar form s, sigma (what people read and write); reading it
-// back reproduces e, f to within a few ulps (s e^{i sigma} rounds), which the comment records
+// e, f exactly (they read back bit for bit); the paper's polar form s, sigma as a comment
 std::string link_line(const char* name, const core::Link& l) {
   return std::string("  ") + name + ": {length: " + text::shortest(l.length) +
-         ", mass: " + text::shortest(l.mass) + ", s: " + text::shortest(l.s()) +
-         ", sigma: " + text::shortest(l.sigma()) + ", inertia: " + text::shortest(l.inertia) + "}\n" +
-         "    # e = " + text::shortest(l.e) + " m, f = " + text::shortest(l.f) + " m\n";
+         ", mass: " + text::shortest(l.mass) + ", e: " + text::shortest(l.e) +
+         ", f: " + text::shortest(l.f) + ", inertia: " + text::shortest(l.inertia) + "}\n" +
+         "    # s = " + text::shortest(l.s()) + " m, sigma = " + text::shortest(l.sigma()) +
+         " rad\n";
+}
+
+// linkage.counterweights: each part's mass, centre in link axes from its pivot, own inertia
+std::string counterweights_yaml(const std::vector<CounterweightPart>& parts,
+                                const core::planar::Linkage* l) {
+  if (parts.empty()) return "";
+  std::string y =
+      "  counterweights:  # parts of their links: merged into them (parallel axes) on reading\n";
+  for (const CounterweightPart& p : parts) {
+    const balance::Counterweight& c = p.counterweight;
+    const std::string from =
+        l ? "from: " + l->nodes[static_cast<std::size_t>(p.pivot)].name + ", " : std::string();
+    const std::string name =
+        l ? l->links[static_cast<std::size_t>(p.link)].name : std::string(p.link == 1 ? "crank" : "rocker");
+    y += "    " + name + ": {" + from + "mass: " + text::shortest(c.mass) + ", at: " + vec(c.position) +
+         ", inertia: " + text::shortest(c.inertia) + "}\n";
+  }
+  return y;
 }
 
 std::string load_line(const char* name, const core::LinkLoad& l) {
@@ -49,7 +67,8 @@ std::string effort(const core::planar::TimeFunction& f) {
 }
 
 // a planar linkage's linkage and loads sections (names are plain: letters, digits, '_', '-')
-std::string planar_linkage_yaml(const core::planar::Linkage& l) {
+std::string planar_linkage_yaml(const core::planar::Linkage& l,
+                                const std::vector<CounterweightPart>& parts) {
   auto node = [&](int i) { return l.nodes[static_cast<std::size_t>(i)].name; };
   std::string y = "linkage:\n  type: planar\n  nodes:\n";
   for (const core::planar::Node& n : l.nodes) {
@@ -97,6 +116,7 @@ std::string planar_linkage_yaml(const core::planar::Linkage& l) {
            ", inertia: " + text::shortest(b.inertia) + "}\n";
     }
   }
+  y += counterweights_yaml(parts, &l);
   y += "  inputs:\n";
   for (const core::planar::Input& in : l.inputs) {
     if (in.kind == core::planar::Input::Kind::kAngle) {
@@ -156,14 +176,19 @@ std::string study_yaml(const Study& study, const std::string& header) {
     y += "\n";
   }
   y += "name: \"" + study.name + "\"\n\n";  // letters, digits, '.', '_', '-': no escapes needed
+  // the links without their counterweight parts, and the parts, when the study has any
+  const Linkage& linkage = study.parts ? study.parts->bare : study.linkage;
+  const std::vector<CounterweightPart> no_parts;
+  const std::vector<CounterweightPart>& parts = study.parts ? study.parts->counterweights : no_parts;
   if (!study.is_fourbar()) {
-    y += planar_linkage_yaml(study.planar()) + planar_scene_yaml(study.scene);
+    y += planar_linkage_yaml(std::get<core::planar::Linkage>(linkage), parts) +
+         planar_scene_yaml(study.scene);
     y += "\nmethod: " + study.method_name() + "\n";
     return y + "tolerance: " + text::shortest(study.tolerance) + "\n";
   }
 
-  // linkage: links in the paper's polar form (see link_line)
-  const core::FourBar& m = study.fourbar();
+  // linkage: links with e, f (see link_line)
+  const core::FourBar& m = std::get<core::FourBar>(linkage);
   y += "linkage:\n";
   y += "  type: fourbar\n";
   y += "  frame: " + text::shortest(m.frame_length) + "\n";
@@ -181,6 +206,7 @@ std::string study_yaml(const Study& study, const std::string& header) {
            ", at: " + vec(discs[i]->at) + "}\n";
     }
   }
+  y += counterweights_yaml(parts, nullptr);
 
   // loads: every value, zero or not
   y += "\nloads:\n";

@@ -203,7 +203,7 @@ TEST_F(CliTest, BalanceStudyPrintsTheComparisonAndWritesItsFiles) {
     EXPECT_NE(out_.find(text), std::string::npos) << text << " not in\n" << out_;
   }
   // the written balanced design runs as a study of its own and reproduces the balanced run
-  // (balanced.yaml gives s, sigma: e, f come back within a few ulps, the outputs within 1e-12)
+  // (balanced.yaml gives every number exactly; the outputs are checked here to 1e-12)
   EXPECT_EQ(run("res/balanced.yaml --out again"), 0) << err_;
   bd::testing::expect_same_numbers(dir_ / "again" / "timeseries.csv",
                                    dir_ / "res" / "balanced-timeseries.csv", 1e-12);

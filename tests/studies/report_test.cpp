@@ -7,6 +7,9 @@
 #include <stdlib.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -30,6 +33,13 @@ namespace fs = std::filesystem;
 using bd::testing::read;
 
 using bd::testing::count;
+
+// a number as the animation's hover text writes it (4 significant digits)
+std::string fmt_for_test(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
 
 // sets an environment variable for the scope, restoring the old value after
 class ScopedEnv {
@@ -127,11 +137,18 @@ TEST_F(ReportTest, BalanceRunWritesASelfContainedReport) {
   EXPECT_EQ(rest.find("<script"), std::string::npos);
   EXPECT_EQ(rest.find("<link"), std::string::npos);
 
+  // the linkage animated (no gnuplot needed): the original and the balanced design
+  EXPECT_NE(html.find("<svg class=\"animation\" id=\"animation-original\""), std::string::npos);
+  EXPECT_NE(html.find("<svg class=\"animation\" id=\"animation-balanced\""), std::string::npos);
+
   if (find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
-  const std::vector<std::string> charts = svgs(html);
-  EXPECT_EQ(charts.size(), 7u);  // angles, reactions, hodograph, Msh, drive, both linkages
-  for (const char* id : {"angles", "reactions", "hodograph", "shaking-moment", "drive", "linkage",
-                         "linkage-balanced"}) {
+  std::vector<std::string> charts;
+  for (const std::string& svg : svgs(html))
+    if (svg.find("class=\"animation\"") == std::string::npos) charts.push_back(svg);
+  // angles, reactions, hodograph, Msh, drive, harmonic orders of both designs
+  EXPECT_EQ(charts.size(), 7u);
+  for (const char* id : {"angles", "reactions", "hodograph", "shaking-moment", "drive",
+                         "harmonics-original", "harmonics-balanced"}) {
     EXPECT_NE(html.find(std::string("id=\"chart-") + id + "\""), std::string::npos) << id;
   }
   for (const std::string& svg : charts) EXPECT_GT(count(svg, "<path"), 3u);
@@ -150,12 +167,15 @@ TEST_F(ReportTest, WithoutGnuplotTheReportSaysSoAndKeepsTheTables) {
   ASSERT_TRUE(r.ok());
   const std::string html = read(dir_ / "report.html");
   EXPECT_NE(html.find("The charts need gnuplot"), std::string::npos);
-  EXPECT_EQ(html.find("<svg"), std::string::npos);
+  // no chart, but the animation, which needs no gnuplot
+  EXPECT_EQ(html.find("<figure class=\"chart\""), std::string::npos);
+  EXPECT_EQ(count(html, "<svg"), 1u);
+  EXPECT_NE(html.find("<svg class=\"animation\" id=\"animation-original\""), std::string::npos);
   for (const std::string& v : metric_values(read(r.summary))) {
     EXPECT_NE(html.find("\"" + v + "\""), std::string::npos) << v;
   }
   EXPECT_NE(html.find("href=\"timeseries.csv\""), std::string::npos);
-  EXPECT_NE(html.find("The linkage at the drawn samples"), std::string::npos);
+  EXPECT_NE(html.find("The linkage at four samples"), std::string::npos);
 }
 
 TEST_F(ReportTest, OptimizeRunWithParetoFrontHasItsChartAndTable) {
@@ -177,10 +197,18 @@ TEST_F(ReportTest, OptimizeRunWithParetoFrontHasItsChartAndTable) {
   EXPECT_NE(html.find("<h2>Comparison</h2>"), std::string::npos);
   EXPECT_NE(html.find("optimised"), std::string::npos);
   if (find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
-  EXPECT_EQ(svgs(html).size(), 8u);
+  // angles, reactions, hodograph, Msh, drive, two harmonic charts, Pareto; two animations
+  EXPECT_EQ(svgs(html).size(), 10u);
   EXPECT_NE(html.find("id=\"chart-pareto\""), std::string::npos);
-  EXPECT_NE(html.find("id=\"chart-linkage-optimized\""), std::string::npos);
-  EXPECT_NE(html.find("The optimised linkage at the drawn samples"), std::string::npos);
+  EXPECT_NE(html.find("id=\"animation-optimized\""), std::string::npos);
+  EXPECT_NE(html.find("The optimised linkage at four samples"), std::string::npos);
+  // the front's axes with their units, the original and the chosen optimum marked
+  const std::size_t at = html.find("id=\"chart-pareto\"");
+  const std::string pareto = html.substr(at, html.find("</svg>", at) - at);
+  EXPECT_NE(pareto.find("Fsh_rms [N]"), std::string::npos);
+  EXPECT_NE(pareto.find("Msh_rms [N m]"), std::string::npos);
+  EXPECT_NE(pareto.find("original design"), std::string::npos);
+  EXPECT_NE(pareto.find("chosen optimum"), std::string::npos);
 }
 
 // the cells' text of each row of the table that follows <h3>heading</h3>
@@ -213,21 +241,22 @@ TEST_F(ReportTest, BalanceShaftsAreDrawnAsParts) {
     const fs::path out = dir_ / example;
     ASSERT_TRUE(run_study(study, out).ok());
     const std::string html = read(out / "report.html");
-    if (find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
-    const std::size_t original = html.find("id=\"chart-linkage\""),
-                      balanced = html.find("id=\"chart-linkage-balanced\"");
+    const std::size_t original = html.find("id=\"animation-original\""),
+                      balanced = html.find("id=\"animation-balanced\"");
     ASSERT_NE(original, std::string::npos);
     ASSERT_NE(balanced, std::string::npos);
     const std::string a = html.substr(original, html.find("</svg>", original) - original);
     const std::string b = html.substr(balanced, html.find("</svg>", balanced) - balanced);
-    EXPECT_EQ(a.find("balance shafts"), std::string::npos) << example;
-    EXPECT_NE(b.find("balance shafts"), std::string::npos) << example;
+    EXPECT_EQ(a.find("balance shaft"), std::string::npos) << example;
+    EXPECT_NE(b.find("balance shaft"), std::string::npos) << example;
     const bool lanchester = std::string(example) == "engine-lanchester.yaml";
-    EXPECT_NE(b.find(lanchester ? "shaft_-1, shaft_2, shaft_-2" : "counter_rocker"),
-              std::string::npos)
-        << example;
-    // only eccentric shafts carry a mass to draw
-    EXPECT_EQ(b.find("shaft masses") != std::string::npos, lanchester) << example;
+    for (const char* shaft : {"shaft_-1", "shaft_2", "shaft_-2"}) {
+      EXPECT_EQ(b.find(std::string("balance shaft ") + shaft) != std::string::npos, lanchester)
+          << example << " " << shaft;
+    }
+    EXPECT_EQ(b.find("balance shaft counter_rocker") != std::string::npos, !lanchester) << example;
+    // only eccentric shafts carry a mass to draw, and it moves
+    EXPECT_EQ(b.find("eccentric mass of") != std::string::npos, lanchester) << example;
   }
 }
 
@@ -236,69 +265,101 @@ TEST_F(ReportTest, BalancedLinkageIsDrawnWithItsCounterweights) {
       load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven-force-balanced.yaml");
   ASSERT_TRUE(run_study(study, dir_).ok());
   const std::string html = read(dir_ / "report.html");
-  // columns: sample, t, theta1, A1, A2, G1, G2, G3, P1, P2, P3, S
-  const auto original = table_after(html, "The linkage at the drawn samples");
-  const auto balanced = table_after(html, "The balanced linkage at the drawn samples");
+  // columns: t, theta1, A1, A2, G1, G2, G3, P1, P2, P3, S
+  const auto original = table_after(html, "The linkage at four samples");
+  const auto balanced = table_after(html, "The balanced linkage at four samples");
   ASSERT_EQ(original.size(), 4u);
   ASSERT_EQ(balanced.size(), 4u);
   for (std::size_t i = 0; i < 4; ++i) {
-    ASSERT_EQ(balanced[i].size(), 12u);
+    ASSERT_EQ(balanced[i].size(), 11u);
     // the same driven motion: the same joints
+    EXPECT_EQ(balanced[i][2], original[i][2]);
     EXPECT_EQ(balanced[i][3], original[i][3]);
-    EXPECT_EQ(balanced[i][4], original[i][4]);
     // force balanced: S stays where it is (to the 4 digits shown); the original's moves
-    EXPECT_EQ(balanced[i][11], balanced[0][11]);
+    EXPECT_EQ(balanced[i][10], balanced[0][10]);
     if (i > 0) {
-      EXPECT_NE(original[i][11], original[0][11]);
+      EXPECT_NE(original[i][10], original[0][10]);
     }
   }
   // at theta1 = 0 the crank lies along +x: its centre of mass is ahead of A0, the balanced
   // crank's (counterweight merged) behind it
-  ASSERT_EQ(original[0][2], "0");
-  EXPECT_EQ(original[0][5].rfind("(0.", 0), 0u) << original[0][5];
-  EXPECT_EQ(balanced[0][5].rfind("(-", 0), 0u) << balanced[0][5];
-  if (find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
-  EXPECT_NE(html.find("id=\"chart-linkage-balanced\""), std::string::npos);
+  ASSERT_EQ(original[0][1], "0");
+  EXPECT_EQ(original[0][4].rfind("(0.", 0), 0u) << original[0][4];
+  EXPECT_EQ(balanced[0][4].rfind("(-", 0), 0u) << balanced[0][4];
+  // the counterweights are drawn as parts on the balanced design's links, not on the original's
+  const std::size_t a = html.find("id=\"animation-original\""),
+                    b = html.find("id=\"animation-balanced\"");
+  ASSERT_NE(a, std::string::npos);
+  ASSERT_NE(b, std::string::npos);
+  const std::string first = html.substr(a, html.find("</svg>", a) - a);
+  const std::string second = html.substr(b, html.find("</svg>", b) - b);
+  EXPECT_EQ(first.find("counterweight on the"), std::string::npos);
+  EXPECT_NE(
+      second.find("counterweight on the crank: " +
+                  std::string(fmt_for_test(study.balance->crank_counterweight->mass)) + " kg"),
+      std::string::npos);
+  EXPECT_NE(second.find("counterweight on the rocker"), std::string::npos);
 }
 
-// The legend of the linkage chart shows each marker as it is drawn: every legend entry of a
-// marker (P1 P2 P3, S, G1 G2 G3) is the plot of that marker, not a stand-in beside it, so its
-// key sample and its points share one symbol and one colour; one entry per sample, each in the
-// sample's colour.
-TEST_F(ReportTest, LinkageLegendShowsTheMarkersAsDrawn) {
-  if (find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
+// the points of a polyline's "x,y x,y ..." text
+std::vector<std::pair<double, double>> points_of(const std::string& text) {
+  std::vector<std::pair<double, double>> out;
+  std::istringstream in(text);
+  for (std::string p; in >> p;) {
+    const std::size_t comma = p.find(',');
+    out.push_back({std::stod(p.substr(0, comma)), std::stod(p.substr(comma + 1))});
+  }
+  return out;
+}
+
+// The linkage animation moves every link over one revolution of the crank and loops without a
+// jump: each link's polyline has an <animate> of its points whose last frame is its first (the
+// periodic end); in every frame the crank's drawn length is the same (l1 at the picture's
+// scale: a rigid link), as are the coupler's and the rocker's, and the ground joints stay put.
+TEST_F(ReportTest, AnimationMovesTheLinksRigidlyOverOneRevolution) {
   const Study study = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml");
   ASSERT_TRUE(run_study(study, dir_).ok());
   const std::string html = read(dir_ / "report.html");
-  const std::size_t at = html.find("id=\"chart-linkage\"");
+  const std::size_t at = html.find("<svg class=\"animation\" id=\"animation-original\"");
   ASSERT_NE(at, std::string::npos);
   const std::string svg = html.substr(at, html.find("</svg>", at) - at);
-  const std::regex use("<use xlink:href='#linkage-gpPt([0-9]+)'[^>]*color='([^']*)'");
-  std::map<std::string, std::set<std::string>> colours;  // marker kind -> colours of entries
-  const std::string group = "<g id=\"linkage-gnuplot_plot_";
-  for (std::size_t g = svg.find(group); g != std::string::npos;) {
-    const std::size_t next = svg.find(group, g + 1);
-    const std::string body =
-        svg.substr(g, next == std::string::npos ? std::string::npos : next - g);
-    g = next;
-    std::string kind;
-    for (const char* k : {">  P1 P2 P3<", ">  S<", ">  G1 G2 G3<"})
-      if (body.find(k) != std::string::npos) kind = k;
-    if (kind.empty()) continue;
-    std::set<std::string> symbols, colour;
-    std::size_t uses = 0;
-    for (auto u = std::sregex_iterator(body.begin(), body.end(), use); u != std::sregex_iterator();
-         ++u, ++uses) {
-      symbols.insert((*u)[1].str());
-      colour.insert((*u)[2].str());
+  const std::regex link(
+      "<polyline[^>]*><title>(crank A0-A1|coupler A1-A2|rocker A2-A3)</title>"
+      "<animate attributeName=\"points\" dur=\"4s\" repeatCount=\"indefinite\""
+      "[^>]*values=\"([^\"]*)\"");
+  std::map<std::string, std::vector<double>> lengths;  // per link, its length in each frame [px]
+  std::size_t frames = 0;
+  for (auto m = std::sregex_iterator(svg.begin(), svg.end(), link); m != std::sregex_iterator();
+       ++m) {
+    std::vector<std::string> values;
+    std::istringstream in((*m)[2].str());
+    for (std::string v; std::getline(in, v, ';');) values.push_back(v);
+    frames = values.size();
+    ASSERT_GE(values.size(), 100u);
+    EXPECT_EQ(values.front(), values.back()) << (*m)[1] << ": the loop closes";
+    for (const std::string& v : values) {
+      const auto p = points_of(v);
+      ASSERT_EQ(p.size(), 2u);
+      lengths[(*m)[1].str()].push_back(
+          std::hypot(p[1].first - p[0].first, p[1].second - p[0].second));
     }
-    EXPECT_GE(uses, 2u) << kind << ": the legend's marker and at least one drawn";
-    EXPECT_EQ(symbols.size(), 1u) << kind;
-    EXPECT_EQ(colour.size(), 1u) << kind;
-    if (colour.size() == 1) colours[kind].insert(*colour.begin());
   }
-  ASSERT_EQ(colours.size(), 3u);
-  for (const auto& [kind, c] : colours) EXPECT_EQ(c.size(), 4u) << kind;  // one per sample
+  ASSERT_EQ(lengths.size(), 3u);
+  EXPECT_EQ(frames, 121u);  // 120 samples of the revolution and the first again
+  // rigid links: one length in every frame, to the rounding of the written coordinates (0.05 px
+  // each: a drawn length is within 2 * 0.05 * sqrt(2) = 0.141 px of the true one, so two frames'
+  // differ by at most 0.283 px), and the lengths in the
+  // ratio of l1 : l2 : l3 = 1 : 3 : 2 (each mean to 0.1 px in about 180 px: 1e-3)
+  const double l[] = {1.0, 3.0, 2.0};
+  const char* names[] = {"crank A0-A1", "coupler A1-A2", "rocker A2-A3"};
+  double mean[3] = {0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    const std::vector<double>& d = lengths[names[k]];
+    const auto [lo, hi] = std::minmax_element(d.begin(), d.end());
+    EXPECT_LE(*hi - *lo, 0.29) << names[k];
+    for (double x : d) mean[k] += x / static_cast<double>(d.size());
+  }
+  for (int k = 1; k < 3; ++k) EXPECT_NEAR(mean[k] / mean[0], l[k] / l[0], 1e-3 * l[k]) << names[k];
 }
 
 TEST_F(ReportTest, ReportIsRebuiltFromTheDataFiles) {

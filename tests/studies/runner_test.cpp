@@ -393,15 +393,15 @@ TEST_F(RunnerTest, BalancedYamlLoadsBackToTheSynthesisedDesignAndReproducesItsRu
     EXPECT_EQ(text.rfind("# The balanced design of study '" + study.name + "'", 0), 0u) << text;
     EXPECT_EQ(text.find("balance:"), std::string::npos) << "no balance section:\n" << text;
 
-    // the same model: every number bit for bit except e, f, which balanced.yaml writes in the
-    // polar form s, sigma and so come back within a few ulps of s
+    // the same model (balanced.yaml writes every number exactly; design_files_test.cpp checks
+    // the samples byte for byte, this the model's every value)
     const Study back = load_study(r.balanced->study_file.string());
     EXPECT_EQ(back.name, study.name + "-balanced");
     EXPECT_FALSE(back.balance.has_value());
     bd::testing::expect_same_model(study.balance->model, back.fourbar());
 
-    // and running it reproduces balanced-timeseries.csv: inputs a few ulps apart, outputs within
-    // 1e-12 of each column's scale (the dynamics is well conditioned away from dead centres)
+    // and running it reproduces balanced-timeseries.csv (to the last bit: design_files_test.cpp;
+    // here to 1e-12 of each column's scale)
     const RunResult again = run_study(back, out / "again");
     ASSERT_TRUE(again.ok());
     EXPECT_EQ(again.method.formulation, r.balanced->method.formulation);
@@ -580,7 +580,7 @@ TEST_F(RunnerTest, OptimizedYamlLoadsBackToTheOptimumAndReproducesItsRun) {
     EXPECT_EQ(text.find("optimize:"), std::string::npos) << "no optimize section:\n" << text;
     EXPECT_NE(text.find("counterweight of "), std::string::npos) << text;
 
-    // the same model, e and f within a few ulps (polar form)
+    // the same model (every number written exactly)
     const Study back = load_study(o.study_file.string());
     EXPECT_EQ(back.name, study.name + "-optimized");
     EXPECT_FALSE(back.optimize.has_value());

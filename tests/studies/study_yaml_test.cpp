@@ -1,7 +1,6 @@
 // Writing a study back as YAML: parse_study() of study_yaml() gives back the same model, scene
-// and options bit for bit ("%.17g"), except e, f, which come back within a few ulps of the
-// polar form s, sigma the file gives, for every example and a study with loads,
-// counter-rotations and a free scene.
+// and options bit for bit (every number written exactly, links by e, f), for every example and a
+// study with loads, counter-rotations and a free scene.
 #include "studies/study/study_yaml.hpp"
 
 #include <gtest/gtest.h>
@@ -21,7 +20,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// %.17g reads back to the same double; e, f to within a few ulps (polar form)
+// exact number text reads back to the same double; the check allows e, f a few ulps (it was
+// written for the polar form s, sigma; e, f are exact now)
 void expect_same_study(const Study& a, const Study& b) {
   EXPECT_EQ(a.name, b.name);
   ASSERT_EQ(a.is_fourbar(), b.is_fourbar());
