@@ -36,8 +36,10 @@ Study sweep_study(int count) {
   const std::size_t b = text.find("\nbalance:");
   const std::size_t e = text.find("\nsweep:");
   text.erase(b, e - b);
-  for (std::size_t at = 0; (at = text.find("count: 21", at)) != std::string::npos;) {
-    text.replace(at, 9, "count: " + std::to_string(count));
+  const std::string counted = "count: " + std::to_string(count);
+  for (std::size_t at = 0; (at = text.find("count: 21", at)) != std::string::npos;
+       at += counted.size()) {
+    text.replace(at, 9, counted);
   }
   return parse_study(text, "paper-fourbar-sweep.yaml");
 }
