@@ -82,6 +82,9 @@ Outputs (in DIR, default results/<name>/ with <name> the study's `name`):
   sweep.json      the study, the design (points, parameters), status and counts
   report.html     charts of the metrics against the parameters
   Options of a sweep run: --resume, --threads N, --progress auto|bar|lines|none.
+  mpirun -np N balance-design run STUDY.yaml shares a sweep's points among N processes (on one
+  machine or a cluster; --threads is then per process) with the same sweep.csv, byte for byte;
+  --resume works with any N (docs/scaling.md).
   Files are written under a temporary name and renamed, so none is ever half-written.
 
 The study-file format is described in docs/study-format.md; examples are in studies/examples/.
