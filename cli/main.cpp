@@ -17,6 +17,7 @@
 #include <variant>
 #include <vector>
 
+#include "cli/mpi_sweep.hpp"
 #include "cli/sweep_display.hpp"
 #include "core/fourbar/metrics.hpp"
 #include "core/number_text.hpp"
@@ -82,6 +83,9 @@ Outputs (in DIR, default results/<name>/ with <name> the study's `name`):
   sweep.json      the study, the design (points, parameters), status and counts
   report.html     charts of the metrics against the parameters
   Options of a sweep run: --resume, --threads N, --progress auto|bar|lines|none.
+  mpirun -np N balance-design run STUDY.yaml shares a sweep's points among N processes (on one
+  machine or a cluster; --threads is then per process) with the same sweep.csv, byte for byte;
+  --resume works with any N (docs/scaling.md).
   Files are written under a temporary name and renamed, so none is ever half-written.
 
 The study-file format is described in docs/study-format.md; examples are in studies/examples/.
@@ -105,7 +109,13 @@ Exit codes:
 )";
 
 // one line on stderr: control characters in `text` (from a file, a key, a message) escaped
+// this process's MPI job, when mpirun started it as one of several ranks (cli/mpi_sweep.hpp);
+// ranks other than 0 say nothing: rank 0 speaks for the job
+bd::cli::MpiWorld* g_mpi = nullptr;
+bool quiet_rank() { return g_mpi != nullptr && g_mpi->rank() > 0; }
+
 void say_error(const std::string& text) {
+  if (quiet_rank()) return;
   std::fprintf(stderr, "%s\n", bd::text::printable(text).c_str());
 }
 
@@ -593,6 +603,13 @@ void catch_stop_signals() {
   sigaction(SIGTERM, &sa, nullptr);
 }
 
+// a rank's threads in an MPI job: --threads, else sweep.threads, else its share of the machine
+int sweep_threads(const st::Study& study, const RunArgs& args) {
+  if (args.threads > 0) return args.threads;
+  if (study.sweep->threads > 0) return study.sweep->threads;
+  return g_mpi->default_threads();
+}
+
 // a study with a sweep section: run_sweep() into `out`, then one line saying what was done
 int run_sweep_study(const st::Study& study, const RunArgs& args, const fs::path& out) {
   st::SweepOptions options;
@@ -605,6 +622,13 @@ int run_sweep_study(const st::Study& study, const RunArgs& args, const fs::path&
   const auto start = std::chrono::steady_clock::now();
   st::SweepResult r;
   try {
+    // in an MPI job, the other ranks take points too (their rows come back to this one)
+    std::unique_ptr<st::SweepPeers> peers;
+    if (g_mpi) {
+      options.threads = sweep_threads(study, args);
+      peers = g_mpi->peers(study, options.threads);
+      options.peers = peers.get();
+    }
     r = st::run_sweep(study, out, options);
   } catch (const bd::InputError& e) {
     say_error(args.study + ": " + e.what());
@@ -638,6 +662,12 @@ int run(const RunArgs& args) {
   std::optional<st::Study> loaded = load_or_say(args.study);
   if (!loaded) return kExitBadInput;
   const st::Study& study = *loaded;
+  if (quiet_rank()) {
+    // another rank of an MPI job: compute the points rank 0 hands out; rank 0 alone runs a
+    // study without a sweep
+    if (study.sweep) g_mpi->work(study, sweep_threads(study, args));
+    return kExitOk;
+  }
 
   const fs::path out = args.out.empty() ? fs::path("results") / study.name : fs::path(args.out);
   if (study.sweep) return run_sweep_study(study, args, out);
@@ -838,7 +868,11 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& bench_args) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  std::unique_ptr<bd::cli::MpiWorld> mpi;  // MPI_Finalize when main returns
   try {
+    mpi = bd::cli::mpi_world(argc, argv);
+    g_mpi = mpi.get();
+    if (quiet_rank()) std::freopen("/dev/null", "w", stdout);
     CLI::App app{std::string("balance-design ") + BD_VERSION + kDescription, "balance-design"};
     // each command's help says what that command does: the outputs belong to run's, the exit
     // codes to the program's and run's (CLI11 copies a footer set now into every subcommand)
@@ -886,11 +920,14 @@ int main(int argc, char** argv) {
       const int code = app.exit(e);
       return code == 0 ? kExitOk : kExitBadInput;
     }
+    if (quiet_rank() && !run_cmd->parsed()) return kExitOk;  // rank 0 does it for the job
     if (validate_cmd->parsed()) return validate(validate_file);
     if (report_cmd->parsed()) return report(report_dir);
     if (bench_cmd->parsed()) return bench(bench_args);
     return run(args);
   } catch (const std::exception& e) {
+    if (quiet_rank()) std::fprintf(stderr, "balance-design (MPI rank %d): ", g_mpi->rank());
+    g_mpi = nullptr;  // said by every rank
     say_error(std::string("balance-design: error: ") + e.what());
     return kExitInternal;
   } catch (...) {

@@ -7,8 +7,10 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <initializer_list>
 #include <limits>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -32,45 +34,39 @@ namespace {
 // ---------------------------------------------------------------------------------------------
 // the data files
 
-// sweep.csv as written: records split at line ends outside quotes (a message may hold one);
-// a last record without its line end was cut short by a kill and is left out
-struct SweepCsv {
-  std::vector<std::string> header;
-  std::vector<std::vector<std::string>> rows;
-  bool cut_short = false;
-};
-
-SweepCsv read_sweep_csv(const fs::path& p) {
-  const std::string text = read_file(p);
-  std::vector<std::string> records;
-  std::string record;
+// sweep.csv read record by record (a sweep of a million points is never held whole): records
+// split at line ends outside quotes (a message may hold one); a last record without its line end
+// was cut short by a kill and is left out. `header` gets the first record, `record` every other,
+// with its number (2 for the first row).
+bool for_each_record(const fs::path& p,
+                     const std::function<void(std::vector<std::string>)>& header,
+                     const std::function<void(std::vector<std::string>, std::size_t)>& record) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + p.string());
+  std::string rec;
   bool quoted = false;
-  for (const char c : text) {
-    if (c == '"') quoted = !quoted;  // "" inside a quoted field toggles twice
-    if (c == '\n' && !quoted) {
-      records.push_back(std::move(record));
-      record.clear();
-    } else {
-      record += c;
+  std::size_t n = 0;
+  std::vector<char> buf(1 << 16);
+  while (in.read(buf.data(), static_cast<std::streamsize>(buf.size())) || in.gcount() > 0) {
+    const auto got = static_cast<std::size_t>(in.gcount());
+    for (std::size_t k = 0; k < got; ++k) {
+      const char c = buf[k];
+      if (c == '"') quoted = !quoted;  // "" inside a quoted field toggles twice
+      if (c != '\n' || quoted) {
+        rec += c;
+        continue;
+      }
+      ++n;
+      if (n == 1) {
+        header(csv_fields(rec));
+      } else if (!rec.empty() && rec != "\r") {
+        record(csv_fields(rec), n);
+      }
+      rec.clear();
     }
   }
-  SweepCsv csv;
-  csv.cut_short = !record.empty();
-  if (records.empty()) {
-    throw std::runtime_error(p.string() + " has no complete header line");
-  }
-  csv.header = csv_fields(records.front());
-  for (std::size_t i = 1; i < records.size(); ++i) {
-    if (records[i].empty() || records[i] == "\r") continue;
-    std::vector<std::string> row = csv_fields(records[i]);
-    if (row.size() != csv.header.size()) {
-      throw std::runtime_error(p.string() + ": record " + std::to_string(i + 1) + " has " +
-                               std::to_string(row.size()) + " fields, the header " +
-                               std::to_string(csv.header.size()));
-    }
-    csv.rows.push_back(std::move(row));
-  }
-  return csv;
+  if (n == 0) throw std::runtime_error(p.string() + " has no complete header line");
+  return !rec.empty();
 }
 
 // a field as a finite number, else nothing
@@ -114,9 +110,42 @@ struct Metric {
   std::vector<Series> series;
 };
 
+// sweep.csv as the page uses it: the rows drawn in the charts (all of them up to a few
+// thousand points, else a regular sample: see Sweep::sampling) and what is counted over all rows
+struct SweepCsv {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;  // the rows charted (and listed, when few)
+  bool cut_short = false;
+  std::size_t total = 0;   // rows in the file
+  std::size_t failed = 0;  // of which status is not ok
+  std::vector<std::vector<std::string>> failed_rows;  // the first kFailedRows of them
+};
+
+// the least value of a series over every row, and how many rows are at the noise floor
+struct Best {
+  std::optional<std::vector<std::string>> row;
+  double value = std::numeric_limits<double>::infinity();
+};
+
+constexpr std::size_t kFailedRows = 50;  // failed points listed; the rest are counted
+constexpr std::size_t kPointRows = 100;  // sweeps up to this size list every point
+constexpr std::size_t kChartRows = 2000;  // points drawn in a chart, at most (about)
+constexpr std::size_t kGridCells = 40;   // a heat map's cells per axis, at most
+// Values of a metric below this fraction of its largest value in the sweep are round-off (a
+// balanced design's shaking force is 1e-13 of the original's): drawn as zero, never ranked.
+constexpr double kNoiseFloor = 1e-9;
+
 struct Sweep {
   Json info;  // sweep.json
   SweepCsv csv;
+  std::string sampling;  // how the charted rows were chosen, when not all ("" when all)
+  std::map<std::string, Best> best;     // by series column, over every row
+  std::map<std::string, double> scale;  // by metric name: largest |value| of any of its series
+  std::vector<std::pair<double, double>> range;  // each parameter's least and largest value
+  // the sample charted: every keep_stride-th point, or on a large grid every grid_step[j]-th
+  // value of each parameter (grid_ny: the second parameter's values, > 0 then)
+  std::size_t keep_stride = 1, grid_ny = 0;
+  std::size_t grid_step[2] = {1, 1};
   std::vector<Parameter> params;
   std::string design;           // grid, random, lhs
   std::string second;           // column prefix of the second design: "balanced_", "optimized_", ""
@@ -148,6 +177,11 @@ struct Sweep {
   // parameter j's value at row r (written for every point, failed ones too)
   std::optional<double> x(std::size_t r, std::size_t j) const { return number(csv.rows[r][1 + j]); }
   const std::string& x_text(std::size_t r, std::size_t j) const { return csv.rows[r][1 + j]; }
+  // a metric's round-off floor: values at or below it are zero to the arithmetic
+  double floor(const Metric& m) const {
+    const auto it = scale.find(m.id);
+    return it == scale.end() ? 0.0 : kNoiseFloor * it->second;
+  }
   // every series of the metrics, the original design's first
   std::vector<Series> all_series() const {
     std::vector<Series> out;
@@ -158,6 +192,11 @@ struct Sweep {
     return out;
   }
 };
+
+void check_header(Sweep& s, const fs::path& csv_file, const fs::path& json_file,
+                  const Study& study);
+void choose_sample(Sweep& s, std::size_t points);
+void take_row(Sweep& s, std::vector<std::string> row);
 
 Sweep load_sweep(const Study& study, const fs::path& dir) {
   const fs::path json_file = dir / "sweep.json";
@@ -188,7 +227,33 @@ Sweep load_sweep(const Study& study, const fs::path& dir) {
   }
   if (s.params.empty()) throw std::runtime_error(json_file.string() + " lists no parameters");
 
-  s.csv = read_sweep_csv(csv_file);
+  std::size_t points = 0;
+  if (const auto n = number(text(s.info, "points")); n && *n > 0) {
+    points = static_cast<std::size_t>(*n);
+  }
+  bool have_header = false;
+  s.csv.cut_short = for_each_record(
+      csv_file, [&](std::vector<std::string> h) { s.csv.header = std::move(h); },
+      [&](std::vector<std::string> row, std::size_t n) {
+        if (!have_header) {
+          check_header(s, csv_file, json_file, study);
+          have_header = true;
+          choose_sample(s, points);
+        }
+        if (row.size() != s.csv.header.size()) {
+          throw std::runtime_error(csv_file.string() + ": record " + std::to_string(n) +
+                                   " has " + std::to_string(row.size()) + " fields, the header " +
+                                   std::to_string(s.csv.header.size()));
+        }
+        take_row(s, std::move(row));
+      });
+  if (!have_header) check_header(s, csv_file, json_file, study);
+  return s;
+}
+
+// the header against sweep.json, then the metrics it has
+void check_header(Sweep& s, const fs::path& csv_file, const fs::path& json_file,
+                  const Study& study) {
   const auto& h = s.csv.header;
   bool header_ok = h.size() >= s.params.size() + 3 && h.front() == "point" &&
                    h[h.size() - 2] == "status" && h.back() == "message";
@@ -230,7 +295,81 @@ Sweep load_sweep(const Study& study, const fs::path& dir) {
                          "added mass [kg]",
                          {{s.second_label, "added_mass", "", true}}});
   }
-  return s;
+  s.range.assign(s.params.size(), {std::numeric_limits<double>::infinity(),
+                                   -std::numeric_limits<double>::infinity()});
+}
+
+// Which rows the charts draw: all of a sweep of up to kChartRows points; of a larger grid of two
+// parameters every k-th value of each (at most kGridCells per axis); else every k-th point
+// (random and LHS points come in random order, so the sample is as random as the design).
+void choose_sample(Sweep& s, std::size_t points) {
+  s.keep_stride = 1;
+  if (points <= kChartRows) return;
+  if (s.params.size() == 2 && s.design == "grid" && !s.params[0].values.empty() &&
+      !s.params[1].values.empty()) {
+    s.grid_ny = s.params[1].values.size();
+    for (std::size_t j = 0; j < 2; ++j) {
+      Parameter& p = s.params[j];
+      const std::size_t n = p.values.size();
+      const std::size_t k = (n + kGridCells - 1) / kGridCells;
+      s.grid_step[j] = k;
+      std::vector<double> kept;
+      for (std::size_t i = 0; i < n; i += k) kept.push_back(p.values[i]);
+      p.values = std::move(kept);
+    }
+    s.sampling = "one in every " + std::to_string(s.grid_step[0]) + " values of " +
+                 s.params[0].path + " and one in every " + std::to_string(s.grid_step[1]) +
+                 " of " + s.params[1].path + " (" + std::to_string(s.params[0].values.size()) +
+                 " x " + std::to_string(s.params[1].values.size()) + " of the grid's points)";
+    return;
+  }
+  s.keep_stride = (points + kChartRows - 1) / kChartRows;
+  s.sampling = "one in every " + std::to_string(s.keep_stride) + " points (" +
+               std::to_string((points + s.keep_stride - 1) / s.keep_stride) + " of " +
+               std::to_string(points) + ")";
+}
+
+// one row of sweep.csv: counted, ranked, and kept when charted
+void take_row(Sweep& s, std::vector<std::string> row) {
+  ++s.csv.total;
+  const bool ok = row[s.status_col] == "ok";
+  if (!ok) {
+    ++s.csv.failed;
+    if (s.csv.failed_rows.size() < kFailedRows) s.csv.failed_rows.push_back(row);
+  }
+  for (std::size_t j = 0; j < s.params.size(); ++j) {
+    if (const auto x = number(row[1 + j])) {
+      s.range[j].first = std::min(s.range[j].first, *x);
+      s.range[j].second = std::max(s.range[j].second, *x);
+    }
+  }
+  for (const Metric& m : s.metrics) {
+    for (const Series& se : m.series) {
+      if (!(row[s.status_col] == "ok" || (!se.second && row[s.status_col] == "no-optimum"))) {
+        continue;
+      }
+      const auto c = s.col(se.column);
+      const auto v = c ? number(row[*c]) : std::nullopt;
+      if (!v) continue;
+      double& scale = s.scale[m.id];
+      scale = std::max(scale, std::abs(*v));
+      Best& b = s.best[se.column];
+      if (*v < b.value) {
+        b.value = *v;
+        b.row = row;
+      }
+    }
+  }
+  // charted?
+  const auto index = number(row[0]);
+  const std::size_t i = index && *index >= 0 ? static_cast<std::size_t>(*index) : 0;
+  bool keep = true;
+  if (s.grid_ny > 0) {
+    keep = (i / s.grid_ny) % s.grid_step[0] == 0 && (i % s.grid_ny) % s.grid_step[1] == 0;
+  } else if (s.keep_stride > 1) {
+    keep = i % s.keep_stride == 0;
+  }
+  if (keep) s.csv.rows.push_back(std::move(row));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -240,9 +379,8 @@ std::string td(const std::string& html) { return "<td>" + html + "</td>"; }
 
 std::string status_section(const Sweep& s, const fs::path& dir) {
   const std::string status = text(s.info, "status");
-  const std::size_t rows = s.csv.rows.size();
-  std::size_t failed = 0;
-  for (std::size_t r = 0; r < rows; ++r) failed += s.status(r) != "ok";
+  const std::size_t rows = s.csv.total;
+  const std::size_t failed = s.csv.failed;
   const std::string points = text(s.info, "points");
   const std::string source = text(s.info, "source");
   const std::string resume = "<code>balance-design run " +
@@ -341,11 +479,12 @@ std::string param_headers(const Sweep& s) {
   for (const Parameter& p : s.params) h += "<th><code>" + esc(p.path) + "</code></th>";
   return h;
 }
-std::string param_cells(const Sweep& s, std::size_t r) {
+std::string param_cells(const Sweep& s, const std::vector<std::string>& row) {
   std::string h;
-  for (std::size_t j = 0; j < s.params.size(); ++j) h += num_cell(s.x_text(r, j));
+  for (std::size_t j = 0; j < s.params.size(); ++j) h += num_cell(row[1 + j]);
   return h;
 }
+std::string param_cells(const Sweep& s, std::size_t r) { return param_cells(s, s.csv.rows[r]); }
 
 std::string best_section(const Sweep& s) {
   bool added_mass = false;
@@ -358,39 +497,45 @@ std::string best_section(const Sweep& s) {
   if (s.second == "optimized_") h += " (for the original design also those without an optimum)";
   h += ".</p>\n<table><tr><th>metric</th><th>least value</th><th>at point</th>" + param_headers(s) +
        "</tr>";
-  bool any = false;
+  bool any = false, noise = false;
+  std::map<std::string, double> floors;  // by series column
+  for (const Metric& m : s.metrics)
+    for (const Series& se : m.series) floors[se.column] = s.floor(m);
   for (const Series& se : s.all_series()) {
-    std::optional<std::size_t> best;
-    double least = std::numeric_limits<double>::infinity();
-    for (std::size_t r = 0; r < s.csv.rows.size(); ++r) {
-      const auto v = s.value(r, se);
-      if (v && *v < least) {
-        least = *v;
-        best = r;
-      }
-    }
-    if (!best) continue;
+    const auto it = s.best.find(se.column);
+    if (it == s.best.end() || !it->second.row) continue;
     any = true;
-    h += "<tr><th>" + esc(se.column) + "</th>" + num_cell(s.csv.rows[*best][*s.col(se.column)]) +
-         num_cell(s.csv.rows[*best][0]) + param_cells(s, *best) + "</tr>";
+    const std::vector<std::string>& row = *it->second.row;
+    h += "<tr><th>" + esc(se.column) + "</th>" + num_cell(row[*s.col(se.column)]);
+    if (it->second.value <= floors[se.column]) {
+      // round-off: no point is better than another
+      noise = true;
+      h += "<td colspan=\"" + std::to_string(1 + s.params.size()) +
+           "\">zero to round-off (every value at or below " + fmt(floors[se.column]) +
+           " ranks alike)</td></tr>";
+      continue;
+    }
+    h += num_cell(row[0]) + param_cells(s, row) + "</tr>";
   }
   if (!any) {
     h += "<tr><td colspan=\"" + std::to_string(3 + s.params.size()) +
          "\">no point has finished with status ok yet</td></tr>";
   }
-  return h + "</table>\n";
+  h += "</table>\n";
+  if (noise) {
+    h += "<p>Values below " + fmt(kNoiseFloor, "%g") +
+         " of a metric's largest value in the sweep are round-off of an exact zero (a fully "
+         "balanced design's shaking force, for one): they are not ranked, and the charts draw "
+         "them as zero.</p>\n";
+  }
+  return h;
 }
 
-constexpr std::size_t kFailedRows = 50;  // failed points listed; the rest are counted
-constexpr std::size_t kPointRows = 100;  // sweeps up to this size list every point
-
 std::string failed_section(const Sweep& s) {
-  std::vector<std::size_t> failed;
-  for (std::size_t r = 0; r < s.csv.rows.size(); ++r)
-    if (s.status(r) != "ok") failed.push_back(r);
-  if (failed.empty())
+  const std::size_t failed = s.csv.failed;
+  if (failed == 0)
     return "<h2>Failed points</h2>\n<p>None: every point ran with status ok.</p>\n";
-  std::string h = "<h2>Failed points</h2>\n<p>" + std::to_string(failed.size()) +
+  std::string h = "<h2>Failed points</h2>\n<p>" + std::to_string(failed) +
                   " point(s) did not finish with status ok (stopped-early: a simulation stopped, "
                   "no-optimum: the optimiser found no design, bad-input: the study at that point "
                   "is invalid, error: an unexpected failure). They are left out of the charts and "
@@ -398,14 +543,13 @@ std::string failed_section(const Sweep& s) {
                   "without an optimum keeps its original design's values there).</p>\n"
                   "<table><tr><th>point</th>" +
                   param_headers(s) + "<th>status</th><th>message</th></tr>";
-  for (std::size_t i = 0; i < failed.size() && i < kFailedRows; ++i) {
-    const std::size_t r = failed[i];
-    h += "<tr>" + num_cell(s.csv.rows[r][0]) + param_cells(s, r) + "<td class=\"bad\">" +
-         esc(s.status(r)) + "</td><td>" + esc(s.csv.rows[r][s.message_col]) + "</td></tr>";
+  for (const std::vector<std::string>& row : s.csv.failed_rows) {
+    h += "<tr>" + num_cell(row[0]) + param_cells(s, row) + "<td class=\"bad\">" +
+         esc(row[s.status_col]) + "</td><td>" + esc(row[s.message_col]) + "</td></tr>";
   }
   h += "</table>\n";
-  if (failed.size() > kFailedRows) {
-    h += "<p>&hellip; and " + std::to_string(failed.size() - kFailedRows) +
+  if (failed > kFailedRows) {
+    h += "<p>&hellip; and " + std::to_string(failed - kFailedRows) +
          " more (see <a href=\"sweep.csv\">sweep.csv</a>).</p>\n";
   }
   return h;
@@ -413,8 +557,8 @@ std::string failed_section(const Sweep& s) {
 
 std::string points_section(const Sweep& s) {
   std::string h = "<h2>Points</h2>\n";
-  if (s.csv.rows.size() > kPointRows) {
-    return h + "<p>" + std::to_string(s.csv.rows.size()) +
+  if (s.csv.total > kPointRows) {
+    return h + "<p>" + std::to_string(s.csv.total) +
            " points: every one, with every metric, is in <a "
            "href=\"sweep.csv\">sweep.csv</a>.</p>\n";
   }
@@ -485,7 +629,75 @@ const char* const kPalette =
     "set palette defined (0 '#440154', 0.25 '#3b528b', 0.5 '#21918c', 0.75 '#5ec962', "
     "1 '#fde725')\n";
 
-std::string axis_label(const Parameter& p) { return p.path + (p.log_scale ? " (log scale)" : ""); }
+// a swept value in an engineer's words with its unit, e.g. "coupler mass m2 [kg]", from its
+// path in the study file (the path itself when it is not one of these)
+std::string engineer_name(const std::string& path) {
+  const std::vector<std::string> k = [&] {
+    std::vector<std::string> parts;
+    std::string part;
+    for (const char c : path) {
+      if (c == '.' || c == '[' || c == ']') {
+        if (!part.empty()) parts.push_back(part);
+        part.clear();
+      } else {
+        part += c;
+      }
+    }
+    if (!part.empty()) parts.push_back(part);
+    return parts;
+  }();
+  if (k.empty()) return path;
+  const std::map<std::string, std::string> links = {{"crank", "1"}, {"coupler", "2"},
+                                                    {"rocker", "3"}};
+  const auto axis = [](const std::string& i) { return std::string(i == "0" ? "x" : "y"); };
+  if (k[0] == "linkage" && k.size() == 2 && k[1] == "frame") return "frame length l4 [m]";
+  if (k[0] == "linkage" && k.size() >= 3) {
+    // a four-bar's links (crank, coupler, rocker) or a planar linkage's (links.NAME.FIELD)
+    const bool planar = k[1] == "links" && k.size() == 4;
+    const std::string name = planar ? k[2] : k[1];
+    const std::string field = planar ? k[3] : k[2];
+    const auto n = links.find(name);
+    const std::string sub = !planar && n != links.end() ? n->second : "";
+    const std::map<std::string, std::string> fields = {
+        {"length", "length l" + sub + " [m]"},
+        {"mass", "mass m" + sub + " [kg]"},
+        {"inertia", "inertia I" + sub + " about its centre of mass [kg m^2]"},
+        {"s", "centre of mass s" + sub + " [m]"},
+        {"sigma", "centre-of-mass angle σ" + sub + " [rad]"},
+        {"e", "centre of mass e" + sub + " along the link [m]"},
+        {"f", "centre of mass f" + sub + " across the link [m]"}};
+    if (const auto f = fields.find(field); f != fields.end() && (planar || k.size() == 3)) {
+      return name + " " + f->second;
+    }
+  }
+  if (k[0] == "loads" && k.size() == 3 && k[1] == "gravity") return "gravity g" + axis(k[2]) + " [m/s^2]";
+  if (k[0] == "loads" && k.size() == 4 && k[2] == "force") {
+    return k[1] + " force F" + axis(k[3]) + " [N]";
+  }
+  if (k[0] == "loads" && k.size() == 3 && k[2] == "moment") return k[1] + " moment [N m]";
+  if (k[0] == "scene" && k.size() == 2) {
+    const std::map<std::string, std::string> scene = {
+        {"omega1", "crank speed ω1 [rad/s]"},
+        {"theta1", "initial crank angle θ1 [rad]"},
+        {"duration", "duration [s]"}};
+    if (const auto f = scene.find(k[1]); f != scene.end()) return f->second;
+  }
+  return path;
+}
+
+std::string axis_label(const Parameter& p) {
+  return engineer_name(p.path) + (p.log_scale ? " (log scale)" : "");
+}
+
+// a value as charted: round-off below the metric's floor drawn as zero
+double charted(double v, double floor) { return std::abs(v) <= floor ? 0.0 : v; }
+
+// " Drawn: every k-th point ...; the tables count every point." when the chart is a sample
+std::string sample_note(const Sweep& s) {
+  if (s.sampling.empty()) return {};
+  return " Drawn: " + s.sampling + " of sweep.csv's " + std::to_string(s.csv.total) +
+         " rows; the best points and the counts are over every row.";
+}
 
 // The cell of grid value v among a parameter's values: from halfway to the lower neighbour to
 // halfway to the upper one (halfway in log for a log-scale parameter), the end cells as wide
@@ -550,13 +762,7 @@ std::string axis(const char* a, double lo, double hi, bool log_scale) {
 // the axis of parameter j just around its values in sweep.csv (gnuplot's autoscale would round
 // out to the next tic, a whole decade on a log axis)
 std::string axis(const Sweep& s, std::size_t j, const char* a) {
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (std::size_t r = 0; r < s.csv.rows.size(); ++r) {
-    if (const auto v = s.x(r, j)) {
-      lo = std::min(lo, *v);
-      hi = std::max(hi, *v);
-    }
-  }
+  double lo = s.range[j].first, hi = s.range[j].second;
   if (!(lo <= hi)) return {};
   const bool log_scale = s.params[j].log_scale && lo > 0;
   if (log_scale) {
@@ -590,7 +796,10 @@ void one_parameter(const Sweep& s, Charts& out) {
         const auto x = s.x(r, 0);
         const auto v = s.value(r, se);
         const auto peak = se.peak.empty() ? v : s.value(r, se, se.peak);
-        if (x && v && peak) pts.emplace_back(*x, num(*x) + "," + num(*v) + "," + num(*peak));
+        if (x && v && peak) {
+          pts.emplace_back(*x, num(*x) + "," + num(charted(*v, s.floor(m))) + "," +
+                                   num(charted(*peak, s.floor(m))));
+        }
       }
       if (pts.empty()) continue;
       std::stable_sort(pts.begin(), pts.end(),
@@ -613,12 +822,14 @@ void one_parameter(const Sweep& s, Charts& out) {
         peaks ? m.name + " (solid, points) and " + m.id + "_max (dotted) of each point"
               : m.name + " of each point";
     out.charts.push_back(
-        {"sweep-" + m.id, m.name + " against " + s.params[0].path,
-         caption + " against " + s.params[0].path +
+        {"sweep-" + m.id, m.name + " against " + engineer_name(s.params[0].path),
+         caption + " against " + engineer_name(s.params[0].path) +
              (m.series.size() > 1
                   ? ", the " + m.series[1].label + " design dashed over the " + m.series[0].label
                   : std::string()) +
-             "; points whose status is not ok are left out.",
+             "; points whose status is not ok are left out; values below " +
+             fmt(kNoiseFloor, "%g") + " of the largest are round-off, drawn as zero." +
+             sample_note(s),
          "set title " + gp_string(m.id + ": " + m.what) + "\nset xlabel " +
              gp_string(axis_label(s.params[0])) + "\nset ylabel " + gp_string(m.what) + "\n" +
              axis(s, 0, "x") + "plot " + plot});
@@ -633,11 +844,14 @@ std::string side_by_side(const std::string& title, const std::vector<std::string
   return c + "unset multiplot";
 }
 
-// the data line of the least value among `v` (value, data line) pairs
-std::string minimum_line(const std::vector<std::pair<double, std::string>>& v) {
+// the data line of the least value among `v` (value, data line) pairs, or nothing when it is
+// round-off (at or below `floor`: then no point is less than another)
+std::optional<std::string> minimum_line(const std::vector<std::pair<double, std::string>>& v,
+                                        double floor) {
   std::size_t best = 0;
   for (std::size_t i = 1; i < v.size(); ++i)
     if (v[i].first < v[best].first) best = i;
+  if (v[best].first <= floor) return std::nullopt;
   return v[best].second;
 }
 
@@ -675,14 +889,15 @@ void heat_maps(const Sweep& s, Charts& out) {
         const std::string cell =
             num(*x) + "," + num(*y) + "," + num(xa) + "," + num(xb) + "," + num(ya) + "," + num(yb);
         if (const auto v = s.value(r, se)) {
-          cells.push_back(cell + "," + num(*v));
+          cells.push_back(cell + "," + num(charted(*v, s.floor(m))));
           values.emplace_back(*v, num(*x) + "," + num(*y));
         } else {
           failed.push_back(cell);
         }
       }
       if (cells.empty() && failed.empty()) continue;
-      std::string p = "set title " + gp_string(se.label) + "\nset xlabel " +
+      std::string title_note, cb = "\nset autoscale cb";
+      std::string p = "\nset xlabel " +
                       gp_string(axis_label(px)) + "\nset ylabel " + gp_string(axis_label(py)) +
                       "\n" + ranges + "unset key\nunset grid\nplot ";
       std::string items;
@@ -695,20 +910,27 @@ void heat_maps(const Sweep& s, Charts& out) {
                  " using 1:2:3:4:5:6 with boxxyerror fs solid 1.0 noborder lc rgb '#c8c8c8' "
                  "notitle";
       }
-      if (!values.empty()) {
-        items += ", " + out.block({minimum_line(values)}) +
+      const auto least = values.empty() ? std::nullopt : minimum_line(values, s.floor(m));
+      if (least) {
+        items += ", " + out.block({*least}) +
                  " using 1:2 with points pt 6 ps 2 lw 2 lc rgb '#e00000' notitle";
+      } else if (!values.empty()) {
+        cb = "\nset cbrange [0:1]";  // all zero to round-off: one colour, no false contrast
+        title_note = " (every value zero to round-off)";
       }
-      panels.push_back(p + items);
+      panels.push_back("set title " + gp_string(se.label + title_note) + cb + p + items);
     }
     if (panels.empty()) continue;
     out.charts.push_back(
-        {"sweep-" + m.id, m.name + " over " + px.path + " and " + py.path,
+        {"sweep-" + m.id, m.name + " over " + engineer_name(px.path) + " and " + engineer_name(py.path),
          m.name + " (" + m.what +
              ") at each grid point, one rectangle per point reaching "
              "halfway to its neighbours" +
              panels_text(m) +
-             ". Grey: failed points; blank: points not run; red circle: the least value.",
+             ". Grey: failed points; blank: points not run; red circle: the least value "
+             "(none where every value is round-off: below " +
+             fmt(kNoiseFloor, "%g") + " of the metric's largest, drawn as zero)." +
+             sample_note(s),
          kPalette + side_by_side(m.name + ": " + m.what, panels), true});
   }
 }
@@ -727,14 +949,15 @@ void scatter_maps(const Sweep& s, Charts& out) {
         const auto y = s.x(r, 1);
         if (!x || !y) continue;
         if (const auto v = s.value(r, se)) {
-          pts.push_back(num(*x) + "," + num(*y) + "," + num(*v));
+          pts.push_back(num(*x) + "," + num(*y) + "," + num(charted(*v, s.floor(m))));
           values.emplace_back(*v, num(*x) + "," + num(*y));
         } else {
           failed.push_back(num(*x) + "," + num(*y));
         }
       }
       if (pts.empty() && failed.empty()) continue;
-      std::string p = "set title " + gp_string(se.label) + "\nset xlabel " +
+      std::string title_note, cb = "\nset autoscale cb";
+      std::string p = "\nset xlabel " +
                       gp_string(axis_label(px)) + "\nset ylabel " + gp_string(axis_label(py)) +
                       "\n" + axis(s, 0, "x") + axis(s, 1, "y") + "unset key\nplot ";
       std::string items;
@@ -745,18 +968,26 @@ void scatter_maps(const Sweep& s, Charts& out) {
         items += std::string(items.empty() ? "" : ", ") + out.block(failed) +
                  " using 1:2 with points pt 2 ps 1.1 lw 2 lc rgb '#808080' notitle";
       }
-      if (!values.empty()) {
-        items += ", " + out.block({minimum_line(values)}) +
+      const auto least = values.empty() ? std::nullopt : minimum_line(values, s.floor(m));
+      if (least) {
+        items += ", " + out.block({*least}) +
                  " using 1:2 with points pt 6 ps 2.2 lw 2 lc rgb '#e00000' notitle";
+      } else if (!values.empty()) {
+        cb = "\nset cbrange [0:1]";
+        title_note = " (every value zero to round-off)";
       }
-      panels.push_back(p + items);
+      panels.push_back("set title " + gp_string(se.label + title_note) + cb + p + items);
     }
     if (panels.empty()) continue;
-    out.charts.push_back({"sweep-" + m.id, m.name + " over " + px.path + " and " + py.path,
+    out.charts.push_back({"sweep-" + m.id,
+                          m.name + " over " + engineer_name(px.path) + " and " + engineer_name(py.path),
                           m.name + " (" + m.what + ") at each point of the " +
                               (s.design == "lhs" ? "Latin-hypercube" : "random") +
                               " design, by colour" + panels_text(m) +
-                              ". Grey crosses: failed points; red circle: the least value.",
+                              ". Grey crosses: failed points; red circle: the least value "
+                              "(none where every value is round-off: below " +
+                              fmt(kNoiseFloor, "%g") + " of the metric's largest, drawn as zero)." +
+                              sample_note(s),
                           kPalette + side_by_side(m.name + ": " + m.what, panels), true});
   }
 }
@@ -781,7 +1012,7 @@ void metric_by_parameter(const Sweep& s, Charts& out) {
           ok = x.has_value();
           if (ok) line += num(*x) + ",";
         }
-        if (ok) lines.push_back(line + num(*v));
+        if (ok) lines.push_back(line + num(charted(*v, s.floor(m))));
       }
       if (lines.empty()) continue;
       blocks.push_back(out.block(lines));
@@ -812,7 +1043,7 @@ void metric_by_parameter(const Sweep& s, Charts& out) {
              (m.series.size() > 1 ? ", the " + m.series[0].label + " design filled, the " +
                                         m.series[1].label + " one open"
                                   : std::string()) +
-             "; points whose status is not ok are left out.",
+             "; points whose status is not ok are left out." + sample_note(s),
          c, rows > 1});
   }
 }

@@ -29,6 +29,9 @@ std::vector<std::vector<double>> sweep_points(const SweepRequest& request);
 ///         that cannot assemble); the message is parse_study()'s, with its file:line:column.
 Study point_study(const Study& base, std::span<const double> values);
 
+/// The fingerprint of a study text as sweep.json gives it: FNV-1a 64, 16 hex digits.
+std::string sweep_fingerprint(const std::string& study_text);
+
 /// The sweep.csv columns after `point` and the parameters' paths, in order. The metrics are
 /// the original design's (core::Metrics, as in summary.json); a study with a balance section
 /// adds the balanced design's as balanced_<metric>, one with an optimize section the optimum's
@@ -52,6 +55,49 @@ struct SweepProgress {
   bool finished{};     // the last call of the run
 };
 
+/// One row of sweep.csv as computed: its text with its '\n', and whether its status is ok.
+struct SweepRow {
+  std::string text;
+  bool ok = false;
+};
+
+/// The row of point `index` of `study`'s sweep, `values` its parameters' values (one of
+/// sweep_points()): the point's study run by compute_study(). Never throws: a point's failure is
+/// its row's status. The same point gives the same bytes in any process, thread or order.
+SweepRow sweep_row(const Study& study, int index, std::span<const double> values);
+
+/// Points handed out by write_sweep(): the next ones in point order, or none.
+struct SweepClaim {
+  int begin{}, end{};  // points [begin, end); empty when there are none to hand out
+  bool later = false;  // none now, because the rows waiting to be written reached their bound:
+                       // ask again shortly
+  bool empty() const { return end <= begin; }
+};
+
+/// What write_sweep() offers to points computed elsewhere (SweepPeers::poll()).
+class SweepWork {
+ public:
+  virtual ~SweepWork() = default;
+  /// The next up to `count` points not yet handed out (none once all are, or the sweep stops).
+  virtual SweepClaim claim(int count) = 0;
+  /// How many points are not yet handed out.
+  virtual int unclaimed() const = 0;
+  /// The row of a point handed out by claim().
+  virtual void deliver(int point, SweepRow row) = 0;
+};
+
+/// Workers outside this process (the other ranks of an MPI run, cli/mpi_sweep.cpp), polled by
+/// write_sweep()'s writer thread every few milliseconds while its own threads compute points.
+class SweepPeers {
+ public:
+  virtual ~SweepPeers() = default;
+  /// Their threads, all together (for sweep.json).
+  virtual int threads() const = 0;
+  /// Answers the peers' requests (claim()) and hands their rows over (deliver()); returns true
+  /// once every peer has finished and delivered every point it claimed.
+  virtual bool poll(SweepWork& work) = 0;
+};
+
 struct SweepOptions {
   /// Continue the sweep in out_dir: keep the rows of sweep.csv (dropping a last line cut short),
   /// after checking that they belong to this study and design, and run the missing points.
@@ -63,6 +109,8 @@ struct SweepOptions {
   /// When it becomes true (e.g. set by a SIGINT handler), no new point is started; the points
   /// running finish and are written, and write_sweep() returns with interrupted set.
   const std::atomic<bool>* stop = nullptr;
+  /// Workers in other processes that take points too (may be null: this process's threads only).
+  SweepPeers* peers = nullptr;
 };
 
 struct SweepResult {

@@ -33,6 +33,7 @@
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
 #include "studies/run/runner.hpp"
+#include "studies/sweep/point_setter.hpp"
 #include "studies/sweep/sweep.hpp"
 
 namespace bd::studies {
@@ -53,8 +54,9 @@ std::string header_line(const Study& study) {
   return line;
 }
 
-// FNV-1a 64 of the study text, 16 hex digits: sweep.json's fingerprint
-std::string fingerprint(const std::string& text) {
+}  // namespace
+
+std::string sweep_fingerprint(const std::string& text) {
   std::uint64_t h = 14695981039346656037ull;
   for (char c : text) {
     h ^= static_cast<unsigned char>(c);
@@ -65,12 +67,9 @@ std::string fingerprint(const std::string& text) {
   return buf;
 }
 
-// --- one point -------------------------------------------------------------------------------
+namespace {
 
-struct PointRow {
-  std::string text;  // the row with its '\n'
-  bool ok = false;
-};
+// --- one point -------------------------------------------------------------------------------
 
 // appends the cells of a second design (balanced or optimised): its metrics, added mass and
 // inertia, or as many empty cells
@@ -105,16 +104,20 @@ std::pair<double, double> added(const Study& study, const RunResult& r) {
   return {mass, inertia};
 }
 
-// the row of point `index`: never throws (a point's failure is its row's status)
-// (`cells`: how many metric cells a row has)
-PointRow point_row(const Study& base, int index, std::span<const double> values,
-                   std::size_t cells) {
+// how many metric cells a row of `study`'s sweep has (a failed point's are all empty)
+std::size_t metric_cells(const Study& study) {
+  return sweep_columns(study).size() - 3 - study.sweep->parameters.size();
+}
+
+}  // namespace
+
+SweepRow sweep_row(const Study& base, int index, std::span<const double> values) {
   std::string head = std::to_string(index);
   for (double v : values) head += "," + text::shortest(v);  // the swept values as a person wrote them
   std::string status = "ok", message;
   std::string body;
   try {
-    const Study study = point_study(base, values);
+    const Study study = detail::sweep_point_study(base, values);
     const RunResult r = compute_study(study);
     for (const MetricValue& m : r.metric_list) body += "," + text::exact(m.value);
     if (base.balance || base.planar_balance) {
@@ -145,21 +148,23 @@ PointRow point_row(const Study& base, int index, std::span<const double> values,
   } catch (const InputError& e) {  // StudyError from point_study() included
     status = "bad-input";
     message = e.what();
-    body.assign(cells, ',');
+    body.assign(metric_cells(base), ',');
   } catch (const std::exception& e) {
     status = "error";
     message = e.what();
-    body.assign(cells, ',');
+    body.assign(metric_cells(base), ',');
   } catch (...) {
     status = "error";
     message = "unknown exception";
-    body.assign(cells, ',');
+    body.assign(metric_cells(base), ',');
   }
-  PointRow row;
+  SweepRow row;
   row.ok = status == "ok";
   row.text = head + body + "," + status + "," + csv_line_field(message) + "\n";
   return row;
 }
+
+namespace {
 
 // --- sweep.json ------------------------------------------------------------------------------
 
@@ -181,7 +186,7 @@ Json identity_json(const Study& study, int points) {
     if (req.design == SweepDesign::kGrid) j["values"] = p.values;
     parameters.push_back(j);
   }
-  return {{"fingerprint", fingerprint(req.study_text)},
+  return {{"fingerprint", sweep_fingerprint(req.study_text)},
           {"design", to_string(req.design)},
           {"seed", req.seed},
           {"points", points},
@@ -449,81 +454,139 @@ void start_files(const Study& study, const fs::path& out_dir, const SweepResult&
   }
 }
 
-// Computes points `first`..n-1 on `threads` workers, which take points in order from a shared
-// counter and hand finished rows to this thread, the only writer, which appends them to
-// sweep.csv in point order. Returns the number of rows sweep.csv holds at the end (fewer than n
-// when stopped); counts.failed counts the failed rows.
-int compute_points(const Study& study, const std::vector<std::vector<double>>& points,
-                   std::size_t cells, int first, int threads, const SweepOptions& options,
-                   const fs::path& csv_file, Counts& counts,
-                   const std::function<void(int, bool)>& report_progress) {
+// most rows computed and waiting for an earlier point before they are written: a slow point
+// holds back at most this many rows in memory (a few MB), whatever the number of points
+constexpr int kRowsAhead = 1 << 14;
+
+// The points of a sweep being computed: handed out in order to this process's threads and to
+// the peers, their rows kept until every earlier point is written.
+class PointQueue final : public SweepWork {
+ public:
+  PointQueue(int first, int n, const SweepOptions& options)
+      : next_(first), written_(first), n_(n), options_(options) {}
+
+  // under the lock (lock())
+  SweepClaim claim(int count) override {
+    if (stopping() || next_ >= n_) return {next_, next_, false};
+    if (next_ - written_ >= kRowsAhead) return {next_, next_, true};
+    const int begin = next_;
+    next_ = std::min(n_, next_ + std::max(count, 1));
+    return {begin, next_, false};
+  }
+  int unclaimed() const override { return n_ - next_; }
+  void deliver(int point, SweepRow row) override {
+    finished_.emplace(point, std::move(row));
+    changed_.notify_one();
+  }
+
+  std::unique_lock<std::mutex> lock() { return std::unique_lock<std::mutex>(mutex_); }
+  bool stopping() const {
+    return halt_.load() || (options_.stop != nullptr && options_.stop->load());
+  }
+  void halt() { halt_ = true; }
+
+  // a local thread's next point, waiting while too many rows wait to be written; -1 when none
+  int next_point() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      const SweepClaim c = claim(1);
+      if (!c.later) return c.empty() ? -1 : c.begin;
+      room_.wait_for(lock, std::chrono::milliseconds(50));
+    }
+  }
+  void local_row(int point, SweepRow row) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    deliver(point, std::move(row));
+  }
+  void local_worker_done() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      ++workers_done_;
+    }
+    changed_.notify_one();
+  }
+
+  // the writer: waits (`lock` held) up to `wait` for the next row in order, or for the end,
+  // then takes the rows ready in point order
+  std::vector<SweepRow> ready_rows(std::unique_lock<std::mutex>& lock,
+                                   std::chrono::milliseconds wait, int threads, bool peers_done) {
+    changed_.wait_for(lock, wait, [&] {
+      return (workers_done_ == threads && peers_done) ||
+             (!finished_.empty() && finished_.begin()->first == written_);
+    });
+    std::vector<SweepRow> batch;
+    for (auto it = finished_.begin(); it != finished_.end() && it->first == written_;
+         it = finished_.erase(it)) {
+      batch.push_back(std::move(it->second));
+      ++written_;
+    }
+    if (!batch.empty()) room_.notify_all();
+    return batch;
+  }
+  bool workers_done(int threads) const { return workers_done_ == threads; }
+  bool nothing_waiting() const { return finished_.empty(); }
+  int written() const { return written_; }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable changed_, room_;
+  std::map<int, SweepRow> finished_;  // rows not written yet (a later point may finish first)
+  int next_, written_, n_;
+  int workers_done_ = 0;
+  std::atomic<bool> halt_{false};  // the writer failed: the workers stop too
+  const SweepOptions& options_;
+};
+
+// Computes points `first`..n-1 on `threads` workers of this process (which take points in order,
+// one at a time) and on options.peers (which claim them in chunks), and appends the rows to
+// sweep.csv in point order on this thread, the only writer. Returns the number of rows sweep.csv
+// holds at the end (fewer than n when stopped); counts.failed counts the failed rows.
+int compute_points(const Study& study, const std::vector<std::vector<double>>& points, int first,
+                   int threads, const SweepOptions& options, const fs::path& csv_file,
+                   Counts& counts, const std::function<void(int, bool)>& report_progress) {
   const int n = static_cast<int>(points.size());
-  std::mutex mutex;
-  std::condition_variable changed;
-  std::map<int, PointRow> finished;  // rows not written yet (a later point may finish first)
-  int workers_done = 0;
-  std::atomic<int> next_point{first};
-  std::atomic<bool> halt{false};  // the writer failed: the workers stop too
-  auto stopping = [&] { return halt.load() || (options.stop != nullptr && options.stop->load()); };
-  int written = first;
+  PointQueue queue(first, n, options);
   RowFile csv(csv_file);
+  // with peers, the writer polls them every 2 ms; alone, it wakes for rows
+  const auto wait = std::chrono::milliseconds(options.peers ? 2 : 100);
+  bool peers_done = options.peers == nullptr;
   {
     std::vector<std::jthread> workers;
     try {
       for (int t = 0; t < threads; ++t) {
         workers.emplace_back([&] {
-          while (!stopping()) {
-            const int i = next_point.fetch_add(1);
-            if (i >= n) break;
-            PointRow row = point_row(study, i, points[static_cast<std::size_t>(i)], cells);
-            {
-              const std::lock_guard<std::mutex> lock(mutex);
-              finished.emplace(i, std::move(row));
-            }
-            changed.notify_one();
+          for (int i; (i = queue.next_point()) >= 0;) {
+            queue.local_row(i, sweep_row(study, i, points[static_cast<std::size_t>(i)]));
           }
-          {
-            const std::lock_guard<std::mutex> lock(mutex);
-            ++workers_done;
-          }
-          changed.notify_one();
+          queue.local_worker_done();
         });
       }
-
-      std::unique_lock<std::mutex> lock(mutex);
+      std::unique_lock<std::mutex> lock = queue.lock();
       for (;;) {
-        changed.wait_for(lock, std::chrono::milliseconds(100), [&] {
-          return workers_done == threads ||
-                 (!finished.empty() && finished.begin()->first == written);
-        });
-        std::vector<PointRow> batch;  // the next rows in point order
-        for (auto it = finished.begin(); it != finished.end() && it->first == written;
-             it = finished.erase(it)) {
-          batch.push_back(std::move(it->second));
-          ++written;
-        }
-        const bool last = workers_done == threads;
-        assert(!last || finished.empty());
+        if (!peers_done) peers_done = options.peers->poll(queue);
+        std::vector<SweepRow> batch = queue.ready_rows(lock, wait, threads, peers_done);
+        const bool last = queue.workers_done(threads) && peers_done && batch.empty();
+        assert(!last || queue.nothing_waiting());
+        int rows = queue.written() - static_cast<int>(batch.size());
         lock.unlock();
-        int rows = written - static_cast<int>(batch.size());
-        for (const PointRow& row : batch) {
+        for (const SweepRow& row : batch) {
           csv.append(row.text);
           if (!row.ok) ++counts.failed;
           report_progress(++rows, false);
         }
-        // every point started has finished once the workers are done, and points start in
-        // order: nothing is left behind
+        // every point handed out has come back once the workers and peers are done, and points
+        // are handed out in order: nothing is left behind
         if (last) break;
         lock.lock();
       }
     } catch (...) {
-      halt = true;
+      queue.halt();
       workers.clear();  // joins them
       throw;
     }
   }  // the workers join here
   csv.close();
-  return written;
+  return queue.written();
 }
 
 }  // namespace
@@ -535,7 +598,6 @@ SweepResult write_sweep(const Study& study, const fs::path& out_dir, const Sweep
   const std::vector<std::vector<double>> points = sweep_points(*study.sweep);
   const int n = static_cast<int>(points.size());
   const std::size_t columns = sweep_columns(study).size();
-  const std::size_t cells = columns - 3 - study.sweep->parameters.size();  // metric cells
   const std::string header = header_line(study);
 
   SweepResult result;
@@ -553,7 +615,8 @@ SweepResult write_sweep(const Study& study, const fs::path& out_dir, const Sweep
   counts.done = kept;
   counts.resumed = kept;
   counts.failed = existing.kept_failed;
-  counts.threads = std::min(std::max(wanted, 1), n - kept);
+  const int local = std::min(std::max(wanted, 1), n - kept);
+  counts.threads = local + (options.peers ? options.peers->threads() : 0);
   start_files(study, out_dir, result, options, existing, header, counts);
 
   auto report_progress = [&](int done, bool last_call) {
@@ -561,7 +624,7 @@ SweepResult write_sweep(const Study& study, const fs::path& out_dir, const Sweep
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     options.progress(SweepProgress{done, n, kept, elapsed, last_call});
   };
-  const int written = compute_points(study, points, cells, kept, counts.threads, options,
+  const int written = compute_points(study, points, kept, local, options,
                                      result.csv, counts, report_progress);
 
   counts.done = written;

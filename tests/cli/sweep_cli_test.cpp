@@ -24,9 +24,8 @@
 #include "studies/studies.hpp"
 #include "studies/study/load_study.hpp"
 #include "tests/support/studies.hpp"
+#include "tests/support/spawn.hpp"
 #include "tests/support/text.hpp"
-
-extern char** environ;
 
 namespace {
 
@@ -38,13 +37,8 @@ const std::string kExamples = BD_SOURCE_DIR "/studies/examples";
 using bd::testing::quote;
 
 using bd::testing::read;
+const auto rows = bd::testing::sweep_rows;
 
-// rows of a sweep.csv: its whole lines after the header
-long rows(const fs::path& csv) {
-  const std::string text = read(csv);
-  const long lines = std::count(text.begin(), text.end(), '\n');
-  return lines > 0 ? lines - 1 : 0;
-}
 
 // the paper's loaded linkage in free motion over 20 s, `count` points of a Latin hypercube: a
 // few milliseconds a point, so one thread takes a second or two
@@ -81,24 +75,12 @@ class SweepCli : public ::testing::Test {
 
   // starts `balance-design ARGS...` (absolute paths) in the background, its output to files
   pid_t start(const std::vector<std::string>& args) {
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    const std::string out = (dir_ / "child-stdout.txt").string();
-    const std::string err = (dir_ / "child-stderr.txt").string();
-    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out.c_str(),
-                                     O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err.c_str(),
-                                     O_WRONLY | O_CREAT | O_TRUNC, 0644);
     std::vector<std::string> all = {kExe};
     all.insert(all.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (std::string& a : all) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    pid_t pid = -1;
-    const int rc = posix_spawn(&pid, kExe.c_str(), &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    EXPECT_EQ(rc, 0) << "posix_spawn failed";
-    return rc == 0 ? pid : -1;
+    const pid_t pid = bd::testing::spawn_to_files(all, (dir_ / "child-stdout.txt").string(),
+                                                  (dir_ / "child-stderr.txt").string());
+    EXPECT_GT(pid, 0) << "posix_spawn failed";
+    return pid;
   }
 
   // waits until `csv` has at least `wanted` rows (true), or the child has ended (false)

@@ -535,9 +535,14 @@ TEST_F(SweepReportTest, OptimizeSweepKeepsTheOriginalOfAPointWithoutOptimum) {
   ASSERT_TRUE(std::regex_search(
       best, m, std::regex("<tr><th>Fsh_rms</th><td class=\"n\" title=\"([^\"]*)\">")));
   EXPECT_EQ(m[1].str(), rows[0][2]);
+  // the second design here is force-balanced: its Fsh is round-off, ranked nowhere
+  EXPECT_TRUE(std::regex_search(
+      best, std::regex("<tr><th>optimized_Fsh_rms</th><td class=\"n\" title=\"[^\"]*\">[^<]*"
+                       "</td><td colspan=\"2\">zero to round-off")))
+      << best;
   ASSERT_TRUE(std::regex_search(
       best, m,
-      std::regex("<tr><th>optimized_Fsh_rms</th><td class=\"n\" title=\"[^\"]*\">[^<]*</td>"
+      std::regex("<tr><th>optimized_Msh_rms</th><td class=\"n\" title=\"[^\"]*\">[^<]*</td>"
                  "<td class=\"n\" title=\"([0-9]+)\">")));
   EXPECT_NE(m[1].str(), "0");  // not at the point without an optimum
   EXPECT_EQ(count(section(html, "Failed points"), ">no-optimum<"), 1u);
@@ -632,6 +637,71 @@ TEST_F(SweepReportTest, WrittenPageIsTheBuiltPage) {
   for (const auto& e : fs::directory_iterator(dir_)) {
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
   }
+}
+
+}  // namespace
+}  // namespace bd::studies
+
+namespace bd::studies {
+namespace {
+
+// A 150 x 150 grid (22,500 points, written by hand: the page reads only the files): the charts
+// draw a regular sample of at most 40 values a side and say so, while the best points and the
+// counts are over every row (the least value sits off the sample), the page stays small, and a
+// force-balanced design's shaking force (round-off, 1e-14 N) is ranked nowhere.
+TEST_F(SweepReportTest, LargeGridIsSampledForTheChartsAndRankedWhole) {
+  std::vector<double> xs, ys;
+  for (int k = 0; k < 150; ++k) {
+    xs.push_back(1.0 + 0.02 * k);
+    ys.push_back(0.5 + 0.01 * k);
+  }
+  const std::vector<Param> params{{"linkage.coupler.mass", false, xs.front(), xs.back(), xs},
+                                  {"linkage.coupler.s", false, ys.front(), ys.back(), ys}};
+  const SweepFolder f(driven_balanced(), params, "grid");
+  const std::vector<std::vector<double>> points = grid(params);
+  f.write(dir_, points, 1, "complete");
+  const std::vector<std::string> header = f.header();
+  std::string csv;
+  for (const std::string& h : header) csv += (csv.empty() ? "" : ",") + h;
+  csv += "\n";
+  const std::size_t metrics = header.size() - 5;  // after point and the two values, before status
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double x = points[i][0], y = points[i][1];
+    std::string row = std::to_string(i) + "," + g17(x) + "," + g17(y);
+    for (std::size_t c = 0; c < metrics; ++c) {
+      const bool balanced_force = header[3 + c].rfind("balanced_Fsh", 0) == 0;
+      // a bowl with its least value at point 151 (x index 1, y index 1: off the sample, which
+      // keeps every 4th value from index 0); the balanced force 1e-14 N of round-off
+      const double v = balanced_force ? 1e-14 * (1 + std::sin(double(i)))
+                                      : 10 + (x - xs[1]) * (x - xs[1]) + (y - ys[1]) * (y - ys[1]);
+      row += "," + g17(v);
+    }
+    csv += row + ",ok,\n";
+  }
+  std::ofstream(dir_ / "sweep.csv", std::ios::binary) << csv;
+
+  const std::string html = sweep_report_html(f.study(), dir_, gnuplot_);
+  EXPECT_LT(html.size(), 5u << 20) << "the page grows with the points";
+  EXPECT_NE(html.find("22500 of 22500 points done"), std::string::npos);
+  const std::string best = section(html, "Best points");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(
+      best, m,
+      std::regex("<tr><th>Fsh_rms</th><td class=\"n\" title=\"[^\"]*\">[^<]*</td>"
+                 "<td class=\"n\" title=\"([0-9]+)\">")));
+  EXPECT_EQ(m[1].str(), "151");
+  EXPECT_NE(best.find("<tr><th>balanced_Fsh_rms</th>"), std::string::npos);
+  EXPECT_TRUE(std::regex_search(best, std::regex("<tr><th>balanced_Fsh_rms</th><td class=\"n\" "
+                                                 "title=\"[^\"]*\">[^<]*</td><td colspan=\"3\">"
+                                                 "zero to round-off")))
+      << best;
+  if (gnuplot_.empty()) return;
+  EXPECT_NE(html.find("Drawn: one in every 4 values of linkage.coupler.mass and one in every 4 "
+                      "of linkage.coupler.s (38 x 38 of the grid's points) of sweep.csv's 22500 "
+                      "rows"),
+            std::string::npos);
+  EXPECT_NE(html.find("coupler mass m2 [kg]"), std::string::npos);  // axes in an engineer's words
+  EXPECT_NE(html.find("every value zero to round-off"), std::string::npos);
 }
 
 }  // namespace
