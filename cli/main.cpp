@@ -224,6 +224,13 @@ int report(const std::string& dir) {
                  source.c_str(), summary.c_str());
     return kExitBadInput;
   }
+  // a data file cut short (a copy interrupted, a full disk): said before drawing from it, as
+  // bad input (exit 2) like a folder that holds no run
+  if (const std::string problem = sweep ? st::sweep_folder_problem(dir) : st::run_folder_problem(dir);
+      !problem.empty()) {
+    say_error(problem + ": the folder holds no whole run; run the study again");
+    return kExitBadInput;
+  }
   // errors: exit 1 with the message
   const fs::path written =
       sweep ? st::write_sweep_report(study, dir) : st::write_report(study, dir);
@@ -869,6 +876,9 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& bench_args) {
 
 int main(int argc, char** argv) {
   std::unique_ptr<bd::cli::MpiWorld> mpi;  // MPI_Finalize when main returns
+  // a file-size limit reached (ulimit -f) ends a write with EFBIG, which the writers report as
+  // one line (exit 1), instead of SIGXFSZ killing the program with a core dump
+  ::signal(SIGXFSZ, SIG_IGN);
   try {
     mpi = bd::cli::mpi_world(argc, argv);
     g_mpi = mpi.get();
@@ -906,7 +916,7 @@ int main(int argc, char** argv) {
     validate_cmd->footer("\nExit codes: 0 the study is valid (one ok line), 2 it is not (one "
                          "line FILE:LINE:COLUMN: message on stderr).\n");
     report_cmd->footer("\nDIR may be given from anywhere. Exit codes: 0 the page was written, "
-                       "1 it could not be, 2 DIR holds no run.\n");
+                       "1 it could not be, 2 DIR holds no run or a data file of it is cut short.\n");
 
     std::vector<std::string> argv_rest = with_default_command(argc, argv);
     if (argv_rest.empty()) {

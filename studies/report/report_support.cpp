@@ -359,11 +359,15 @@ bool executable(const fs::path& p) {
 
 namespace {
 
-// a temporary directory, removed with everything in it
+// a temporary directory, removed with everything in it; named after this process, so that the
+// next report removes it if a kill left it behind
 class TempDir {
  public:
   TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "bd-report-XXXXXX").string();
+    const fs::path tmp = fs::temp_directory_path();
+    remove_stale_scratch(tmp, "bd-report-");
+    std::string pattern =
+        (tmp / ("bd-report-" + std::to_string(::getpid()) + "-XXXXXX")).string();
     if (::mkdtemp(pattern.data()) == nullptr) {
       throw std::runtime_error("cannot create a temporary directory: " +
                                std::string(std::strerror(errno)));

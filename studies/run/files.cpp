@@ -9,11 +9,13 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
 
 #include "core/number_text.hpp"
+#include "studies/run/runner.hpp"
 
 namespace bd::studies {
 
@@ -23,6 +25,20 @@ namespace {
 
 [[noreturn]] void fail(const char* what, const fs::path& p) {
   throw std::runtime_error(std::string(what) + " " + p.string() + ": " + std::strerror(errno));
+}
+
+// a process id or counter as written in a temporary's name
+bool digits(const std::string& t) {
+  return !t.empty() && t.size() < 10 &&
+         std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
+// true when the process `pid_text` (digits) no longer exists; false for this process, and for
+// one that exists or that we may not ask about
+bool process_gone(const std::string& pid_text) {
+  const auto pid = static_cast<pid_t>(std::stol(pid_text));
+  if (pid == ::getpid() || pid <= 0) return false;
+  return ::kill(pid, 0) != 0 && errno == ESRCH;
 }
 
 std::string quote(const std::string& text) {
@@ -42,7 +58,7 @@ AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
   name.append(".").append(std::to_string(counter++)).append(".tmp");
   temp_ = target_.parent_path() / name;
   file_ = std::fopen(temp_.c_str(), "wbx");
-  if (!file_) fail("cannot create", temp_);
+  if (!file_) fail("cannot create", target_);  // the user's file named, not the temporary
 }
 
 AtomicFile::~AtomicFile() {
@@ -60,7 +76,7 @@ void AtomicFile::commit() {
   file_ = nullptr;
   if (write_error || close_error) {
     errno = write_error ? saved : errno;
-    fail("cannot write", temp_);
+    fail("cannot write", target_);
   }
   std::error_code ec;
   fs::rename(temp_, target_, ec);
@@ -84,17 +100,138 @@ void remove_stale_temporaries(const fs::path& dir) {
     if (pid_at == std::string::npos || pid_at == 0) continue;
     const std::string pid_text = stem.substr(pid_at + 1, counter - pid_at - 1);
     const std::string counter_text = stem.substr(counter + 1);
-    auto digits = [](const std::string& t) {
-      return !t.empty() && t.size() < 10 &&
-             std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
-    };
     if (!digits(pid_text) || !digits(counter_text)) continue;
-    const auto pid = static_cast<pid_t>(std::stol(pid_text));
-    if (pid == ::getpid() || pid <= 0) continue;
-    if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge
+    if (!process_gone(pid_text)) continue;
     std::error_code rm;
     fs::remove(it->path(), rm);
   }
+}
+
+void remove_stale_scratch(const fs::path& dir, const std::string& prefix) {
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    // <prefix><pid>-...
+    if (!name.starts_with(prefix)) continue;
+    const std::size_t dash = name.find('-', prefix.size());
+    if (dash == std::string::npos) continue;
+    const std::string pid_text = name.substr(prefix.size(), dash - prefix.size());
+    if (!digits(pid_text) || !process_gone(pid_text)) continue;
+    std::error_code rm;
+    fs::remove_all(it->path(), rm);
+  }
+}
+
+namespace {
+
+// `key.sub[3]` of the first number in `j` that is not finite, or ""
+std::string non_finite_at(const nlohmann::ordered_json& j, const std::string& at) {
+  if (j.is_number_float()) {
+    return std::isfinite(j.get<double>()) ? std::string() : (at.empty() ? "(the top)" : at);
+  }
+  if (j.is_object()) {
+    for (const auto& [key, value] : j.items()) {
+      if (std::string where = non_finite_at(value, at.empty() ? key : at + "." + key);
+          !where.empty()) {
+        return where;
+      }
+    }
+  } else if (j.is_array()) {
+    for (std::size_t k = 0; k < j.size(); ++k) {
+      if (std::string where = non_finite_at(j[k], at + "[" + std::to_string(k) + "]");
+          !where.empty()) {
+        return where;
+      }
+    }
+  }
+  return {};
+}
+
+// the number of lines of `text` and what is wrong with it as a CSV data file ("" when whole)
+std::string csv_text_problem(const std::string& text, std::size_t* rows) {
+  *rows = 0;
+  if (text.empty()) return "empty";
+  if (text.back() != '\n') return "its last line is cut short (no line end)";
+  std::size_t fields = 0;
+  std::size_t line_no = 0;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = text.find('\n', at);
+    const std::size_t n = csv_fields(text.substr(at, end - at)).size();
+    ++line_no;
+    if (line_no == 1) {
+      fields = n;
+    } else if (n != fields) {
+      return "line " + std::to_string(line_no) + " has " + std::to_string(n) + " fields, the header " +
+             std::to_string(fields) + " (cut short)";
+    }
+    at = end + 1;
+  }
+  *rows = line_no - 1;
+  return {};
+}
+
+}  // namespace
+
+void check_json_numbers(const nlohmann::ordered_json& j, const fs::path& file) {
+  if (const std::string where = non_finite_at(j, ""); !where.empty()) {
+    throw std::runtime_error("internal error: " + file.string() + " would hold a number that is " +
+                             "not finite at " + where + " (written as null, as if never computed)");
+  }
+}
+
+namespace {
+
+// the JSON object in `file`, or a discarded value when it is no JSON object
+nlohmann::ordered_json json_object(const fs::path& file) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::parse(read_file(file), nullptr, false);
+  if (!j.is_object()) j = nlohmann::ordered_json(nlohmann::ordered_json::value_t::discarded);
+  return j;
+}
+
+}  // namespace
+
+std::string sweep_folder_problem(const fs::path& dir) {
+  const fs::path file = dir / "sweep.json";
+  if (json_object(file).is_discarded()) {
+    return file.string() + ": not valid JSON (cut short or damaged)";
+  }
+  return {};
+}
+
+std::string run_folder_problem(const fs::path& dir) {
+  const fs::path summary_file = dir / "summary.json";
+  const nlohmann::ordered_json summary = json_object(summary_file);
+  if (summary.is_discarded()) {
+    return summary_file.string() + ": not valid JSON (cut short or damaged)";
+  }
+  std::error_code ec;
+  // each timeseries and the run in summary.json that gives its samples
+  const std::pair<const char*, const char*> series[] = {{"timeseries.csv", ""},
+                                                        {"balanced-timeseries.csv", "balanced_run"},
+                                                        {"optimized-timeseries.csv", "optimized_run"}};
+  for (const char* name : kRunFiles) {
+    const std::string_view n(name);
+    if (!n.ends_with(".csv")) continue;
+    const fs::path file = dir / name;
+    if (!fs::exists(file, ec)) continue;
+    std::size_t rows = 0;
+    if (const std::string why = csv_text_problem(read_file(file), &rows); !why.empty()) {
+      return file.string() + ": " + why;
+    }
+    for (const auto& [csv, run] : series) {
+      if (n != csv) continue;
+      const nlohmann::ordered_json& owner = *run ? summary.value(run, nlohmann::ordered_json()) : summary;
+      if (!owner.is_object() || !owner.contains("samples") || !owner["samples"].is_number_unsigned()) {
+        continue;
+      }
+      const auto samples = owner["samples"].get<std::size_t>();
+      if (rows != samples) {
+        return file.string() + ": " + std::to_string(rows) + " rows where summary.json says " +
+               std::to_string(samples) + " samples (cut short)";
+      }
+    }
+  }
+  return {};
 }
 
 void write_text_file(const std::string& text, const fs::path& file) {

@@ -3,6 +3,7 @@
 /// split one way for every writer and reader (timeseries, comparison, sweep and bench files).
 #include <cstdio>
 #include <filesystem>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,27 @@ class AtomicFile {
 /// timeseries in size. Those of running processes (a sweep's other points) are kept. Quiet: a
 /// temporary that cannot be removed stays.
 void remove_stale_temporaries(const std::filesystem::path& dir);
+
+/// Removes from `dir` the scratch folders or files named '<prefix><pid>-...' whose process is gone
+/// (a report's gnuplot folder, 'bd-report-<pid>-XXXXXX' in the temporary directory, left by a
+/// run killed while it drew). Quiet, as remove_stale_temporaries().
+void remove_stale_scratch(const std::filesystem::path& dir, const std::string& prefix);
+
+/// Throws std::runtime_error naming `file` and the key (e.g. "metrics.Fsh_rms") if `j` holds a
+/// number that is NaN or an infinity: nlohmann-json would write it as null, a value that was
+/// never computed. No value is written as an explicit null.
+void check_json_numbers(const nlohmann::ordered_json& j, const std::filesystem::path& file);
+
+/// What is wrong with the output folder `dir` of a single run, in one line naming the file, or ""
+/// when its data files are whole: summary.json parses, every CSV of the run (kRunFiles) ends its
+/// last line, each of its lines has the header's number of fields, and each timeseries has as
+/// many rows as summary.json's samples. A file cut short (a copy interrupted, another program
+/// filling the disk) shows here, before `balance-design report` draws from it.
+std::string run_folder_problem(const std::filesystem::path& dir);
+
+/// The same for a sweep's folder: sweep.json parses. (A last line of sweep.csv cut short is an
+/// interrupted sweep's, which its page shows and --resume drops.)
+std::string sweep_folder_problem(const std::filesystem::path& dir);
 
 /// Writes `text` to `file` through an AtomicFile.
 /// @throws std::runtime_error if the file cannot be written (the message names it).

@@ -675,8 +675,12 @@ void write_run(const Study& study, RunResult& result, const fs::path& out_dir) {
   // Pareto front of another design)
   // and its page: a run that fails midway (a full disk) must not leave the old report beside
   // the new data files (issue 17)
-  std::vector<std::string> names(std::begin(kRunFiles), std::end(kRunFiles));
-  names.emplace_back("report.html");
+  // summary.json and the page first: if a later removal fails (a folder in the way), no
+  // summary.json is left to vouch for the files that remain
+  std::vector<std::string> names = {"summary.json", "report.html"};
+  for (const char* name : kRunFiles) {
+    if (names.front() != name) names.emplace_back(name);
+  }
   for (const std::string& name : names) {
     if (fs::remove(out_dir / name, ec); ec) {
       throw std::runtime_error("cannot remove the earlier run's " + (out_dir / name).string() +

@@ -1,11 +1,13 @@
 // summary.json: what a run computed, as one JSON document written by nlohmann-json (keys in the
-// order below, numbers in their shortest exact text, a number that is not finite as null).
+// order below, numbers in their shortest exact text; null only where a value was not computed,
+// and a number that is not finite anywhere else an internal error, never written as null).
 #include <cassert>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <variant>
 
+#include "studies/run/files.hpp"
 #include "studies/run/runner.hpp"
 
 namespace bd::studies {
@@ -15,6 +17,9 @@ namespace {
 using Json = nlohmann::ordered_json;
 
 Json vec(const Vec2& v) { return Json::array({v.x(), v.y()}); }
+
+// a value that may not have been computed (NaN): null then
+Json value_or_null(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
 // the metrics in their table's order
 Json metrics_json(const MetricList& metrics) {
@@ -320,7 +325,9 @@ void add_solver_fields(Json& j, const Result& r, const OptimizedRun& o) {
   if (static_cast<std::size_t>(r.x.size()) == o.variable_names.size()) {
     for (std::size_t k = 0; k < o.variable_names.size(); ++k) {
       variables.push_back(
-          {{"name", o.variable_names[k]}, {"value", r.x[static_cast<Eigen::Index>(k)]}});
+          {{"name", o.variable_names[k]},
+           {"value", found ? Json(r.x[static_cast<Eigen::Index>(k)])
+                           : value_or_null(r.x[static_cast<Eigen::Index>(k)])}});
     }
   }
   j["variables"] = variables;
@@ -386,7 +393,7 @@ Json planar_optimize_json(const Study& study, const RunResult& result) {
     // other route of the engine (dae) against the reduced route's
     j["verified_with"] = is_free(study.scene) ? "dae route" : "the optimum simulated";
     j["verification_error"] = r.verification_error;
-    j["inertial_verification_error"] = r.inertial_error;  // null when not computed
+    j["inertial_verification_error"] = value_or_null(r.inertial_error);  // null: not computed
   }
   j["counterweights"] = cws;
   if (req.pareto) {
@@ -454,6 +461,7 @@ std::string summary_json(const Study& study, const RunResult& result) {
       if (o.harmonics) j["optimized_harmonics"] = harmonics_json(*o.harmonics);
     }
   }
+  check_json_numbers(j, "summary.json");
   // invalid UTF-8 in a message (a key copied from a study file) is replaced, never a failure
   return j.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }

@@ -211,6 +211,7 @@ std::string sweep_json(const Study& study, int points, const Counts& c) {
   j["resumed"] = c.resumed;
   j["failed"] = c.failed;
   j["elapsed_s"] = std::round(c.elapsed_s * 1000) / 1000;  // to the millisecond
+  check_json_numbers(j, "sweep.json");
   return j.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
@@ -303,7 +304,8 @@ std::string row_problem(const std::string& line, std::size_t i, std::size_t colu
 // --- writing rows ----------------------------------------------------------------------------
 
 // sweep.csv opened for appending: each row goes out in one write(2), so a kill leaves at most
-// one line cut short
+// one line cut short; a row that cannot be written whole (a full disk, a file-size limit) is
+// taken back, so the file ends with whole rows
 class RowFile {
  public:
   explicit RowFile(fs::path file) : file_(std::move(file)) {
@@ -317,12 +319,20 @@ class RowFile {
   }
 
   void append(const std::string& row) {
+    const off_t before = ::lseek(fd_, 0, SEEK_END);
     const char* p = row.data();
     std::size_t left = row.size();
     while (left > 0) {  // one write unless the kernel takes less (a full disk)
       const ssize_t n = ::write(fd_, p, left);
       if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) fail("cannot write");
+      if (n <= 0) {
+        const int saved = errno == 0 ? ENOSPC : errno;  // write(2) taking 0 bytes: no space
+        if (before >= 0 && ::ftruncate(fd_, before) != 0) {
+          // the row stays cut short (--resume drops it); the error said is the write's
+        }
+        errno = saved;
+        fail("cannot write");
+      }
       p += n;
       left -= static_cast<std::size_t>(n);
     }
@@ -571,6 +581,7 @@ int compute_points(const Study& study, const std::vector<std::vector<double>>& p
         lock.unlock();
         for (const SweepRow& row : batch) {
           csv.append(row.text);
+          counts.done = rows + 1;  // what sweep.json says if a later row cannot be written
           if (!row.ok) ++counts.failed;
           report_progress(++rows, false);
         }
@@ -624,8 +635,22 @@ SweepResult write_sweep(const Study& study, const fs::path& out_dir, const Sweep
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     options.progress(SweepProgress{done, n, kept, elapsed, last_call});
   };
-  const int written = compute_points(study, points, kept, local, options,
-                                     result.csv, counts, report_progress);
+  int written = kept;
+  try {
+    written = compute_points(study, points, kept, local, options, result.csv, counts,
+                             report_progress);
+  } catch (...) {
+    // sweep.csv ends with whole rows (the one that failed was taken back); sweep.json says the
+    // sweep stopped, not that it is running (a full disk may refuse this too: the error thrown
+    // is the one that says why)
+    counts.status = "interrupted";
+    counts.elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
+    try {
+      write_text_file(sweep_json(study, n, counts), result.summary);
+    } catch (...) {
+    }
+    throw;
+  }
 
   counts.done = written;
   counts.status = written == n ? "complete" : "interrupted";
