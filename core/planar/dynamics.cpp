@@ -279,7 +279,8 @@ Unexpected<PlanarError> singular_at(const Model& model, const Workspace& ws,
 // triangular solves instead of a Jacobian and a factorisation. It converges linearly; a
 // contraction worse than kChordContraction, or too many steps, hands over to Newton. On success
 // the position is exact to round-off: after the step that moves no coordinate by more than the
-// step limit, one more (the remaining error shrinks by the contraction again). The angle inputs'
+// step limit, one more (the remaining error shrinks by the contraction again), unless the
+// contraction of the last two steps puts that one below round-off. The angle inputs'
 // rows are taken as u × d (detail::AngleRow::kCross: no atan2 per iteration), which the first
 // step's reach keeps near their root, where they and the angle form agree.
 bool chord_iterations(const Model& model, Workspace& ws) {
@@ -299,6 +300,10 @@ bool chord_iterations(const Model& model, Workspace& ws) {
     detail::nodes_from_q(s, ws.q, in.x);
     if (converged) return true;
     converged = size <= step_limit;
+    // the next step, as the last two shrank, would move no coordinate by more than round-off:
+    // it is not taken
+    if (converged && it > 0 && size * (size / previous) <= kRefactorStep * model.length_scale())
+      return true;
     previous = size;
   }
   return false;
@@ -513,6 +518,11 @@ void link_node_forces(const Model& model, Workspace& ws) {
     const Vec4 inertia = s.element_M[k] * acc;
     const double moment =
         s.shafts.empty() ? s.link_moment[k] : detail::link_moment_at(s, static_cast<int>(k), in.x);
+    if (s.link_force[k].isZero(0.0) && moment == 0.0) {  // an unloaded link (as applied_forces)
+      f(static_cast<int>(k), e.p) += inertia.segment<2>(0);
+      f(static_cast<int>(k), e.q) += inertia.segment<2>(2);
+      continue;
+    }
     const Vec4 applied = element_nodal_forces(s.com_weights[k], s.link_force[k], moment,
                                               in.x[static_cast<std::size_t>(e.p)],
                                               in.x[static_cast<std::size_t>(e.q)]);
