@@ -112,6 +112,7 @@ void SmallLu::compute(const Eigen::MatrixXd& a) {
 }
 
 void SmallLu::solve_in_place(double* b) const {
+  if (n_ == 0) return;  // nothing to solve (and no kernel chosen if never factorised)
   solve_kernel_(lu_.data(), perm_.indices().data(), b, n_);
 }
 
@@ -138,7 +139,7 @@ void SmallLu::solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const {
 
 void SmallLu::solve_transpose(Eigen::VectorXd& b) const {
   if (n_ <= kFixedSize) {
-    transpose_kernel_(lu_.data(), perm_.indices().data(), b.data(), n_);
+    if (n_ > 0) transpose_kernel_(lu_.data(), perm_.indices().data(), b.data(), n_);
     return;
   }
   // A = P⁻¹ L U: Uᵀ, then Lᵀ, then the permutation
