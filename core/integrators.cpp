@@ -14,6 +14,7 @@
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <cstddef>
@@ -193,7 +194,12 @@ void Integration::set_up_sensitivities(const Problem& p) {
   // centred differences along (s_i, e_i) at once (DQrhomax = 0), increments ~sqrt(rtol):
   // truncation ~rtol relative, below the integration error
   check_setup(CVodeSetSensDQMethod(memory_, CV_CENTERED, 0.0), "CVodeSetSensDQMethod");
-  check_setup(CVodeSensEEtolerances(memory_), "CVodeSensEEtolerances");
+  std::vector<double> absolute(s.which.size());
+  const double* atol = N_VGetArrayPointer(atol_);
+  const double atol_min = *std::min_element(atol, atol + N_VGetLength(atol_));
+  for (std::size_t i = 0; i < absolute.size(); ++i) absolute[i] = atol_min / s.scales[i];
+  check_setup(CVodeSensSStolerances(memory_, s.tolerance, absolute.data()),
+              "CVodeSensSStolerances");
   check_setup(CVodeSetSensErrCon(memory_, SUNTRUE), "CVodeSetSensErrCon");
   if (p.integrator == Integrator::kCvodeAdams) {
     sensitivity_nonlinear_ = SUNNonlinSol_FixedPointSens(sensitivity_count_, y_, 0, context_);

@@ -61,11 +61,13 @@ struct Problem {
   /// them there to form its centred difference quotients of (df/dy) s_i + df/dp_i (one
   /// directional difference, two right-hand sides per sensitivity), so no Jacobian is written
   /// by hand. The sensitivities start at 0 (y0 does not depend on p) and take part in the error
-  /// test, each with the state's tolerances divided by its scale (CVodeSensEEtolerances).
+  /// test at their own relative `tolerance` and the state's smallest absolute tolerance divided
+  /// by their scale.
   struct Sensitivities {
     double* parameters{};         // every parameter the right-hand side reads
     std::vector<int> which;       // the entries differentiated
     std::vector<double> scales;   // their typical magnitudes (CVODES' pbar), > 0, as `which`
+    double tolerance = 1e-7;      // relative, of the sensitivities' error test
   } sensitivities;
 };
 

@@ -49,12 +49,16 @@ struct OptimizeOptions {
 };
 
 /// Whether options.algorithm can solve the problem at all, decided without solving anything:
-/// a gradient method (uses_gradients()) in a free scene, whose evaluations are simulations
-/// without derivatives, or mma with force_balance (equalities, which mma does not take), is a
-/// problem with field "algorithm", e.g. text() "algorithm 'slsqp' needs gradients, which a free
-/// scene does not provide; use cobyla or isres". optimize() refuses what this refuses.
+/// a gradient method (uses_gradients()) in a free scene on the opened loop (formulation
+/// kOpenedLoop, whose DAE has no sensitivities; the reduced equation's give the gradients of
+/// every other free scene), or mma with force_balance (equalities, which mma does not take), is
+/// a problem with field "algorithm", e.g. text() "algorithm 'slsqp' needs gradients, which a
+/// free scene on the opened loop (method opened-loop) does not provide; use cobyla or isres, or
+/// the method mass-matrix or complex-masses". optimize() refuses what this refuses.
 bd::Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options);
-/// The same for any linkage type's problem: in a free scene or not, with force balance or not.
+/// The same for any linkage type's problem: in a free scene without gradients (the general
+/// planar linkage's) or not, with force balance or not; e.g. text() "algorithm 'slsqp' needs
+/// gradients, which a free scene does not provide; use cobyla or isres".
 bd::Problem check_algorithm(const OptimizeOptions& options, bool free_scene, bool force_balance);
 
 enum class Termination {

@@ -1,5 +1,6 @@
 #include "core/fourbar/sensitivity.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <numbers>
@@ -16,6 +17,15 @@ namespace {
 // the step of a sample's directional difference, relative to the parameter's scale (see the
 // header: truncation ~h², round-off ~eps/h)
 constexpr double kStep = 1e-5;
+
+// The sensitivities' relative tolerance, at most as tight as this: their right-hand side is
+// CVODES' difference quotient of the dynamics, whose round-off (that of the loop closure and the
+// solve, over an increment ~sqrt(rtol)) leaves a noise floor near 1e-9 of the derivatives. The
+// error test cannot see below it and only shrinks the step: measured on the paper's four-bar
+// (1 s, gravity), 1e-9 takes ~3000 steps, 1e-8 ~650, 1e-7 ~330 against 158 for the state alone,
+// and with 1e-7 every sample's derivative and every metric's gradient agrees with central
+// differences of full runs to 1e-6 of its size (tests/core/sensitivity_test.cpp).
+constexpr double kSensitivityTolerance = 1e-7;
 
 // the numbers of a sample, by kind: angles (differences taken modulo 2π, as the dynamics
 // returns theta2 and theta3 wrapped while a trajectory continues them), other scalars, vectors
@@ -99,6 +109,7 @@ FreeSensitivities simulate_free_sensitivities(const FourBar& model, const FreeSc
   FreeSensitivities out;
   out.parameters = parameters;
   detail::StateSensitivities state;
+  state.tolerance = std::max(options.tolerance, kSensitivityTolerance);
   for (const LinkParameter& p : parameters) {
     state.which.push_back(4 * (p.link - 1) + static_cast<int>(p.kind));
     state.scales.push_back(scale_of(model, p));

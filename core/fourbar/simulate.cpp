@@ -432,7 +432,7 @@ Trajectory detail::simulate_free_reduced(const FourBar& model, const FreeScene& 
     sensitivities->parameters = link_parameters(model);
     motion.link_parameters = sensitivities->parameters.data();
     problem.sensitivities = {sensitivities->parameters.data(), sensitivities->which,
-                             sensitivities->scales};
+                             sensitivities->scales, sensitivities->tolerance};
     sensitivities->state.assign(1, std::vector<Vec2>(sensitivities->which.size(), Vec2::Zero()));
   }
   integrators::Integration integration(problem);

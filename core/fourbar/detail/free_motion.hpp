@@ -56,6 +56,7 @@ inline FourBar with_link_parameters(const FourBar& model, const double* p) {
 struct StateSensitivities {
   std::vector<int> which;      // the entries of LinkParameters differentiated
   std::vector<double> scales;  // their typical magnitudes, > 0 (CVODES' pbar)
+  double tolerance{};          // relative, of the sensitivities' error test
   LinkParameters parameters{};  // set by the run: the model's
   /// set by the run: per sample, per entry of `which`, d(theta1, omega1)/dp [rad/unit],
   /// [rad/s/unit]
