@@ -30,7 +30,9 @@ bool uses_gradients(Algorithm a);
 /// trying, as words: "ipopt, mlsl, slsqp" (driven scenes), "isres" (free scenes, after cobyla).
 std::string other_algorithms(Algorithm used, bool free_scene);
 /// The method a study gets when it names none: slsqp in a driven scene (exact gradients from
-/// the regressor), cobyla in a free one (every evaluation a simulation, no gradients).
+/// the regressor), cobyla in a free one (every evaluation a simulation; a four-bar's gradient
+/// methods there take the gradients of forward sensitivities, but the general planar linkage's
+/// free scenes have none, and docs/performance.md, "Free scenes", says why cobyla stays).
 constexpr Algorithm default_algorithm(bool free_scene) {
   return free_scene ? Algorithm::kCobyla : Algorithm::kSlsqp;
 }
