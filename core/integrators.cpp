@@ -188,9 +188,9 @@ void Integration::set_up_sensitivities(const Problem& p) {
   // same dense linear solver)
   check_setup(CVodeSensInit(memory_, sensitivity_count_, CV_STAGGERED, nullptr, sensitivities_),
               "CVodeSensInit");
-  check_setup(CVodeSetSensParams(memory_, s.parameters, parameter_scales_.data(),
-                                 parameter_list_.data()),
-              "CVodeSetSensParams");
+  check_setup(
+      CVodeSetSensParams(memory_, s.parameters, parameter_scales_.data(), parameter_list_.data()),
+      "CVodeSetSensParams");
   // centred differences along (s_i, e_i) at once (DQrhomax = 0), increments ~sqrt(rtol):
   // truncation ~rtol relative, below the integration error
   check_setup(CVodeSetSensDQMethod(memory_, CV_CENTERED, 0.0), "CVodeSetSensDQMethod");

@@ -64,10 +64,10 @@ struct Problem {
   /// test at their own relative `tolerance` and the state's smallest absolute tolerance divided
   /// by their scale.
   struct Sensitivities {
-    double* parameters{};         // every parameter the right-hand side reads
-    std::vector<int> which;       // the entries differentiated
-    std::vector<double> scales;   // their typical magnitudes (CVODES' pbar), > 0, as `which`
-    double tolerance = 1e-7;      // relative, of the sensitivities' error test
+    double* parameters{};        // every parameter the right-hand side reads
+    std::vector<int> which;      // the entries differentiated
+    std::vector<double> scales;  // their typical magnitudes (CVODES' pbar), > 0, as `which`
+    double tolerance = 1e-7;     // relative, of the sensitivities' error test
   } sensitivities;
 };
 

@@ -147,7 +147,8 @@ double FreeNlp::objective(const VectorXd& x, VectorXd* grad) const {
       const Inertial in = inertial(x, grad != nullptr);
       f += w * added_mass(in.q) / original_mass_;
       if (grad) {
-        for (int k = 1; k <= 3; ++k) *grad += w * in.B.row(link_base(k)).transpose() / original_mass_;
+        for (int k = 1; k <= 3; ++k)
+          *grad += w * in.B.row(link_base(k)).transpose() / original_mass_;
       }
       continue;
     }

@@ -42,8 +42,7 @@ constexpr Vec2 DynamicsSample::*kVectors[] = {
     &DynamicsSample::FA2, &DynamicsSample::Fsh_inertial, &DynamicsSample::Fsh_static};
 
 // (a - b) / step, number by number
-DynamicsSample difference_quotient(const DynamicsSample& a, const DynamicsSample& b,
-                                   double step) {
+DynamicsSample difference_quotient(const DynamicsSample& a, const DynamicsSample& b, double step) {
   constexpr double kTwoPi = 2 * std::numbers::pi;
   DynamicsSample d;
   for (auto f : kAngles) {
@@ -141,8 +140,7 @@ FreeSensitivities simulate_free_sensitivities(const FourBar& model, const FreeSc
         const DynamicsError& e = plus ? minus.error() : plus.error();
         out.trajectory.status = status_of(e.kind);
         out.trajectory.message = "sensitivity at t = " + text::digits(out.trajectory.t[i], 10) +
-                                 " s, theta1 = " + text::digits(s.theta1, 10) +
-                                 " rad: " + e.what();
+                                 " s, theta1 = " + text::digits(s.theta1, 10) + " rad: " + e.what();
         out.derivative.clear();
         return out;
       }

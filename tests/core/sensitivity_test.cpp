@@ -75,13 +75,13 @@ Trajectory run(FourBar m, const FreeScene& scene, double tolerance, Formulation 
 
 // the quantities compared sample by sample
 std::vector<double> numbers(const DynamicsSample& s) {
-  return {s.state.theta1,   s.state.omega1,   s.state.alpha1,   s.RA0.x(),
-          s.RA0.y(),        s.RA3.x(),        s.RA3.y(),        s.Fsh_inertial.x(),
-          s.Fsh_inertial.y(), s.Msh_inertial, s.Fsh.x(),        s.Msh};
+  return {s.state.theta1,     s.state.omega1, s.state.alpha1, s.RA0.x(),
+          s.RA0.y(),          s.RA3.x(),      s.RA3.y(),      s.Fsh_inertial.x(),
+          s.Fsh_inertial.y(), s.Msh_inertial, s.Fsh.x(),      s.Msh};
 }
-const char* const kNames[] = {"theta1", "omega1", "alpha1", "RA0x", "RA0y", "RA3x",
-                              "RA3y",   "Fsh_inertial_x", "Fsh_inertial_y", "Msh_inertial",
-                              "Fshx",   "Msh"};
+const char* const kNames[] = {"theta1",         "omega1",       "alpha1", "RA0x",
+                              "RA0y",           "RA3x",         "RA3y",   "Fsh_inertial_x",
+                              "Fsh_inertial_y", "Msh_inertial", "Fshx",   "Msh"};
 
 struct Case {
   std::string name;
@@ -93,8 +93,8 @@ struct Case {
 std::vector<Case> cases() {
   std::mt19937_64 rng(15);
   return {
-      {"paper four-bar with gravity", samples::with_paper_loads(samples::paper_fourbar_unloaded(),
-                                                                Vec2(0, -9.81)),
+      {"paper four-bar with gravity",
+       samples::with_paper_loads(samples::paper_fourbar_unloaded(), Vec2(0, -9.81)),
        FreeScene{.theta1 = 1.0, .omega1 = 3.0, .duration = 1.0, .samples = 41},
        Formulation::kComplexMasses},
       {"random crank-rocker", samples::random_crank_rocker(rng),
@@ -206,8 +206,7 @@ TEST(Sensitivity, SamplesAndMetricsMatchCentralDifferencesOfFullRuns) {
       }
       ASSERT_GT(largest, 0.0) << info.name;
       for (std::size_t j = 0; j < got.size(); ++j) {
-        EXPECT_NEAR(got[j], referee[j], kTolerance * largest)
-            << info.name << " by parameter " << j;
+        EXPECT_NEAR(got[j], referee[j], kTolerance * largest) << info.name << " by parameter " << j;
       }
     }
   }
@@ -239,8 +238,10 @@ TEST(Sensitivity, BdfAgreesWithAdams) {
   // BDF (orders <= 5) needs far more steps than Adams at this tolerance: two parameters
   const std::vector<LinkParameter> some = {{1, LinkParameter::Kind::kMass},
                                            {3, LinkParameter::Kind::kF}};
-  const Eigen::MatrixXd a = metric_gradients(simulate_free_sensitivities(c.model, c.scene, some, adams));
-  const Eigen::MatrixXd b = metric_gradients(simulate_free_sensitivities(c.model, c.scene, some, bdf));
+  const Eigen::MatrixXd a =
+      metric_gradients(simulate_free_sensitivities(c.model, c.scene, some, adams));
+  const Eigen::MatrixXd b =
+      metric_gradients(simulate_free_sensitivities(c.model, c.scene, some, bdf));
   // two integrators at tolerance 1e-10: their sensitivities differ by ~1e-9 of their size
   EXPECT_LT((a - b).norm(), 1e-6 * a.norm());
   EXPECT_GT(a.norm(), 0.0);
@@ -273,8 +274,10 @@ TEST(Sensitivity, RefusesWhatItCannotDifferentiate) {
                      "integrator: forward sensitivities need cvode-adams or cvode-bdf (CVODES), "
                      "got erk5");
   expect_input_error(
-      [&] { simulate_free_sensitivities(c.model, c.scene, {{1}, {2}, {1}}, {}); }, "parameters",
-      "parameters[2] is listed twice");
+      [&] {
+        simulate_free_sensitivities(c.model, c.scene, {{1}, {2}, {1}}, {});
+      },
+      "parameters", "parameters[2] is listed twice");
   expect_input_error([&] { simulate_free_sensitivities(c.model, c.scene, {{4}}, {}); },
                      "parameters", "parameters[0].link must be 1, 2 or 3, got 4");
 }

@@ -28,18 +28,21 @@ std::size_t metric_index_of(Metric m) { return static_cast<std::size_t>(m); }
 // rocker and the coupler's mass and centre of mass as variables
 DesignProblem free_problem(Metric metric) {
   DesignProblem p;
-  p.original = core::samples::with_paper_loads(core::samples::paper_fourbar_unloaded(),
-                                               Vec2(0, -9.81));
+  p.original =
+      core::samples::with_paper_loads(core::samples::paper_fourbar_unloaded(), Vec2(0, -9.81));
   p.scene = core::FreeScene{.theta1 = 1.0, .omega1 = 3.0, .duration = 1.0, .samples = 41};
   p.formulation = core::Formulation::kComplexMasses;
   p.tolerance = 1e-10;
   p.counterweights = {CounterweightVariables{.link = 1, .mass_max = 4.0, .distance_max = 0.8},
                       CounterweightVariables{.link = 3, .mass_max = 4.0, .distance_max = 0.8}};
-  p.link_parameters = {
-      LinkParameterVariable{.link = 2, .parameter = LinkParameterVariable::Parameter::kMass,
-                            .lower = 1.0, .upper = 5.0},
-      LinkParameterVariable{.link = 2, .parameter = LinkParameterVariable::Parameter::kE,
-                            .lower = 0.5, .upper = 2.0}};
+  p.link_parameters = {LinkParameterVariable{.link = 2,
+                                             .parameter = LinkParameterVariable::Parameter::kMass,
+                                             .lower = 1.0,
+                                             .upper = 5.0},
+                       LinkParameterVariable{.link = 2,
+                                             .parameter = LinkParameterVariable::Parameter::kE,
+                                             .lower = 0.5,
+                                             .upper = 2.0}};
   p.objective = {Term{metric, 1.0}};
   return p;
 }
@@ -91,8 +94,7 @@ TEST(FreeNlp, GradientOfEveryMetricMatchesCentralDifferences) {
       ASSERT_GT(d.cwiseAbs().maxCoeff(), 0.0);
       for (int j = 0; j < nlp.n(); ++j) {
         EXPECT_NEAR(g(j), d(j), kTolerance * d.cwiseAbs().maxCoeff())
-            << nlp.variable_names()[static_cast<std::size_t>(j)] << " ("
-            << to_string(form) << ")";
+            << nlp.variable_names()[static_cast<std::size_t>(j)] << " (" << to_string(form) << ")";
       }
     }
   }

@@ -54,9 +54,9 @@ inline FourBar with_link_parameters(const FourBar& model, const double* p) {
 
 /// What simulate_free_reduced() takes and gives for forward sensitivities.
 struct StateSensitivities {
-  std::vector<int> which;      // the entries of LinkParameters differentiated
-  std::vector<double> scales;  // their typical magnitudes, > 0 (CVODES' pbar)
-  double tolerance{};          // relative, of the sensitivities' error test
+  std::vector<int> which;       // the entries of LinkParameters differentiated
+  std::vector<double> scales;   // their typical magnitudes, > 0 (CVODES' pbar)
+  double tolerance{};           // relative, of the sensitivities' error test
   LinkParameters parameters{};  // set by the run: the model's
   /// set by the run: per sample, per entry of `which`, d(theta1, omega1)/dp [rad/unit],
   /// [rad/s/unit]
@@ -68,8 +68,7 @@ struct StateSensitivities {
 /// sensitivities of (theta1, omega1) when `sensitivities` is not null (options.integrator
 /// kCvodeAdams or kCvodeBdf).
 Trajectory simulate_free_reduced(const FourBar& model, const FreeScene& scene,
-                                 const SimulateOptions& options,
-                                 StateSensitivities* sensitivities);
+                                 const SimulateOptions& options, StateSensitivities* sensitivities);
 
 /// Sets the status (kIntegratorFailed) and message of a run whose integration stopped short on
 /// its own account, the dynamics not having failed: `max_steps` used up (Outcome::kMaxSteps), or
