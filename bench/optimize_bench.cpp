@@ -5,7 +5,10 @@
 // - one fresh driven simulation of the same design (core::simulate_driven, what an evaluation
 //   would cost without the regressor), and of one revolution's metrics from it;
 // - one whole optimisation of the Berkof–Lowen problem (force balance as equalities, least RMS
-//   shaking moment) by SLSQP and by Ipopt.
+//   shaking moment) by SLSQP and by Ipopt;
+// - one whole optimisation in a free scene (the loaded linkage under gravity swinging from a
+//   push), derivative-free (cobyla) and with gradients by forward sensitivities (slsqp, mma,
+//   ipopt), and one evaluation there with and without the gradient.
 #include <benchmark/benchmark.h>
 
 #include <numbers>
@@ -134,5 +137,41 @@ BENCHMARK_CAPTURE(BM_Optimize, budget_mma, budget, Algorithm::kMma)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Optimize, budget_ipopt, budget, Algorithm::kIpopt)
     ->Unit(benchmark::kMillisecond);
+
+// the free-scene problem (docs/performance.md, "Free scenes"): the paper's loaded four-bar under
+// gravity, from theta1 = 1 rad at 3 rad/s for 1 s (41 samples), least RMS shaking force with
+// counterweights on crank and rocker and at most 2 kg added
+DesignProblem free_budget() {
+  DesignProblem p;
+  p.original = core::samples::with_paper_loads(core::samples::paper_fourbar_unloaded(),
+                                               Vec2(0, -9.81));
+  p.scene = core::FreeScene{.theta1 = 1.0, .omega1 = 3.0, .duration = 1.0, .samples = 41};
+  p.formulation = core::Formulation::kComplexMasses;
+  p.counterweights = {CounterweightVariables{.link = 1, .mass_max = 4.0, .distance_max = 0.8},
+                      CounterweightVariables{.link = 3, .mass_max = 4.0, .distance_max = 0.8}};
+  p.objective = {Term{Metric::kFshRms, 1.0}};
+  p.limits = {Limit{Metric::kAddedMass, 2.0}};
+  return p;
+}
+BENCHMARK_CAPTURE(BM_Optimize, free_cobyla, free_budget, Algorithm::kCobyla)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Optimize, free_slsqp, free_budget, Algorithm::kSlsqp)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Optimize, free_mma, free_budget, Algorithm::kMma)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Optimize, free_ipopt, free_budget, Algorithm::kIpopt)
+    ->Unit(benchmark::kMillisecond);
+
+// one free-scene evaluation: a simulation (no gradient) or the sensitivity run (with it)
+void BM_FreeObjective(benchmark::State& state) {
+  const Nlp nlp(free_budget());
+  Eigen::VectorXd x = nlp.start(), g(nlp.n());
+  const bool gradient = state.range(0) != 0;
+  for (auto _ : state) {
+    double f = nlp.objective(nudged(nlp, x), gradient ? &g : nullptr);
+    benchmark::DoNotOptimize(f);
+  }
+}
+BENCHMARK(BM_FreeObjective)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace

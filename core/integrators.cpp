@@ -3,9 +3,9 @@
 #include <arkode/arkode.h>
 #include <arkode/arkode_butcher_erk.h>
 #include <arkode/arkode_erkstep.h>
-#include <cvode/cvode.h>
-#include <cvode/cvode_ls.h>
-#include <cvode/cvode_proj.h>
+#include <cvodes/cvodes.h>
+#include <cvodes/cvodes_ls.h>
+#include <cvodes/cvodes_proj.h>
 #include <ida/ida.h>
 #include <ida/ida_ls.h>
 #include <nvector/nvector_serial.h>
@@ -14,6 +14,7 @@
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <cstddef>
@@ -135,6 +136,7 @@ Integration::Integration(const Problem& p)
   switch (package_) {
     case Package::kCvode:
       set_up_cvode(p);
+      if (!p.sensitivities.which.empty()) set_up_sensitivities(p);
       break;
     case Package::kArkode:
       set_up_arkode(p);
@@ -170,6 +172,46 @@ void Integration::set_up_cvode(const Problem& p) {
   }
   check_setup(CVodeSetStopTime(memory_, p.t_end), "CVodeSetStopTime");
   if (p.root != nullptr) check_setup(CVodeRootInit(memory_, 1, p.root), "CVodeRootInit");
+}
+
+void Integration::set_up_sensitivities(const Problem& p) {
+  const Problem::Sensitivities& s = p.sensitivities;
+  assert(s.parameters != nullptr && s.scales.size() == s.which.size());
+  sensitivity_count_ = static_cast<int>(s.which.size());
+  sensitivities_ = N_VCloneVectorArray(sensitivity_count_, y_);
+  check_allocated(sensitivities_, "N_VCloneVectorArray");
+  for (int i = 0; i < sensitivity_count_; ++i) N_VConst(0.0, sensitivities_[i]);
+  parameter_scales_ = s.scales;
+  parameter_list_ = s.which;
+  // staggered corrector: the state's step is converged first, then the sensitivities' on the
+  // same step, by the state's kind of iteration (fixed point for Adams, Newton for BDF with the
+  // same dense linear solver)
+  check_setup(CVodeSensInit(memory_, sensitivity_count_, CV_STAGGERED, nullptr, sensitivities_),
+              "CVodeSensInit");
+  check_setup(
+      CVodeSetSensParams(memory_, s.parameters, parameter_scales_.data(), parameter_list_.data()),
+      "CVodeSetSensParams");
+  // centred differences along (s_i, e_i) at once (DQrhomax = 0), increments ~sqrt(rtol):
+  // truncation ~rtol relative, below the integration error
+  check_setup(CVodeSetSensDQMethod(memory_, CV_CENTERED, 0.0), "CVodeSetSensDQMethod");
+  std::vector<double> absolute(s.which.size());
+  const double* atol = N_VGetArrayPointer(atol_);
+  const double atol_min = *std::min_element(atol, atol + N_VGetLength(atol_));
+  for (std::size_t i = 0; i < absolute.size(); ++i) absolute[i] = atol_min / s.scales[i];
+  check_setup(CVodeSensSStolerances(memory_, s.tolerance, absolute.data()),
+              "CVodeSensSStolerances");
+  check_setup(CVodeSetSensErrCon(memory_, SUNTRUE), "CVodeSetSensErrCon");
+  if (p.integrator == Integrator::kCvodeAdams) {
+    sensitivity_nonlinear_ = SUNNonlinSol_FixedPointSens(sensitivity_count_, y_, 0, context_);
+    check_allocated(sensitivity_nonlinear_, "SUNNonlinSol_FixedPointSens");
+    check_setup(CVodeSetNonlinearSolverSensStg(memory_, sensitivity_nonlinear_),
+                "CVodeSetNonlinearSolverSensStg");
+  }
+}
+
+const double* Integration::sensitivity(int i) const {
+  assert(i >= 0 && i < sensitivity_count_);
+  return N_VGetArrayPointer(sensitivities_[i]);
 }
 
 void Integration::set_up_arkode(const Problem& p) {
@@ -235,6 +277,8 @@ Integration::~Integration() {
         break;
     }
   }
+  if (sensitivity_nonlinear_ != nullptr) SUNNonlinSolFree(sensitivity_nonlinear_);
+  if (sensitivities_ != nullptr) N_VDestroyVectorArray(sensitivities_, sensitivity_count_);
   if (nonlinear_ != nullptr) SUNNonlinSolFree(nonlinear_);
   if (linear_ != nullptr) SUNLinSolFree(linear_);
   if (matrix_ != nullptr) SUNMatDestroy(matrix_);
@@ -277,6 +321,10 @@ Integration::Outcome Integration::advance(double t_out, bool stop_at_output) {
       CVodeSetMaxNumSteps(memory_, rest);
       if (stop_at_output) CVodeSetStopTime(memory_, t_out);
       flag = CVode(memory_, t_out, y_, &t_, CV_NORMAL);
+      if (flag >= 0 && sensitivity_count_ > 0) {
+        double t_sensitivity = 0;
+        check_setup(CVodeGetSens(memory_, &t_sensitivity, sensitivities_), "CVodeGetSens");
+      }
       static_assert(CV_ROOT_RETURN == 2 && CV_TOO_MUCH_WORK == -1);
       break;
     case Package::kArkode:

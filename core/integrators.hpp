@@ -1,6 +1,7 @@
 #pragma once
 /// The SUNDIALS integrators of free motion behind one door (core/simulation.hpp `Integrator`):
-/// CVODE (Adams-Moulton, BDF), ARKODE ERKStep (embedded explicit Runge-Kutta pairs) for an ODE
+/// CVODE (Adams-Moulton, BDF; from the CVODES library, which adds forward sensitivities with
+/// respect to parameters), ARKODE ERKStep (embedded explicit Runge-Kutta pairs) for an ODE
 /// y' = f(t, y), and IDA for a DAE F(t, y, y') = 0. Used by core/fourbar/simulate.cpp (the
 /// four-bar's reduced equation in theta1) and core/fourbar/opened_loop_dae.cpp (its opened loop's
 /// ODE and DAE). Internal to core: SUNDIALS types appear in no public header.
@@ -54,6 +55,20 @@ struct Problem {
   std::vector<double> yp0;         // y'(0), consistent with y0 (F(0, y0, yp0) = 0)
   std::vector<bool> differential;  // false: algebraic, excluded from the error test
   double initial_step{};           // [s]; 0: IDA's own estimate
+  /// kCvodeAdams and kCvodeBdf only: CVODES' forward sensitivities s_i = dy/dp_i of the state
+  /// with respect to the parameters p[which[i]], none when `which` is empty. The right-hand side
+  /// reads every parameter from `parameters` (through user_data) at each call: CVODES perturbs
+  /// them there to form its centred difference quotients of (df/dy) s_i + df/dp_i (one
+  /// directional difference, two right-hand sides per sensitivity), so no Jacobian is written
+  /// by hand. The sensitivities start at 0 (y0 does not depend on p) and take part in the error
+  /// test at their own relative `tolerance` and the state's smallest absolute tolerance divided
+  /// by their scale.
+  struct Sensitivities {
+    double* parameters{};        // every parameter the right-hand side reads
+    std::vector<int> which;      // the entries differentiated
+    std::vector<double> scales;  // their typical magnitudes (CVODES' pbar), > 0, as `which`
+    double tolerance = 1e-7;     // relative, of the sensitivities' error test
+  } sensitivities;
 };
 
 /// An integration in progress. Not copyable or movable (SUNDIALS keeps pointers into it).
@@ -88,6 +103,9 @@ class Integration {
   double t() const { return t_; }  // time reached [s]
   const double* y() const;         // the state at t()
   long steps() const;              // steps taken so far
+  /// The sensitivity dy/dp_i at t() (Problem::sensitivities, its i-th parameter), after an
+  /// advance() that reached t_out or a root.
+  const double* sensitivity(int i) const;
   /// After kFailed: the integrator's flag name and its last error message, e.g.
   /// "CV_CONV_FAILURE: CVode: At t = 1.2 and h = 1e-15, the corrector convergence failed ...".
   const std::string& failure() const { return failure_; }
@@ -100,6 +118,8 @@ class Integration {
   void set_up_ida(const Problem& p);
   // the dense matrix and linear solver of BDF and IDA's Newton iterations
   void set_up_dense_solver(const Problem& p);
+  // CVODES' forward sensitivities (after set_up_cvode)
+  void set_up_sensitivities(const Problem& p);
 
   Package package_;
   bool stop_at_outputs_;
@@ -110,6 +130,11 @@ class Integration {
   // the SUNDIALS objects; members left null are not used by this integrator
   SUNContext context_{};
   N_Vector y_{}, yp_{}, atol_{}, id_{};
+  N_Vector* sensitivities_{};  // CVODES' s_i, Problem::sensitivities.which.size() of them
+  int sensitivity_count_{};
+  std::vector<double> parameter_scales_;  // CVODES keeps the pointers
+  std::vector<int> parameter_list_;
+  SUNNonlinearSolver sensitivity_nonlinear_{};
   SUNMatrix matrix_{};
   SUNLinearSolver linear_{};
   SUNNonlinearSolver nonlinear_{};

@@ -52,9 +52,13 @@
 /// regressor y_i = A_i q is computed once from core's inverse dynamics; every metric is then a
 /// quadratic form in q with an exact gradient through ∂q/∂x, at a cost independent of the
 /// number of samples for RMS metrics (|A q|² = |R q|² with R from a QR of the stacked rows).
-/// Free scenes: every evaluation is a forward simulation (core::simulate_free); no gradients
-/// (has_gradients() is false): derivative-free solvers only. A design whose simulation fails
-/// evaluates to +infinity (objective, limit constraints and every metric).
+/// Free scenes: every evaluation is a forward simulation (core::simulate_free). With the
+/// reduced equation in theta1 (formulations mass-matrix, complex-masses) the gradients come from
+/// the same simulation's forward sensitivities (core/fourbar/sensitivity.hpp, CVODES) with
+/// respect to the varied links' mass parameters, chained through ∂q/∂x; a peak's gradient is
+/// its largest sample's. On the opened loop (opened-loop) has_gradients() is false:
+/// derivative-free solvers only. A design whose simulation fails evaluates to +infinity
+/// (objective, limit constraints and every metric; gradient 0).
 ///
 /// Evaluations are const; free scenes keep the last simulation in a mutex-guarded cache, so the
 /// objective and the constraints at the same x simulate once.

@@ -206,6 +206,7 @@ Problem OptimizeOptions::validate() const {
 Problem check_algorithm(const OptimizeOptions& options, bool free_scene, bool force_balance) {
   const std::string name = std::string("'") + to_string(options.algorithm) + "'";
   if (uses_gradients(options.algorithm) && free_scene) {
+    // the general planar linkage's free scenes: no sensitivities yet
     return FieldError{"algorithm", -1,
                       name +
                           " needs gradients, which a free scene does not provide; use cobyla "
@@ -221,8 +222,17 @@ Problem check_algorithm(const OptimizeOptions& options, bool free_scene, bool fo
 }
 
 Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options) {
-  return check_algorithm(options, std::holds_alternative<core::FreeScene>(problem.scene),
-                         problem.force_balance);
+  // a four-bar's free scene has gradients by forward sensitivities of its reduced equation
+  // (optimize/free_nlp.cpp), but not on the opened loop's DAE
+  if (uses_gradients(options.algorithm) && std::holds_alternative<core::FreeScene>(problem.scene) &&
+      problem.formulation == core::Formulation::kOpenedLoop) {
+    return FieldError{"algorithm", -1,
+                      std::string("'") + to_string(options.algorithm) +
+                          "' needs gradients, which a free scene on the opened loop (method "
+                          "opened-loop) does not provide; use cobyla or isres, or the method "
+                          "mass-matrix or complex-masses"};
+  }
+  return check_algorithm(options, false, problem.force_balance);
 }
 
 void detail::check_inputs(const DesignProblem& problem, const OptimizeOptions& options) {

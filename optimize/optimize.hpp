@@ -31,7 +31,9 @@ bool uses_gradients(Algorithm a);
 /// trying, as words: "ipopt, mlsl, slsqp" (driven scenes), "isres" (free scenes, after cobyla).
 std::string other_algorithms(Algorithm used, bool free_scene);
 /// The method a study gets when it names none: slsqp in a driven scene (exact gradients from
-/// the regressor), cobyla in a free one (every evaluation a simulation, no gradients).
+/// the regressor), cobyla in a free one (every evaluation a simulation; a four-bar's gradient
+/// methods there take the gradients of forward sensitivities, but the general planar linkage's
+/// free scenes have none, and docs/performance.md, "Free scenes", says why cobyla stays).
 constexpr Algorithm default_algorithm(bool free_scene) {
   return free_scene ? Algorithm::kCobyla : Algorithm::kSlsqp;
 }
@@ -50,12 +52,16 @@ struct OptimizeOptions {
 };
 
 /// Whether options.algorithm can solve the problem at all, decided without solving anything:
-/// a gradient method (uses_gradients()) in a free scene, whose evaluations are simulations
-/// without derivatives, or mma with force_balance (equalities, which mma does not take), is a
-/// problem with field "algorithm", e.g. text() "algorithm 'slsqp' needs gradients, which a free
-/// scene does not provide; use cobyla or isres". optimize() refuses what this refuses.
+/// a gradient method (uses_gradients()) in a free scene on the opened loop (formulation
+/// kOpenedLoop, whose DAE has no sensitivities; the reduced equation's give the gradients of
+/// every other free scene), or mma with force_balance (equalities, which mma does not take), is
+/// a problem with field "algorithm", e.g. text() "algorithm 'slsqp' needs gradients, which a
+/// free scene on the opened loop (method opened-loop) does not provide; use cobyla or isres, or
+/// the method mass-matrix or complex-masses". optimize() refuses what this refuses.
 bd::Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options);
-/// The same for any linkage type's problem: in a free scene or not, with force balance or not.
+/// The same for any linkage type's problem: in a free scene without gradients (the general
+/// planar linkage's) or not, with force balance or not; e.g. text() "algorithm 'slsqp' needs
+/// gradients, which a free scene does not provide; use cobyla or isres".
 bd::Problem check_algorithm(const OptimizeOptions& options, bool free_scene, bool force_balance);
 
 enum class Termination {

@@ -135,6 +135,9 @@ struct FreeMotion {
   const FourBar* model{};
   DynamicsConstants constants;  // of *model
   Formulation formulation{};
+  // with forward sensitivities: the links' parameters the right-hand side takes (CVODES
+  // perturbs them in place), replacing those of *model
+  const double* link_parameters{};
   long evaluations{};     // forward_dynamics calls (right-hand side and samples)
   bool rhs_failed{};      // a right-hand side failed since the last reset
   DynamicsError error;    // the latest failure of the dynamics
@@ -150,8 +153,14 @@ int free_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) {
   const double* x = N_VGetArrayPointer(y);
   const double theta1 = x[0], omega1 = x[1];
   ++motion.evaluations;
-  const auto sample =
-      detail::forward_dynamics(*motion.model, motion.constants, theta1, omega1, motion.formulation);
+  auto sample = [&] {
+    if (motion.link_parameters == nullptr) {
+      return detail::forward_dynamics(*motion.model, motion.constants, theta1, omega1,
+                                      motion.formulation);
+    }
+    const FourBar model = detail::with_link_parameters(*motion.model, motion.link_parameters);
+    return forward_dynamics(model, theta1, omega1, motion.formulation);
+  }();
   if (!sample || at_dead_centre(*sample, 0.1 * kDeadCentreSin, motion.error)) {
     motion.rhs_failed = true;
     if (!sample) motion.error = sample.error();
@@ -390,6 +399,12 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
   if (options.formulation == Formulation::kOpenedLoop) {
     return simulate_free_opened_loop(model, scene, options);
   }
+  return detail::simulate_free_reduced(model, scene, options, nullptr);
+}
+
+Trajectory detail::simulate_free_reduced(const FourBar& model, const FreeScene& scene,
+                                         const SimulateOptions& options,
+                                         StateSensitivities* sensitivities) {
   const auto samples = static_cast<std::size_t>(scene.samples);
   Trajectory out;
   out.t.reserve(samples);
@@ -412,7 +427,15 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
   out.samples.push_back(*first);
 
   // each output by the integrator's dense output, then the dynamics at that state
-  integrators::Integration integration(reduced_problem(model, scene, options, motion));
+  integrators::Problem problem = reduced_problem(model, scene, options, motion);
+  if (sensitivities != nullptr) {
+    sensitivities->parameters = link_parameters(model);
+    motion.link_parameters = sensitivities->parameters.data();
+    problem.sensitivities = {sensitivities->parameters.data(), sensitivities->which,
+                             sensitivities->scales, sensitivities->tolerance};
+    sensitivities->state.assign(1, std::vector<Vec2>(sensitivities->which.size(), Vec2::Zero()));
+  }
+  integrators::Integration integration(problem);
   out.status = SimulationStatus::kCompleted;
   out.message = "completed";
   for (std::size_t j = 1; j < samples; ++j) {
@@ -431,6 +454,13 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
     continue_angles(model, out.samples.back().state, sample->state);
     out.t.push_back(t_reached);
     out.samples.push_back(*sample);
+    if (sensitivities != nullptr) {
+      std::vector<Vec2>& s = sensitivities->state.emplace_back();
+      for (std::size_t i = 0; i < sensitivities->which.size(); ++i) {
+        const double* d = integration.sensitivity(static_cast<int>(i));
+        s.emplace_back(d[0], d[1]);
+      }
+    }
   }
 
   out.steps = integration.steps();

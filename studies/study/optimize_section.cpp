@@ -391,10 +391,10 @@ class OptimizeReader {
     }
   }
 
-  // a gradient method in a free scene (whose every evaluation is a simulation, without
-  // derivatives) is reported at `algorithm` in optimize()'s own words (optimize() refuses what
-  // check_algorithm() refuses). In a free scene that is its only complaint; in a driven scene
-  // (mma with force_balance) the run reports it, as before.
+  // a gradient method in a free scene on the opened loop (whose DAE has no sensitivities) is
+  // reported at `algorithm` in optimize()'s own words (optimize() refuses what
+  // check_algorithm() refuses). In a free scene every complaint is reported here; in a driven
+  // scene (mma with force_balance) the run reports it, as before.
   void check_algorithm(const optimize::DesignProblem& problem, const OptimizeRequest& req,
                        const YAML::Mark& algorithm_mark) {
     if (!std::holds_alternative<core::FreeScene>(problem.scene)) return;

@@ -1057,26 +1057,37 @@ TEST(Optimize, FreeSceneWithCobylaRunsAndReports) {
   EXPECT_NE(r.brief_report().find("cobyla"), std::string::npos);
 }
 
-TEST(Optimize, GradientMethodOnAFreeSceneIsRefused) {
+TEST(Optimize, GradientMethodOnAFreeSceneNeedsTheReducedEquation) {
+  const std::string opened =
+      "' needs gradients, which a free scene on the opened loop (method opened-loop) does not "
+      "provide; use cobyla or isres, or the method mass-matrix or complex-masses";
   for (Algorithm a : {Algorithm::kSlsqp, Algorithm::kIpopt}) {
     OptimizeOptions o;
     o.algorithm = a;
-    // said without solving anything, in optimize()'s words
-    const Problem refused = check_algorithm(free_problem(), o);
+    // the reduced equation has forward sensitivities (tests/optimize/free_nlp_test.cpp)
+    EXPECT_FALSE(check_algorithm(free_problem(), o));
+    // the opened loop's DAE has none: said without solving anything, in optimize()'s words
+    DesignProblem p = free_problem();
+    p.formulation = core::Formulation::kOpenedLoop;
+    const Problem refused = check_algorithm(p, o);
     ASSERT_TRUE(refused);
     EXPECT_EQ(refused->field, "algorithm");
-    EXPECT_EQ(refused->text(),
-              std::string("algorithm '") + to_string(a) +
-                  "' needs gradients, which a free scene does not provide; use cobyla or isres");
+    EXPECT_EQ(refused->text(), std::string("algorithm '") + to_string(a) + opened);
     try {
-      (void)optimize(free_problem(), o);
-      FAIL() << "a gradient method on a free scene was accepted";
+      (void)optimize(p, o);
+      FAIL() << "a gradient method on the opened loop's free scene was accepted";
     } catch (const InputError& e) {
-      EXPECT_EQ(std::string(e.what()),
-                std::string("algorithm '") + to_string(a) +
-                    "' needs gradients, which a free scene does not provide; use cobyla or isres");
+      EXPECT_EQ(std::string(e.what()), std::string("algorithm '") + to_string(a) + opened);
     }
   }
+  // the general planar linkage's free scenes have no sensitivities yet
+  OptimizeOptions o;
+  o.algorithm = Algorithm::kSlsqp;
+  const Problem refused = check_algorithm(o, true, false);
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->text(),
+            "algorithm 'slsqp' needs gradients, which a free scene does not provide; use cobyla "
+            "or isres");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1,0 +1,214 @@
+#include "core/fourbar/sensitivity.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <numbers>
+#include <string>
+
+#include "core/fourbar/detail/free_motion.hpp"
+#include "core/input_error.hpp"
+#include "core/number_text.hpp"
+
+namespace bd::core {
+
+namespace {
+
+// the step of a sample's directional difference, relative to the parameter's scale (see the
+// header: truncation ~h², round-off ~eps/h)
+constexpr double kStep = 1e-5;
+
+// The sensitivities' relative tolerance, at most as tight as this: their right-hand side is
+// CVODES' difference quotient of the dynamics, whose round-off (that of the loop closure and the
+// solve, over an increment ~sqrt(rtol)) leaves a noise floor near 1e-9 of the derivatives. The
+// error test cannot see below it and only shrinks the step: measured on the paper's four-bar
+// (1 s, gravity), 1e-9 takes ~3000 steps, 1e-8 ~650, 1e-7 ~330 against 158 for the state alone,
+// and with 1e-7 every sample's derivative and every metric's gradient agrees with central
+// differences of full runs to 1e-6 of its size (tests/core/sensitivity_test.cpp).
+constexpr double kSensitivityTolerance = 1e-7;
+
+// the numbers of a sample, by kind: angles (differences taken modulo 2π, as the dynamics
+// returns theta2 and theta3 wrapped while a trajectory continues them), other scalars, vectors
+constexpr double FourBarState::*kAngles[] = {&FourBarState::theta2, &FourBarState::theta3};
+constexpr double FourBarState::*kStateScalars[] = {
+    &FourBarState::theta1, &FourBarState::omega1, &FourBarState::alpha1, &FourBarState::omega2,
+    &FourBarState::omega3, &FourBarState::alpha2, &FourBarState::alpha3};
+constexpr double DynamicsSample::*kScalars[] = {&DynamicsSample::Msh, &DynamicsSample::tau,
+                                                &DynamicsSample::Msh_inertial,
+                                                &DynamicsSample::Msh_static};
+constexpr Vec2 DynamicsSample::*kVectors[] = {
+    &DynamicsSample::RA0, &DynamicsSample::RA3,          &DynamicsSample::RC1,
+    &DynamicsSample::RC3, &DynamicsSample::Fsh,          &DynamicsSample::FA1,
+    &DynamicsSample::FA2, &DynamicsSample::Fsh_inertial, &DynamicsSample::Fsh_static};
+
+// (a - b) / step, number by number
+DynamicsSample difference_quotient(const DynamicsSample& a, const DynamicsSample& b, double step) {
+  constexpr double kTwoPi = 2 * std::numbers::pi;
+  DynamicsSample d;
+  for (auto f : kAngles) {
+    d.state.*f = std::remainder(a.state.*f - b.state.*f, kTwoPi) / step;
+  }
+  for (auto f : kStateScalars) d.state.*f = (a.state.*f - b.state.*f) / step;
+  for (auto f : kScalars) d.*f = (a.*f - b.*f) / step;
+  for (auto f : kVectors) d.*f = (a.*f - b.*f) / step;
+  return d;
+}
+
+// the typical magnitude of a parameter (CVODES' pbar, and the scale of the difference step)
+double scale_of(const FourBar& model, const LinkParameter& p) {
+  const Link& l = link(model, p.link);
+  switch (p.kind) {
+    case LinkParameter::Kind::kMass:
+      return l.mass;  // > 0 in a checked model
+    case LinkParameter::Kind::kE:
+    case LinkParameter::Kind::kF:
+      return l.length;
+    case LinkParameter::Kind::kInertia:
+      break;
+  }
+  return l.inertia + l.mass * l.length * l.length / 12;  // a rod's, at least
+}
+
+void check(const std::vector<LinkParameter>& parameters, const SimulateOptions& options) {
+  if (options.formulation == Formulation::kOpenedLoop) {
+    throw InputError(FieldError{"formulation", -1,
+                                ": forward sensitivities need the reduced equation in theta1 "
+                                "(mass-matrix or complex-masses), got opened-loop"});
+  }
+  if (options.integrator != Integrator::kCvodeAdams &&
+      options.integrator != Integrator::kCvodeBdf) {
+    throw InputError(FieldError{"integrator", -1,
+                                std::string(": forward sensitivities need cvode-adams or "
+                                            "cvode-bdf (CVODES), got ") +
+                                    to_string(options.integrator)});
+  }
+  std::vector<bool> seen(detail::kLinkParameters, false);
+  for (std::size_t j = 0; j < parameters.size(); ++j) {
+    const LinkParameter& p = parameters[j];
+    if (p.link < 1 || p.link > 3) {
+      throw InputError(FieldError{"parameters", static_cast<int>(j),
+                                  ".link must be 1, 2 or 3, got " + std::to_string(p.link)});
+    }
+    const auto i = static_cast<std::size_t>(4 * (p.link - 1) + static_cast<int>(p.kind));
+    if (seen[i]) {
+      throw InputError(FieldError{"parameters", static_cast<int>(j), "is listed twice"});
+    }
+    seen[i] = true;
+  }
+}
+
+}  // namespace
+
+FreeSensitivities simulate_free_sensitivities(const FourBar& model, const FreeScene& scene,
+                                              const std::vector<LinkParameter>& parameters,
+                                              const SimulateOptions& options) {
+  throw_if(options.validate());
+  validate_scene(scene);
+  check(parameters, options);
+  FreeSensitivities out;
+  out.parameters = parameters;
+  detail::StateSensitivities state;
+  state.tolerance = std::max(options.tolerance, kSensitivityTolerance);
+  for (const LinkParameter& p : parameters) {
+    state.which.push_back(4 * (p.link - 1) + static_cast<int>(p.kind));
+    state.scales.push_back(scale_of(model, p));
+  }
+  out.trajectory = detail::simulate_free_reduced(model, scene, options, &state);
+  if (!out.trajectory.ok()) return out;
+
+  // each sample's derivative along (s_j, e_j): the dynamics at the state and parameters moved
+  // by ±h along it
+  const std::size_t n = out.trajectory.samples.size();
+  out.derivative.assign(parameters.size(), std::vector<DynamicsSample>(n));
+  for (std::size_t j = 0; j < parameters.size(); ++j) {
+    const double h = kStep * state.scales[j];
+    for (std::size_t i = 0; i < n; ++i) {
+      const FourBarState& s = out.trajectory.samples[i].state;
+      const Vec2 ds = state.state[i][j];
+      auto at = [&](double step) {
+        detail::LinkParameters p = state.parameters;
+        p[static_cast<std::size_t>(state.which[j])] += step;
+        ++out.sensitivity_evaluations;
+        return forward_dynamics(detail::with_link_parameters(model, p.data()),
+                                s.theta1 + step * ds.x(), s.omega1 + step * ds.y(),
+                                options.formulation);
+      };
+      const auto plus = at(h), minus = at(-h);
+      if (!plus || !minus) {
+        // within h of a position where the dynamics refuses: the run's derivatives are not
+        // to be had there
+        const DynamicsError& e = plus ? minus.error() : plus.error();
+        out.trajectory.status = status_of(e.kind);
+        out.trajectory.message = "sensitivity at t = " + text::digits(out.trajectory.t[i], 10) +
+                                 " s, theta1 = " + text::digits(s.theta1, 10) + " rad: " + e.what();
+        out.derivative.clear();
+        return out;
+      }
+      out.derivative[j][i] = difference_quotient(*plus, *minus, 2 * h);
+    }
+  }
+  return out;
+}
+
+namespace {
+
+// a quantity of a sample as a vector (a moment's or torque's second component 0)
+Vec2 components(const DynamicsSample& s, Quantity q) {
+  switch (q) {
+    case Quantity::kShakingForce:
+      return s.Fsh_inertial;
+    case Quantity::kShakingMoment:
+      return {s.Msh_inertial, 0.0};
+    case Quantity::kDriveTorque:
+      return {s.tau, 0.0};
+    case Quantity::kReactionA0:
+      return s.RA0;
+    case Quantity::kReactionA3:
+      return s.RA3;
+  }
+  return Vec2::Zero();
+}
+
+}  // namespace
+
+Eigen::MatrixXd metric_gradients(const FreeSensitivities& run) {
+  const std::vector<DynamicsSample>& samples = run.trajectory.samples;
+  const auto m = static_cast<Eigen::Index>(run.parameters.size());
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(kMetricCount), m);
+  if (samples.empty() || run.derivative.size() != run.parameters.size()) return g;
+  const Metrics values = metrics(run.trajectory);
+  const double n = static_cast<double>(samples.size());
+  for (std::size_t k = 0; k < kMetricCount; ++k) {
+    const MetricInfo& info = kMetricTable[k];
+    const auto row = static_cast<Eigen::Index>(k);
+    if (info.statistic == Statistic::kRms) {
+      const double rms = values.*info.field;
+      if (!(rms > 0)) continue;
+      for (Eigen::Index j = 0; j < m; ++j) {
+        const auto& d = run.derivative[static_cast<std::size_t>(j)];
+        double sum = 0;
+        for (std::size_t i = 0; i < samples.size(); ++i) {
+          sum += components(samples[i], info.quantity).dot(components(d[i], info.quantity));
+        }
+        g(row, j) = sum / (n * rms);
+      }
+      continue;
+    }
+    // the largest sample, the first of equal ones (as metrics() keeps it)
+    std::size_t at = 0;
+    double peak = 0;
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      const double x = magnitude(samples[i], info.quantity);
+      if (x > peak) peak = x, at = i;
+    }
+    if (!(peak > 0)) continue;
+    const Vec2 v = components(samples[at], info.quantity);
+    for (Eigen::Index j = 0; j < m; ++j) {
+      const auto& d = run.derivative[static_cast<std::size_t>(j)];
+      g(row, j) = v.dot(components(d[at], info.quantity)) / peak;
+    }
+  }
+  return g;
+}
+
+}  // namespace bd::core
