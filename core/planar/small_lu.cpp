@@ -104,16 +104,14 @@ void SmallLu::compute(const Eigen::MatrixXd& a) {
   lu_ = a;
   perm_.resize(n_);
   swaps_ = by_size(n_, [&](auto size) {
-    constexpr int N = decltype(size)::value;
-    solve_kernel_ = &solve_vector<N>;
-    transpose_kernel_ = &solve_transpose_vector<N>;
-    return factorise<N>(lu_.data(), perm_.indices().data(), n_);
+    return factorise<decltype(size)::value>(lu_.data(), perm_.indices().data(), n_);
   });
 }
 
 void SmallLu::solve_in_place(double* b) const {
-  if (n_ == 0) return;  // nothing to solve (and no kernel chosen if never factorised)
-  solve_kernel_(lu_.data(), perm_.indices().data(), b, n_);
+  by_size(n_, [&](auto size) {
+    solve_vector<decltype(size)::value>(lu_.data(), perm_.indices().data(), b, n_);
+  });
 }
 
 void SmallLu::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
@@ -133,19 +131,20 @@ void SmallLu::solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const {
     x.noalias() = dynamic_.solve(b);
     return;
   }
-  if (&x != &b) x = b;
-  for (Eigen::Index j = 0; j < x.cols(); ++j) solve_in_place(x.col(j).data());
+  x.noalias() = perm_ * b;
+  lu_.triangularView<Eigen::UnitLower>().solveInPlace(x);
+  lu_.triangularView<Eigen::Upper>().solveInPlace(x);
 }
 
 void SmallLu::solve_transpose(Eigen::VectorXd& b) const {
-  if (n_ <= kFixedSize) {
-    if (n_ > 0) transpose_kernel_(lu_.data(), perm_.indices().data(), b.data(), n_);
-    return;
-  }
   // A = P⁻¹ L U: Uᵀ, then Lᵀ, then the permutation
   factors().triangularView<Eigen::Upper>().transpose().solveInPlace(b);
   factors().triangularView<Eigen::UnitLower>().transpose().solveInPlace(b);
-  b = dynamic_.permutationP().transpose() * b;
+  if (n_ > kFixedSize) {
+    b = dynamic_.permutationP().transpose() * b;
+  } else {
+    b = perm_.transpose() * b;
+  }
 }
 
 double SmallLu::determinant() const {
