@@ -416,8 +416,12 @@ TEST(PlanarOptimize, ConvexBudgetProblemsReachTheIndependentGlobalOptimum) {
     for (Eigen::Index c = 0; c < D.size(); ++c) least += best.segment<2>(2 * c).norm() / D[c];
     for (double fraction : {0.3, 0.7, 1.5}) {
       p.limits = {{"added_mass", fraction * least}};
-      const double reference =
-          q.rms(fraction < 1 ? budget_minimiser(q, D, fraction * least) : best);
+      // where the budget does not bind and the six-bar can be fully force balanced, the optimum
+      // is Fsh = 0: the quadratic's own minimum, sqrt(c - g'H^-1 g), is then a difference of
+      // large terms known only to about sqrt(machine epsilon) of the original (3e-7 of it
+      // measured on six-bar #2), so a value below 1e-6 of the original is that round-off
+      double reference = q.rms(fraction < 1 ? budget_minimiser(q, D, fraction * least) : best);
+      if (fraction >= 1 && reference < 1e-6 * original) reference = 0;
       const double tolerance = fraction < 1 ? 1e-6 * reference : 1e-6 * original;
       for (optimize::Algorithm a : {optimize::Algorithm::kSlsqp, optimize::Algorithm::kMma,
                                     optimize::Algorithm::kIpopt}) {
