@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/number_text.hpp"
+#include "core/polar_angle.hpp"
 #include "core/planar/system.hpp"
 
 namespace bd::core::planar {
@@ -46,6 +47,14 @@ constexpr double kSingularPivot = 1e-4;
 // pivots within this ratio of each other leave the condition estimate far above kSingularSolution
 // (the rows have gradients of unit length and the systems are small)
 constexpr double kWellConditionedPivot = 1e-2;
+
+// x rounded to the nearest whole number, ties to even (std::round's ties away from zero would
+// differ only at a jump of exactly half a turn, which continued angles exclude); |x| < 2^51.
+// std::round is a library call on the baseline x86-64 this is built for.
+double nearest_whole(double x) {
+  constexpr double kRound = 6755399441055744.0;  // 1.5·2^52
+  return (x + kRound) - kRound;
+}
 
 std::string inputs_text(const Model& model, const std::vector<double>& inputs) {
   std::string s;
@@ -270,7 +279,10 @@ Unexpected<PlanarError> singular_at(const Model& model, const Workspace& ws,
 // triangular solves instead of a Jacobian and a factorisation. It converges linearly; a
 // contraction worse than kChordContraction, or too many steps, hands over to Newton. On success
 // the position is exact to round-off: after the step that moves no coordinate by more than the
-// step limit, one more (the remaining error shrinks by the contraction again).
+// step limit, one more (the remaining error shrinks by the contraction again), unless the
+// contraction of the last two steps puts that one below round-off. The angle inputs'
+// rows are taken as u × d (detail::AngleRow::kCross: no atan2 per iteration), which the first
+// step's reach keeps near their root, where they and the angle form agree.
 bool chord_iterations(const Model& model, Workspace& ws) {
   const System& s = model.system();
   Instant& in = ws.instant;
@@ -278,7 +290,7 @@ bool chord_iterations(const Model& model, Workspace& ws) {
   double previous = std::numeric_limits<double>::infinity();
   bool converged = false;
   for (int it = 0; it < kChordIterations; ++it) {
-    detail::constraint_values(s, in.x, ws.target, ws.g);
+    detail::constraint_values(s, in.x, ws.target, ws.g, detail::AngleRow::kCross);
     ws.lu.solve(ws.g, ws.step);
     const double size = ws.step.cwiseAbs().maxCoeff();
     if (!std::isfinite(size) || (it == 0 && size > kChordReach * model.length_scale()) ||
@@ -288,6 +300,10 @@ bool chord_iterations(const Model& model, Workspace& ws) {
     detail::nodes_from_q(s, ws.q, in.x);
     if (converged) return true;
     converged = size <= step_limit;
+    // the next step, as the last two shrank, would move no coordinate by more than round-off:
+    // it is not taken
+    if (converged && it > 0 && size * (size / previous) <= kRefactorStep * model.length_scale())
+      return true;
     previous = size;
   }
   return false;
@@ -423,6 +439,21 @@ std::vector<double> efforts_at(const Model& model, double t) {
 
 namespace {
 
+// y = M x for the small square M, by columns (Eigen's general product costs several times the
+// products themselves at these sizes)
+void multiply(const MatrixXd& M, const VectorXd& x, VectorXd& y) {
+  const Eigen::Index n = M.rows();
+  y.resize(n);
+  if (n == 0) return;
+  const double* m = M.data();
+  double* out = y.data();
+  for (Eigen::Index i = 0; i < n; ++i) out[i] = m[i] * x[0];
+  for (Eigen::Index j = 1; j < n; ++j) {
+    const double xj = x[j];
+    for (Eigen::Index i = 0; i < n; ++i) out[i] += m[i + n * j] * xj;
+  }
+}
+
 // the node velocities for the inputs' rates, with the factorisation at the current position
 void velocities(const Model& model, Workspace& ws, const std::vector<double>& rates) {
   const System& s = model.system();
@@ -444,8 +475,8 @@ void link_kinematics(const Model& model, Instant& in) {
     const std::size_t p = static_cast<std::size_t>(e.p), q = static_cast<std::size_t>(e.q);
     const Vec2 d = in.x[q] - in.x[p], dv = in.v[q] - in.v[p], da = in.a[q] - in.a[p];
     const double n2 = d.squaredNorm();
-    const double a = std::atan2(d.y(), d.x());
-    in.angle[k] = a + 2 * kPi * std::round((in.angle[k] - a) / (2 * kPi));
+    const double a = polar_angle(d.y(), d.x());
+    in.angle[k] = a + 2 * kPi * nearest_whole((in.angle[k] - a) / (2 * kPi));
     in.omega[k] = cross(d, dv) / n2;
     in.alpha[k] = cross(d, da) / n2 - 2 * d.dot(dv) * in.omega[k] / n2;
   }
@@ -487,6 +518,11 @@ void link_node_forces(const Model& model, Workspace& ws) {
     const Vec4 inertia = s.element_M[k] * acc;
     const double moment =
         s.shafts.empty() ? s.link_moment[k] : detail::link_moment_at(s, static_cast<int>(k), in.x);
+    if (s.link_force[k].isZero(0.0) && moment == 0.0) {  // an unloaded link (as applied_forces)
+      f(static_cast<int>(k), e.p) += inertia.segment<2>(0);
+      f(static_cast<int>(k), e.q) += inertia.segment<2>(2);
+      continue;
+    }
     const Vec4 applied = element_nodal_forces(s.com_weights[k], s.link_force[k], moment,
                                               in.x[static_cast<std::size_t>(e.p)],
                                               in.x[static_cast<std::size_t>(e.q)]);
@@ -654,7 +690,7 @@ Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t) 
   in.t = t;
   detail::node_rates_from(s, ws.qdd, in.a);
   detail::applied_forces(s, in.x, in.v, nullptr, ws.F);
-  ws.rhs.noalias() = s.M * ws.qdd;
+  multiply(s.M, ws.qdd, ws.rhs);
   ws.rhs -= ws.F;
   // Gᵀ λ = rhs, in place
   ws.lambda = ws.rhs;
@@ -710,7 +746,7 @@ Expected<bool, PlanarError> forward_dynamics(const Model& model, Workspace& ws, 
   detail::applied_forces(s, ws.instant.x, ws.instant.v, nullptr, ws.F);
   ws.MT.noalias() = s.M * ws.T;
   ws.reduced.noalias() = ws.T.transpose() * ws.MT;
-  ws.rhs.noalias() = s.M * ws.c;
+  multiply(s.M, ws.c, ws.rhs);
   ws.rhs += ws.F;  // F - M c with c = -G⁻¹ γ
   ws.right.noalias() = ws.T.transpose() * ws.rhs;
   for (int k = 0; k < dof; ++k) ws.right[k] += efforts[static_cast<std::size_t>(k)];

@@ -104,14 +104,16 @@ void SmallLu::compute(const Eigen::MatrixXd& a) {
   lu_ = a;
   perm_.resize(n_);
   swaps_ = by_size(n_, [&](auto size) {
-    return factorise<decltype(size)::value>(lu_.data(), perm_.indices().data(), n_);
+    constexpr int N = decltype(size)::value;
+    solve_kernel_ = &solve_vector<N>;
+    transpose_kernel_ = &solve_transpose_vector<N>;
+    return factorise<N>(lu_.data(), perm_.indices().data(), n_);
   });
 }
 
 void SmallLu::solve_in_place(double* b) const {
-  by_size(n_, [&](auto size) {
-    solve_vector<decltype(size)::value>(lu_.data(), perm_.indices().data(), b, n_);
-  });
+  if (n_ == 0) return;  // nothing to solve (and no kernel chosen if never factorised)
+  solve_kernel_(lu_.data(), perm_.indices().data(), b, n_);
 }
 
 void SmallLu::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
@@ -131,20 +133,19 @@ void SmallLu::solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const {
     x.noalias() = dynamic_.solve(b);
     return;
   }
-  x.noalias() = perm_ * b;
-  lu_.triangularView<Eigen::UnitLower>().solveInPlace(x);
-  lu_.triangularView<Eigen::Upper>().solveInPlace(x);
+  if (&x != &b) x = b;
+  for (Eigen::Index j = 0; j < x.cols(); ++j) solve_in_place(x.col(j).data());
 }
 
 void SmallLu::solve_transpose(Eigen::VectorXd& b) const {
+  if (n_ <= kFixedSize) {
+    if (n_ > 0) transpose_kernel_(lu_.data(), perm_.indices().data(), b.data(), n_);
+    return;
+  }
   // A = P⁻¹ L U: Uᵀ, then Lᵀ, then the permutation
   factors().triangularView<Eigen::Upper>().transpose().solveInPlace(b);
   factors().triangularView<Eigen::UnitLower>().transpose().solveInPlace(b);
-  if (n_ > kFixedSize) {
-    b = dynamic_.permutationP().transpose() * b;
-  } else {
-    b = perm_.transpose() * b;
-  }
+  b = dynamic_.permutationP().transpose() * b;
 }
 
 double SmallLu::determinant() const {

@@ -6,8 +6,9 @@
 /// (complete unrolling, the same operations in the same order as Eigen's); larger systems are
 /// Eigen::PartialPivLU's. Eigen's dynamic-size LU and triangular solves spend most of their
 /// instructions on block and loop overhead at these sizes (docs/performance.md, "The general
-/// planar engine"). The transposed and many-column solves, once per evaluation, are Eigen's on
-/// the same factors.
+/// planar engine"). The many-column solve runs the one-vector kernel per column; the transposed
+/// solve has its own kernel (Uᵀ, Lᵀ by rows, then the swaps), whose sums run in another order
+/// than Eigen's: its results agree with Eigen's to round-off, not bit for bit.
 ///
 /// Sized once (compute() allocates only when the size changes), so an evaluation allocates
 /// nothing.
@@ -43,6 +44,9 @@ class SmallLu {
 
   const Eigen::MatrixXd& factors() const { return n_ > kFixedSize ? dynamic_.matrixLU() : lu_; }
 
+  using Kernel = void (*)(const double* lu, const int* perm, double* b, int n);
+  Kernel solve_kernel_ = nullptr;      // b = A⁻¹ b for this size (set by compute())
+  Kernel transpose_kernel_ = nullptr;  // b = A⁻ᵀ b
   int n_ = 0;
   int swaps_ = 0;
   Eigen::MatrixXd a_;   // the matrix factorised

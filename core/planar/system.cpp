@@ -228,6 +228,9 @@ System::System(const Linkage& l) : linkage(l) {
     if (!l.nodes[i].ground) {
       coord[i] = n;
       n += 2;
+      moving.push_back(static_cast<int>(i));
+    } else {
+      fixed.push_back(static_cast<int>(i));
     }
   }
   structural_rows = add_slider_rows(*this, add_link_rows(*this));
@@ -237,13 +240,12 @@ System::System(const Linkage& l) : linkage(l) {
 }
 
 void nodes_from_q(const System& s, const VectorXd& q, NodeVectors& x) {
-  const std::size_t nodes = s.coord.size();
-  x.resize(nodes);
-  const int* coord = s.coord.data();
+  x.resize(s.coord.size());
+  for (int i : s.fixed) x[static_cast<std::size_t>(i)] = s.linkage.nodes[static_cast<std::size_t>(i)].position;
   const double* qv = q.data();
-  for (std::size_t i = 0; i < nodes; ++i) {
-    const int c = coord[i];
-    x[i] = c < 0 ? s.linkage.nodes[i].position : Vec2(qv[c], qv[c + 1]);
+  for (int i : s.moving) {
+    const int c = s.coord[static_cast<std::size_t>(i)];
+    x[static_cast<std::size_t>(i)] = Vec2(qv[c], qv[c + 1]);
   }
 }
 
@@ -298,7 +300,7 @@ void input_targets(const System& s, const std::vector<double>& inputs, std::vect
 }
 
 void constraint_values(const System& s, const NodeVectors& x, const std::vector<Vec2>& targets,
-                       VectorXd& g) {
+                       VectorXd& g, AngleRow angle_row) {
   g.resize(targets.empty() ? s.structural_rows : s.rows);
   for (std::size_t k = 0; k < s.elements.size(); ++k) {
     const System::ElementRow& e = s.elements[k];
@@ -320,9 +322,13 @@ void constraint_values(const System& s, const NodeVectors& x, const std::vector<
   if (targets.empty()) return;
   for (const System::InputRow& in : s.inputs) {
     const Vec2& target = targets[static_cast<std::size_t>(in.input)];
-    g[in.row] =
-        in.angle ? in.length * angle_from(target, at(x, in.q) - at(x, in.p))
-                 : slide_position(s, s.sliders[static_cast<std::size_t>(in.slider)], x) - target.x();
+    if (!in.angle) {
+      g[in.row] = slide_position(s, s.sliders[static_cast<std::size_t>(in.slider)], x) - target.x();
+    } else if (angle_row == AngleRow::kCross) {
+      g[in.row] = cross(target, at(x, in.q) - at(x, in.p));
+    } else {
+      g[in.row] = in.length * angle_from(target, at(x, in.q) - at(x, in.p));
+    }
   }
 }
 

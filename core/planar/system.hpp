@@ -42,6 +42,7 @@ struct System {
   int structural_rows{};   // rows of the constraints (not the inputs)
   int rows{};              // structural rows + inputs
   std::vector<int> coord;  // per node: index of its x in q, -1 for a ground node
+  std::vector<int> moving, fixed;  // the moving and the ground nodes, in node order
 
   struct ElementRow {  // one per link, row = link index
     int p{}, q{};      // element nodes
@@ -133,10 +134,22 @@ int row_gradient(const System& s, const NodeVectors& x, int row, GradientEntry o
 /// of an angle input at θ, (s, 0) for a slide at s. Computed once per position solve, so that
 /// its iterations evaluate no trigonometric function.
 void input_targets(const System& s, const std::vector<double>& inputs, std::vector<Vec2>& targets);
+/// How constraint_values() writes an angle input's row.
+enum class AngleRow {
+  /// l (φ - θ) by atan2 of the angle from the target direction: linear in the angle, for
+  /// iterations from afar (Newton's method, assembly).
+  kAngle,
+  /// u × d, u the target direction (cos θ, sin θ) and d the link's element vector: linear in the
+  /// node coordinates, no trigonometric function. Near the root it equals l sin(φ - θ) with
+  /// |d| = l, so it has the same root (φ = θ; its other, φ = θ + π, lies half a turn away) and
+  /// there the same gradient as the angle form, l perp(d) / |d|² = perp(u): the chord method's
+  /// factorisation serves both. For iterations that start near the root.
+  kCross,
+};
 /// g(q) with the inputs at `targets` (input_targets()); the structural rows only when `targets`
 /// is empty.
 void constraint_values(const System& s, const NodeVectors& x, const std::vector<Vec2>& targets,
-                       VectorXd& g);
+                       VectorXd& g, AngleRow angle_row = AngleRow::kAngle);
 /// G = ∂g/∂q (rows x n); without the input rows when rows == structural_rows.
 void constraint_jacobian(const System& s, const NodeVectors& x, int rows, MatrixXd& G);
 /// γ = Ġ q̇ (rows), for the velocities v of the nodes.
