@@ -66,6 +66,15 @@ struct ConvexAwareSolve {
   LowerBound bound;
 };
 
+/// A lower bound from tight_bound(), and the best design its refining runs reached where that is
+/// better than the design it started from (`better` empty otherwise).
+struct TightBound {
+  double value = std::numeric_limits<double>::quiet_NaN();
+  Eigen::VectorXd better;
+  double objective = std::numeric_limits<double>::quiet_NaN();  // at `better`
+  Algorithm by = Algorithm::kSlsqp;                               // the run that reached it
+};
+
 /// The best Lagrangian bound (first_order()) of a convex program near x. The bound is as tight as
 /// the first-order conditions hold, and a solver's usual end, within sqrt(tolerance) of them,
 /// leaves it up to ~1e-4 of the objective below the optimum; so it is taken at x, at x without
@@ -75,10 +84,15 @@ struct ConvexAwareSolve {
 /// 1e-14 (each restart renews its Hessian), and, where these leave it more than 1e-7 of the
 /// objective's size below f(x), at the end of an Ipopt run to 1e-10 (its interior path reaches
 /// an optimum on the cone's apex, where SLSQP's steps turn with the round-off). Each is a bound;
-/// the largest is kept.
+/// the largest is kept. The runs' feasible ends are designs too: the best, where it is below
+/// f(x), comes back as `better` (a solver that stalled short of a convex optimum, as MMA can,
+/// is taken on to it).
 template <class Nlp>
-double tight_bound(const Nlp& program, const Eigen::VectorXd& x, const OptimizeOptions& options) {
-  double bound = std::max(
+TightBound tight_bound(const Nlp& program, const Eigen::VectorXd& x,
+                       const OptimizeOptions& options) {
+  TightBound out;
+  double& bound = out.value;
+  bound = std::max(
       first_order(program, x).lower_bound,
       first_order(program, program.without_vanishing_counterweights(x, 1e-6)).lower_bound);
   OptimizeOptions tight = options;
@@ -86,10 +100,23 @@ double tight_bound(const Nlp& program, const Eigen::VectorXd& x, const OptimizeO
   tight.relative_tolerance = 1e-14;
   tight.check_gradients = false;
   const double f = program.objective(x, nullptr), close = 1e-7 * std::max(std::abs(f), 1.0);
+  const auto keep = [&](const Solved& refined, Algorithm by) {
+    if (!found_design(refined.termination) ||
+        !(refined.constraint_violation <= options.constraint_tolerance)) {
+      return;
+    }
+    const double best = out.better.size() > 0 ? out.objective : f;
+    if (refined.objective < best) {
+      out.better = refined.x;
+      out.objective = refined.objective;
+      out.by = by;
+    }
+  };
   Eigen::VectorXd at = x;
   for (int run = 0; run < 3 && f - bound > close; ++run) {
     const Solved refined = solve(program, at, tight);
     if (refined.x.size() != x.size()) break;
+    keep(refined, Algorithm::kSlsqp);
     const double next = first_order(program, refined.x).lower_bound;
     const bool gained = next > bound + 1e-12 * std::max(std::abs(bound), 1.0);
     bound = std::max(bound, next);
@@ -101,10 +128,11 @@ double tight_bound(const Nlp& program, const Eigen::VectorXd& x, const OptimizeO
     tight.relative_tolerance = 1e-10;
     const Solved refined = solve(program, x, tight);
     if (refined.x.size() == x.size()) {
+      keep(refined, Algorithm::kIpopt);
       bound = std::max(bound, first_order(program, refined.x).lower_bound);
     }
   }
-  return bound;
+  return out;
 }
 
 /// The lower bound of a problem that is not convex: the Lagrangian bound (first_order()) of its
@@ -132,7 +160,7 @@ LowerBound relaxation_bound(const Problem& problem, const Eigen::VectorXd& best,
   }
   starts.push_back(relaxed.start(true));
   const Solved solved = solve_from(relaxed, starts, local);
-  out.value = tight_bound(relaxed, solved.x, local);
+  out.value = tight_bound(relaxed, solved.x, local).value;
   out.words = "from the convex relaxation in which each counterweight's inertia about its pivot "
               "(mass x distance², and a disc's own inertia) may take any value between its "
               "least for the mass and mass moment and its largest within distance_max";
@@ -183,9 +211,30 @@ ConvexAwareSolve solve_convex_aware(const Nlp& nlp, const Problem& problem,
   if (convex && found) {
     // the certificate and the bound from the convex program's first-order conditions at the design
     const Eigen::VectorXd at = convex->from_positions(solved.x);
-    stationarity = first_order(*convex, at).residual;
-    out.bound.value = tight_bound(*convex, at, options);
+    const TightBound tight = tight_bound(*convex, at, options);
+    out.bound.value = tight.value;
     out.bound.words = "the first-order (Lagrangian) bound of the convex problem at the design";
+    stationarity = first_order(*convex, at).residual;
+    if (tight.better.size() > 0) {
+      // the bound's refining runs went on to a better design of the convex problem: return it
+      Eigen::VectorXd x = nlp.start_at(convex->to_positions(tight.better));
+      nlp.polish(x);
+      const double f = nlp.objective(x, nullptr);
+      if (f < solved.objective && constraint_violation(nlp, x) <= options.constraint_tolerance) {
+        const double residual = first_order(*convex, convex->from_positions(x)).residual;
+        solved.message += "; the lower bound's refinement (" + std::string(to_string(tight.by)) +
+                          " on the convex problem) went on to a design " +
+                          text::digits(solved.objective - f, 2) +
+                          " lower in the objective, which is returned";
+        solved.x = x;
+        solved.objective = f;
+        solved.constraint_violation = constraint_violation(nlp, x);
+        stationarity = residual;
+        if (!(residual > stationarity_tolerance(options.relative_tolerance))) {
+          solved.termination = Termination::kConverged;
+        }
+      }
+    }
   } else if (!why_not.empty() && nlp.has_gradients()) {
     out.bound = relaxation_bound<Nlp>(problem, found ? solved.x : Eigen::VectorXd(), options);
   } else if (!why_not.empty()) {

@@ -370,8 +370,9 @@ std::vector<Algorithm> continuations(Algorithm a) {
 // A converged end of a gradient method checked against the first-order conditions, and
 // continued where they do not hold (nlopt_driver.hpp, solve()). Where a degenerate optimum keeps
 // the residual up (many constraints active together, as a peak's rows at a force-balanced
-// design), runs that go on from the point and change the objective by less than the tolerance
-// (relative to the objective's size, 1 for the original design) settle it: converged.
+// design), runs that go on from the point, end converged themselves and change the objective by
+// less than the tolerance (relative to the objective's size, 1 for the original design) settle
+// it: converged. A continuation stopped by the evaluation budget settles nothing.
 void ensure_first_order(const Program& nlp, const OptimizeOptions& options, detail::Solved& r) {
   if (!nlp.has_gradients() || r.termination != Termination::kConverged) return;
   const double tolerance = detail::stationarity_tolerance(options.relative_tolerance);
@@ -379,7 +380,7 @@ void ensure_first_order(const Program& nlp, const OptimizeOptions& options, deta
   if (!(r.stationarity > tolerance)) return;
   const double first = r.stationarity, f_first = r.objective;
   std::string continued;
-  int runs = 0;
+  int runs = 0, settled = 0;
   for (Algorithm a : continuations(options.algorithm)) {
     if (r.evaluations >= options.max_evaluations) break;
     OptimizeOptions next = options;
@@ -388,6 +389,7 @@ void ensure_first_order(const Program& nlp, const OptimizeOptions& options, deta
     detail::Solved s = run_once(nlp, r.x, next);
     add_costs(s, r);
     ++runs;
+    if (s.termination == Termination::kConverged) ++settled;
     continued += std::string(continued.empty() ? "" : ", then ") + to_string(a);
     if (!found_design(s.termination) || s.objective > r.objective) continue;
     r.x = s.x;
@@ -404,7 +406,7 @@ void ensure_first_order(const Program& nlp, const OptimizeOptions& options, deta
     return;
   }
   const double gain = f_first - r.objective;
-  if (runs > 0 && gain <= options.relative_tolerance * std::max(std::abs(f_first), 1.0)) {
+  if (settled > 0 && gain <= options.relative_tolerance * std::max(std::abs(f_first), 1.0)) {
     r.message += said + ", which changed the objective by " + text::digits(gain, 2) +
                  " only: a degenerate optimum, taken as converged";
     return;
