@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/planar/dynamics.hpp"
+#include "core/planar/simulate.hpp"
 #include "studies/study/sections.hpp"
 #include "studies/study/yaml_reader.hpp"
 
@@ -110,6 +111,7 @@ class PlanarSection::Impl {
         d.samples = read_count(r_, *n, "scene.samples", dur ? 2 : 1, kMaxRows);
       }
       check_start(e, l, d.start);
+      check_turns(e, type, l, d);
       return d;
     }
     if (t == "free") {
@@ -580,6 +582,31 @@ class PlanarSection::Impl {
         model, ws, start.empty() ? core::planar::drawn_inputs(model) : start);
     if (!ok) r_.fail(e.key_mark, "scene: " + ok.error().detail + " (the start of the scene)");
   }
+
+  // a driven scene over whole revolutions: refused at scene.type when the linkage cannot be
+  // assembled somewhere in the first revolution, as the four-bar's crank that cannot turn fully
+  // is (the run would stop at the first limit position). The revolution is stepped as the run
+  // steps it (at its samples, at most 3600), positions and dynamics; a singular position on an
+  // assembly that goes on (a dead centre) stops the run there instead, with the samples before.
+  void check_turns(const MapReader::Entry& e, const MapReader::Entry& type,
+                   const core::planar::Linkage& l, const core::planar::DrivenScene& d) {
+    if (d.duration > 0) return;
+    core::planar::DrivenScene one = d;
+    one.revolutions = 1;
+    one.samples = std::min(d.samples, kTurnCheckSamples);
+    core::planar::Trajectory run;
+    try {
+      run = core::planar::simulate_driven(core::planar::Model(l), one);
+    } catch (const InputError& err) {
+      r_.fail(e.key_mark, "scene: " + std::string(err.what()));
+    }
+    if (run.status != core::SimulationStatus::kAssemblyFailed) return;
+    r_.fail(mark_of(type.value, type.key_mark),
+            "scene.type: driven turns the inputs through whole revolutions, but " + run.message +
+                ", so the run would stop there; simulate it with type: free, which passes the "
+                "limit positions where the linkage does, or change the link lengths");
+  }
+  static constexpr int kTurnCheckSamples = 3600;
 
   struct Place {
     std::string path;

@@ -6,9 +6,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 #include <string>
 
@@ -186,6 +188,51 @@ TEST_F(CliTest, PlanarSimulationStoppedEarlyNamesWhereItStopped) {
             std::string::npos)
       << err_;
   EXPECT_EQ(bd::testing::read(dir_ / "bench" / "driven-convergence.csv").substr(0, 7), "method,");
+}
+
+TEST_F(CliTest, PlanarDrivenInputThatCannotTurnFullyIsRefusedAtSceneType) {
+  // a non-Grashof four-bar on the general engine (crank 0.5, coupler 0.335, rocker 0.35, frame
+  // 0.3: s + l = 0.8 > p + q = 0.685): its crank reaches a limit position near 2.02 rad, where
+  // |A1 - A3| = coupler + rocker; a driven scene is refused before it runs, a free one is not
+  const std::string linkage =
+      "name: rocks\n"
+      "linkage:\n"
+      "  type: planar\n"
+      "  nodes:\n"
+      "    A0: {at: [0, 0], ground: true}\n"
+      "    A3: {at: [0.3, 0], ground: true}\n"
+      "    A1: [0, 0.5]\n"
+      "    A2: [0.3, 0.35]\n"
+      "  links:\n"
+      "    crank: {nodes: [A0, A1], mass: 1.0, e: 0.1, f: 0, inertia: 0.002}\n"
+      "    coupler: {nodes: [A1, A2], mass: 1.0, e: 0.1, f: 0, inertia: 0.002}\n"
+      "    rocker: {nodes: [A3, A2], mass: 1.0, e: 0.1, f: 0, inertia: 0.002}\n"
+      "  inputs:\n"
+      "    crank: {link: crank}\n";
+  write("rocks.yaml", linkage + "scene:\n  type: driven\n  speeds: [6.283185307179586]\n");
+  for (const char* command : {"validate rocks.yaml", "rocks.yaml --out res"}) {
+    EXPECT_EQ(run(command), 2) << command << ": " << err_;
+    EXPECT_EQ(err_.rfind("rocks.yaml:16:9: scene.type: driven turns the inputs through whole "
+                         "revolutions, but the linkage cannot be assembled at crank = 2.02",
+                         0),
+              0u)
+        << err_;
+    EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "res" / "timeseries.csv"));
+  // the angle named is the first of the 360 samples past the limit position, where
+  // |A1 - A3| = coupler + rocker; by the law of cosines in the triangle A0 A1 A3 the crank's
+  // angle from A0->A3 is then acos((0.5^2 + 0.3^2 - d^2) / (2 0.5 0.3)); it starts at pi/2 and
+  // turns positively
+  const double d = std::hypot(0.3, 0.15) + 0.35;
+  const double limit = std::acos((0.25 + 0.09 - d * d) / 0.3);
+  const std::size_t at = err_.find("crank = ");
+  ASSERT_NE(at, std::string::npos) << err_;
+  const double named = std::stod(err_.substr(at + 8));
+  EXPECT_GT(named, limit);
+  EXPECT_LE(named, limit + 2 * std::numbers::pi / 360) << limit;
+  write("free.yaml", linkage + "scene: {type: free, duration: 0.5, rates: [6.283185307179586]}\n");
+  EXPECT_EQ(run("validate free.yaml"), 0) << err_;
 }
 
 TEST_F(CliTest, BalanceStudyPrintsTheComparisonAndWritesItsFiles) {
