@@ -150,4 +150,11 @@ Metrics metrics(const FourBar& model, const DrivenScene& scene, const Trajectory
       peaks);
 }
 
+Metrics metrics(const FourBar& model, const Trajectory& trajectory, const SimulateOptions& options,
+                PeakList* peaks) {
+  return with_peaks(
+      trajectory, 0.0,
+      [&](double s) { return free_sample_at(model, options, trajectory, s); }, peaks);
+}
+
 }  // namespace bd::core

@@ -553,6 +553,23 @@ FourBarState on_closure(FourBarState s, DaeMotion& motion) {
 OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FreeScene& scene,
                                              const OpenedLoopDaeOptions& options) {
   validate(scene, options);
+  // a consistent start: the closed pose on the model's branch and the rates it allows (the
+  // dependent rates are undefined at a dead centre, so a start there is an error)
+  const auto pose = nonsingular_pose(model, scene.theta1);
+  if (!pose) {
+    OpenedLoopDaeResult out;
+    out.method = resolved_method(options);
+    fail(out.trajectory, pose.error(), 0.0);
+    return out;
+  }
+  return simulate_opened_loop_dae(model, solve_velocity(model, *pose, scene.omega1), scene,
+                                  options);
+}
+
+OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FourBarState& start,
+                                             const FreeScene& scene,
+                                             const OpenedLoopDaeOptions& options) {
+  validate(scene, options);
   const auto samples = static_cast<std::size_t>(scene.samples);
   OpenedLoopDaeResult out;
   out.method = resolved_method(options);
@@ -566,15 +583,6 @@ OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FreeSce
   motion.beta = options.baumgarte_beta;
   motion.length_scale =
       model.crank.length + model.coupler.length + model.rocker.length + model.frame_length;
-
-  // a consistent start: the closed pose on the model's branch and the rates it allows (the
-  // dependent rates are undefined at a dead centre, so a start there is an error)
-  const auto pose = nonsingular_pose(model, scene.theta1);
-  if (!pose) {
-    fail(traj, pose.error(), 0.0);
-    return out;
-  }
-  const FourBarState start = solve_velocity(model, *pose, scene.omega1);
   ++motion.evaluations;
   const auto first = forward_dynamics_opened_loop(model, start, closure_bias(motion, start));
   if (!first) {

@@ -108,6 +108,14 @@ struct OpenedLoopDaeResult {
 OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FreeScene& scene,
                                              const OpenedLoopDaeOptions& options = {});
 
+/// The same from a given state (its angles and rates; the accelerations are not read), at t = 0,
+/// instead of scene.theta1 and scene.omega1: a run continued from a sample of another
+/// (core::free_sample_at()). The state is taken as it is: off the closure by a sample's
+/// integration error, the stabilisation (or the projection) keeps it there.
+OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FourBarState& start,
+                                             const FreeScene& scene,
+                                             const OpenedLoopDaeOptions& options = {});
+
 /// How simulate_free() integrates Formulation::kOpenedLoop with each core::Integrator (the
 /// options' tolerances and max_steps carried over, samples projected onto the closure):
 /// - kCvodeAdams: Adams with Baumgarte stabilisation (CVODE cannot project an Adams run);

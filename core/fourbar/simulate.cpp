@@ -2,6 +2,7 @@
 
 #include <fmt/printf.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
@@ -287,18 +288,24 @@ namespace {
 // Formulation::kOpenedLoop: the opened loop's own form, the DAE in theta1..theta3, kept on the
 // loop closure as the integrator allows (opened_loop_dae_options); it has no singularity at a
 // crank limit position and passes through it.
+// `from`: the state at t = 0 instead of the scene's theta1 and omega1 (free_sample_at()).
 Trajectory simulate_free_opened_loop(const FourBar& model, const FreeScene& scene,
-                                     const SimulateOptions& options) {
+                                     const SimulateOptions& options,
+                                     const FourBarState* from = nullptr) {
   const OpenedLoopDaeOptions dae = opened_loop_dae_options(options);
+  auto run = [&](const FourBar& m) {
+    return from ? simulate_opened_loop_dae(m, *from, scene, dae).trajectory
+                : simulate_opened_loop_dae(m, scene, dae).trajectory;
+  };
   if (!has_counter_rotations(model)) {
-    Trajectory out = simulate_opened_loop_dae(model, scene, dae).trajectory;
+    Trajectory out = run(model);
     for (DynamicsSample& s : out.samples) set_derived_outputs(model, s);
     return out;
   }
   // discs: the motion from the equations with I_k + J_k, then each sample's reactions from the
   // bare linkage loaded by the mesh forces at the sample's own state
   // (core/fourbar/counter_rotation.hpp)
-  Trajectory out = simulate_opened_loop_dae(with_disc_inertia(model), scene, dae).trajectory;
+  Trajectory out = run(with_disc_inertia(model));
   for (std::size_t i = 0; i < out.samples.size(); ++i) {
     const FourBarState& s = out.samples[i].state;
     const MeshForces f = mesh_forces(model, s);
@@ -400,6 +407,28 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
     return simulate_free_opened_loop(model, scene, options);
   }
   return detail::simulate_free_reduced(model, scene, options, nullptr);
+}
+
+std::optional<DynamicsSample> free_sample_at(const FourBar& model, const SimulateOptions& options,
+                                             const Trajectory& run, double t) {
+  if (run.t.empty() || !(t >= run.t.front()) || !(t <= run.t.back())) return std::nullopt;
+  // the last sample at or before t
+  const auto after = std::upper_bound(run.t.begin(), run.t.end(), t);
+  const auto i = static_cast<std::size_t>(after - run.t.begin()) - 1;
+  const DynamicsSample& from = run.samples[i];
+  if (t == run.t[i]) return from;
+  FreeScene step;
+  step.theta1 = from.state.theta1;
+  step.omega1 = from.state.omega1;
+  step.duration = t - run.t[i];
+  step.samples = 2;
+  Trajectory to = options.formulation == Formulation::kOpenedLoop
+                      ? simulate_free_opened_loop(model, step, options, &from.state)
+                      : detail::simulate_free_reduced(model, step, options, nullptr);
+  if (!to.ok() || to.samples.size() != 2) return std::nullopt;
+  DynamicsSample s = to.samples.back();
+  continue_angles(model, from.state, s.state);
+  return s;
 }
 
 Trajectory detail::simulate_free_reduced(const FourBar& model, const FreeScene& scene,

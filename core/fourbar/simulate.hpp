@@ -2,6 +2,7 @@
 /// Scenes: free motion (forward dynamics integrated by a SUNDIALS integrator with error control,
 /// output at the requested instants by the integrator's dense output) and driven motion (constant
 /// crank speed, inverse dynamics per sample, no integration).
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -77,6 +78,15 @@ struct Trajectory {
 ///         with the field of SimulateOptions::validate() or validate_scene().
 Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
                          const SimulateOptions& options = {});
+/// The sample at time t of a free run `run` = simulate_free(model, scene, options): integrated
+/// by the same formulation and integrator from the run's last sample at or before t, in one run
+/// whose last step ends at t, and its dynamics evaluated there; exact to the integration
+/// tolerance, as the run's own samples are. The reduced formulations continue from the sample's
+/// theta1 and omega1 on the model's branch; the opened loop from its whole state (the branch it
+/// has reached). None outside the run's times or where that integration fails. Used to locate
+/// a free run's peaks between its samples (core/fourbar/metrics.hpp).
+std::optional<DynamicsSample> free_sample_at(const FourBar& model, const SimulateOptions& options,
+                                             const Trajectory& run, double t);
 /// @throws bd::InputError if the scene or options are invalid (omega1 == 0, revolutions < 1, ...),
 ///         with the field of SimulateOptions::validate() or "scene.theta1", "scene.omega1",
 ///         "scene.revolutions", "scene.samples"; none for revolutions * samples above 1e8.

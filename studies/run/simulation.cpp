@@ -146,6 +146,7 @@ Simulation simulate_unchecked(const Study& study, const MethodChoice& method,
                               const Tolerances& tolerances) {
   Simulation s;
   s.method = method;
+  s.tolerances = tolerances;
   if (study.is_fourbar()) {
     if (!method.general_engine()) {
       s.fourbar = closed_form(study, method, tolerances);
@@ -200,7 +201,23 @@ MetricList metric_list(const core::Metrics& metrics, const core::PeakList* peaks
 core::Metrics fourbar_metrics(const Study& study, const Simulation& simulation,
                               core::PeakList* peaks) {
   const auto* driven = std::get_if<core::DrivenScene>(&study.scene);
-  if (!driven) return core::metrics(simulation.fourbar, peaks);
+  if (!driven) {
+    // the peaks located between the samples by the closed form: the run's own formulation and
+    // integrator, or, for a run on the general engine, the mass-matrix form where the crank
+    // turns fully and the opened loop where it reaches limit positions (which it passes)
+    core::SimulateOptions options;
+    if (simulation.method.general_engine()) {
+      options.formulation = core::crank_turns_fully(study.fourbar())
+                                ? core::Formulation::kMassMatrix
+                                : core::Formulation::kOpenedLoop;
+    } else {
+      options.formulation = simulation.method.formulation;
+      options.integrator = simulation.method.integrator;
+    }
+    options.tolerance = simulation.tolerances.relative;
+    options.absolute_tolerance = simulation.tolerances.absolute;
+    return core::metrics(study.fourbar(), simulation.fourbar, options, peaks);
+  }
   const core::Formulation f = simulation.method.general_engine()
                                   ? core::Formulation::kMassMatrix
                                   : simulation.method.formulation;

@@ -36,6 +36,12 @@ struct RunStatus {
 RunStatus run_status(const core::Trajectory& trajectory);
 RunStatus run_status(const core::planar::Trajectory& trajectory);
 
+/// A free run's integration tolerances: relative, and absolute on the coordinates and rates.
+struct Tolerances {
+  double relative = 1e-10;
+  double absolute = 1e-12;
+};
+
 /// A simulation of a study: a four-bar's trajectory (`fourbar`) or a planar linkage's table
 /// (`planar`), the other left empty.
 struct Simulation {
@@ -43,6 +49,7 @@ struct Simulation {
   core::Trajectory fourbar;
   core::planar::Trajectory planar;
   bool is_planar{};
+  Tolerances tolerances;  // a free run's, as it was integrated
 
   RunStatus status() const;
   bool ok() const {
@@ -58,11 +65,6 @@ Simulation simulate(const Study& study);
 /// The same with a given method (the balanced or optimised design's own choice).
 Simulation simulate(const Study& study, const MethodChoice& method);
 
-/// A free run's integration tolerances: relative, and absolute on the coordinates and rates.
-struct Tolerances {
-  double relative = 1e-10;
-  double absolute = 1e-12;
-};
 /// The same with given tolerances (the bench's runs; simulate() above integrates at the study's
 /// tolerance and the integrators' default absolute tolerance, 1e-12). Driven scenes ignore them.
 Simulation simulate(const Study& study, const MethodChoice& method, const Tolerances& tolerances);
@@ -71,7 +73,8 @@ Simulation simulate(const Study& study, const MethodChoice& method, const Tolera
 /// core::kTotalMetrics) or a planar linkage's (core::planar::metric_table()). In a driven scene
 /// every peak is resolved between the samples by the exact inverse dynamics (core/peaks.hpp; a
 /// four-bar's by its closed form, the mass matrix's when the run took the general engine); in a
-/// free scene a peak is the largest sample.
+/// four-bar's free scene by the state integrated from the sample before each instant
+/// (core::free_sample_at()); in a planar linkage's free scene a peak is the largest sample.
 MetricList metric_list(const Study& study, const Simulation& simulation);
 /// A four-bar's run's metrics, as metric_list() computes them, with where their peaks lie.
 core::Metrics fourbar_metrics(const Study& study, const Simulation& simulation,
