@@ -36,33 +36,11 @@ const char* to_string(Formulation f) {
 }
 
 void set_derived_outputs(const FourBar& model, DynamicsSample& s) {
-  const Pose pose = pose_of(s.state);
-  s.Fsh_inertial = Vec2(0, 0);
-  s.Msh_inertial = 0.0;
-  s.Fsh_static = Vec2(0, 0);
-  s.Msh_static = 0.0;
-  const double alpha[] = {s.state.alpha1, s.state.alpha2, s.state.alpha3};
-  Vec2 net[3];  // per link: m a - (F + m g), what the joints, supports and gears must supply
-  for (int k = 1; k <= 3; ++k) {
-    const Link& l = link(model, k);
-    const LinkLoad& load = link_load(model, k);
-    const Vec2 c = centre_of_mass(model, k, pose);
-    const Vec2 ma = l.mass * centre_of_mass_acceleration(model, k, s.state);
-    // H about A0 = Σ (c × m v + I ω), so dH/dt = Σ (c × m a + I α)
-    s.Fsh_inertial -= ma;
-    s.Msh_inertial -= cross(c, ma) + l.inertia * alpha[k - 1];
-    const Vec2 f = load.force + l.mass * model.loads.gravity;
-    s.Fsh_static += f;
-    s.Msh_static += cross(c, f) + load.moment;
-    net[k - 1] = ma - f;
-  }
-  // the crank: net = -RA0 - RC1 - FA1 (its support, its gear, the coupler); the rocker:
-  // net = -RA3 - RC3 + FA2
-  s.FA1 = -net[0] - s.RA0 - s.RC1;
-  s.FA2 = net[2] + s.RA3 + s.RC3;
-  // a disc turns at minus its link's rate about a shaft fixed in the frame: -dH/dt = +J α_link
-  s.Msh_inertial += model.counter_rotations.crank.inertia * s.state.alpha1 +
-                    model.counter_rotations.rocker.inertia * s.state.alpha3;
+  // the link vectors from the angles: three sincos (the sweeps, which hold them from the
+  // position solve, call derived_outputs_at() with theirs)
+  const LinkVectors v = link_vectors(model, pose_of(s.state));
+  detail::derived_outputs_at(detail::derived_constants(model), detail::xy(v.l1),
+                             detail::xy(v.l2), detail::xy(v.l3), s);
 }
 
 namespace {
@@ -118,9 +96,29 @@ Expected<DynamicsSample, DynamicsError> inverse_dynamics(const FourBar& model, d
 
 namespace detail {
 
+DerivedConstants derived_constants(const FourBar& model) {
+  DerivedConstants c;
+  const Xy g = xy(model.loads.gravity);
+  const auto per_link = [&](const Link& l, const LinkLoad& load, Xy& s, double& m, double& I,
+                            Xy& F, double& M) {
+    s = Xy{l.e / l.length, l.f / l.length};
+    m = l.mass;
+    I = l.inertia;
+    F = xy(load.force) + l.mass * g;
+    M = load.moment;
+  };
+  per_link(model.crank, model.loads.crank, c.s1, c.m1, c.I1, c.F1, c.M1);
+  per_link(model.coupler, model.loads.coupler, c.s2, c.m2, c.I2, c.F2, c.M2);
+  per_link(model.rocker, model.loads.rocker, c.s3, c.m3, c.I3, c.F3, c.M3);
+  c.J1 = model.counter_rotations.crank.inertia;
+  c.J3 = model.counter_rotations.rocker.inertia;
+  c.l4 = model.frame_length;
+  return c;
+}
+
 DynamicsConstants dynamics_constants(const FourBar& model) {
   return {mass_matrix_constants(model), opened_loop_constants(model), complex_mass_constants(model),
-          has_counter_rotations(model)};
+          derived_constants(model), has_counter_rotations(model)};
 }
 
 Expected<DynamicsSample, DynamicsError> forward_dynamics(const FourBar& model,

@@ -31,6 +31,7 @@ using detail::close_instant;
 using detail::ClosedInstant;
 using detail::CrankInput;
 using detail::CrankSweep;
+using detail::derived_outputs_at;
 using detail::dynamics_at;
 using detail::dynamics_constants;
 using detail::DynamicsConstants;
@@ -556,14 +557,17 @@ Trajectory simulate_driven(const FourBar& model, const DrivenScene& scene,
         failure = dynamics_at(model, constants, instant, CrankInput::inverse(0.0),
                               options.formulation, sample);
       }
-      if (failure) error = failure->error();
+      if (failure) {
+        error = failure->error();
+      } else {  // set_derived_outputs() from the link vectors the instant holds
+        derived_outputs_at(constants.derived, instant.l1, instant.l2, instant.l3, sample);
+      }
     }
     if (error) {
       out.samples.pop_back();
       fail(out, *error, t, theta1);
       break;
     }
-    if (!constants.counter_rotations) set_derived_outputs(model, sample);
     FourBarState& state = sample.state;
     const double wrapped2 = state.theta2, wrapped3 = state.theta3;
     if (j > 0 && short_steps) {

@@ -120,6 +120,16 @@ void resize(Instant& in, const Model& m) {
 
 bool finite(const VectorXd& v) { return v.allFinite(); }
 
+// dst = src; for the usual equal sizes a plain copy (operator= of a vector of one or two values
+// costs several times the copy)
+void copy_values(const std::vector<double>& src, std::vector<double>& dst) {
+  if (dst.size() == src.size()) {
+    std::copy(src.begin(), src.end(), dst.begin());
+  } else {
+    dst = src;
+  }
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -324,7 +334,7 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
   }
   if (s.n == 0) {
     in.x = guess;
-    in.input = inputs;
+    copy_values(inputs, in.input);
     return true;
   }
   detail::input_targets(s, inputs, ws.target);
@@ -338,7 +348,7 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
         (!(ws.lu.pivot_ratio() >= kWellConditionedPivot) && !(ws.lu.rcond() >= kSingularSolution)))
       return singular_at(model, ws, inputs);
     ws.factorised = true;
-    in.input = inputs;
+    copy_values(inputs, in.input);
     return true;
   };
   if (ws.factorised) {
@@ -383,7 +393,7 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
       if (!(ws.lu.pivot_ratio() >= kWellConditionedPivot) && !(ws.lu.rcond() >= kSingularSolution))
         return singular_at(model, ws, inputs);
       ws.factorised = true;
-      in.input = inputs;
+      copy_values(inputs, in.input);
       return true;
     }
   }
@@ -439,18 +449,30 @@ std::vector<double> efforts_at(const Model& model, double t) {
 
 namespace {
 
-// y = M x for the small square M, by columns (Eigen's general product costs several times the
-// products themselves at these sizes)
+// out = M x for the n x n column-major m, by columns; N = n at compile time (unrolled) or 0
+template <int N>
+void multiply_columns(const double* m, const double* x, double* out, int n_run) {
+  const int n = N > 0 ? N : n_run;
+  for (int i = 0; i < n; ++i) out[i] = m[i] * x[0];
+  for (int j = 1; j < n; ++j) {
+    const double xj = x[j];
+    for (int i = 0; i < n; ++i) out[i] += m[i + n * j] * xj;
+  }
+}
+
+// y = M x for the small square M (Eigen's general product costs several times the products
+// themselves at these sizes); the sizes of the usual linkages (2 to 8 coordinates) unrolled
 void multiply(const MatrixXd& M, const VectorXd& x, VectorXd& y) {
-  const Eigen::Index n = M.rows();
+  const int n = static_cast<int>(M.rows());
   y.resize(n);
   if (n == 0) return;
   const double* m = M.data();
-  double* out = y.data();
-  for (Eigen::Index i = 0; i < n; ++i) out[i] = m[i] * x[0];
-  for (Eigen::Index j = 1; j < n; ++j) {
-    const double xj = x[j];
-    for (Eigen::Index i = 0; i < n; ++i) out[i] += m[i + n * j] * xj;
+  switch (n) {
+    case 2: return multiply_columns<2>(m, x.data(), y.data(), n);
+    case 4: return multiply_columns<4>(m, x.data(), y.data(), n);
+    case 6: return multiply_columns<6>(m, x.data(), y.data(), n);
+    case 8: return multiply_columns<8>(m, x.data(), y.data(), n);
+    default: return multiply_columns<0>(m, x.data(), y.data(), n);
   }
 }
 
@@ -464,7 +486,7 @@ void velocities(const Model& model, Workspace& ws, const std::vector<double>& ra
   }
   ws.lu.solve(ws.rhs, ws.qd);
   detail::node_rates_from(s, ws.qd, ws.instant.v);
-  ws.instant.input_rate = rates;
+  copy_values(rates, ws.instant.input_rate);
 }
 
 // the link angles, rates and accelerations and the sliders' positions and rates, from the nodes
@@ -513,24 +535,27 @@ void link_node_forces(const Model& model, Workspace& ws) {
   };
   for (std::size_t k = 0; k < l.links.size(); ++k) {
     const System::ElementRow& e = s.elements[k];
+    const Vec2& xp = in.x[static_cast<std::size_t>(e.p)];
+    const Vec2& xq = in.x[static_cast<std::size_t>(e.q)];
     Vec4 acc;
     acc << in.a[static_cast<std::size_t>(e.p)], in.a[static_cast<std::size_t>(e.q)];
     const Vec4 inertia = s.element_M[k] * acc;
+    // the element's own row (row k): its axial force λ_k along the unit vector p -> q,
+    // row_gradient()'s element case without its dispatch
+    const Vec2 axial = ws.lambda[static_cast<Eigen::Index>(k)] * ((xq - xp) / e.length);
     const double moment =
         s.shafts.empty() ? s.link_moment[k] : detail::link_moment_at(s, static_cast<int>(k), in.x);
     if (s.link_force[k].isZero(0.0) && moment == 0.0) {  // an unloaded link (as applied_forces)
-      f(static_cast<int>(k), e.p) += inertia.segment<2>(0);
-      f(static_cast<int>(k), e.q) += inertia.segment<2>(2);
+      f(static_cast<int>(k), e.p) += inertia.segment<2>(0) + axial;
+      f(static_cast<int>(k), e.q) += inertia.segment<2>(2) - axial;
       continue;
     }
-    const Vec4 applied = element_nodal_forces(s.com_weights[k], s.link_force[k], moment,
-                                              in.x[static_cast<std::size_t>(e.p)],
-                                              in.x[static_cast<std::size_t>(e.q)]);
-    f(static_cast<int>(k), e.p) += inertia.segment<2>(0) - applied.segment<2>(0);
-    f(static_cast<int>(k), e.q) += inertia.segment<2>(2) - applied.segment<2>(2);
+    const Vec4 applied = element_nodal_forces(s.com_weights[k], s.link_force[k], moment, xp, xq);
+    f(static_cast<int>(k), e.p) += inertia.segment<2>(0) - applied.segment<2>(0) + axial;
+    f(static_cast<int>(k), e.q) += inertia.segment<2>(2) - applied.segment<2>(2) - axial;
   }
   GradientEntry entries[3];
-  for (int row = 0; row < s.rows; ++row) {
+  for (int row = static_cast<int>(l.links.size()); row < s.rows; ++row) {
     const int count = detail::row_gradient(s, in.x, row, entries);
     for (int j = 0; j < count; ++j) {
       if (entries[j].link >= 0)
@@ -726,7 +751,7 @@ Expected<bool, PlanarError> inverse_dynamics(const Model& model, Workspace& ws, 
     ws.rhs[in.row] += in.angle ? in.length * z : z;
   }
   ws.lu.solve(ws.rhs, ws.qdd);
-  ws.instant.input_acceleration = accelerations;
+  copy_values(accelerations, ws.instant.input_acceleration);
   return finish(model, ws, t);
 }
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 #include <cmath>
+#include <utility>
 
 #include "core/input_error.hpp"
 #include "core/integrators.hpp"
@@ -286,9 +287,11 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
           guess[k] = at.x[k] + (31 * dx + h * (dv + h * da));
         }
       }
-      previous = at.x;
-      v_previous = at.v;
-      a_previous = at.a;
+      // the last sample's vectors become the previous ones by a swap, not a copy: the solve
+      // and the dynamics below write every entry of the instant's before reading it
+      std::swap(previous, ws.instant.x);
+      std::swap(v_previous, ws.instant.v);
+      std::swap(a_previous, ws.instant.a);
     }
     auto ok = solve_position(model, ws, guess, z);
     if (ok && i > 0 && branch() != drawn_branch) {
@@ -304,7 +307,7 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
       }
     }
     if (ok) ok = inverse_dynamics(model, ws, t, scene.speeds, zero);
-    z_previous = z;
+    std::swap(z_previous, z);  // z is written whole at the next sample
     ++out.rhs_evaluations;
     if (!ok) {
       fail(out, ok.error(), t);

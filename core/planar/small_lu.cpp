@@ -100,20 +100,27 @@ void SmallLu::compute(const Eigen::MatrixXd& a) {
     dynamic_.compute(a);
     return;
   }
-  a_ = a;  // for rcond(): the 1-norm, only when asked
-  lu_ = a;
-  perm_.resize(n_);
-  swaps_ = by_size(n_, [&](auto size) {
+  by_size(n_, [&](auto size) {
     constexpr int N = decltype(size)::value;
+    const int n = N > 0 ? N : n_;
+    std::copy_n(a.data(), n * n, a_);  // for rcond(): the 1-norm, only when asked
+    std::copy_n(a.data(), n * n, lu_);
     solve_kernel_ = &solve_vector<N>;
     transpose_kernel_ = &solve_transpose_vector<N>;
-    return factorise<N>(lu_.data(), perm_.indices().data(), n_);
+    swaps_ = factorise<N>(lu_, perm_, n);
+    double smallest = std::numeric_limits<double>::infinity(), largest = 0;
+    for (int k = 0; k < n; ++k) {
+      const double p = std::abs(lu_[k + n * k]);
+      smallest = std::min(smallest, p);
+      largest = std::max(largest, p);
+    }
+    pivot_ratio_ = smallest / largest;
   });
 }
 
 void SmallLu::solve_in_place(double* b) const {
   if (n_ == 0) return;  // nothing to solve (and no kernel chosen if never factorised)
-  solve_kernel_(lu_.data(), perm_.indices().data(), b, n_);
+  solve_kernel_(lu_, perm_, b, n_);
 }
 
 void SmallLu::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
@@ -139,22 +146,25 @@ void SmallLu::solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const {
 
 void SmallLu::solve_transpose(Eigen::VectorXd& b) const {
   if (n_ <= kFixedSize) {
-    if (n_ > 0) transpose_kernel_(lu_.data(), perm_.indices().data(), b.data(), n_);
+    if (n_ > 0) transpose_kernel_(lu_, perm_, b.data(), n_);
     return;
   }
   // A = P⁻¹ L U: Uᵀ, then Lᵀ, then the permutation
-  factors().triangularView<Eigen::Upper>().transpose().solveInPlace(b);
-  factors().triangularView<Eigen::UnitLower>().transpose().solveInPlace(b);
+  dynamic_.matrixLU().triangularView<Eigen::Upper>().transpose().solveInPlace(b);
+  dynamic_.matrixLU().triangularView<Eigen::UnitLower>().transpose().solveInPlace(b);
   b = dynamic_.permutationP().transpose() * b;
 }
 
 double SmallLu::determinant() const {
   if (n_ > kFixedSize) return dynamic_.determinant();
-  return (swaps_ % 2 ? -1.0 : 1.0) * lu_.diagonal().prod();
+  double d = swaps_ % 2 ? -1.0 : 1.0;
+  for (int k = 0; k < n_; ++k) d *= lu_[k + n_ * k];
+  return d;
 }
 
 double SmallLu::pivot_ratio() const {
-  const auto d = factors().diagonal().cwiseAbs();
+  if (n_ <= kFixedSize) return pivot_ratio_;
+  const auto d = dynamic_.matrixLU().diagonal().cwiseAbs();
   return d.minCoeff() / d.maxCoeff();
 }
 
@@ -196,7 +206,12 @@ double SmallLu::inverse_norm_estimate() const {
 double SmallLu::rcond() const {
   if (n_ > kFixedSize) return dynamic_.rcond();
   if (n_ == 0) return std::numeric_limits<double>::infinity();
-  const double l1_norm = a_.cwiseAbs().colwise().sum().maxCoeff();  // as Eigen's
+  double l1_norm = 0;  // as Eigen's: the largest column sum of |a|
+  for (int j = 0; j < n_; ++j) {
+    double column = 0;
+    for (int i = 0; i < n_; ++i) column += std::abs(a_[i + n_ * j]);
+    l1_norm = std::max(l1_norm, column);
+  }
   if (l1_norm == 0.0) return 0.0;
   if (n_ == 1) return 1.0;
   const double inverse_norm = inverse_norm_estimate();

@@ -42,17 +42,19 @@ class SmallLu {
   void solve_in_place(double* b) const;
   double inverse_norm_estimate() const;
 
-  const Eigen::MatrixXd& factors() const { return n_ > kFixedSize ? dynamic_.matrixLU() : lu_; }
-
   using Kernel = void (*)(const double* lu, const int* perm, double* b, int n);
   Kernel solve_kernel_ = nullptr;      // b = A⁻¹ b for this size (set by compute())
   Kernel transpose_kernel_ = nullptr;  // b = A⁻ᵀ b
   int n_ = 0;
   int swaps_ = 0;
-  Eigen::MatrixXd a_;   // the matrix factorised
-  Eigen::MatrixXd lu_;  // L below the diagonal (unit diagonal implied), U on and above
-  Eigen::Transpositions<Eigen::Dynamic, Eigen::Dynamic, int> perm_;  // P, the row swaps in order
-  Eigen::PartialPivLU<Eigen::MatrixXd> dynamic_;                      // above kFixedSize
+  double pivot_ratio_ = 0;  // up to kFixedSize, found by compute()
+  // up to kFixedSize, column-major n x n in fixed arrays (no Eigen assignment, whose size checks
+  // cost as much as copying a 4 x 4)
+  double a_[kFixedSize * kFixedSize]{};   // the matrix factorised, for rcond()
+  double lu_[kFixedSize * kFixedSize]{};  // L below the diagonal (unit diagonal implied), U on
+                                          // and above
+  int perm_[kFixedSize]{};                // P, the row swaps in order
+  Eigen::PartialPivLU<Eigen::MatrixXd> dynamic_;  // above kFixedSize
   mutable Eigen::VectorXd v_, sign_, old_sign_;  // rcond's scratch
 };
 

@@ -400,8 +400,17 @@ int row_gradient(const System& s, const NodeVectors& x, int row, GradientEntry o
 
 void constraint_jacobian(const System& s, const NodeVectors& x, int rows, MatrixXd& G) {
   G.setZero(rows, s.n);
+  // the element rows (the first, one per link) written directly: row_gradient()'s
+  // element case without its dispatch
+  const int elements = std::min(rows, static_cast<int>(s.elements.size()));
+  for (int row = 0; row < elements; ++row) {
+    const System::ElementRow& e = s.elements[static_cast<std::size_t>(row)];
+    const Vec2 d = (at(x, e.q) - at(x, e.p)) / e.length;
+    add_gradient(s, G, row, e.q, d);
+    add_gradient(s, G, row, e.p, -d);
+  }
   GradientEntry entries[3];
-  for (int row = 0; row < rows; ++row) {
+  for (int row = elements; row < rows; ++row) {
     const int count = row_gradient(s, x, row, entries);
     for (int k = 0; k < count; ++k) add_gradient(s, G, row, entries[k].node, entries[k].grad);
   }

@@ -134,7 +134,8 @@ TEST(DynamicsConstants, CrankSweepGivesCosAndSinOfEachAngle) {
 
 TEST(DynamicsConstants, DrivenSweepMatchesInverseDynamicsAtEverySample) {
   // the sweep's route (constants once, the crank vector turned, the angles continued by whole
-  // turns) against inverse_dynamics() at the same crank angles: the same numbers to round-off,
+  // turns, the derived outputs from the position solve's link vectors) against
+  // inverse_dynamics() at the same crank angles: the same numbers to round-off,
   // and the angles the one-instant ones plus whole turns
   std::mt19937_64 rng(33);
   std::vector<FourBar> models = {samples::paper_fourbar(), samples::double_crank()};
@@ -167,6 +168,14 @@ TEST(DynamicsConstants, DrivenSweepMatchesInverseDynamicsAtEverySample) {
         EXPECT_LT((got.RA3 - want->RA3).norm(), 1e-13 * F) << at;
         EXPECT_NEAR(got.Msh, want->Msh, 1e-13 * M) << at;
         EXPECT_NEAR(got.tau, want->tau, 1e-13 * M) << at;
+        // the derived outputs, from the sweep's link vectors here and from sincos of the angles
+        // there
+        EXPECT_LT((got.FA1 - want->FA1).norm(), 1e-13 * F) << at;
+        EXPECT_LT((got.FA2 - want->FA2).norm(), 1e-13 * F) << at;
+        EXPECT_LT((got.Fsh_inertial - want->Fsh_inertial).norm(), 1e-13 * F) << at;
+        EXPECT_LT((got.Fsh_static - want->Fsh_static).norm(), 1e-13 * F) << at;
+        EXPECT_NEAR(got.Msh_inertial, want->Msh_inertial, 1e-13 * M) << at;
+        EXPECT_NEAR(got.Msh_static, want->Msh_static, 1e-13 * M) << at;
         if (j > 0) {  // continuous: far less than a turn between samples
           EXPECT_LT(std::abs(got.state.theta2 - tr.samples[j - 1].state.theta2), 1.0) << at;
           EXPECT_LT(std::abs(got.state.theta3 - tr.samples[j - 1].state.theta3), 1.0) << at;

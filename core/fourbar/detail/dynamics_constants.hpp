@@ -66,12 +66,28 @@ struct OpenedLoopConstants {
 };
 OpenedLoopConstants opened_loop_constants(const FourBar& model);
 
+/// What the outputs derived from a sample need of the model (derived_outputs_at(),
+/// core/fourbar/detail/formulation_support.hpp): per link k its centre-of-mass offset as a factor
+/// of the link vector, s̄_k/l_k, so that s̄_k in ground axes is s̄_k/l_k ⊗ l̄_k (no angle, no
+/// sincos), its mass, inertia and the constant force F̄_k + m_k ḡ with the applied moment.
+struct DerivedConstants {
+  Xy s1, s2, s3;                // s̄_k / l_k = (e_k + i f_k) / l_k [-]
+  double m1{}, m2{}, m3{};      // [kg]
+  double I1{}, I2{}, I3{};      // about the centres of mass [kg m^2]
+  Xy F1, F2, F3;                // F̄_k + m_k ḡ [N]
+  double M1{}, M2{}, M3{};      // applied moments [N m]
+  double J1{}, J3{};            // counter-rotating discs on crank and rocker [kg m^2]
+  double l4{};                  // frame length [m]
+};
+DerivedConstants derived_constants(const FourBar& model);
+
 /// All three, and whether the model has counter-rotations (whose reactions need loads that
 /// change with the state, so they take the one-instant route).
 struct DynamicsConstants {
   MassMatrixConstants mass_matrix;
   OpenedLoopConstants opened_loop;
   ComplexMassConstants complex_masses;
+  DerivedConstants derived;
   bool counter_rotations{};
 };
 /// The constants of `model` for all formulations; valid for that model only.

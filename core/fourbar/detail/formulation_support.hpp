@@ -143,6 +143,45 @@ inline std::optional<Failure> complete_sample(const FourBar& model, const Xy& RA
   return std::nullopt;
 }
 
+/// Fills the outputs of `s` derived from its state, its reactions and the model (the constants
+/// `c`): the inertial and static parts of the shaking force and moment and the joint forces FA1,
+/// FA2, as set_derived_outputs() (core/fourbar/dynamics.hpp) says. l1, l2, l3 are the link
+/// vectors l̄k = l_k (cos θk, sin θk) [m] of the sample's pose: a sweep passes those of its
+/// position solve, so no angle goes through sincos again.
+inline void derived_outputs_at(const DerivedConstants& c, const Xy& l1, const Xy& l2, const Xy& l3,
+                               DynamicsSample& s) {
+  const FourBarState& x = s.state;
+  // each centre of mass: its link's first joint (A0 = 0, A1 = l̄1, A2 = A3 - l̄3) plus s̄_k in
+  // ground axes; its acceleration: the joint's plus α_k i s̄_k - ω_k² s̄_k
+  const Xy rho1 = cmul(c.s1, l1), rho2 = cmul(c.s2, l2), rho3 = cmul(c.s3, l3);
+  const Xy c1 = rho1, c2 = l1 + rho2, c3 = Xy{c.l4 - l3.x, -l3.y} + rho3;
+  const Xy a_A1 = x.alpha1 * perp(l1) - (x.omega1 * x.omega1) * l1;
+  const Xy a_A2 = (x.omega3 * x.omega3) * l3 - x.alpha3 * perp(l3);
+  const Xy ma1 = c.m1 * (x.alpha1 * perp(rho1) - (x.omega1 * x.omega1) * rho1);
+  const Xy ma2 = c.m2 * (a_A1 + x.alpha2 * perp(rho2) - (x.omega2 * x.omega2) * rho2);
+  const Xy ma3 = c.m3 * (a_A2 + x.alpha3 * perp(rho3) - (x.omega3 * x.omega3) * rho3);
+  // H about A0 = Σ (c × m v + I ω), so dH/dt = Σ (c × m a + I α); a disc turns at minus its
+  // link's rate about a shaft fixed in the frame: -dH/dt = +J α_link
+  const Xy Fi = -(ma1 + ma2 + ma3);
+  s.Fsh_inertial.x() = Fi.x;
+  s.Fsh_inertial.y() = Fi.y;
+  s.Msh_inertial = -((cross(c1, ma1) + c.I1 * x.alpha1) + (cross(c2, ma2) + c.I2 * x.alpha2) +
+                     (cross(c3, ma3) + c.I3 * x.alpha3)) +
+                   (c.J1 * x.alpha1 + c.J3 * x.alpha3);
+  const Xy Fs = c.F1 + c.F2 + c.F3;
+  s.Fsh_static.x() = Fs.x;
+  s.Fsh_static.y() = Fs.y;
+  s.Msh_static = (cross(c1, c.F1) + c.M1) + (cross(c2, c.F2) + c.M2) + (cross(c3, c.F3) + c.M3);
+  // per link, m a - (F + m g) is what the joints, supports and gears supply: on the crank
+  // -RA0 - RC1 - FA1 (its support, its gear, the coupler), on the rocker -RA3 - RC3 + FA2
+  const Xy FA1 = (c.F1 - ma1) - xy(s.RA0) - xy(s.RC1);
+  const Xy FA2 = (ma3 - c.F3) + xy(s.RA3) + xy(s.RC3);
+  s.FA1.x() = FA1.x;
+  s.FA1.y() = FA1.y;
+  s.FA2.x() = FA2.x;
+  s.FA2.y() = FA2.y;
+}
+
 /// Which of θ̈1 and tau a formulation solves for at an instant: forward dynamics (tau = 0) has
 /// the crank acceleration unknown, inverse dynamics the torque for a given one.
 struct CrankInput {
