@@ -410,18 +410,14 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
   return detail::simulate_free_reduced(model, scene, options, nullptr);
 }
 
-std::optional<DynamicsSample> free_sample_at(const FourBar& model, const SimulateOptions& options,
-                                             const Trajectory& run, double t) {
-  if (run.t.empty() || !(t >= run.t.front()) || !(t <= run.t.back())) return std::nullopt;
-  // the last sample at or before t
-  const auto after = std::upper_bound(run.t.begin(), run.t.end(), t);
-  const auto i = static_cast<std::size_t>(after - run.t.begin()) - 1;
-  const DynamicsSample& from = run.samples[i];
-  if (t == run.t[i]) return from;
+std::optional<DynamicsSample> free_sample_from(const FourBar& model, const SimulateOptions& options,
+                                               double t0, const DynamicsSample& from, double t) {
+  if (t == t0) return from;
+  if (!(t > t0)) return std::nullopt;
   FreeScene step;
   step.theta1 = from.state.theta1;
   step.omega1 = from.state.omega1;
-  step.duration = t - run.t[i];
+  step.duration = t - t0;
   step.samples = 2;
   Trajectory to = options.formulation == Formulation::kOpenedLoop
                       ? simulate_free_opened_loop(model, step, options, &from.state)
@@ -430,6 +426,15 @@ std::optional<DynamicsSample> free_sample_at(const FourBar& model, const Simulat
   DynamicsSample s = to.samples.back();
   continue_angles(model, from.state, s.state);
   return s;
+}
+
+std::optional<DynamicsSample> free_sample_at(const FourBar& model, const SimulateOptions& options,
+                                             const Trajectory& run, double t) {
+  if (run.t.empty() || !(t >= run.t.front()) || !(t <= run.t.back())) return std::nullopt;
+  // the last sample at or before t
+  const auto after = std::upper_bound(run.t.begin(), run.t.end(), t);
+  const auto i = static_cast<std::size_t>(after - run.t.begin()) - 1;
+  return free_sample_from(model, options, run.t[i], run.samples[i], t);
 }
 
 Trajectory detail::simulate_free_reduced(const FourBar& model, const FreeScene& scene,

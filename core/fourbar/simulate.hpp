@@ -87,6 +87,10 @@ Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
 /// a free run's peaks between its samples (core/fourbar/metrics.hpp).
 std::optional<DynamicsSample> free_sample_at(const FourBar& model, const SimulateOptions& options,
                                              const Trajectory& run, double t);
+/// The same from a given sample `from` at time t0 <= t (a sample of the run, or an instant
+/// computed so); none for t < t0 or where the integration fails.
+std::optional<DynamicsSample> free_sample_from(const FourBar& model, const SimulateOptions& options,
+                                               double t0, const DynamicsSample& from, double t);
 /// @throws bd::InputError if the scene or options are invalid (omega1 == 0, revolutions < 1, ...),
 ///         with the field of SimulateOptions::validate() or "scene.theta1", "scene.omega1",
 ///         "scene.revolutions", "scene.samples"; none for revolutions * samples above 1e8.
