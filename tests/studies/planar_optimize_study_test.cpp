@@ -112,6 +112,7 @@ TEST(PlanarOptimizeStudy, MistakesAreOneLineAtTheirPlace) {
   std::string free = kEngine;
   free.replace(free.find("  type: driven\n"), 15, "  type: free\n  duration: 0.1\n");
   free.erase(free.find("  speeds:"), free.find("  samples:") - free.find("  speeds:"));
+  free.insert(free.find("  samples:"), "  rates: [20.0]\n");  // set in motion: Msh_rms > 0
   EXPECT_NO_THROW(
       parse_study(free + "optimize:\n  algorithm: slsqp\n" + kObjective + kVariables, "e.yaml"));
   // a balance section beside it
