@@ -60,18 +60,8 @@ int counterweight_pivot(const cp::Linkage& l, int link) {
 }
 
 Eigen::VectorXd Parameters::of(const cp::Linkage& l) {
-  VectorXd theta = VectorXd::Zero(count(l));
-  for (std::size_t k = 0; k < l.links.size(); ++k) {
-    const cp::Link& link = l.links[k];
-    const int i = static_cast<int>(k);
-    theta[link_mass(i)] = link.mass;
-    theta[link_me(i)] = link.mass * link.e;
-    theta[link_mf(i)] = link.mass * link.f;
-    theta[link_J(i)] = link.inertia + link.mass * (link.e * link.e + link.f * link.f);
-  }
-  for (std::size_t j = 0; j < l.point_masses.size(); ++j)
-    theta[point_mass(l, static_cast<int>(j))] = l.point_masses[j].mass;
-  return theta;
+  const std::vector<double> pi = cp::mass_parameters(l);
+  return Eigen::Map<const VectorXd>(pi.data(), static_cast<Eigen::Index>(pi.size()));
 }
 
 std::vector<ComplexMass> equivalent_masses(const cp::Linkage& l) {

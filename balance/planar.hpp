@@ -28,9 +28,10 @@ namespace bd::balance::planar {
 
 namespace cp = core::planar;
 
-/// The layout of the mass-parameter vector: per link k, columns 4k + 0..3 are m [kg], m e,
-/// m f [kg m] (its first moment about its first node, in link axes) and J [kg m^2] (inertia
-/// about its first node: I + m (e² + f²)); then one column per point mass [kg].
+/// The layout of the mass-parameter vector, core's (core/planar/model.hpp, mass_parameters()):
+/// per link k, columns 4k + 0..3 are m [kg], m e, m f [kg m] (its first moment about its first
+/// node, in link axes) and J [kg m^2] (inertia about its first node: I + m (e² + f²)); then one
+/// column per point mass [kg].
 struct Parameters {
   static int link_mass(int k) { return 4 * k; }
   static int link_me(int k) { return 4 * k + 1; }
@@ -39,9 +40,7 @@ struct Parameters {
   static int point_mass(const cp::Linkage& l, int j) {
     return 4 * static_cast<int>(l.links.size()) + j;
   }
-  static int count(const cp::Linkage& l) {
-    return 4 * static_cast<int>(l.links.size()) + static_cast<int>(l.point_masses.size());
-  }
+  static int count(const cp::Linkage& l) { return cp::mass_parameter_count(l); }
   /// The linkage's values.
   static Eigen::VectorXd of(const cp::Linkage& l);
 };

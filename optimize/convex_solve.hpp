@@ -9,7 +9,8 @@
 /// certificate of a global optimum (detail::optimality()).
 ///
 /// `Nlp` is a linkage type's program (Nlp, planar::PlanarNlp) with start(bool),
-/// start_scaled(double), start_at(), from_positions(), to_positions() and why_not_convex().
+/// start_scaled(double), start_at(), from_positions(), to_positions(), why_not_convex() and
+/// free_scene().
 #include <Eigen/Core>
 #include <cmath>
 #include <limits>
@@ -235,6 +236,11 @@ ConvexAwareSolve solve_convex_aware(const Nlp& nlp, const Problem& problem,
         }
       }
     }
+  } else if (nlp.free_scene()) {
+    // no relaxation to try (building one would cost a simulation to say so)
+    out.bound.words = "no lower bound: in a free scene the motion itself changes with the "
+                      "design, so the forces are not linear in the masses and no convex problem "
+                      "bounds the objective from below";
   } else if (!why_not.empty() && nlp.has_gradients()) {
     out.bound = relaxation_bound<Nlp>(problem, found ? solved.x : Eigen::VectorXd(), options);
   } else if (!why_not.empty()) {

@@ -35,6 +35,7 @@ const std::vector<std::string>& Nlp::constraint_names() const {
   return program_->constraint_names();
 }
 bool Nlp::has_gradients() const { return program_->has_gradients(); }
+bool Nlp::free_scene() const { return program_->free_scene(); }
 std::string Nlp::why_not_convex() const { return program_->why_not_convex(); }
 Eigen::VectorXd Nlp::from_positions(const Eigen::VectorXd& x) const {
   return program_->start_at(program_->from_positions(x));

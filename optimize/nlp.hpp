@@ -123,8 +123,11 @@ class Nlp final : public Program {
   /// "force balance, crank side (real part)", "Fsh_rms <= 0.2 x original", ...).
   const std::vector<std::string>& variable_names() const override;
   const std::vector<std::string>& constraint_names() const override;  // equalities first
-  /// True when exact gradients are available (driven scenes).
+  /// True when exact gradients are available (driven scenes; free scenes on the reduced
+  /// equation, by forward sensitivities).
   bool has_gradients() const override;
+  /// True in a free scene (every evaluation a simulation).
+  bool free_scene() const;
   /// Empty when the program is convex in mass-moment variables
   /// (CounterweightVariablesAs::kMassMoments), else why not in an engineer's words. Convex: a
   /// driven scene (the motion, so every sample's outputs, is then independent of the design);

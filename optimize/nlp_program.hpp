@@ -15,6 +15,7 @@
 #include <memory>
 #include <string>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "optimize/nlp.hpp"
@@ -77,6 +78,7 @@ class NlpProgram {
   const std::vector<std::string>& variable_names() const { return variable_names_; }
   const std::vector<std::string>& constraint_names() const { return constraint_names_; }
   virtual bool has_gradients() const = 0;
+  bool free_scene() const { return std::holds_alternative<core::FreeScene>(problem_.scene); }
   /// Nlp::why_not_convex(); the default: not convex, a free scene.
   virtual std::string why_not_convex() const;
   Eigen::VectorXd from_positions(const Eigen::VectorXd& x) const;

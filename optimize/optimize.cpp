@@ -203,14 +203,14 @@ Problem OptimizeOptions::validate() const {
   return std::nullopt;
 }
 
-Problem check_algorithm(const OptimizeOptions& options, bool free_scene, bool force_balance) {
+Problem check_algorithm(const OptimizeOptions& options, const std::string& without_gradients,
+                        const std::string& instead, bool force_balance) {
   const std::string name = std::string("'") + to_string(options.algorithm) + "'";
-  if (uses_gradients(options.algorithm) && free_scene) {
-    // the general planar linkage's free scenes: no sensitivities yet
+  if (uses_gradients(options.algorithm) && !without_gradients.empty()) {
     return FieldError{"algorithm", -1,
-                      name +
-                          " needs gradients, which a free scene does not provide; use cobyla "
-                          "or isres"};
+                      name + " needs gradients, which " + without_gradients +
+                          " does not provide; use cobyla or isres" +
+                          (instead.empty() ? "" : ", or " + instead)};
   }
   if (options.algorithm == Algorithm::kMma && force_balance) {
     return FieldError{"algorithm", -1,
@@ -224,15 +224,10 @@ Problem check_algorithm(const OptimizeOptions& options, bool free_scene, bool fo
 Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options) {
   // a four-bar's free scene has gradients by forward sensitivities of its reduced equation
   // (optimize/free_nlp.cpp), but not on the opened loop's DAE
-  if (uses_gradients(options.algorithm) && std::holds_alternative<core::FreeScene>(problem.scene) &&
-      problem.formulation == core::Formulation::kOpenedLoop) {
-    return FieldError{"algorithm", -1,
-                      std::string("'") + to_string(options.algorithm) +
-                          "' needs gradients, which a free scene on the opened loop (method "
-                          "opened-loop) does not provide; use cobyla or isres, or the method "
-                          "mass-matrix or complex-masses"};
-  }
-  return check_algorithm(options, false, problem.force_balance);
+  const bool opened = std::holds_alternative<core::FreeScene>(problem.scene) &&
+                      problem.formulation == core::Formulation::kOpenedLoop;
+  return check_algorithm(options, opened ? "a free scene on the opened loop (method opened-loop)" : "",
+                         "the method mass-matrix or complex-masses", problem.force_balance);
 }
 
 void detail::check_inputs(const DesignProblem& problem, const OptimizeOptions& options) {

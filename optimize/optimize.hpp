@@ -31,9 +31,10 @@ bool uses_gradients(Algorithm a);
 /// trying, as words: "ipopt, mlsl, slsqp" (driven scenes), "isres" (free scenes, after cobyla).
 std::string other_algorithms(Algorithm used, bool free_scene);
 /// The method a study gets when it names none: slsqp in a driven scene (exact gradients from
-/// the regressor), cobyla in a free one (every evaluation a simulation; a four-bar's gradient
-/// methods there take the gradients of forward sensitivities, but the general planar linkage's
-/// free scenes have none, and docs/performance.md, "Free scenes", says why cobyla stays).
+/// the regressor), cobyla in a free one (every evaluation a simulation; the gradient methods
+/// there take the gradients of forward sensitivities, each evaluation dearer, and a simulation
+/// that fails mid-search gives them no slope: docs/performance.md, "Free scenes", says why
+/// cobyla stays).
 constexpr Algorithm default_algorithm(bool free_scene) {
   return free_scene ? Algorithm::kCobyla : Algorithm::kSlsqp;
 }
@@ -59,10 +60,12 @@ struct OptimizeOptions {
 /// free scene on the opened loop (method opened-loop) does not provide; use cobyla or isres, or
 /// the method mass-matrix or complex-masses". optimize() refuses what this refuses.
 bd::Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options);
-/// The same for any linkage type's problem: in a free scene without gradients (the general
-/// planar linkage's) or not, with force balance or not; e.g. text() "algorithm 'slsqp' needs
-/// gradients, which a free scene does not provide; use cobyla or isres".
-bd::Problem check_algorithm(const OptimizeOptions& options, bool free_scene, bool force_balance);
+/// The same for any linkage type's problem: `without_gradients` empty where the problem has
+/// gradients, else what lacks them and `instead` what would give them; with force balance or
+/// not; e.g. text() "algorithm 'slsqp' needs gradients, which a free scene on the dae route
+/// does not provide; use cobyla or isres, or the reduced route".
+bd::Problem check_algorithm(const OptimizeOptions& options, const std::string& without_gradients,
+                            const std::string& instead, bool force_balance);
 
 enum class Termination {
   kNotRun,

@@ -167,16 +167,24 @@ Problem DesignProblem::validate() const {
 
 // ---------------------------------------------------------------------------------------------
 
+// a free scene's simulation at x: its metrics (table order; +inf when it failed) and, when it
+// was a run with sensitivities, their gradients (table rows x n; zero where it failed)
+struct PlanarNlp::Evaluation {
+  VectorXd x;
+  std::vector<double> metrics;
+  MatrixXd gradient;
+};
+
 struct PlanarNlp::Impl {
   DesignProblem p;
   bool free{};     // a free scene: metrics by simulation, no regressor
   bool moments{};  // counterweights as (m, p = m r): CounterweightVariablesAs::kMassMoments
   bool relaxed{};  // and their inertias relaxed: CounterweightVariablesAs::kRelaxation
   std::vector<detail::RelaxedCounterweight> relaxed_cw;  // kRelaxation: their variables
-  // a free scene's last simulation: its x and metrics (table order; +inf when it failed)
+  // a free scene's last simulation
   mutable std::mutex cache_mutex;
-  mutable VectorXd cached_x;
-  mutable std::vector<double> cached;
+  mutable Evaluation cached;
+  std::vector<int> sensitivity_parameters;  // free scenes: the entries of q the design varies
   int nq{}, samples{};
   VectorXd q0;
   double mass0{}, length{};
@@ -281,19 +289,9 @@ void PlanarNlp::Impl::build_regressor() {
   for (const cp::ColumnMetric& m : table)
     for (const std::string& c : m.columns) used.insert(c);
   auto run = [&](const VectorXd& q, const char* what) {
-    cp::Linkage d = l;
-    for (std::size_t k = 0; k < l.links.size(); ++k) {
-      const int i = static_cast<int>(k);
-      cp::Link& link = d.links[k];
-      link.mass = q[P::link_mass(i)];
-      link.e = q[P::link_me(i)] / link.mass;
-      link.f = q[P::link_mf(i)] / link.mass;
-      link.inertia = q[P::link_J(i)] - link.mass * (link.e * link.e + link.f * link.f);
-    }
-    for (std::size_t j = 0; j < l.point_masses.size(); ++j)
-      d.point_masses[j].mass = q[P::point_mass(l, static_cast<int>(j))];
-    const cp::Trajectory t =
-        cp::simulate_driven(cp::Model(cp::make_linkage(d)), std::get<cp::DrivenScene>(p.scene));
+    const cp::Trajectory t = cp::simulate_driven(
+        cp::Model(cp::make_linkage(cp::with_mass_parameters(l, q.data()))),
+        std::get<cp::DrivenScene>(p.scene));
     if (!t.ok()) throw InputError(std::string(what) + " cannot run in the scene: " + t.message);
     return t;
   };
@@ -718,24 +716,66 @@ PlanarNlp::PlanarNlp(const DesignProblem& problem, CounterweightVariablesAs as)
       normaliser(m.p.limits[i].metric, "limits", static_cast<int>(i));
   m.set_up_variables();
   m.set_up_constraints();
+  if (m.free) {  // the sensitivities' parameters: every mass parameter of each varied link
+    std::set<int> varied;
+    for (const CounterweightVariables& c : m.p.counterweights) varied.insert(c.link);
+    for (const LinkParameterVariable& v : m.p.link_parameters) varied.insert(v.link);
+    for (int k : varied)
+      m.sensitivity_parameters.insert(m.sensitivity_parameters.end(),
+                                      {P::link_mass(k), P::link_me(k), P::link_mf(k), P::link_J(k)});
+  }
 }
 
 PlanarNlp::~PlanarNlp() = default;
 
-bool PlanarNlp::has_gradients() const { return !impl_->free; }
+bool PlanarNlp::free_scene() const { return impl_->free; }
 
-// a free scene: the metrics of the design at x simulated (the last one kept: the objective and
-// the constraints at the same x simulate once); +inf when the simulation fails
-std::vector<double> PlanarNlp::simulated(const VectorXd& x) const {
+bool PlanarNlp::has_gradients() const {
+  const cp::SimulateOptions& o = impl_->p.simulate;
+  return !impl_->free || (o.route == cp::Route::kReduced &&
+                          (o.integrator == core::Integrator::kCvodeAdams ||
+                           o.integrator == core::Integrator::kCvodeBdf));
+}
+
+// A free scene: the metrics of the design at x simulated and, with `gradient`, their gradients
+// from the same run's forward sensitivities (core/planar/simulate.hpp) with respect to the
+// varied links' mass parameters q, chained with ∂q/∂x. The last evaluation is kept, so the
+// objective and the constraints at the same x simulate once: a plain simulation when no
+// derivative is asked for, the run with sensitivities when one is. A failed simulation gives
+// +inf (gradient 0).
+PlanarNlp::Evaluation PlanarNlp::simulated(const VectorXd& x, bool gradient) const {
   const Impl& m = *impl_;
   const std::lock_guard<std::mutex> lock(m.cache_mutex);
-  if (m.cached_x.size() == x.size() && m.cached_x == x) return m.cached;
-  const cp::Trajectory t =
-      cp::simulate_free(cp::Model(design(x)), std::get<cp::FreeScene>(m.p.scene), m.p.simulate);
-  m.cached = t.ok() ? cp::metric_values(m.table, t.table)
-                    : std::vector<double>(m.table.size(), std::numeric_limits<double>::infinity());
-  m.cached_x = x;
-  return m.cached;
+  if (m.cached.x.size() == x.size() && m.cached.x == x &&
+      (!gradient || m.cached.gradient.size() != 0)) {
+    return m.cached;
+  }
+  Evaluation e;
+  e.x = x;
+  const cp::Model model(design(x));
+  const cp::FreeScene& scene = std::get<cp::FreeScene>(m.p.scene);
+  const std::vector<double> failed(m.table.size(), std::numeric_limits<double>::infinity());
+  if (!gradient) {
+    const cp::Trajectory t = cp::simulate_free(model, scene, m.p.simulate);
+    e.metrics = t.ok() ? cp::metric_values(m.table, t.table) : failed;
+  } else {
+    const cp::FreeSensitivities run =
+        cp::simulate_free_sensitivities(model, scene, m.sensitivity_parameters, m.p.simulate);
+    e.gradient = MatrixXd::Zero(static_cast<Eigen::Index>(m.table.size()), m.n);
+    e.metrics = failed;
+    if (run.trajectory.ok()) {
+      e.metrics = cp::metric_values(m.table, run.trajectory.table);
+      VectorXd q;
+      MatrixXd J;
+      m.q_of(x, q, &J);
+      MatrixXd dq(static_cast<Eigen::Index>(m.sensitivity_parameters.size()), m.n);
+      for (std::size_t j = 0; j < m.sensitivity_parameters.size(); ++j)
+        dq.row(static_cast<Eigen::Index>(j)) = J.row(m.sensitivity_parameters[j]);
+      e.gradient = cp::metric_gradients(m.table, run) * dq;
+    }
+  }
+  m.cached = e;
+  return e;
 }
 
 int PlanarNlp::n() const { return impl_->n; }
@@ -754,19 +794,31 @@ const std::vector<double>& PlanarNlp::original_metrics() const { return impl_->o
 double PlanarNlp::objective(const VectorXd& x, VectorXd* grad) const {
   const Impl& m = *impl_;
   if (m.free) {  // RMS smoothed as in driven scenes, a peak exactly (no bound variable)
-    if (grad) throw std::logic_error("PlanarNlp: a free scene has no gradients");
-    const std::vector<double> v = simulated(x);
+    if (grad && !has_gradients())
+      throw std::logic_error("PlanarNlp: this free scene's route has no gradients");
+    const Evaluation e = simulated(x, grad != nullptr);
     double f = 0;
+    if (grad) grad->setZero(m.n);
     for (std::size_t k = 0; k < m.table.size(); ++k) {
       if (!(m.weight[k] > 0)) continue;
-      const double r = v[k] / m.original[k];
-      f += m.weight[k] * (m.table[k].statistic == core::Statistic::kMax
-                              ? r
-                              : std::sqrt(r * r + m.p.smoothing * m.p.smoothing));
+      const double r = e.metrics[k] / m.original[k];
+      const bool peak = m.table[k].statistic == core::Statistic::kMax;
+      const double term = peak ? r : std::sqrt(r * r + m.p.smoothing * m.p.smoothing);
+      f += m.weight[k] * term;
+      // d(term)/dr: 1 for a peak, r / term for a smoothed RMS
+      if (grad && std::isfinite(r)) {
+        *grad += m.weight[k] * (peak ? 1.0 : r / term) / m.original[k] *
+                 e.gradient.row(static_cast<Eigen::Index>(k)).transpose();
+      }
     }
     VectorXd q;
-    m.q_of(x, q, nullptr);
-    if (m.added_weight > 0) f += m.added_weight * m.added(q, nullptr, nullptr) / m.mass0;
+    MatrixXd J;
+    VectorXd g;
+    m.q_of(x, q, grad ? &J : nullptr);
+    if (m.added_weight > 0) {
+      f += m.added_weight * m.added(q, grad ? &J : nullptr, grad ? &g : nullptr) / m.mass0;
+      if (grad) *grad += m.added_weight / m.mass0 * g;
+    }
     return f;
   }
   VectorXd q;
@@ -813,12 +865,18 @@ void PlanarNlp::inequalities(const VectorXd& x, VectorXd& c, MatrixXd* jac) cons
   m.q_of(x, q, jac ? &J : nullptr);
   c.resize(static_cast<Eigen::Index>(m.rows.size()));
   if (jac) jac->setZero(static_cast<Eigen::Index>(m.rows.size()), m.n);
-  if (m.free && jac) throw std::logic_error("PlanarNlp: a free scene has no gradients");
-  const std::vector<double> simulated_metrics = m.free ? simulated(x) : std::vector<double>{};
-  // a free scene's limit: (metric / bound)² - 1 from the simulation, a peak over all samples
-  auto free_limit = [&](const Impl::Row& row) {
+  if (m.free && jac && !has_gradients())
+    throw std::logic_error("PlanarNlp: this free scene's route has no gradients");
+  const Evaluation simulated_metrics =
+      m.free ? simulated(x, jac != nullptr) : Evaluation{};
+  // a free scene's limit: (metric / bound)² - 1 from the simulation, a peak over all samples,
+  // and its gradient 2 ratio / bound · d(metric)/dx
+  auto free_limit = [&](const Impl::Row& row, Eigen::Index r) {
     const auto k = static_cast<std::size_t>(row.index);
-    const double ratio = simulated_metrics[k] / (row.value * m.original[k]);
+    const double bound = row.value * m.original[k], ratio = simulated_metrics.metrics[k] / bound;
+    if (jac && std::isfinite(ratio)) {
+      jac->row(r) = 2 * ratio / bound * simulated_metrics.gradient.row(static_cast<Eigen::Index>(k));
+    }
     return ratio * ratio - 1;
   };
   std::map<int, Impl::Columns> cache;  // per metric
@@ -867,7 +925,7 @@ void PlanarNlp::inequalities(const VectorXd& x, VectorXd& c, MatrixXd* jac) cons
         break;
       case Impl::Row::Kind::kRmsLimit: {
         if (m.free) {
-          c[r] = free_limit(row);
+          c[r] = free_limit(row, r);
           break;
         }
         const double bound = row.value * m.original[static_cast<std::size_t>(row.index)];
@@ -894,7 +952,7 @@ void PlanarNlp::inequalities(const VectorXd& x, VectorXd& c, MatrixXd* jac) cons
       }
       case Impl::Row::Kind::kPeakLimit: {
         if (m.free) {
-          c[r] = free_limit(row);
+          c[r] = free_limit(row, r);
           break;
         }
         const double bound = row.value * m.original[static_cast<std::size_t>(row.index)];
@@ -940,7 +998,7 @@ std::string PlanarNlp::constraint_text(int i, const VectorXd& x) const {
     case Impl::Row::Kind::kRmsLimit: {
       const auto k = static_cast<std::size_t>(row.index);
       const double value =
-          m.free ? simulated(x)[k] : std::sqrt(m.rms2(m.columns(row.index, q, nullptr), nullptr));
+          m.free ? simulated(x, false).metrics[k] : std::sqrt(m.rms2(m.columns(row.index, q, nullptr), nullptr));
       return m.table[k].name + " is " + text::digits(value, 6) + " " + m.table[k].unit + " = " +
              text::digits(value / m.original[k], 4) + " x the original's, at most " +
              text::digits(row.value, 6) + " x";
@@ -948,7 +1006,7 @@ std::string PlanarNlp::constraint_text(int i, const VectorXd& x) const {
     case Impl::Row::Kind::kPeakLimit: {
       const auto k = static_cast<std::size_t>(row.index);
       if (m.free) {
-        const double value = simulated(x)[k];
+        const double value = simulated(x, false).metrics[k];
         return m.table[k].name + " is " + text::digits(value, 6) + " " + m.table[k].unit + " = " +
                text::digits(value / m.original[k], 4) + " x the original's, at most " +
                text::digits(row.value, 6) + " x";
@@ -1224,7 +1282,7 @@ cp::Linkage PlanarNlp::design(const VectorXd& x) const {
 
 std::vector<double> PlanarNlp::metrics(const VectorXd& x) const {
   const Impl& m = *impl_;
-  if (m.free) return simulated(x);
+  if (m.free) return simulated(x, false).metrics;
   VectorXd q;
   m.q_of(x, q, nullptr);
   std::vector<double> out;
@@ -1279,7 +1337,19 @@ std::string Result::brief_report() const {
 }
 
 Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options) {
-  return optimize::check_algorithm(options, std::holds_alternative<cp::FreeScene>(problem.scene),
+  // a free scene's gradients come from the reduced route's forward sensitivities (CVODES)
+  std::string without;
+  if (std::holds_alternative<cp::FreeScene>(problem.scene)) {
+    const cp::SimulateOptions& o = problem.simulate;
+    if (o.route != cp::Route::kReduced) {
+      without = "a free scene on the dae route";
+    } else if (o.integrator != core::Integrator::kCvodeAdams &&
+               o.integrator != core::Integrator::kCvodeBdf) {
+      without = std::string("a free scene integrated by ") + core::to_string(o.integrator);
+    }
+  }
+  return optimize::check_algorithm(options, without,
+                                   "the reduced route integrated by cvode-adams or cvode-bdf",
                                    problem.force_balance);
 }
 

@@ -78,8 +78,10 @@ struct Limit {
 struct DesignProblem {
   cp::Linkage original;
   /// A driven scene: exact gradients from the regressor. A free scene: every evaluation is a
-  /// simulation of the design (the reduced route, `simulate`), without gradients (cobyla,
-  /// isres); the optimum is verified by the other route (dae).
+  /// simulation of the design (`simulate`: by default the reduced route with cvode-adams), its
+  /// gradients from the same run's forward sensitivities with respect to the varied links' mass
+  /// parameters (core/planar/simulate.hpp, simulate_free_sensitivities(); none on the dae route
+  /// or with an ERK pair: cobyla, isres only); the optimum is verified by the other route.
   std::variant<cp::DrivenScene, cp::FreeScene> scene;
   cp::SimulateOptions simulate;  // a free scene's integration
   std::vector<CounterweightVariables> counterweights;
@@ -117,6 +119,8 @@ class PlanarNlp final : public Program {
   const std::vector<std::string>& variable_names() const override;
   const std::vector<std::string>& constraint_names() const override;
   bool has_gradients() const override;
+  /// True in a free scene (every evaluation a simulation).
+  bool free_scene() const;
   double objective(const Eigen::VectorXd& x, Eigen::VectorXd* grad) const override;
   void equalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
                   Eigen::MatrixXd* jac) const override;
@@ -171,11 +175,13 @@ class PlanarNlp final : public Program {
   const std::vector<double>& original_metrics() const;
 
  private:
-  std::vector<double> simulated(const Eigen::VectorXd& x) const;
+  struct Impl;
+  /// A free scene's evaluation at x (optimize/planar.cpp).
+  struct Evaluation;
+  Evaluation simulated(const Eigen::VectorXd& x, bool gradient) const;
   /// start()'s design variables in positions (bound variables not set).
   Eigen::VectorXd positions_start(bool original) const;
   void set_bound_variables(Eigen::VectorXd& x) const;
-  struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 
@@ -216,7 +222,8 @@ struct Result {
 };
 
 /// Empty when the algorithm can take the problem, else why not (field "algorithm"): a gradient
-/// method in a free scene, mma with force balance.
+/// method in a free scene whose simulation has no sensitivities (the dae route, an ERK pair),
+/// mma with force balance.
 bd::Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& options);
 
 /// Solves the problem from PlanarNlp::start() (and, when that finds no design, once more from the

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <string>
 
+#include "core/detail/sensitivity.hpp"
 #include "core/fourbar/detail/free_motion.hpp"
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
@@ -13,19 +14,6 @@
 namespace bd::core {
 
 namespace {
-
-// the step of a sample's directional difference, relative to the parameter's scale (see the
-// header: truncation ~h², round-off ~eps/h)
-constexpr double kStep = 1e-5;
-
-// The sensitivities' relative tolerance, at most as tight as this: their right-hand side is
-// CVODES' difference quotient of the dynamics, whose round-off (that of the loop closure and the
-// solve, over an increment ~sqrt(rtol)) leaves a noise floor near 1e-9 of the derivatives. The
-// error test cannot see below it and only shrinks the step: measured on the paper's four-bar
-// (1 s, gravity), 1e-9 takes ~3000 steps, 1e-8 ~650, 1e-7 ~330 against 158 for the state alone,
-// and with 1e-7 every sample's derivative and every metric's gradient agrees with central
-// differences of full runs to 1e-6 of its size (tests/core/sensitivity_test.cpp).
-constexpr double kSensitivityTolerance = 1e-7;
 
 // the numbers of a sample, by kind: angles (differences taken modulo 2π, as the dynamics
 // returns theta2 and theta3 wrapped while a trajectory continues them), other scalars, vectors
@@ -75,13 +63,7 @@ void check(const std::vector<LinkParameter>& parameters, const SimulateOptions& 
                                 ": forward sensitivities need the reduced equation in theta1 "
                                 "(mass-matrix or complex-masses), got opened-loop"});
   }
-  if (options.integrator != Integrator::kCvodeAdams &&
-      options.integrator != Integrator::kCvodeBdf) {
-    throw InputError(FieldError{"integrator", -1,
-                                std::string(": forward sensitivities need cvode-adams or "
-                                            "cvode-bdf (CVODES), got ") +
-                                    to_string(options.integrator)});
-  }
+  detail::require_sensitivity_integrator(options.integrator);
   std::vector<bool> seen(detail::kLinkParameters, false);
   for (std::size_t j = 0; j < parameters.size(); ++j) {
     const LinkParameter& p = parameters[j];
@@ -108,7 +90,7 @@ FreeSensitivities simulate_free_sensitivities(const FourBar& model, const FreeSc
   FreeSensitivities out;
   out.parameters = parameters;
   detail::StateSensitivities state;
-  state.tolerance = std::max(options.tolerance, kSensitivityTolerance);
+  state.tolerance = std::max(options.tolerance, detail::kSensitivityTolerance);
   for (const LinkParameter& p : parameters) {
     state.which.push_back(4 * (p.link - 1) + static_cast<int>(p.kind));
     state.scales.push_back(scale_of(model, p));
@@ -121,7 +103,7 @@ FreeSensitivities simulate_free_sensitivities(const FourBar& model, const FreeSc
   const std::size_t n = out.trajectory.samples.size();
   out.derivative.assign(parameters.size(), std::vector<DynamicsSample>(n));
   for (std::size_t j = 0; j < parameters.size(); ++j) {
-    const double h = kStep * state.scales[j];
+    const double h = detail::kSensitivityStep * state.scales[j];
     for (std::size_t i = 0; i < n; ++i) {
       const FourBarState& s = out.trajectory.samples[i].state;
       const Vec2 ds = state.state[i][j];
@@ -177,35 +159,15 @@ Eigen::MatrixXd metric_gradients(const FreeSensitivities& run) {
   Eigen::MatrixXd g = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(kMetricCount), m);
   if (samples.empty() || run.derivative.size() != run.parameters.size()) return g;
   const Metrics values = metrics(run.trajectory);
-  const double n = static_cast<double>(samples.size());
   for (std::size_t k = 0; k < kMetricCount; ++k) {
     const MetricInfo& info = kMetricTable[k];
-    const auto row = static_cast<Eigen::Index>(k);
-    if (info.statistic == Statistic::kRms) {
-      const double rms = values.*info.field;
-      if (!(rms > 0)) continue;
-      for (Eigen::Index j = 0; j < m; ++j) {
-        const auto& d = run.derivative[static_cast<std::size_t>(j)];
-        double sum = 0;
-        for (std::size_t i = 0; i < samples.size(); ++i) {
-          sum += components(samples[i], info.quantity).dot(components(d[i], info.quantity));
-        }
-        g(row, j) = sum / (n * rms);
-      }
-      continue;
-    }
-    // the largest sample, the first of equal ones (as metrics() keeps it)
-    std::size_t at = 0;
-    double peak = 0;
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-      const double x = magnitude(samples[i], info.quantity);
-      if (x > peak) peak = x, at = i;
-    }
-    if (!(peak > 0)) continue;
-    const Vec2 v = components(samples[at], info.quantity);
+    const auto v = [&](std::size_t i) { return components(samples[i], info.quantity); };
+    const std::size_t at = detail::peak_sample(samples.size(), v);
     for (Eigen::Index j = 0; j < m; ++j) {
       const auto& d = run.derivative[static_cast<std::size_t>(j)];
-      g(row, j) = v.dot(components(d[at], info.quantity)) / peak;
+      g(static_cast<Eigen::Index>(k), j) = detail::metric_derivative(
+          info.statistic, samples.size(), values.*info.field, at, v,
+          [&](std::size_t i) { return components(d[i], info.quantity); });
     }
   }
   return g;

@@ -198,6 +198,7 @@ Model& Model::operator=(const Model& other) {
 }
 
 const Linkage& Model::linkage() const { return system_->linkage; }
+void Model::set_mass_parameters(const double* pi) { detail::set_mass_parameters(*system_, pi); }
 int Model::coordinates() const { return system_->n; }
 int Model::inputs() const { return static_cast<int>(system_->inputs.size()); }
 

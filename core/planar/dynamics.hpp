@@ -65,6 +65,9 @@ class Model {
   /// A length scale of the linkage: its longest element [m].
   double length_scale() const { return length_scale_; }
   const detail::System& system() const { return *system_; }
+  /// Replaces the mass parameters (model.hpp, mass_parameters()' layout) in place, unchecked:
+  /// what forward sensitivities' difference quotients evaluate (simulate_free_sensitivities()).
+  void set_mass_parameters(const double* pi);
 
  private:
   std::unique_ptr<detail::System> system_;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/detail/sensitivity.hpp"
+
 namespace bd::core::planar {
 
 std::vector<ColumnMetric> metric_table(const Model& model) {
@@ -101,6 +103,33 @@ std::vector<double> metric_values(const std::vector<ColumnMetric>& metrics, cons
     out[k] = m.statistic == Statistic::kRms ? rms.rms() : peak;
   }
   return out;
+}
+
+Eigen::MatrixXd metric_gradients(const std::vector<ColumnMetric>& metrics,
+                                 const FreeSensitivities& run) {
+  const Series& table = run.trajectory.table;
+  const auto m = static_cast<Eigen::Index>(run.parameters.size());
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(metrics.size()), m);
+  const std::size_t rows = table.rows();
+  if (rows == 0 || run.derivative.size() != run.parameters.size()) return g;
+  const std::vector<double> values = metric_values(metrics, table);
+  const std::vector<std::vector<int>> columns = metric_columns(metrics, table);
+  // a metric's vector in a row of a table: one column as (x, 0), or an x, y pair
+  const auto vector_in = [](const std::vector<int>& c, std::span<const double> row) {
+    return Vec2(row[static_cast<std::size_t>(c[0])],
+                c.size() > 1 ? row[static_cast<std::size_t>(c[1])] : 0.0);
+  };
+  for (std::size_t k = 0; k < metrics.size(); ++k) {
+    const auto v = [&](std::size_t i) { return vector_in(columns[k], table.row(i)); };
+    const std::size_t at = core::detail::peak_sample(rows, v);
+    for (Eigen::Index j = 0; j < m; ++j) {
+      const Series& d = run.derivative[static_cast<std::size_t>(j)];
+      g(static_cast<Eigen::Index>(k), j) = core::detail::metric_derivative(
+          metrics[k].statistic, rows, values[k], at, v,
+          [&](std::size_t i) { return vector_in(columns[k], d.row(i)); });
+    }
+  }
+  return g;
 }
 
 std::vector<Peak> sampled_peaks(const std::vector<ColumnMetric>& metrics, const Series& table) {

@@ -6,6 +6,7 @@
 /// then the total shaking force and moment (core::kTotalMetrics). Fsh and Msh are their inertial
 /// parts (the columns Fshx_inertial, Fshy_inertial, Msh_inertial); the totals are Fshx, Fshy, Msh.
 /// Each is the magnitude of one column (Msh, tau) or of an x, y pair of columns.
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
@@ -44,5 +45,13 @@ std::vector<Peak> sampled_peaks(const std::vector<ColumnMetric>& metrics, const 
 std::vector<double> metric_values(const Model& model, const DrivenScene& scene,
                                   const std::vector<ColumnMetric>& metrics, const Trajectory& run,
                                   std::vector<Peak>* peaks = nullptr);
+
+/// The gradients of the table's metrics over a run with sensitivities: row k, column j is
+/// d(metrics[k])/d(run.parameters[j]). An RMS's derivative is Σ_i v_i · dv_i / (n · RMS) over
+/// the samples' vectors v_i of its columns (0 where the RMS is 0); a peak's is that of the
+/// largest sample's magnitude, v · dv / |v| (the first of equal largest ones, as
+/// metric_values() takes it; 0 where the magnitude is 0). Needs a completed run.
+Eigen::MatrixXd metric_gradients(const std::vector<ColumnMetric>& metrics,
+                                 const FreeSensitivities& run);
 
 }  // namespace bd::core::planar

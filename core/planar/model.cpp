@@ -296,4 +296,36 @@ double total_mass(const Linkage& l) {
   return m;
 }
 
+int mass_parameter_count(const Linkage& l) {
+  return 4 * static_cast<int>(l.links.size()) + static_cast<int>(l.point_masses.size());
+}
+
+std::vector<double> mass_parameters(const Linkage& l) {
+  std::vector<double> pi;
+  pi.reserve(static_cast<std::size_t>(mass_parameter_count(l)));
+  for (const Link& link : l.links) {
+    pi.insert(pi.end(), {link.mass, link.mass * link.e, link.mass * link.f,
+                         link.inertia + link.mass * (link.e * link.e + link.f * link.f)});
+  }
+  for (const PointMass& pm : l.point_masses) pi.push_back(pm.mass);
+  return pi;
+}
+
+void set_mass_parameters(Linkage& l, const double* pi) {
+  for (Link& link : l.links) {
+    link.mass = pi[0];
+    link.e = link.mass != 0 ? pi[1] / link.mass : 0.0;
+    link.f = link.mass != 0 ? pi[2] / link.mass : 0.0;
+    link.inertia = pi[3] - link.mass * (link.e * link.e + link.f * link.f);
+    pi += 4;
+  }
+  for (PointMass& pm : l.point_masses) pm.mass = *pi++;
+}
+
+Linkage with_mass_parameters(const Linkage& l, const double* pi) {
+  Linkage out = l;
+  set_mass_parameters(out, pi);
+  return out;
+}
+
 }  // namespace bd::core::planar

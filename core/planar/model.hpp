@@ -171,4 +171,18 @@ int pivot_of(const Linkage& linkage, int link);
 /// Σ of the link masses, point masses and balance shafts' masses [kg].
 double total_mass(const Linkage& linkage);
 
+/// The linkage's mass parameters π, in which every force of a given motion is affine: per link
+/// k at 4k its mass m [kg], its first moments m e and m f about its first node in its axes
+/// [kg m] and its inertia about that node J = I + m (e² + f²) [kg m^2]; then per point mass j
+/// at 4 (links) + j its mass [kg]. (The balance layer's regressors and the optimiser's
+/// sensitivities use this layout.)
+int mass_parameter_count(const Linkage& linkage);
+std::vector<double> mass_parameters(const Linkage& linkage);
+/// The linkage with its links' and point masses' mass parameters set from `pi` (the layout
+/// above, mass_parameter_count() values): e = m e / m, f = m f / m, I = J - m (e² + f²) (a link
+/// without mass: e = f = 0, I = J). Not checked (make_linkage() checks).
+Linkage with_mass_parameters(const Linkage& linkage, const double* pi);
+/// The same in place.
+void set_mass_parameters(Linkage& linkage, const double* pi);
+
 }  // namespace bd::core::planar

@@ -1,9 +1,11 @@
 #include "core/planar/simulate.hpp"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
+#include "core/detail/sensitivity.hpp"
 #include "core/input_error.hpp"
 #include "core/integrators.hpp"
 #include "core/number_text.hpp"
@@ -341,6 +343,12 @@ struct Motion {
   std::vector<Vec2> cache;  // positions of the last successful evaluation (Newton's guess)
   std::vector<double> z, zd, efforts;  // scratch: the inputs, their rates, the drives' efforts
   std::vector<double> sample_angle;    // reduced route: the link angles of the last sample
+  // forward sensitivities: the model's mass parameters π are read from `parameters` (which
+  // CVODES perturbs for its difference quotients) at every evaluation; `applied` are the ones
+  // the model (`varied`, the same as `model`) has
+  Model* varied{};
+  const double* parameters{};
+  std::vector<double> applied;
   // dae route scratch
   MatrixXd kkt;
   VectorXd kkt_rhs, kkt_solution, rate_residual;
@@ -360,6 +368,11 @@ Expected<bool, PlanarError> reduced_state(Motion& m, double t, const double* y) 
   const int dof = m.dof;
   m.z.assign(y, y + dof);
   m.zd.assign(y + dof, y + 2 * dof);
+  if (m.varied != nullptr &&
+      !std::equal(m.applied.begin(), m.applied.end(), m.parameters)) {
+    m.applied.assign(m.parameters, m.parameters + m.applied.size());
+    m.varied->set_mass_parameters(m.parameters);
+  }
   efforts_at(*m.model, t, m.efforts);
   auto ok = solve_position(*m.model, *m.ws, m.cache, m.z);
   if (ok) ok = forward_dynamics(*m.model, *m.ws, t, m.zd, m.efforts);
@@ -636,17 +649,93 @@ void sample_run(const Model& model, Motion& m, integrators::Integration& integra
   out.rhs_evaluations = m.evaluations;
 }
 
+// What free_reduced() takes and gives for forward sensitivities (simulate_free_sensitivities()).
+struct StateSensitivities {
+  Model* model{};                 // the run's model, its mass parameters set from `parameters`
+  std::vector<int> which;         // the entries of π differentiated
+  std::vector<double> scales;     // their typical magnitudes, > 0 (CVODES' pbar)
+  double tolerance{};             // relative, of the sensitivities' error test
+  std::vector<double> parameters; // π, the model's; CVODES perturbs them in place
+  std::vector<Series> derivative; // per entry of `which`: the samples' derivatives
+};
+
+// A sample of the reduced route at (t, y): the dynamics there, the link angles continued from
+// `angles` (a sample's continue the last sample's, not the last evaluation's, which may lie a
+// step ahead, up to a turn or more of a crank at loose tolerance), an angle input's the
+// integrated value itself.
+Expected<bool, PlanarError> reduced_sample(Motion& m, double t, const double* y,
+                                           const std::vector<double>& angles) {
+  Workspace& ws = *m.ws;
+  ws.instant.angle = angles;
+  auto ok = reduced_state(m, t, y);
+  if (!ok) return ok;
+  const std::vector<Input>& inputs = m.model->linkage().inputs;
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    if (inputs[k].kind == Input::Kind::kAngle)
+      ws.instant.angle[static_cast<std::size_t>(inputs[k].link)] = y[k];
+  }
+  return ok;
+}
+
+// Appends to each sens.derivative[j] the derivative of the sample at (t, y) along (s_j, e_j):
+// the sample moved by ±h along it (h = kSensitivityStep times the parameter's scale), its rows
+// differenced. `integration` gives s_j (null: s_j = 0, the start). Leaves ws.instant at a moved
+// sample.
+Expected<bool, PlanarError> sample_derivatives(const Model& model, Motion& m,
+                                               StateSensitivities& sens, double t, const double* y,
+                                               const integrators::Integration* integration,
+                                               const std::vector<double>& angles, Series& scratch) {
+  const std::size_t n = 2 * static_cast<std::size_t>(m.dof);
+  std::vector<double> moved(n);
+  for (std::size_t j = 0; j < sens.which.size(); ++j) {
+    const double h = core::detail::kSensitivityStep * sens.scales[j];
+    const double* d = integration != nullptr ? integration->sensitivity(static_cast<int>(j)) : nullptr;
+    double& parameter = sens.parameters[static_cast<std::size_t>(sens.which[j])];
+    const double nominal = parameter;
+    scratch.values.clear();
+    for (const double step : {h, -h}) {
+      for (std::size_t i = 0; i < n; ++i) moved[i] = y[i] + (d != nullptr ? step * d[i] : 0.0);
+      parameter = nominal + step;
+      const auto ok = reduced_sample(m, t, moved.data(), angles);
+      parameter = nominal;
+      if (!ok) return ok;
+      append_row(model, m.ws->instant, scratch);
+    }
+    const std::size_t w = scratch.width();
+    std::vector<double>& out = sens.derivative[j].values;
+    for (std::size_t c = 0; c < w; ++c)
+      out.push_back((scratch.values[c] - scratch.values[w + c]) / (2 * h));
+  }
+  return true;
+}
+
 Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scene,
                         const std::vector<double>& start, const std::vector<double>& rates,
-                        const SimulateOptions& options) {
+                        const SimulateOptions& options, StateSensitivities* sens) {
   const int dof = model.inputs();
   Trajectory out = empty_table(model, scene);
   Motion m = motion(model, ws, Route::kReduced, options);
   m.cache = ws.instant.x;
   std::vector<double> y0 = start;
   y0.insert(y0.end(), rates.begin(), rates.end());
+  Series scratch;  // sensitivities: the rows of the moved samples
+  if (sens != nullptr) {
+    m.varied = sens->model;
+    m.parameters = sens->parameters.data();
+    m.applied = sens->parameters;
+    scratch.columns = out.table.columns;
+    sens->derivative.assign(sens->which.size(), Series{out.table.columns, {}});
+    for (Series& d : sens->derivative) d.values.reserve(out.table.values.capacity());
+  }
+  const std::vector<double> drawn_angles = ws.instant.angle;
+  Expected<bool, PlanarError> first = true;
+  if (sens != nullptr) {
+    first = sample_derivatives(model, m, *sens, 0.0, y0.data(), nullptr, drawn_angles, scratch);
+    ws.instant.angle = drawn_angles;
+    m.cache = ws.instant.x;
+  }
   ++m.evaluations;
-  auto first = reduced_state(m, 0.0, y0.data());
+  if (first) first = reduced_state(m, 0.0, y0.data());
   if (first && std::abs(normalised_determinant(ws)) <= kLimitDeterminant) {
     first = Unexpected<PlanarError>(
         PlanarError{PlanarError::Kind::kSingular, "the start is a limit position of the inputs"});
@@ -661,26 +750,25 @@ Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scen
 
   integrators::Problem problem = free_problem(options, y0, scene.duration, m, reduced_rhs);
   problem.root = reduced_root;
+  if (sens != nullptr) {
+    problem.sensitivities = {sens->parameters.data(), sens->which, sens->scales, sens->tolerance};
+  }
   integrators::Integration integration(problem);
   const auto where = [&] {
     return state_text(model, integration.t(),
                       std::vector<double>(integration.y(), integration.y() + dof));
   };
-  // a sample's link angles continue the last sample's, not the last evaluation's (a step ahead,
-  // up to a turn or more of a crank at loose tolerance), and an angle input's is the integrated
-  // value itself
   m.sample_angle = ws.instant.angle;
   sample_run(model, m, integration, scene, options, out, where, [&] {
-    ws.instant.angle = m.sample_angle;
-    auto ok = reduced_state(m, integration.t(), integration.y());
-    if (ok) {
-      for (std::size_t k = 0; k < model.linkage().inputs.size(); ++k) {
-        const Input& in = model.linkage().inputs[k];
-        if (in.kind == Input::Kind::kAngle)
-          ws.instant.angle[static_cast<std::size_t>(in.link)] = integration.y()[k];
+    if (sens != nullptr) {
+      if (auto ok = sample_derivatives(model, m, *sens, integration.t(), integration.y(),
+                                       &integration, m.sample_angle, scratch);
+          !ok) {
+        return ok;
       }
-      m.sample_angle = ws.instant.angle;
     }
+    auto ok = reduced_sample(m, integration.t(), integration.y(), m.sample_angle);
+    if (ok) m.sample_angle = ws.instant.angle;
     return ok;
   });
   return out;
@@ -726,8 +814,11 @@ Trajectory free_dae(const Model& model, Workspace& ws, const FreeScene& scene,
 
 }  // namespace
 
-Trajectory simulate_free(const Model& model, const FreeScene& scene,
-                         const SimulateOptions& options) {
+namespace {
+
+// simulate_free()'s checks of the scene and options; the start assembled in ws; the rates
+std::vector<double> free_rates(const Model& model, const FreeScene& scene,
+                               const SimulateOptions& options) {
   const int dof = model.inputs();
   if (!(scene.duration > 0) || !std::isfinite(scene.duration)) {
     throw InputError(
@@ -747,10 +838,73 @@ Trajectory simulate_free(const Model& model, const FreeScene& scene,
   const std::vector<double> rates =
       scene.rates.empty() ? std::vector<double>(static_cast<std::size_t>(dof), 0.0) : scene.rates;
   check_count(rates, dof, "scene.rates", "rates");
+  return rates;
+}
+
+// the typical magnitude of mass parameter i (simulate_free_sensitivities())
+double parameter_scale(const Linkage& l, int i) {
+  const int links = static_cast<int>(l.links.size());
+  if (i >= 4 * links) return l.point_masses[static_cast<std::size_t>(i - 4 * links)].mass;
+  const int k = i / 4;
+  const double m = l.links[static_cast<std::size_t>(k)].mass > 0
+                       ? l.links[static_cast<std::size_t>(k)].mass
+                       : total_mass(l);
+  const double length = element_length(l, k);
+  const int kind = i - 4 * k;
+  return kind == 0 ? m : kind == 3 ? m * length * length : m * length;
+}
+
+}  // namespace
+
+Trajectory simulate_free(const Model& model, const FreeScene& scene,
+                         const SimulateOptions& options) {
+  const std::vector<double> rates = free_rates(model, scene, options);
   Workspace ws(model);
   const std::vector<double> start = start_of(model, ws, scene.start, "scene");
-  return options.route == Route::kDae ? free_dae(model, ws, scene, start, rates, options)
-                                      : free_reduced(model, ws, scene, start, rates, options);
+  return options.route == Route::kDae
+             ? free_dae(model, ws, scene, start, rates, options)
+             : free_reduced(model, ws, scene, start, rates, options, nullptr);
+}
+
+FreeSensitivities simulate_free_sensitivities(const Model& model, const FreeScene& scene,
+                                              const std::vector<int>& parameters,
+                                              const SimulateOptions& options) {
+  const std::vector<double> rates = free_rates(model, scene, options);
+  if (options.route != Route::kReduced) {
+    throw InputError(FieldError{"route", -1,
+                                ": forward sensitivities need the reduced route (the ODE in the "
+                                "inputs), got dae"});
+  }
+  core::detail::require_sensitivity_integrator(options.integrator);
+  const Linkage& l = model.linkage();
+  const int count = mass_parameter_count(l);
+  std::vector<bool> seen(static_cast<std::size_t>(count), false);
+  StateSensitivities sens;
+  for (std::size_t j = 0; j < parameters.size(); ++j) {
+    const int i = parameters[j];
+    if (i < 0 || i >= count) {
+      throw InputError(FieldError{"parameters", static_cast<int>(j),
+                                  ": must be a mass parameter's index, 0 to " +
+                                      std::to_string(count - 1) + ", got " + std::to_string(i)});
+    }
+    if (seen[static_cast<std::size_t>(i)]) {
+      throw InputError(FieldError{"parameters", static_cast<int>(j), "is listed twice"});
+    }
+    seen[static_cast<std::size_t>(i)] = true;
+    sens.which.push_back(i);
+    sens.scales.push_back(parameter_scale(l, i));
+  }
+  Model varied = model;
+  sens.model = &varied;
+  sens.tolerance = std::max(options.tolerance, core::detail::kSensitivityTolerance);
+  sens.parameters = mass_parameters(l);
+  Workspace ws(varied);
+  const std::vector<double> start = start_of(varied, ws, scene.start, "scene");
+  FreeSensitivities out;
+  out.parameters = parameters;
+  out.trajectory = free_reduced(varied, ws, scene, start, rates, options, &sens);
+  if (out.trajectory.ok()) out.derivative = std::move(sens.derivative);
+  return out;
 }
 
 }  // namespace bd::core::planar

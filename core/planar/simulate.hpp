@@ -96,4 +96,40 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene);
 Trajectory simulate_free(const Model& model, const FreeScene& scene,
                          const SimulateOptions& options = {});
 
+/// A free run with the first derivatives of its samples with respect to mass parameters.
+struct FreeSensitivities {
+  /// The run: the reduced route's equations, integrator and tolerances, with the sensitivities
+  /// in the integrator's error test (so its steps, and its samples to within the integration's
+  /// error, differ from simulate_free()'s).
+  Trajectory trajectory;
+  std::vector<int> parameters;  // indices into mass_parameters() (core/planar/model.hpp)
+  /// derivative[j]: every number of trajectory.table differentiated with respect to
+  /// parameters[j], in the table's layout (its columns, the t column 0), in their units per the
+  /// parameter's unit. Empty where the run failed.
+  std::vector<Series> derivative;
+};
+
+/// simulate_free() on the reduced route with forward sensitivities of the samples with respect
+/// to the mass parameters `parameters` (indices into mass_parameters(model.linkage())).
+///
+/// The state y = (z, ż) of the reduced equation y' = f(y, π) has the sensitivities
+/// s_j = dy/dπ_j, which obey s_j' = (df/dy) s_j + df/dπ_j, s_j(0) = 0. CVODES integrates them
+/// with the state (staggered corrector, in the error test at the relative tolerance
+/// max(options.tolerance, 1e-7)), forming their right-hand side by its own centred difference
+/// quotient along (s_j, e_j): the right-hand side reads π from the array CVODES perturbs and
+/// sets the model's mass matrix and weights from it (Model::set_mass_parameters()), so the
+/// dynamics needs no derivative code of its own (as the four-bar's,
+/// core/fourbar/sensitivity.hpp). Each sample's numbers are functions g(y, π); their total
+/// derivative dg/dy · s_j + dg/dπ_j is the derivative of g along (s_j, e_j), a centred
+/// difference of the sample's evaluation (no integration) with the step 1e-5 of the parameter's
+/// scale (CVODES' pbar: per link its mass m, m L, m L, m L² with L its element length and m its
+/// mass, or the linkage's total mass for a massless link; a point mass its mass). The
+/// derivatives are good to ~1e-6 of their size (tests/core/planar/sensitivity_test.cpp).
+/// @throws bd::InputError as simulate_free() does for an invalid scene or options; also, with
+///         field "route" or "integrator", for the dae route or an ERK pair, and with field
+///         "parameters" (index: the entry) for an index outside the layout or one listed twice.
+FreeSensitivities simulate_free_sensitivities(const Model& model, const FreeScene& scene,
+                                              const std::vector<int>& parameters,
+                                              const SimulateOptions& options = {});
+
 }  // namespace bd::core::planar

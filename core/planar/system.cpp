@@ -42,6 +42,20 @@ double angle_from(const Vec2& u, const Vec2& d) { return std::atan2(cross(u, d),
 
 namespace {
 
+// link k's element mass, mass matrix and centre of mass on the element, from its parameters
+void set_element_mass(System& s, int k) {
+  const Link& link = s.linkage.links[static_cast<std::size_t>(k)];
+  double geared = 0;  // the balance shafts' inertia, as the link sees it
+  for (const BalanceShaft& b : s.linkage.shafts) {
+    if (b.link == k) geared += b.ratio * b.ratio * (b.inertia + b.mass * b.eccentricity.squaredNorm());
+  }
+  const auto i = static_cast<std::size_t>(k);
+  const ElementMass em{s.elements[i].length, link.mass, link.e, link.f, link.inertia + geared};
+  s.element_mass[i] = em;
+  s.element_M[i] = element_mass_matrix(em);
+  s.com_weights[i] = point_weights(link.e / em.length, link.f / em.length);
+}
+
 // one row per link (its element's length), then two per further node of a link (held on the
 // element as a material point); returns the next free row
 int add_link_rows(System& s) {
@@ -55,16 +69,10 @@ int add_link_rows(System& s) {
                    l.nodes[static_cast<std::size_t>(p)].position;
     s.elements.push_back({p, q, d.norm(), d.squaredNorm()});
     s.row_ref.push_back({System::RowRef::Kind::kElement, static_cast<int>(k)});
-    double geared = 0;  // the balance shafts' inertia, as the link sees it
-    for (const BalanceShaft& b : l.shafts) {
-      if (b.link == static_cast<int>(k)) {
-        geared += b.ratio * b.ratio * (b.inertia + b.mass * b.eccentricity.squaredNorm());
-      }
-    }
-    ElementMass em{d.norm(), link.mass, link.e, link.f, link.inertia + geared};
-    s.element_mass.push_back(em);
-    s.element_M.push_back(element_mass_matrix(em));
-    s.com_weights.push_back(point_weights(link.e / em.length, link.f / em.length));
+    s.element_mass.emplace_back();
+    s.element_M.emplace_back();
+    s.com_weights.emplace_back();
+    set_element_mass(s, static_cast<int>(k));
     for (std::size_t j = 2; j < link.nodes.size(); ++j) {
       const int r = link.nodes[j];
       const Vec2 c = link_coordinates(l.nodes[static_cast<std::size_t>(p)].position,
@@ -237,6 +245,12 @@ System::System(const Linkage& l) : linkage(l) {
   rows = add_input_rows(*this, structural_rows);
   add_masses_and_loads(*this);
   add_shafts(*this);
+}
+
+void set_mass_parameters(System& s, const double* pi) {
+  planar::set_mass_parameters(s.linkage, pi);
+  for (std::size_t k = 0; k < s.linkage.links.size(); ++k) set_element_mass(s, static_cast<int>(k));
+  add_masses_and_loads(s);
 }
 
 void nodes_from_q(const System& s, const VectorXd& q, NodeVectors& x) {

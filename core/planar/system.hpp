@@ -103,6 +103,11 @@ struct System {
   explicit System(const Linkage& linkage);
 };
 
+/// Replaces the links' and point masses' mass parameters by `pi` (core/planar/model.hpp,
+/// mass_parameters()' layout) in place: the element masses, the mass matrix and the weights.
+/// For the difference quotients of forward sensitivities; not checked.
+void set_mass_parameters(System& s, const double* pi);
+
 /// All coordinates of the nodes: ground nodes as drawn, moving ones from q.
 void nodes_from_q(const System& s, const VectorXd& q, NodeVectors& x);
 /// The velocities (or accelerations) of the nodes, ground nodes 0.

@@ -1080,14 +1080,16 @@ TEST(Optimize, GradientMethodOnAFreeSceneNeedsTheReducedEquation) {
       EXPECT_EQ(std::string(e.what()), std::string("algorithm '") + to_string(a) + opened);
     }
   }
-  // the general planar linkage's free scenes have no sensitivities yet
+  // the words any linkage type's scene without gradients gets (the general planar linkage's:
+  // tests/optimize/planar_free_test.cpp)
   OptimizeOptions o;
   o.algorithm = Algorithm::kSlsqp;
-  const Problem refused = check_algorithm(o, true, false);
+  const Problem refused = check_algorithm(o, "a free scene on the dae route", "", false);
   ASSERT_TRUE(refused);
   EXPECT_EQ(refused->text(),
-            "algorithm 'slsqp' needs gradients, which a free scene does not provide; use cobyla "
-            "or isres");
+            "algorithm 'slsqp' needs gradients, which a free scene on the dae route does not "
+            "provide; use cobyla or isres");
+  EXPECT_FALSE(check_algorithm(o, "", "", false));
 }
 
 // ---------------------------------------------------------------------------------------------

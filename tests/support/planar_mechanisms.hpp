@@ -110,6 +110,14 @@ inline cp::TimeFunction harmonic(double mean, double amplitude, double frequency
   return f;
 }
 
+/// A constant or harmonic drive effort of up to `size`, or none.
+inline cp::TimeFunction random_effort(Rng& rng, double size) {
+  if (coin(rng, 0.3)) return cp::TimeFunction{};
+  if (coin(rng)) return constant(uniform(rng, -size, size));
+  return harmonic(uniform(rng, -size, size), uniform(rng, 0, size), uniform(rng, 1, 10),
+                  uniform(rng, -kPi, kPi));
+}
+
 /// The size of a linkage: its longest element [m].
 inline double size_of(const cp::Linkage& l) {
   double L = 0;

@@ -138,14 +138,6 @@ FreeRun free_agreement(const cp::Linkage& linkage, const std::vector<double>& ra
   return out;
 }
 
-// a constant or harmonic drive effort of up to `size`, or none
-cp::TimeFunction random_effort(Rng& rng, double size) {
-  if (coin(rng, 0.3)) return cp::TimeFunction{};
-  if (coin(rng)) return constant(uniform(rng, -size, size));
-  return harmonic(uniform(rng, -size, size), uniform(rng, 0, size), uniform(rng, 1, 10),
-                  uniform(rng, -kPi, kPi));
-}
-
 template <class Make>
 void run_family(const char* family, std::uint64_t seed, int count, double duration, Make make) {
   Rng rng(seed);
