@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -106,19 +107,40 @@ class MpiSweepCli : public ::testing::Test {
     return pid;
   }
 
-  // the pid of the process started by mpirun as rank `rank` (its environment says so), or -1
-  static pid_t rank_pid(int rank) {
+  // the parent of process `pid` (field 4 of /proc/PID/stat), or -1
+  static pid_t parent_of(pid_t pid) {
+    const std::string stat = read(fs::path("/proc") / std::to_string(pid) / "stat");
+    const std::size_t name_end = stat.rfind(')');  // the command's name may hold ") "
+    if (name_end == std::string::npos) return -1;
+    std::istringstream fields(stat.substr(name_end + 1));
+    char state = 0;
+    pid_t parent = -1;
+    fields >> state >> parent;
+    return fields ? parent : -1;
+  }
+
+  static bool descends_from(pid_t pid, pid_t ancestor) {
+    for (int depth = 0; pid > 1 && depth < 32; ++depth) {
+      pid = parent_of(pid);
+      if (pid == ancestor) return true;
+    }
+    return false;
+  }
+
+  // the pid of the process that mpirun `job` started as rank `rank` (its environment says so),
+  // or -1: only job's descendants are looked at, so another MPI job on the machine (another
+  // test, or someone else's run) is never taken for it
+  static pid_t rank_pid(pid_t job, int rank) {
     const std::string wanted = "OMPI_COMM_WORLD_RANK=" + std::to_string(rank);
     for (const fs::directory_entry& e : fs::directory_iterator("/proc")) {
       const std::string name = e.path().filename().string();
       if (name.find_first_not_of("0123456789") != std::string::npos) continue;
-      std::string cmdline = read(e.path() / "cmdline");
-      if (cmdline.find("balance-design") == std::string::npos) continue;
-      if (cmdline.rfind(kMpirun, 0) == 0 || cmdline.rfind("mpirun", 0) == 0) continue;
+      const pid_t pid = std::stoi(name);
+      if (!descends_from(pid, job)) continue;
       std::string env = read(e.path() / "environ");
       std::replace(env.begin(), env.end(), '\0', '\n');
       if (env.find("\n" + wanted + "\n") != std::string::npos || env.rfind(wanted + "\n", 0) == 0)
-        return std::stoi(name);
+        return pid;
     }
     return -1;
   }
@@ -178,7 +200,7 @@ TEST_F(MpiSweepCli, RankKilledMidSweepThenResumedGivesTheSameBytes) {
   while (std::chrono::steady_clock::now() < deadline) {
     if (::waitpid(job, &status, WNOHANG) == job) break;
     if (!killed && rows(csv) >= 10) {
-      const pid_t rank1 = rank_pid(1);
+      const pid_t rank1 = rank_pid(job, 1);
       if (rank1 > 0) killed = ::kill(rank1, SIGKILL) == 0;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
