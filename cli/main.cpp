@@ -121,7 +121,7 @@ void say_error(const std::string& text) {
 
 // a sweep's design: how many points, and each parameter's values or range
 void print_sweep_design(const st::SweepRequest& sweep) {
-  const std::size_t points = st::sweep_points(sweep).size();
+  const auto points = static_cast<std::size_t>(st::sweep_size(sweep));
   std::printf("  sweep    %s design, %zu point%s, %zu parameter%s", st::to_string(sweep.design),
               points, points == 1 ? "" : "s", sweep.parameters.size(),
               sweep.parameters.size() == 1 ? "" : "s");

@@ -174,7 +174,7 @@ void MpiWorld::work(const st::Study& study, int threads) {
   PMPI_Bcast(&go, 1, MPI_INT, 0, MPI_COMM_WORLD);
   if (!go) return;
 
-  const std::vector<std::vector<double>> points = st::sweep_points(*study.sweep);
+  st::PointCursor points(*study.sweep);  // the chunks come in increasing order
   std::mutex mutex;
   std::condition_variable for_workers, for_main;
   std::deque<int> queue;                          // points given, not started
@@ -184,15 +184,18 @@ void MpiWorld::work(const st::Study& study, int threads) {
   std::vector<std::jthread> pool;
   for (int t = 0; t < threads; ++t) {
     pool.emplace_back([&] {
+      std::vector<double> values;
       std::unique_lock<std::mutex> lock(mutex);
       for (;;) {
         for_workers.wait(lock, [&] { return !queue.empty() || over; });
         if (queue.empty()) return;
         const int i = queue.front();
         queue.pop_front();
+        const std::span<const double> v = points.at(i);
+        values.assign(v.begin(), v.end());
         ++busy;
         lock.unlock();
-        st::SweepRow row = st::sweep_row(study, i, points[static_cast<std::size_t>(i)]);
+        st::SweepRow row = st::sweep_row(study, i, values);
         lock.lock();
         out.emplace_back(i, std::move(row));
         --busy;
