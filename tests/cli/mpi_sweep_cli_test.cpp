@@ -241,4 +241,71 @@ TEST_F(MpiSweepCli, ThreadedSweepInterruptedThenResumedOnTwoRanks) {
   EXPECT_EQ(read(dir_ / "part" / "sweep.csv"), full);
 }
 
+// summary.json without the lines that hold a wall time (they differ from run to run): the
+// solver's seconds, and its one-line report that states them
+std::string without_times(const std::string& json) {
+  std::istringstream in(json);
+  std::string kept;
+  for (std::string line; std::getline(in, line);) {
+    if (line.find("\"seconds\"") == std::string::npos &&
+        line.find("\"brief_report\"") == std::string::npos) {
+      kept += line + "\n";
+    }
+  }
+  return kept;
+}
+
+// A multistart (mlsl, six starts) over the driven paper four-bar's counterweights, its local
+// runs shared between two ranks: the optimum's files are the bytes of the run in one process,
+// and the summary reports every start and how many reached the best value.
+TEST_F(MpiSweepCli, MultistartSharedAmongRanksGivesTheSameOptimum) {
+  std::string study = read(kExamples + "/weighted-counterweights.yaml");
+  study = bd::testing::edited(study, "algorithm: slsqp", "algorithm: mlsl\n  starts: 6");
+  study = bd::testing::edited(study, "max_evaluations: 2000", "max_evaluations: 1200");
+  std::ofstream(dir_ / "mlsl.yaml") << study;
+  ASSERT_EQ(run("mlsl.yaml --out alone"), 0) << err_;
+  ASSERT_EQ(mpirun("mlsl.yaml --out ranks"), 0) << err_;
+  // rank 0 alone speaks
+  EXPECT_EQ(std::count(out_.begin(), out_.end(), '\n'), 1) << out_;
+  for (const char* file : {"optimized.yaml", "comparison.csv", "optimized-timeseries.csv"}) {
+    const std::string alone = read(dir_ / "alone" / file);
+    EXPECT_FALSE(alone.empty()) << file;
+    EXPECT_EQ(read(dir_ / "ranks" / file), alone) << file;
+  }
+  const std::string summary = without_times(read(dir_ / "alone" / "summary.json"));
+  EXPECT_EQ(without_times(read(dir_ / "ranks" / "summary.json")), summary);
+  EXPECT_NE(summary.find("6 local runs"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"starts\": 6"), std::string::npos) << summary;
+}
+
+#ifndef BD_WITH_MPI
+// The program built without MPI, started as one of two ranks (the environment mpirun gives its
+// ranks; no mpirun needed): it refuses with one line that says why, and writes nothing, rather
+// than letting every rank run the whole study into the same folder.
+TEST(MpiSweepCliWithoutMpi, RefusesToRunAsOneOfSeveralRanks) {
+  ASSERT_TRUE(fs::exists(kExe)) << kExe << " not built";
+  const fs::path dir = fs::temp_directory_path() /
+                       ("bd_mpi_none_test_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string cmd = "cd " + quote(dir.string()) + " && OMPI_COMM_WORLD_SIZE=2 " +
+                          quote(kExe) + " run " + quote(kExamples + "/paper-fourbar-sweep.yaml") +
+                          " --out out --progress none >stdout.txt 2>stderr.txt </dev/null";
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  const std::string err = read(dir / "stderr.txt");
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_NE(err.find("built without MPI"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  // alone, the same program runs the sweep
+  const std::string alone = "cd " + quote(dir.string()) + " && " + quote(kExe) + " run " +
+                            quote(kExamples + "/paper-fourbar-sweep.yaml") +
+                            " --out out --progress none >stdout.txt 2>stderr.txt </dev/null";
+  EXPECT_EQ(std::system(alone.c_str()), 0) << read(dir / "stderr.txt");
+  EXPECT_EQ(rows(dir / "out" / "sweep.csv"), 441);
+  fs::remove_all(dir);
+}
+#endif
+
 }  // namespace
