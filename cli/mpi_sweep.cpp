@@ -164,14 +164,17 @@ class RankStartPool final : public optimize::StartPool {
       const std::lock_guard<std::mutex> lock(mutex);
       return next < count ? next++ : -1;
     };
+    const auto store = [&](int i, optimize::LocalRun r, std::string failure) {
+      const std::lock_guard<std::mutex> lock(mutex);
+      runs[static_cast<std::size_t>(i)] = std::move(r);
+      failures[static_cast<std::size_t>(i)] = std::move(failure);
+      ++done;
+    };
     std::jthread own([&] {
       for (int i; (i = claim()) >= 0;) {
         std::string failure;
         optimize::LocalRun r = run_start(run, i, failure);
-        const std::lock_guard<std::mutex> lock(mutex);
-        runs[static_cast<std::size_t>(i)] = std::move(r);
-        failures[static_cast<std::size_t>(i)] = std::move(failure);
-        ++done;
+        store(i, std::move(r), std::move(failure));
       }
     });
     int released = 0;  // ranks told that no start is left
@@ -194,10 +197,7 @@ class RankStartPool final : public optimize::StartPool {
       if (finished >= 0) {
         std::string failure;
         optimize::LocalRun r = get_run(buf, at, failure);
-        const std::lock_guard<std::mutex> lock(mutex);
-        runs[static_cast<std::size_t>(finished)] = std::move(r);
-        failures[static_cast<std::size_t>(finished)] = std::move(failure);
-        ++done;
+        store(finished, std::move(r), std::move(failure));
       }
       const std::int32_t start = claim();
       if (start < 0) ++released;
