@@ -121,7 +121,7 @@ void say_error(const std::string& text) {
 
 // a sweep's design: how many points, and each parameter's values or range
 void print_sweep_design(const st::SweepRequest& sweep) {
-  const std::size_t points = st::sweep_points(sweep).size();
+  const auto points = static_cast<std::size_t>(st::sweep_size(sweep));
   std::printf("  sweep    %s design, %zu point%s, %zu parameter%s", st::to_string(sweep.design),
               points, points == 1 ? "" : "s", sweep.parameters.size(),
               sweep.parameters.size() == 1 ? "" : "s");
@@ -610,6 +610,15 @@ void catch_stop_signals() {
   sigaction(SIGTERM, &sa, nullptr);
 }
 
+// whether the study's optimisation is a multistart (mlsl), whose local runs an MPI job shares
+bool shares_starts(const st::Study& study) {
+  const auto mlsl = [](const bd::optimize::OptimizeOptions& o) {
+    return o.algorithm == bd::optimize::Algorithm::kMlsl;
+  };
+  return (study.optimize && mlsl(study.optimize->options)) ||
+         (study.planar_optimize && mlsl(study.planar_optimize->options));
+}
+
 // a rank's threads in an MPI job: --threads, else sweep.threads, else its share of the machine
 int sweep_threads(const st::Study& study, const RunArgs& args) {
   if (args.threads > 0) return args.threads;
@@ -668,11 +677,28 @@ int run(const RunArgs& args) {
   // load and validate: any mistake is one line on stderr, and nothing is written
   std::optional<st::Study> loaded = load_or_say(args.study);
   if (!loaded) return kExitBadInput;
+  // in an MPI job, a multistart's local runs are shared among the ranks: each rank runs the
+  // study (a sweep's points share the ranks instead)
+  std::unique_ptr<bd::optimize::StartPool> start_pool;
+  if (g_mpi && !loaded->sweep && shares_starts(*loaded)) {
+    start_pool = g_mpi->start_pool();
+    if (loaded->optimize) loaded->optimize->options.start_pool = start_pool.get();
+    if (loaded->planar_optimize) loaded->planar_optimize->options.start_pool = start_pool.get();
+  }
   const st::Study& study = *loaded;
   if (quiet_rank()) {
-    // another rank of an MPI job: compute the points rank 0 hands out; rank 0 alone runs a
-    // study without a sweep
-    if (study.sweep) g_mpi->work(study, sweep_threads(study, args));
+    // another rank of an MPI job: compute the points rank 0 hands out, or run the study with
+    // rank 0 for its multistarts' sake (rank 0 alone writes its outputs); else rank 0 alone
+    // runs the study
+    if (study.sweep) {
+      g_mpi->work(study, sweep_threads(study, args));
+    } else if (start_pool) {
+      try {
+        st::compute_study(study);
+      } catch (const bd::InputError&) {
+        // rank 0 meets the same and says it
+      }
+    }
     return kExitOk;
   }
 

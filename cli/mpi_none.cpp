@@ -24,5 +24,6 @@ std::unique_ptr<studies::SweepPeers> MpiWorld::peers(const studies::Study&, int)
   return nullptr;
 }
 void MpiWorld::work(const studies::Study&, int) {}
+std::unique_ptr<optimize::StartPool> MpiWorld::start_pool() { return nullptr; }
 
 }  // namespace bd::cli

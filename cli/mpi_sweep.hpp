@@ -2,11 +2,14 @@
 // A sweep spread over the ranks of an MPI job (`mpirun -np N balance-design run sweep.yaml`):
 // rank 0 writes sweep.csv and sweep.json as a run without MPI does (studies::write_sweep()) and
 // hands out points on request; every other rank computes the points it is given on its own
-// threads and sends their rows back. Built only where MPI is found (BD_HAVE_MPI); without it,
-// mpi_world() reports one process and the program runs as it always has.
+// threads and sends their rows back. A study without a sweep whose optimisation is a multistart
+// (mlsl) shares its local runs the same way (start_pool()). Built only with MPI (BD_HAVE_MPI);
+// without it (cli/mpi_none.cpp), mpi_world() reports one process and the program runs as it
+// always has.
 #include <cstdlib>
 #include <memory>
 
+#include "optimize/optimize.hpp"
 #include "studies/studies.hpp"
 
 namespace bd::cli {
@@ -33,6 +36,13 @@ class MpiWorld {
   /// Ranks 1..N-1: compute the points rank 0 hands out, `threads` at a time, until it has no
   /// more. Returns when rank 0 says the sweep is over.
   void work(const studies::Study& study, int threads);
+
+  /// The ranks as one pool for a multistart's local runs (mlsl), in a study without a sweep:
+  /// every rank runs the same study, so each multistart is reached by all of them in the same
+  /// order, and run_all() is collective. Rank 0 hands out the starts one at a time on request
+  /// (dynamic load balancing), computing some itself on a second thread; every rank returns
+  /// every run, the same bytes as a run in one process.
+  std::unique_ptr<optimize::StartPool> start_pool();
 
  private:
   friend std::unique_ptr<MpiWorld> mpi_world(int& argc, char**& argv);

@@ -408,11 +408,20 @@ double radical_inverse(int i, int b) {
   return r;
 }
 
+// the local runs of a multistart, one after the other in this thread (no StartPool given)
+std::vector<LocalRun> run_here(int count, const std::function<LocalRun(int)>& run) {
+  std::vector<LocalRun> runs;
+  runs.reserve(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) runs.push_back(run(i));
+  return runs;
+}
+
 // "mlsl": a multistart of SLSQP runs from x0 and from Halton points (randomly shifted by the
-// seed, a Cranley-Patterson rotation) within the bounds, the best feasible optimum kept
+// seed, a Cranley-Patterson rotation) within the bounds, the best feasible optimum kept. Each
+// run has a budget of its own and depends on its index alone, so the runs may be computed
+// anywhere (options.start_pool) and give the same result.
 DriverOutcome multistart(const Program& nlp, const VectorXd& x0, const OptimizeOptions& options) {
-  constexpr int kStarts = 8;
-  TrackedNlp tracked(nlp, options.constraint_tolerance);
+  const int starts = std::max(options.starts, 1);
   VectorXd lower = nlp.lower(), upper = nlp.upper();
   finite_bounds(x0, lower, upper);
   const int n = nlp.n();
@@ -422,16 +431,9 @@ DriverOutcome multistart(const Program& nlp, const VectorXd& x0, const OptimizeO
   VectorXd shift(n);
   for (int i = 0; i < n; ++i) shift[i] = uniform(rng);
 
-  DriverOutcome out;
-  bool have = false, have_feasible = false;
-  double best_f = HUGE_VAL, best_violation = HUGE_VAL;
-  int best_start = 0, runs = 0, feasible_runs = 0;
-  Run best_run;
-  std::vector<double> feasible_values;
-  for (int s = 0; s < kStarts; ++s) {
-    const int left = options.max_evaluations - tracked.evaluations();
-    if (left <= 0) break;
-    const int budget = std::max(1, left / (kStarts - s));
+  const auto local_run = [&](int s) {
+    const int budget = std::max(1, options.max_evaluations / starts +
+                                       (s < options.max_evaluations % starts ? 1 : 0));
     VectorXd start = x0;
     if (s > 0) {
       for (int i = 0; i < n; ++i) {
@@ -439,49 +441,61 @@ DriverOutcome multistart(const Program& nlp, const VectorXd& x0, const OptimizeO
         start[i] = lower[i] + u * (upper[i] - lower[i]);
       }
     }
-    tracked.reset_best();
+    TrackedNlp tracked(nlp, options.constraint_tolerance);
     Run run = run_slsqp(tracked, start, nlp.lower(), nlp.upper(), budget, options);
-    ++runs;
     std::string note;
-    run.x = chosen_point(run, tracked, options.constraint_tolerance, note);
-    const double violation = constraint_violation(nlp, run.x);
-    const bool feasible = violation <= options.constraint_tolerance;
-    if (feasible) {
-      ++feasible_runs;
-      run.f = nlp.objective(run.x, nullptr);
-      feasible_values.push_back(run.f);
-    }
+    LocalRun out;
+    out.x = chosen_point(run, tracked, options.constraint_tolerance, note);
+    out.violation = constraint_violation(nlp, out.x);
+    out.objective =
+        out.violation <= options.constraint_tolerance ? nlp.objective(out.x, nullptr) : run.f;
+    out.evaluations = tracked.evaluations();
+    out.result = run.result;
+    out.error = run.error;
+    return out;
+  };
+  const std::vector<LocalRun> runs = options.start_pool
+                                         ? options.start_pool->run_all(starts, local_run)
+                                         : run_here(starts, local_run);
+
+  DriverOutcome out;
+  bool have = false, have_feasible = false;
+  double best_f = HUGE_VAL, best_violation = HUGE_VAL;
+  int best_start = 0, feasible_runs = 0;
+  const LocalRun* best = nullptr;
+  for (int s = 0; s < starts; ++s) {
+    const LocalRun& run = runs[static_cast<std::size_t>(s)];
+    out.evaluations += run.evaluations;
+    const bool feasible = run.violation <= options.constraint_tolerance;
+    if (feasible) ++feasible_runs;
     // a feasible run beats an infeasible one; among feasible ones the lower objective wins,
     // among infeasible ones the smaller violation
-    const bool better = !have || (feasible && (!have_feasible || run.f < best_f)) ||
-                        (!feasible && !have_feasible && violation < best_violation);
+    const bool better = !have || (feasible && (!have_feasible || run.objective < best_f)) ||
+                        (!feasible && !have_feasible && run.violation < best_violation);
     if (better) {
       have = true;
       have_feasible = feasible;
-      best_f = run.f;
-      best_violation = violation;
+      best_f = run.objective;
+      best_violation = run.violation;
       best_start = s + 1;
-      best_run = run;
+      best = &run;
     }
   }
-  out.x = have ? best_run.x : x0;
-  out.evaluations = tracked.evaluations();
+  out.x = best->x;
   out.iterations = out.evaluations;
-  out.termination = have ? termination_of(best_run.result) : Termination::kMaxEvaluations;
-  if (out.termination == Termination::kConverged &&
-      tracked.evaluations() >= options.max_evaluations && runs < kStarts) {
-    out.termination = Termination::kMaxEvaluations;
+  out.termination = termination_of(static_cast<nlopt_result>(best->result));
+  out.starts = starts;
+  for (const LocalRun& run : runs) {
+    if (run.violation <= options.constraint_tolerance &&
+        run.objective <= best_f + kSameValue * std::max(std::abs(best_f), 1.0)) {
+      ++out.starts_at_best;
+    }
   }
-  out.starts = runs;
-  for (double f : feasible_values) {
-    if (f <= best_f + kSameValue * std::max(std::abs(best_f), 1.0)) ++out.starts_at_best;
-  }
-  out.message = "multistart of NLopt LD_SLSQP (mlsl): " + std::to_string(runs) + " of " +
-                std::to_string(kStarts) + " local runs, " + std::to_string(feasible_runs) +
-                " feasible, " + std::to_string(out.starts_at_best) +
-                " reaching the best value; best from start " + std::to_string(best_start) + ": " +
-                describe(best_run.result);
-  if (!best_run.error.empty()) out.message += ": " + best_run.error;
+  out.message = "multistart of NLopt LD_SLSQP (mlsl): " + std::to_string(starts) +
+                " local runs, " + std::to_string(feasible_runs) + " feasible, " +
+                std::to_string(out.starts_at_best) + " reaching the best value; best from start " +
+                std::to_string(best_start) + ": " + describe(static_cast<nlopt_result>(best->result));
+  if (!best->error.empty()) out.message += ": " + best->error;
   return out;
 }
 

@@ -86,9 +86,11 @@ double constraint_violation(const Program& nlp, const Eigen::VectorXd& x, int* w
 /// - mma: LD_MMA takes inequalities only (optimize() refuses equalities: as pairs ±c <= δ they
 ///   stall MMA far from the optimum); they are tightened to c + δ <= 0 with
 ///   δ = 0.5 · options.constraint_tolerance, as MMA's last iterates may lie just outside.
-/// - mlsl: a multistart of LD_SLSQP runs (NLopt's own G_MLSL cannot take constraints): the
-///   first from x0, the others from a randomly shifted Halton sequence within the bounds
-///   (seeded by options.seed); the best feasible local optimum is kept.
+/// - mlsl: a multistart of options.starts LD_SLSQP runs (NLopt's own G_MLSL cannot take
+///   constraints): the first from x0, the others from a randomly shifted Halton sequence within
+///   the bounds (seeded by options.seed), each with its own share of the budget, so that each
+///   depends on its index alone and options.start_pool may compute them anywhere; the best
+///   feasible local optimum is kept (the first of equals).
 /// Budget: options.max_evaluations objective evaluations in all; xtol_rel = ftol_rel =
 /// options.relative_tolerance for the local methods, the budget alone for isres.
 /// A program solved by options.algorithm from x0, with the feasibility of the point returned

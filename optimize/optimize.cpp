@@ -192,6 +192,11 @@ Problem OptimizeOptions::validate() const {
     return FieldError{"max_evaluations", -1,
                       "must be >= 1, got " + std::to_string(max_evaluations)};
   }
+  if (starts < 1 || starts > max_evaluations) {
+    return FieldError{"starts", -1,
+                      "must be >= 1 and <= max_evaluations (" + std::to_string(max_evaluations) +
+                          ": each start needs an evaluation), got " + std::to_string(starts)};
+  }
   if (!(std::isfinite(relative_tolerance) && relative_tolerance > 0 && relative_tolerance < 1)) {
     return FieldError{"relative_tolerance", -1,
                       "must be in (0, 1), got " + text::exact(relative_tolerance)};

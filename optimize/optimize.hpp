@@ -2,6 +2,7 @@
 /// Solving a DesignProblem with NLopt or Ipopt (Ceres-style: options in, result out). The
 /// solvers' headers appear only in optimize/nlopt_driver.cpp and optimize/ipopt_driver.cpp.
 #include <Eigen/Core>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -39,15 +40,41 @@ constexpr Algorithm default_algorithm(bool free_scene) {
   return free_scene ? Algorithm::kCobyla : Algorithm::kSlsqp;
 }
 
+/// One local run of a multistart (mlsl): what the choice of the best run needs from it.
+struct LocalRun {
+  Eigen::VectorXd x;     // the point the run returns
+  double objective{};    // at x (a feasible run's is re-evaluated there)
+  double violation{};    // largest scaled constraint violation at x
+  int evaluations{};     // objective evaluations the run spent
+  int result{};          // NLopt's result code
+  std::string error;     // what went wrong, if anything ("" when nothing)
+};
+
+/// Where a multistart's local runs are computed: each run depends on its index alone, so every
+/// pool gives the same runs. Without one (OptimizeOptions::start_pool null) they run one after
+/// the other in the calling thread; the command-line program's MPI job shares them among its
+/// ranks (cli/mpi_sweep.hpp).
+class StartPool {
+ public:
+  virtual ~StartPool() = default;
+  /// runs[i] = run(i) for every i in [0, count), wherever each is computed.
+  virtual std::vector<LocalRun> run_all(int count, const std::function<LocalRun(int)>& run) = 0;
+};
+
 struct OptimizeOptions {
   Algorithm algorithm = Algorithm::kSlsqp;
   int max_evaluations = 2000;
+  /// mlsl: its local runs; each gets max_evaluations / starts evaluations (the first ones one
+  /// more while the division leaves some), whatever the others spend
+  int starts = 8;
+  /// mlsl: where the local runs are computed (null: here, one after the other). Not owned.
+  StartPool* start_pool = nullptr;
   double relative_tolerance = 1e-8;    // on x and on the objective
   double constraint_tolerance = 1e-9;  // feasibility of the reported optimum (scaled)
   bool check_gradients = false;        // compare analytic gradients with central differences first
   unsigned seed = 1;                   // global methods
   /// Empty when valid, else the first problem, its field one of "algorithm",
-  /// "max_evaluations", "relative_tolerance", "constraint_tolerance"; e.g. text()
+  /// "max_evaluations", "starts", "relative_tolerance", "constraint_tolerance"; e.g. text()
   /// "max_evaluations must be >= 1, got 0".
   bd::Problem validate() const;
 };

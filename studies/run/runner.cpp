@@ -43,7 +43,8 @@ void refuse_non_finite(Result& r) {
 
 // solves an optimize study's problem and simulates the optimum; not run when the original's
 // simulation stopped early (its metrics are the normalisers)
-OptimizedRun optimize_study(const Study& study, const RunResult& original) {
+OptimizedRun optimize_study(const Study& study, const RunResult& original,
+                            const ComputeParts& parts) {
   OptimizedRun o;
   if (!original.status().ok()) {
     o.result.message = "not run: the original design's simulation stopped early (" +
@@ -69,7 +70,7 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original) {
   core::PeakList peaks;
   o.metrics = fourbar_metrics(best, sim, &peaks);
   o.metric_list = metric_list(o.metrics, &peaks);
-  o.harmonics = harmonics(best, o.trajectory, o.planar);
+  if (parts.harmonics) o.harmonics = harmonics(best, o.trajectory, o.planar);
   if (req.pareto) {
     o.pareto = optimize::pareto_front(problem, req.pareto->first, req.pareto->second,
                                       req.pareto->points, req.options);
@@ -79,7 +80,8 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original) {
 
 // a planar study's optimum: solved in its driven scene (the regressor comes from the original's
 // run), then simulated; not run when the original stopped early
-OptimizedRun planar_optimize_study(const Study& study, const RunResult& original) {
+OptimizedRun planar_optimize_study(const Study& study, const RunResult& original,
+                                   const ComputeParts& parts) {
   OptimizedRun o;
   o.is_planar = true;
   if (!original.status().ok()) {
@@ -98,7 +100,7 @@ OptimizedRun planar_optimize_study(const Study& study, const RunResult& original
   o.method = sim.method;
   o.metric_list = metric_list(best, sim);
   o.planar = std::move(sim.planar);
-  o.harmonics = harmonics(best, o.trajectory, o.planar);
+  if (parts.harmonics) o.harmonics = harmonics(best, o.trajectory, o.planar);
   if (const std::optional<PlanarParetoRequest>& p = study.planar_optimize->pareto) {
     o.planar_pareto =
         optimize::planar::pareto_front(planar_design_problem(study), p->first, p->second, p->points,
@@ -570,7 +572,8 @@ std::string with_every_condition(const core::planar::Linkage& l, const core::pla
 // a planar study's balanced design: synthesised from the original's motion (its configurations
 // give the balance conditions), then simulated in the same scene; not run when the original
 // stopped early
-BalancedRun planar_balanced_run(const Study& study, const RunResult& original) {
+BalancedRun planar_balanced_run(const Study& study, const RunResult& original,
+                                const ComputeParts& parts) {
   namespace bp = balance::planar;
   BalancedRun b;
   b.is_planar = true;
@@ -615,7 +618,7 @@ BalancedRun planar_balanced_run(const Study& study, const RunResult& original) {
   b.method = sim.method;
   b.metric_list = metric_list(balanced, sim);
   b.planar = std::move(sim.planar);
-  b.harmonics = harmonics(balanced, b.trajectory, b.planar);
+  if (parts.harmonics) b.harmonics = harmonics(balanced, b.trajectory, b.planar);
   return b;
 }
 
@@ -630,7 +633,7 @@ RunStatus simulation_status(const RunResult& r) {
   return run_status(r.trajectory);
 }
 
-RunResult compute_study(const Study& study) {
+RunResult compute_study(const Study& study, const ComputeParts& parts) {
   RunResult result;
   Simulation sim = simulate(study);
   result.method = sim.method;
@@ -643,7 +646,7 @@ RunResult compute_study(const Study& study) {
   }
   result.trajectory = std::move(sim.fourbar);
   result.planar = std::move(sim.planar);
-  result.harmonics = harmonics(study, result.trajectory, result.planar);
+  if (parts.harmonics) result.harmonics = harmonics(study, result.trajectory, result.planar);
   if (study.balance) {
     const Study design = balanced_study(study);
     const Simulation balanced = simulate(design);
@@ -653,12 +656,12 @@ RunResult compute_study(const Study& study) {
     core::PeakList peaks;
     b.metrics = fourbar_metrics(design, balanced, &peaks);
     b.metric_list = metric_list(b.metrics, &peaks);
-    b.harmonics = harmonics(design, b.trajectory, b.planar);
+    if (parts.harmonics) b.harmonics = harmonics(design, b.trajectory, b.planar);
     result.balanced = std::move(b);
   }
-  if (study.planar_balance) result.balanced = planar_balanced_run(study, result);
-  if (study.optimize) result.optimized = optimize_study(study, result);
-  if (study.planar_optimize) result.optimized = planar_optimize_study(study, result);
+  if (study.planar_balance) result.balanced = planar_balanced_run(study, result, parts);
+  if (study.optimize) result.optimized = optimize_study(study, result, parts);
+  if (study.planar_optimize) result.optimized = planar_optimize_study(study, result, parts);
   return result;
 }
 

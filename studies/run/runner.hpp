@@ -165,6 +165,13 @@ struct ComparisonRow {
 /// result.optimized has found its optimum.
 std::vector<ComparisonRow> comparison(const Study& study, const RunResult& result);
 
+/// What compute_study() computes besides each design's run and metrics.
+struct ComputeParts {
+  /// The harmonic orders of the shaking force and moment (harmonics.csv and the page; a
+  /// sweep's rows hold none, and their FFTs cost a sixth of a driven point).
+  bool harmonics = true;
+};
+
 /// What run_study() (studies/studies.hpp) computes, without writing anything: simulates the study's
 /// scene, and with a balance section the balanced design, with an optimize section solves the
 /// design problem and simulates the optimum (each as run_study() describes). The result's file
@@ -173,7 +180,7 @@ std::vector<ComparisonRow> comparison(const Study& study, const RunResult& resul
 /// by a mutex: Debian 12's Ipopt 3.11.9 calls MUMPS, which is not thread-safe, and has no lock of
 /// its own (Ipopt takes one around MUMPS from 3.14 on).
 /// @throws bd::InputError as run_study().
-RunResult compute_study(const Study& study);
+RunResult compute_study(const Study& study, const ComputeParts& parts = {});
 
 /// Writes the data files of a computed run into out_dir (creating out_dir when needed) and sets
 /// the result's file paths. `timeseries.csv` and `summary.json`; each file is written to a

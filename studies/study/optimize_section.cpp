@@ -27,14 +27,15 @@ class OptimizeReader {
  public:
   explicit OptimizeReader(const Reporter& r) : r_(r) {}
 
-  // optimize: {algorithm, objective, constraints, variables, max_evaluations, tolerance, pareto}
+  // optimize: {algorithm, objective, constraints, variables, max_evaluations, starts, tolerance,
+  // pareto}
   OptimizeRequest read_optimize(const MapReader::Entry& e, const Study& study) {
     OptimizeRequest req;
     const MapReader o(r_, e.value, "optimize", e.key_mark,
-                      "(algorithm, objective, constraints, variables, max_evaluations, tolerance, "
-                      "pareto)");
+                      "(algorithm, objective, constraints, variables, max_evaluations, starts, "
+                      "tolerance, pareto)");
     o.check_keys({"algorithm", "objective", "constraints", "variables", "max_evaluations",
-                  "tolerance", "pareto"});
+                  "starts", "tolerance", "pareto"});
     const SolverMarks marks = read_solver(o, e.key_mark, is_free(study.scene), req.options);
     read_objective(o.require("objective", "the metrics to minimise, each with a weight"), study,
                    req);
@@ -57,16 +58,16 @@ class OptimizeReader {
   }
 
   // a planar linkage's optimize: {algorithm, objective, constraints, variables, max_evaluations,
-  // tolerance, pareto}
+  // starts, tolerance, pareto}
   PlanarOptimizeRequest read_planar_optimize(const MapReader::Entry& e, const Study& study) {
     namespace op = optimize::planar;
     PlanarOptimizeRequest req;
     const core::planar::Linkage& linkage = study.planar();
     const MapReader o(r_, e.value, "optimize", e.key_mark,
-                      "(algorithm, objective, constraints, variables, max_evaluations, "
+                      "(algorithm, objective, constraints, variables, max_evaluations, starts, "
                       "tolerance, pareto)");
     o.check_keys({"algorithm", "objective", "constraints", "variables", "max_evaluations",
-                  "tolerance", "pareto"});
+                  "starts", "tolerance", "pareto"});
     const SolverMarks marks = read_solver(o, e.key_mark, is_free(study.scene), req.options);
     table_ = core::planar::metric_table(core::planar::Model(linkage));
 
@@ -281,13 +282,13 @@ class OptimizeReader {
   }
 
   struct SolverMarks {
-    YAML::Mark section, algorithm, evaluations, tolerance;
+    YAML::Mark section, algorithm, evaluations, starts, tolerance;
   };
 
-  // algorithm, max_evaluations, tolerance; each mark defaults to the section's
+  // algorithm, max_evaluations, starts, tolerance; each mark defaults to the section's
   SolverMarks read_solver(const MapReader& o, const YAML::Mark& section, bool free_scene,
                           optimize::OptimizeOptions& options) {
-    SolverMarks marks{section, section, section, section};
+    SolverMarks marks{section, section, section, section, section};
     // without the key, the method that suits the scene: a free scene's evaluations are
     // simulations without derivatives
     options.algorithm = optimize::default_algorithm(free_scene);
@@ -306,6 +307,15 @@ class OptimizeReader {
     if (const MapReader::Entry* n = o.find("max_evaluations")) {
       options.max_evaluations = read_count(r_, *n, "optimize.max_evaluations", 1, 1e9);
       marks.evaluations = mark_of(n->value, n->key_mark);
+    }
+    if (const MapReader::Entry* k = o.find("starts")) {
+      options.starts = read_count(r_, *k, "optimize.starts", 1, 1e6);
+      marks.starts = mark_of(k->value, k->key_mark);
+      if (options.algorithm != optimize::Algorithm::kMlsl) {
+        r_.fail(marks.starts, std::string("optimize.starts is the number of local runs of the "
+                                          "multistart mlsl; algorithm ") +
+                                  optimize::to_string(options.algorithm) + " runs once");
+      }
     }
     if (const MapReader::Entry* t = o.find("tolerance")) {
       const double tol = read_number(r_, *t, "optimize.tolerance", "");
@@ -327,6 +337,7 @@ class OptimizeReader {
     if (!p) return;
     YAML::Mark where = marks.section;
     if (p->field == "max_evaluations") where = marks.evaluations;
+    if (p->field == "starts") where = marks.starts;
     if (p->field == "relative_tolerance" || p->field == "constraint_tolerance") {
       where = marks.tolerance;
     }

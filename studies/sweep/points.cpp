@@ -2,12 +2,14 @@
 // in sweep_runner.cpp, the report in sweep_report.cpp.
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "studies/study/load_study.hpp"
 #include "studies/study/load_study_internal.hpp"
@@ -98,61 +100,112 @@ double draw_in(double lo, double hi, double u, bool log_scale) {
 
 }  // namespace
 
+int sweep_size(const SweepRequest& request) {
+  if (request.parameters.empty()) return 0;
+  if (request.design != SweepDesign::kGrid) return std::max(request.points, 0);
+  std::size_t n = 1;
+  for (const SweepParameter& p : request.parameters) n *= p.values.size();
+  return static_cast<int>(n);
+}
+
 std::vector<std::vector<double>> sweep_points(const SweepRequest& request) {
-  const std::size_t np = request.parameters.size();
+  PointCursor cursor(request);
   std::vector<std::vector<double>> points;
-  if (np == 0) return points;
-
-  if (request.design == SweepDesign::kGrid) {
-    // the Cartesian product, like nested loops with the first parameter outermost: an odometer
-    // whose last digit turns fastest
-    std::size_t n = 1;
-    for (const SweepParameter& p : request.parameters) n *= p.values.size();
-    points.reserve(n);
-    std::vector<std::size_t> digit(np, 0);
-    for (std::size_t i = 0; i < n; ++i) {
-      std::vector<double> point(np);
-      for (std::size_t j = 0; j < np; ++j) point[j] = request.parameters[j].values[digit[j]];
-      points.push_back(std::move(point));
-      for (std::size_t j = np; j-- > 0;) {
-        if (++digit[j] < request.parameters[j].values.size()) break;
-        digit[j] = 0;
-      }
-    }
-    return points;
-  }
-
-  const std::size_t n = request.points > 0 ? static_cast<std::size_t>(request.points) : 0;
-  points.assign(n, std::vector<double>(np));
-  Generator g(request.seed);
-  if (request.design == SweepDesign::kRandom) {
-    // point by point, parameter by parameter: one uniform draw each
-    for (std::size_t i = 0; i < n; ++i) {
-      for (std::size_t j = 0; j < np; ++j) {
-        const SweepParameter& p = request.parameters[j];
-        points[i][j] = draw_in(p.from, p.to, g.uniform(), p.log_scale);
-      }
-    }
-    return points;
-  }
-
-  // Latin hypercube: parameter by parameter, a random permutation of the strata 0..n-1
-  // (Fisher-Yates, from the last position down), then point by point one uniform draw inside
-  // the point's stratum [e_s, e_{s+1}), e_s the value at fraction s/n of [from, to]
-  std::vector<std::size_t> stratum(n);
-  for (std::size_t j = 0; j < np; ++j) {
-    const SweepParameter& p = request.parameters[j];
-    for (std::size_t i = 0; i < n; ++i) stratum[i] = i;
-    for (std::size_t i = n; i-- > 1;) std::swap(stratum[i], stratum[g.below(i + 1)]);
-    const double dn = static_cast<double>(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const double s = static_cast<double>(stratum[i]);
-      const double lo = at_fraction(p.from, p.to, s / dn, p.log_scale);
-      const double hi = at_fraction(p.from, p.to, (s + 1) / dn, p.log_scale);
-      points[i][j] = draw_in(lo, hi, g.uniform(), p.log_scale);
-    }
+  points.reserve(static_cast<std::size_t>(cursor.size()));
+  for (int i = 0; i < cursor.size(); ++i) {
+    const std::span<const double> v = cursor.at(i);
+    points.emplace_back(v.begin(), v.end());
   }
   return points;
+}
+
+// Where the design's points come from. Grid: the Cartesian product, like nested loops with the
+// first parameter outermost (an odometer whose last digit turns fastest). Random: point by
+// point, parameter by parameter, one uniform draw each, from one generator. Latin hypercube:
+// parameter by parameter, a random permutation of the strata 0..n-1 (Fisher-Yates, from the
+// last position down), then point by point one uniform draw inside the point's stratum
+// [e_s, e_{s+1}), e_s the value at fraction s/n of [from, to]; the generator after each
+// parameter's permutation is kept with the permutation, and skips the n draws that follow.
+struct PointCursor::State {
+  const SweepRequest* request{};
+  std::size_t n{}, np{};
+  std::vector<double> values;  // the point last asked for
+  std::vector<std::size_t> radix;           // grid: each parameter's count
+  std::vector<Generator> generators;        // random: one; LHS: one per parameter
+  std::vector<std::vector<std::uint32_t>> strata;  // LHS: per parameter, point -> stratum
+  std::size_t next{};  // random, LHS: the point whose draws come next
+};
+
+PointCursor::PointCursor(const SweepRequest& request) : state_(std::make_unique<State>()) {
+  State& st = *state_;
+  st.request = &request;
+  st.np = request.parameters.size();
+  st.values.resize(st.np);
+  if (st.np == 0) return;
+  st.n = static_cast<std::size_t>(sweep_size(request));
+  if (request.design == SweepDesign::kGrid) {
+    for (const SweepParameter& p : request.parameters) st.radix.push_back(p.values.size());
+    return;
+  }
+  Generator g(request.seed);
+  if (request.design == SweepDesign::kRandom) {
+    st.generators.push_back(g);
+    return;
+  }
+  // parameter by parameter: the permutation's draws, then the n uniform ones skipped
+  std::vector<std::uint32_t> stratum(st.n);
+  for (std::size_t j = 0; j < st.np; ++j) {
+    for (std::size_t i = 0; i < st.n; ++i) stratum[i] = static_cast<std::uint32_t>(i);
+    for (std::size_t i = st.n; i-- > 1;) std::swap(stratum[i], stratum[g.below(i + 1)]);
+    st.generators.push_back(g);
+    st.strata.push_back(stratum);
+    for (std::size_t i = 0; i < st.n; ++i) g.next();
+  }
+}
+
+PointCursor::PointCursor(PointCursor&&) noexcept = default;
+PointCursor& PointCursor::operator=(PointCursor&&) noexcept = default;
+PointCursor::~PointCursor() = default;
+
+int PointCursor::size() const { return static_cast<int>(state_->n); }
+
+std::span<const double> PointCursor::at(int index) {
+  State& st = *state_;
+  const SweepRequest& request = *st.request;
+  const auto i = static_cast<std::size_t>(index);
+  if (request.design == SweepDesign::kGrid) {
+    // the odometer's digits of i, the last parameter turning fastest
+    std::size_t rest = i;
+    for (std::size_t j = st.np; j-- > 0;) {
+      st.values[j] = request.parameters[j].values[rest % st.radix[j]];
+      rest /= st.radix[j];
+    }
+    return st.values;
+  }
+  if (request.design == SweepDesign::kRandom) {
+    Generator& g = st.generators[0];
+    for (; st.next < i; ++st.next) {
+      for (std::size_t j = 0; j < st.np; ++j) g.next();
+    }
+    for (std::size_t j = 0; j < st.np; ++j) {
+      const SweepParameter& p = request.parameters[j];
+      st.values[j] = draw_in(p.from, p.to, g.uniform(), p.log_scale);
+    }
+    st.next = i + 1;
+    return st.values;
+  }
+  const double dn = static_cast<double>(st.n);
+  for (std::size_t j = 0; j < st.np; ++j) {
+    Generator& g = st.generators[j];
+    for (std::size_t k = st.next; k < i; ++k) g.next();
+    const SweepParameter& p = request.parameters[j];
+    const double s = static_cast<double>(st.strata[j][i]);
+    const double lo = at_fraction(p.from, p.to, s / dn, p.log_scale);
+    const double hi = at_fraction(p.from, p.to, (s + 1) / dn, p.log_scale);
+    st.values[j] = draw_in(lo, hi, g.uniform(), p.log_scale);
+  }
+  st.next = i + 1;
+  return st.values;
 }
 
 namespace {

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -19,6 +20,32 @@ namespace bd::studies {
 /// the request's seed by a generator of our own (not the standard library's distributions), so
 /// the same request gives the same points, bit for bit, with every compiler and machine.
 std::vector<std::vector<double>> sweep_points(const SweepRequest& request);
+
+/// How many points the design has (sweep_points().size(), without computing them).
+int sweep_size(const SweepRequest& request);
+
+/// The design's points one at a time, in increasing order, without holding them all (a sweep
+/// of 10^6 points would hold 10^6 vectors): the same values as sweep_points(), bit for bit. A
+/// grid point comes from its index; a random one from the generator moved on past the points
+/// skipped (a few nanoseconds each); a Latin hypercube keeps its strata, 4 bytes per point and
+/// parameter, and one generator per parameter.
+class PointCursor {
+ public:
+  explicit PointCursor(const SweepRequest& request);
+  PointCursor(PointCursor&&) noexcept;
+  PointCursor& operator=(PointCursor&&) noexcept;
+  ~PointCursor();
+
+  /// Points in the design.
+  int size() const;
+  /// Point i's values (one per parameter), valid until the next call. Precondition:
+  /// 0 <= i < size(), and i is at least the previous call's i (points may be skipped).
+  std::span<const double> at(int i);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 /// The study at one point of `base`'s sweep: base.sweep->study_text with each parameter's path
 /// set to values[j] (written "%.17g"), the sweep section removed, parsed and checked as

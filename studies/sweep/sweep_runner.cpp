@@ -18,11 +18,13 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -118,7 +120,7 @@ SweepRow sweep_row(const Study& base, int index, std::span<const double> values)
   std::string body;
   try {
     const Study study = detail::sweep_point_study(base, values);
-    const RunResult r = compute_study(study);
+    const RunResult r = compute_study(study, ComputeParts{.harmonics = false});
     for (const MetricValue& m : r.metric_list) body += "," + text::exact(m.value);
     if (base.balance || base.planar_balance) {
       const bool have = r.balanced && (study.balance || r.balanced->design);
@@ -249,33 +251,29 @@ std::string identity_difference(const Json& old, const Study& study, int points)
   return {};
 }
 
-// the complete rows of a sweep.csv text after its header, and where they end
-struct CsvRows {
-  bool has_header = false;        // a complete header line
-  std::string header;             // without its '\n'
-  std::vector<std::string> rows;  // complete lines, without their '\n'
-  std::size_t complete_size{};    // bytes up to the last '\n' (the header's included)
-};
-
-CsvRows split_rows(const std::string& text) {
-  CsvRows out;
-  std::size_t start = 0;
-  for (std::size_t nl; (nl = text.find('\n', start)) != std::string::npos; start = nl + 1) {
-    std::string line = text.substr(start, nl - start);
-    if (!out.has_header) {
-      out.has_header = true;
-      out.header = std::move(line);
-    } else {
-      out.rows.push_back(std::move(line));
-    }
-    out.complete_size = nl + 1;
+// sweep.csv's complete lines, one at a time (a last line without its '\n' was cut short by a
+// kill and is not one), read through a buffer: a sweep of 10^6 rows is never held whole
+class CsvLines {
+ public:
+  explicit CsvLines(const fs::path& file) : in_(file, std::ios::binary) {}
+  bool opened() const { return in_.is_open(); }
+  // the next complete line, without its '\n'; false at the end
+  bool next(std::string& line) {
+    if (!std::getline(in_, line) || in_.eof()) return false;
+    complete_size_ += line.size() + 1;
+    return true;
   }
-  return out;
-}
+  // bytes up to the end of the last complete line read
+  std::uintmax_t complete_size() const { return complete_size_; }
+
+ private:
+  std::ifstream in_;
+  std::uintmax_t complete_size_{};
+};
 
 // what is wrong with kept row i, in words; empty when it is the row of point i of this design
 std::string row_problem(const std::string& line, std::size_t i, std::size_t columns,
-                        const std::vector<double>& values) {
+                        std::span<const double> values) {
   const std::vector<std::string> f = csv_fields(line);
   if (f.size() != columns) {
     return "it has " + std::to_string(f.size()) + " fields, the header " + std::to_string(columns);
@@ -378,19 +376,21 @@ std::vector<std::string> sweep_columns(const Study& study) {
 namespace {
 
 // What the folder holds already, checked against this sweep: the rows a resumed sweep keeps.
+// sweep.csv is read row by row, never whole.
 struct Existing {
-  std::string csv_text;  // sweep.csv as found ("" for none)
-  CsvRows csv;           // its lines
+  std::uintmax_t csv_size{};       // sweep.csv's bytes as found (0 for none)
+  bool has_header = false;         // it has a complete header line
+  std::uintmax_t complete_size{};  // bytes up to its last '\n'
   int kept{}, kept_failed{};
 };
 
 Existing existing_rows(const Study& study, const fs::path& out_dir, const SweepResult& result,
-                       const SweepOptions& options, const std::vector<std::vector<double>>& points,
-                       const std::string& header, std::size_t columns) {
-  const int n = static_cast<int>(points.size());
+                       const SweepOptions& options, int n, const std::string& header,
+                       std::size_t columns) {
   Existing e;
-  e.csv_text = read_or_empty(result.csv);
-  e.csv = split_rows(e.csv_text);
+  std::error_code ec;
+  e.csv_size = fs::exists(result.csv, ec) ? fs::file_size(result.csv, ec) : 0;
+  if (ec) e.csv_size = 0;
   const std::string old_json = read_or_empty(result.summary);
   std::optional<Json> old_summary;
   if (!old_json.empty()) {
@@ -398,42 +398,56 @@ Existing existing_rows(const Study& study, const fs::path& out_dir, const SweepR
     Json j = Json::parse(old_json, nullptr, false);
     if (!j.is_discarded() && j.is_object()) old_summary = std::move(j);
   }
-  if (e.csv_text.empty()) return e;
+  if (e.csv_size == 0) return e;
+  CsvLines lines(result.csv);
+  if (!lines.opened()) throw std::runtime_error("cannot read " + result.csv.string());
+  std::string line;
+  e.has_header = lines.next(line);
+  const bool header_matches = e.has_header && line == header;
+  e.complete_size = lines.complete_size();
   if (!options.resume) {
     // a finished sweep is replaced; an unfinished one only on request
     int folder_points = n;
     if (old_summary && (*old_summary)["points"].is_number_integer()) {
       folder_points = (*old_summary)["points"].get<int>();
     }
-    if (static_cast<int>(e.csv.rows.size()) < folder_points) {
-      throw InputError(out_dir.string() + " holds an unfinished sweep (" +
-                       std::to_string(e.csv.rows.size()) + " of " + std::to_string(folder_points) +
+    long rows = 0;
+    while (rows < folder_points && lines.next(line)) ++rows;
+    if (rows < folder_points) {
+      throw InputError(out_dir.string() + " holds an unfinished sweep (" + std::to_string(rows) +
+                       " of " + std::to_string(folder_points) +
                        " points): pass --resume to continue it, or remove the folder to start "
                        "over");
     }
     return e;
   }
-  if (!e.csv.has_header) return e;
+  if (!e.has_header) return e;
   // resume: the rows must be this sweep's, point by point
   if (!old_summary) refuse(out_dir, "its sweep.json is missing or unreadable");
   if (const std::string why = identity_difference(*old_summary, study, n); !why.empty()) {
     refuse(out_dir, why);
   }
-  if (e.csv.header != header) refuse(out_dir, "the sweep.csv header differs");
-  if (static_cast<int>(e.csv.rows.size()) > n) {
-    refuse(out_dir, "sweep.csv has " + std::to_string(e.csv.rows.size()) + " rows for " +
-                        std::to_string(n) + " points");
-  }
-  for (std::size_t i = 0; i < e.csv.rows.size(); ++i) {
-    if (const std::string why = row_problem(e.csv.rows[i], i, columns, points[i]); !why.empty()) {
+  if (!header_matches) refuse(out_dir, "the sweep.csv header differs");
+  PointCursor points(*study.sweep);
+  int i = 0;
+  for (; lines.next(line); ++i) {
+    if (i >= n) {
+      long rows = i + 1;
+      while (lines.next(line)) ++rows;
+      refuse(out_dir, "sweep.csv has " + std::to_string(rows) + " rows for " + std::to_string(n) +
+                          " points");
+    }
+    const auto at = static_cast<std::size_t>(i);
+    if (const std::string why = row_problem(line, at, columns, points.at(i)); !why.empty()) {
       throw InputError(result.csv.string() + ": row " + std::to_string(i + 1) + " is not point " +
                        std::to_string(i) + " of this design (" + why +
                        "); remove the folder to start over");
     }
-    const std::vector<std::string> f = csv_fields(e.csv.rows[i]);
+    const std::vector<std::string> f = csv_fields(line);
     if (f[columns - 2] != "ok") ++e.kept_failed;
   }
-  e.kept = static_cast<int>(e.csv.rows.size());
+  e.kept = i;
+  e.complete_size = lines.complete_size();
   return e;
 }
 
@@ -452,9 +466,9 @@ void start_files(const Study& study, const fs::path& out_dir, const SweepResult&
   // the study itself, which `balance-design report DIR` reads from the folder
   if (study.sweep) write_text_file(study.sweep->study_text, out_dir / "study.yaml");
   write_text_file(sweep_json(study, result.points, counts), result.summary);
-  if (options.resume && existing.csv.has_header) {  // checked: this sweep's header and rows
-    if (existing.csv.complete_size != existing.csv_text.size()) {
-      fs::resize_file(result.csv, existing.csv.complete_size, ec);
+  if (options.resume && existing.has_header) {  // checked: this sweep's header and rows
+    if (existing.complete_size != existing.csv_size) {
+      fs::resize_file(result.csv, existing.complete_size, ec);
       if (ec) {
         throw std::runtime_error("cannot truncate " + result.csv.string() + ": " + ec.message());
       }
@@ -472,8 +486,8 @@ constexpr int kRowsAhead = 1 << 14;
 // the peers, their rows kept until every earlier point is written.
 class PointQueue final : public SweepWork {
  public:
-  PointQueue(int first, int n, const SweepOptions& options)
-      : next_(first), written_(first), n_(n), options_(options) {}
+  PointQueue(const SweepRequest& sweep, int first, const SweepOptions& options)
+      : points_(sweep), next_(first), written_(first), n_(points_.size()), options_(options) {}
 
   // under the lock (lock())
   SweepClaim claim(int count) override {
@@ -495,12 +509,19 @@ class PointQueue final : public SweepWork {
   }
   void halt() { halt_ = true; }
 
-  // a local thread's next point, waiting while too many rows wait to be written; -1 when none
-  int next_point() {
+  // a local thread's next point and its values, waiting while too many rows wait to be
+  // written; -1 when none
+  int next_point(std::vector<double>& values) {
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
       const SweepClaim c = claim(1);
-      if (!c.later) return c.empty() ? -1 : c.begin;
+      if (!c.later) {
+        if (c.empty()) return -1;
+        // points are claimed in increasing order, as the cursor wants them
+        const std::span<const double> v = points_.at(c.begin);
+        values.assign(v.begin(), v.end());
+        return c.begin;
+      }
       room_.wait_for(lock, std::chrono::milliseconds(50));
     }
   }
@@ -541,6 +562,7 @@ class PointQueue final : public SweepWork {
   std::mutex mutex_;
   std::condition_variable changed_, room_;
   std::map<int, SweepRow> finished_;  // rows not written yet (a later point may finish first)
+  PointCursor points_;                // the values of the points handed to local threads
   int next_, written_, n_;
   int workers_done_ = 0;
   std::atomic<bool> halt_{false};  // the writer failed: the workers stop too
@@ -551,11 +573,10 @@ class PointQueue final : public SweepWork {
 // one at a time) and on options.peers (which claim them in chunks), and appends the rows to
 // sweep.csv in point order on this thread, the only writer. Returns the number of rows sweep.csv
 // holds at the end (fewer than n when stopped); counts.failed counts the failed rows.
-int compute_points(const Study& study, const std::vector<std::vector<double>>& points, int first,
-                   int threads, const SweepOptions& options, const fs::path& csv_file,
-                   Counts& counts, const std::function<void(int, bool)>& report_progress) {
-  const int n = static_cast<int>(points.size());
-  PointQueue queue(first, n, options);
+int compute_points(const Study& study, int first, int threads, const SweepOptions& options,
+                   const fs::path& csv_file, Counts& counts,
+                   const std::function<void(int, bool)>& report_progress) {
+  PointQueue queue(*study.sweep, first, options);
   RowFile csv(csv_file);
   // with peers, the writer polls them every 2 ms; alone, it wakes for rows
   const auto wait = std::chrono::milliseconds(options.peers ? 2 : 100);
@@ -565,8 +586,9 @@ int compute_points(const Study& study, const std::vector<std::vector<double>>& p
     try {
       for (int t = 0; t < threads; ++t) {
         workers.emplace_back([&] {
-          for (int i; (i = queue.next_point()) >= 0;) {
-            queue.local_row(i, sweep_row(study, i, points[static_cast<std::size_t>(i)]));
+          std::vector<double> values;
+          for (int i; (i = queue.next_point(values)) >= 0;) {
+            queue.local_row(i, sweep_row(study, i, values));
           }
           queue.local_worker_done();
         });
@@ -606,8 +628,7 @@ SweepResult write_sweep(const Study& study, const fs::path& out_dir, const Sweep
   if (!study.sweep)
     throw InputError("write_sweep: study '" + study.name + "' has no sweep section");
   const Clock::time_point start = Clock::now();
-  const std::vector<std::vector<double>> points = sweep_points(*study.sweep);
-  const int n = static_cast<int>(points.size());
+  const int n = sweep_size(*study.sweep);
   const std::size_t columns = sweep_columns(study).size();
   const std::string header = header_line(study);
 
@@ -615,7 +636,7 @@ SweepResult write_sweep(const Study& study, const fs::path& out_dir, const Sweep
   result.points = n;
   result.csv = out_dir / "sweep.csv";
   result.summary = out_dir / "sweep.json";
-  const Existing existing = existing_rows(study, out_dir, result, options, points, header, columns);
+  const Existing existing = existing_rows(study, out_dir, result, options, n, header, columns);
   const int kept = existing.kept;
 
   const int wanted = options.threads > 0 ? options.threads
@@ -637,8 +658,7 @@ SweepResult write_sweep(const Study& study, const fs::path& out_dir, const Sweep
   };
   int written = kept;
   try {
-    written = compute_points(study, points, kept, local, options, result.csv, counts,
-                             report_progress);
+    written = compute_points(study, kept, local, options, result.csv, counts, report_progress);
   } catch (...) {
     // sweep.csv ends with whole rows (the one that failed was taken back); sweep.json says the
     // sweep stopped, not that it is running (a full disk may refuse this too: the error thrown

@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -106,19 +107,40 @@ class MpiSweepCli : public ::testing::Test {
     return pid;
   }
 
-  // the pid of the process started by mpirun as rank `rank` (its environment says so), or -1
-  static pid_t rank_pid(int rank) {
+  // the parent of process `pid` (field 4 of /proc/PID/stat), or -1
+  static pid_t parent_of(pid_t pid) {
+    const std::string stat = read(fs::path("/proc") / std::to_string(pid) / "stat");
+    const std::size_t name_end = stat.rfind(')');  // the command's name may hold ") "
+    if (name_end == std::string::npos) return -1;
+    std::istringstream fields(stat.substr(name_end + 1));
+    char state = 0;
+    pid_t parent = -1;
+    fields >> state >> parent;
+    return fields ? parent : -1;
+  }
+
+  static bool descends_from(pid_t pid, pid_t ancestor) {
+    for (int depth = 0; pid > 1 && depth < 32; ++depth) {
+      pid = parent_of(pid);
+      if (pid == ancestor) return true;
+    }
+    return false;
+  }
+
+  // the pid of the process that mpirun `job` started as rank `rank` (its environment says so),
+  // or -1: only job's descendants are looked at, so another MPI job on the machine (another
+  // test, or someone else's run) is never taken for it
+  static pid_t rank_pid(pid_t job, int rank) {
     const std::string wanted = "OMPI_COMM_WORLD_RANK=" + std::to_string(rank);
     for (const fs::directory_entry& e : fs::directory_iterator("/proc")) {
       const std::string name = e.path().filename().string();
       if (name.find_first_not_of("0123456789") != std::string::npos) continue;
-      std::string cmdline = read(e.path() / "cmdline");
-      if (cmdline.find("balance-design") == std::string::npos) continue;
-      if (cmdline.rfind(kMpirun, 0) == 0 || cmdline.rfind("mpirun", 0) == 0) continue;
+      const pid_t pid = std::stoi(name);
+      if (!descends_from(pid, job)) continue;
       std::string env = read(e.path() / "environ");
       std::replace(env.begin(), env.end(), '\0', '\n');
       if (env.find("\n" + wanted + "\n") != std::string::npos || env.rfind(wanted + "\n", 0) == 0)
-        return std::stoi(name);
+        return pid;
     }
     return -1;
   }
@@ -178,7 +200,7 @@ TEST_F(MpiSweepCli, RankKilledMidSweepThenResumedGivesTheSameBytes) {
   while (std::chrono::steady_clock::now() < deadline) {
     if (::waitpid(job, &status, WNOHANG) == job) break;
     if (!killed && rows(csv) >= 10) {
-      const pid_t rank1 = rank_pid(1);
+      const pid_t rank1 = rank_pid(job, 1);
       if (rank1 > 0) killed = ::kill(rank1, SIGKILL) == 0;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
@@ -218,5 +240,75 @@ TEST_F(MpiSweepCli, ThreadedSweepInterruptedThenResumedOnTwoRanks) {
   EXPECT_NE(out_.find("2000 of 2000 points (700 resumed)"), std::string::npos) << out_;
   EXPECT_EQ(read(dir_ / "part" / "sweep.csv"), full);
 }
+
+// summary.json without the lines that hold a wall time (they differ from run to run): the
+// solver's seconds, and its one-line report that states them
+std::string without_times(const std::string& json) {
+  std::istringstream in(json);
+  std::string kept;
+  for (std::string line; std::getline(in, line);) {
+    if (line.find("\"seconds\"") == std::string::npos &&
+        line.find("\"brief_report\"") == std::string::npos) {
+      kept += line + "\n";
+    }
+  }
+  return kept;
+}
+
+// A multistart (mlsl, six starts) over the driven paper four-bar's counterweights, its local
+// runs shared between two ranks: the optimum's files are the bytes of the run in one process,
+// and the summary reports every start and how many reached the best value.
+TEST_F(MpiSweepCli, MultistartSharedAmongRanksGivesTheSameOptimum) {
+  std::string study = read(kExamples + "/weighted-counterweights.yaml");
+  study = bd::testing::edited(study, "algorithm: slsqp", "algorithm: mlsl\n  starts: 6");
+  study = bd::testing::edited(study, "max_evaluations: 2000", "max_evaluations: 1200");
+  std::ofstream(dir_ / "mlsl.yaml") << study;
+  ASSERT_EQ(run("mlsl.yaml --out alone"), 0) << err_;
+  const std::string alone_out = out_;
+  ASSERT_EQ(mpirun("mlsl.yaml --out ranks"), 0) << err_;
+  // rank 0 alone speaks: the summary of the run in one process, line for line
+  EXPECT_EQ(std::count(out_.begin(), out_.end(), '\n'),
+            std::count(alone_out.begin(), alone_out.end(), '\n'))
+      << out_;
+  for (const char* file : {"optimized.yaml", "comparison.csv", "optimized-timeseries.csv"}) {
+    const std::string alone = read(dir_ / "alone" / file);
+    EXPECT_FALSE(alone.empty()) << file;
+    EXPECT_EQ(read(dir_ / "ranks" / file), alone) << file;
+  }
+  const std::string summary = without_times(read(dir_ / "alone" / "summary.json"));
+  EXPECT_EQ(without_times(read(dir_ / "ranks" / "summary.json")), summary);
+  EXPECT_NE(summary.find("6 local runs"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"starts\": 6"), std::string::npos) << summary;
+}
+
+#ifndef BD_WITH_MPI
+// The program built without MPI, started as one of two ranks (the environment mpirun gives its
+// ranks; no mpirun needed): it refuses with one line that says why, and writes nothing, rather
+// than letting every rank run the whole study into the same folder.
+TEST(MpiSweepCliWithoutMpi, RefusesToRunAsOneOfSeveralRanks) {
+  ASSERT_TRUE(fs::exists(kExe)) << kExe << " not built";
+  const fs::path dir = fs::temp_directory_path() /
+                       ("bd_mpi_none_test_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string cmd = "cd " + quote(dir.string()) + " && OMPI_COMM_WORLD_SIZE=2 " +
+                          quote(kExe) + " run " + quote(kExamples + "/paper-fourbar-sweep.yaml") +
+                          " --out out --progress none >stdout.txt 2>stderr.txt </dev/null";
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  const std::string err = read(dir / "stderr.txt");
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_NE(err.find("built without MPI"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  // alone, the same program runs the sweep
+  const std::string alone = "cd " + quote(dir.string()) + " && " + quote(kExe) + " run " +
+                            quote(kExamples + "/paper-fourbar-sweep.yaml") +
+                            " --out out --progress none >stdout.txt 2>stderr.txt </dev/null";
+  EXPECT_EQ(std::system(alone.c_str()), 0) << read(dir / "stderr.txt");
+  EXPECT_EQ(rows(dir / "out" / "sweep.csv"), 441);
+  fs::remove_all(dir);
+}
+#endif
 
 }  // namespace

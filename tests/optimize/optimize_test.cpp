@@ -45,10 +45,12 @@
 #include <Eigen/Eigenvalues>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <numbers>
 #include <ostream>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "balance/conditions.hpp"
@@ -758,6 +760,77 @@ TEST(Optimize, NonConvexProblemsGetALowerBoundThatNoDesignBeats) {
     EXPECT_NE(m.message.find(std::to_string(m.starts_at_best) + " reaching the best value"),
               std::string::npos);
   }
+}
+
+// A multistart's local runs each depend on their index alone: computed by a StartPool in reverse
+// order on another thread (as an MPI job's ranks compute them, in any order, elsewhere) they give
+// the very bits of the runs made one after the other here; each start is asked for once, each
+// run keeps to its share of the budget, and the count of starts at the best value is the
+// runs' own.
+TEST(Optimize, MultistartGivesTheSameBitsWhereverItsRunsAreComputed) {
+  class ReversedPool final : public StartPool {
+   public:
+    std::vector<LocalRun> run_all(int count, const std::function<LocalRun(int)>& run) override {
+      std::vector<LocalRun> runs(static_cast<std::size_t>(count));
+      std::thread([&] {
+        for (int i = count - 1; i >= 0; --i) {
+          runs[static_cast<std::size_t>(i)] = run(i);
+          asked.push_back(i);
+        }
+      }).join();
+      seen = runs;
+      return runs;
+    }
+    std::vector<int> asked;
+    std::vector<LocalRun> seen;
+  };
+  DesignProblem p = counterweight_problem(1.0, 10.0);
+  p.objective = {Term{Metric::kMshRms, 1.0}, Term{Metric::kTauMax, 0.5}};
+  OptimizeOptions o = options_for(Algorithm::kMlsl);
+  o.max_evaluations = 1003;
+  o.starts = 5;
+  const OptimizeResult here = optimize(p, o);
+  ReversedPool pool;
+  o.start_pool = &pool;
+  const OptimizeResult there = optimize(p, o);
+  SCOPED_TRACE(here.brief_report() + " | " + here.message);
+  ASSERT_TRUE(here.ok());
+  EXPECT_EQ(pool.asked, (std::vector<int>{4, 3, 2, 1, 0}));
+  ASSERT_EQ(here.x.size(), there.x.size());
+  for (Eigen::Index i = 0; i < here.x.size(); ++i) EXPECT_EQ(here.x[i], there.x[i]) << i;
+  EXPECT_EQ(here.objective, there.objective);
+  EXPECT_EQ(here.message, there.message);
+  EXPECT_EQ(here.evaluations, there.evaluations);
+  EXPECT_EQ(here.starts, 5);
+  EXPECT_EQ(there.starts, 5);
+  EXPECT_EQ(here.starts_at_best, there.starts_at_best);
+  // 1003 evaluations over 5 starts: 201, 201, 201, 200, 200, whatever each run spends
+  int spent = 0, at_best = 0;
+  double best = HUGE_VAL;
+  for (const LocalRun& r : pool.seen) {
+    if (r.violation <= o.constraint_tolerance) best = std::min(best, r.objective);
+  }
+  for (std::size_t s = 0; s < pool.seen.size(); ++s) {
+    const LocalRun& r = pool.seen[s];
+    EXPECT_LE(r.evaluations, s < 3 ? 201 : 200) << s;
+    spent += r.evaluations;
+    if (r.violation <= o.constraint_tolerance && r.objective <= best + 1e-6 * std::max(best, 1.0))
+      ++at_best;
+  }
+  EXPECT_LE(spent, here.evaluations);  // the multistart's, and any continuation after it
+  EXPECT_EQ(here.starts_at_best, at_best);
+  EXPECT_GE(at_best, 1);
+  EXPECT_NE(here.message.find(std::to_string(at_best) + " reaching the best value"),
+            std::string::npos);
+  // the objective reported is the best run's (the continuation after it can only improve it)
+  EXPECT_LE(here.objective, best * (1 + 1e-12));
+
+  // more starts than evaluations: refused, naming the field
+  o.starts = 2000;
+  o.max_evaluations = 1000;
+  const bd::Problem e = o.validate();
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->field, "starts");
 }
 
 // The relaxation itself: at a real design (its inertias at their real values) the relaxed

@@ -625,7 +625,18 @@ TEST(LoadStudy, OptimizeMistakesAreReportedWhereTheyAre) {
       "RA3_max, added_mass";
   expect_error(opt_edit("  tolerance: 1.0e-7\n", "  tolerence: 1.0e-7\n"), 32, 3,
                "unknown key 'tolerence' in optimize; allowed keys: algorithm, objective, "
-               "constraints, variables, max_evaluations, tolerance, pareto");
+               "constraints, variables, max_evaluations, starts, tolerance, pareto");
+  // starts: mlsl's local runs, an error with another algorithm, at the key's value
+  expect_error(opt_edit("  tolerance: 1.0e-7\n", "  tolerance: 1.0e-7\n  starts: 4\n"), 33, 11,
+               "optimize.starts is the number of local runs of the multistart mlsl; algorithm "
+               "slsqp runs once");
+  for (const char* starts : {"0", "501"}) {  // at least one, at most max_evaluations (500)
+    std::string mlsl = opt_edit("algorithm: slsqp", "algorithm: mlsl");
+    mlsl.insert(mlsl.find("  tolerance: 1.0e-7\n  pareto"), std::string("  starts: ") + starts +
+                                                                "\n");
+    expect_error(mlsl, 32, 11, starts[0] == '0' ? "optimize.starts" : "optimize: starts must be "
+                                                                      ">= 1 and <= max_evaluations");
+  }
   expect_error(opt_edit("algorithm: slsqp", "algorithm: bfgs"), 19, 14,
                "unknown algorithm 'bfgs' in optimize.algorithm; expected one of slsqp, mma, "
                "ipopt, mlsl, isres, cobyla");
