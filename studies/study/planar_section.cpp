@@ -110,8 +110,9 @@ class PlanarSection::Impl {
       if (const MapReader::Entry* n = sc.find("samples")) {
         d.samples = read_count(r_, *n, "scene.samples", dur ? 2 : 1, kMaxRows);
       }
-      check_start(e, l, d.start);
-      check_turns(e, type, l, d);
+      const core::planar::Model model(l);
+      check_start(e, model, d.start);
+      check_turns(e, type, model, d);
       return d;
     }
     if (t == "free") {
@@ -126,7 +127,7 @@ class PlanarSection::Impl {
       if (const MapReader::Entry* n = sc.find("samples")) {
         f.samples = read_count(r_, *n, "scene.samples", 2, kMaxRows);
       }
-      check_start(e, l, f.start);
+      check_start(e, core::planar::Model(l), f.start);
       return f;
     }
     r_.fail(mark_of(type.value, type.key_mark),
@@ -574,9 +575,8 @@ class PlanarSection::Impl {
   }
 
   // the linkage assembles at the scene's start (empty: as drawn)
-  void check_start(const MapReader::Entry& e, const core::planar::Linkage& l,
+  void check_start(const MapReader::Entry& e, const core::planar::Model& model,
                    const std::vector<double>& start) {
-    const core::planar::Model model(l);
     core::planar::Workspace ws(model);
     const auto ok = core::planar::assemble(
         model, ws, start.empty() ? core::planar::drawn_inputs(model) : start);
@@ -589,14 +589,14 @@ class PlanarSection::Impl {
   // steps it (at its samples, at most 3600), positions and dynamics; a singular position on an
   // assembly that goes on (a dead centre) stops the run there instead, with the samples before.
   void check_turns(const MapReader::Entry& e, const MapReader::Entry& type,
-                   const core::planar::Linkage& l, const core::planar::DrivenScene& d) {
+                   const core::planar::Model& model, const core::planar::DrivenScene& d) {
     if (d.duration > 0) return;
     core::planar::DrivenScene one = d;
     one.revolutions = 1;
     one.samples = std::min(d.samples, kTurnCheckSamples);
     core::planar::Trajectory run;
     try {
-      run = core::planar::simulate_driven(core::planar::Model(l), one);
+      run = core::planar::simulate_driven(model, one);
     } catch (const InputError& err) {
       r_.fail(e.key_mark, "scene: " + std::string(err.what()));
     }
