@@ -130,7 +130,7 @@ Metrics metrics(const FourBar& model, const DrivenScene& scene, const Trajectory
 
 /// Metrics of a free run `trajectory` = simulate_free(model, scene, options) with every peak
 /// resolved between the samples: maximised over time by the state integrated from the sample
-/// before each instant, the last step ending there (free_sample_at(), core/fourbar/simulate.hpp),
+/// before each instant, the last step ending there (free_sample_from(), core/fourbar/simulate.hpp),
 /// exact to the integration tolerance as the samples are. The ends of the run are brackets of
 /// their own (not periodic).
 Metrics metrics(const FourBar& model, const Trajectory& trajectory, const SimulateOptions& options,

@@ -110,7 +110,7 @@ OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FreeSce
 
 /// The same from a given state (its angles and rates; the accelerations are not read), at t = 0,
 /// instead of scene.theta1 and scene.omega1: a run continued from a sample of another
-/// (core::free_sample_at()). The state is taken as it is: off the closure by a sample's
+/// (core::free_sample_from()). The state is taken as it is: off the closure by a sample's
 /// integration error, the stabilisation (or the projection) keeps it there.
 OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FourBarState& start,
                                              const FreeScene& scene,

@@ -289,7 +289,7 @@ namespace {
 // Formulation::kOpenedLoop: the opened loop's own form, the DAE in theta1..theta3, kept on the
 // loop closure as the integrator allows (opened_loop_dae_options); it has no singularity at a
 // crank limit position and passes through it.
-// `from`: the state at t = 0 instead of the scene's theta1 and omega1 (free_sample_at()).
+// `from`: the state at t = 0 instead of the scene's theta1 and omega1 (free_sample_from()).
 Trajectory simulate_free_opened_loop(const FourBar& model, const FreeScene& scene,
                                      const SimulateOptions& options,
                                      const FourBarState* from = nullptr) {
@@ -426,15 +426,6 @@ std::optional<DynamicsSample> free_sample_from(const FourBar& model, const Simul
   DynamicsSample s = to.samples.back();
   continue_angles(model, from.state, s.state);
   return s;
-}
-
-std::optional<DynamicsSample> free_sample_at(const FourBar& model, const SimulateOptions& options,
-                                             const Trajectory& run, double t) {
-  if (run.t.empty() || !(t >= run.t.front()) || !(t <= run.t.back())) return std::nullopt;
-  // the last sample at or before t
-  const auto after = std::upper_bound(run.t.begin(), run.t.end(), t);
-  const auto i = static_cast<std::size_t>(after - run.t.begin()) - 1;
-  return free_sample_from(model, options, run.t[i], run.samples[i], t);
 }
 
 Trajectory detail::simulate_free_reduced(const FourBar& model, const FreeScene& scene,

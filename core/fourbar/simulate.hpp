@@ -78,17 +78,14 @@ struct Trajectory {
 ///         with the field of SimulateOptions::validate() or validate_scene().
 Trajectory simulate_free(const FourBar& model, const FreeScene& scene,
                          const SimulateOptions& options = {});
-/// The sample at time t of a free run `run` = simulate_free(model, scene, options): integrated
-/// by the same formulation and integrator from the run's last sample at or before t, in one run
-/// whose last step ends at t, and its dynamics evaluated there; exact to the integration
-/// tolerance, as the run's own samples are. The reduced formulations continue from the sample's
-/// theta1 and omega1 on the model's branch; the opened loop from its whole state (the branch it
-/// has reached). None outside the run's times or where that integration fails. Used to locate
-/// a free run's peaks between its samples (core/fourbar/metrics.hpp).
-std::optional<DynamicsSample> free_sample_at(const FourBar& model, const SimulateOptions& options,
-                                             const Trajectory& run, double t);
-/// The same from a given sample `from` at time t0 <= t (a sample of the run, or an instant
-/// computed so); none for t < t0 or where the integration fails.
+/// The sample at time t of a free run of simulate_free(model, scene, options), from a given
+/// sample `from` at time t0 <= t (a sample of the run, or an instant computed so): integrated by
+/// the same formulation and integrator in one run whose last step ends at t, and its dynamics
+/// evaluated there; exact to the integration tolerance, as the run's own samples are. The reduced
+/// formulations continue from the sample's theta1 and omega1 on the model's branch; the opened
+/// loop from its whole state (the branch it has reached). None for t < t0 or where the
+/// integration fails. Used to locate a free run's peaks between its samples
+/// (core/fourbar/metrics.hpp).
 std::optional<DynamicsSample> free_sample_from(const FourBar& model, const SimulateOptions& options,
                                                double t0, const DynamicsSample& from, double t);
 /// @throws bd::InputError if the scene or options are invalid (omega1 == 0, revolutions < 1, ...),

@@ -156,7 +156,7 @@ Brute open_parabola_peak(const std::vector<double>& x, double h) {
 }
 
 // A free run's peaks, located between 41 samples by integrating from the sample before each
-// instant (core::free_sample_at), against a separate run of 100 001 samples refined by the
+// instant (core::free_sample_from), against a separate run of 100 001 samples refined by the
 // parabola (error ~ (λ h)³ with h = 2e-5 s, below 1e-12): both runs at a tolerance of 1e-12, so
 // that their integration errors (~1e-11 of the values) stay below the 1e-9 asked. The paper
 // four-bar on the reduced equation (mass matrix) and a triple rocker on the opened loop, which
