@@ -21,6 +21,7 @@
 #include "core/number_text.hpp"
 #include "core/types.hpp"
 #include "optimize/first_order.hpp"
+#include "optimize/fixed_variables.hpp"
 #include "optimize/nlopt_driver.hpp"
 #include "optimize/optimize.hpp"
 
@@ -34,6 +35,22 @@ inline Vec2 position_of(double mass, const Vec2& moment, double distance_max) {
   const double d = r.norm();
   if (d > distance_max) r *= distance_max / d;
   return r;
+}
+
+/// The variables (mass and mass moment or position) of the counterweights whose mass at x is
+/// below `fraction` of their mass_max (Program::vanishing_counterweight_variables()); `first` holds
+/// each counterweight's first variable, its mass.
+template <class Counterweight>
+std::vector<int> vanishing_counterweight_variables(const Eigen::VectorXd& x,
+                                                   const std::vector<int>& first,
+                                                   const std::vector<Counterweight>& counterweights,
+                                                   double fraction) {
+  std::vector<int> out;
+  for (std::size_t c = 0; c < first.size(); ++c) {
+    const int j = first[c];
+    if (x(j) < fraction * counterweights[c].mass_max) out.insert(out.end(), {j, j + 1, j + 2});
+  }
+  return out;
 }
 
 /// Row `row` of the inequalities as the first-order check reads a counterweight's cone whose
@@ -81,7 +98,10 @@ struct TightBound {
 /// leaves it up to ~1e-4 of the objective below the optimum; so it is taken at x, at x without
 /// the counterweights below 1e-6 of their mass_max (a vanishing counterweight's mass moment has
 /// a direction of round-off, which the conditions cannot meet; on the apex the cone's
-/// subgradient can), at the ends of up to three SLSQP runs on from x to a relative tolerance of
+/// subgradient can), where that leaves it more than 1e-7 of the objective's size below the best
+/// design known, at x taken on by Newton steps on its active set (newton_polish(); where
+/// counterweights vanish, after an SLSQP run to 1e-14 with them held on the apex), and where
+/// even that leaves it open, at the ends of up to three SLSQP runs on from x to a relative tolerance of
 /// 1e-14 (each restart renews its Hessian), and, where these leave it more than 1e-7 of the
 /// objective's size below f(x), at the end of an Ipopt run to 1e-10 (its interior path reaches
 /// an optimum on the cone's apex, where SLSQP's steps turn with the round-off). Each is a bound;
@@ -113,8 +133,35 @@ TightBound tight_bound(const Nlp& program, const Eigen::VectorXd& x,
       out.by = by;
     }
   };
+  // the gap still open between the bound and the best design known
+  const auto open = [&] { return (out.better.size() > 0 ? out.objective : f) - bound > close; };
+  if (open()) {
+    // Newton steps on the active set's conditions (newton_polish()); first, where counterweights
+    // vanish, those held on their cones' apex and the rest solved again (FixedVariables: smooth
+    // there). The bound at the end is the whole program's, the apex read by the cone's subgradient
+    const std::vector<int> held_at_apex = program.vanishing_counterweight_variables(x, 1e-6);
+    Solved polished;
+    polished.termination = Termination::kConverged;
+    if (held_at_apex.empty()) {
+      polished.x = newton_polish(program, x, options.constraint_tolerance);
+    } else {
+      const Eigen::VectorXd snapped = program.without_vanishing_counterweights(x, 1e-6);
+      const FixedVariables held(program, held_at_apex, snapped);
+      const Solved refined = solve(held, held.reduce(snapped), tight, false);
+      polished.termination = refined.termination;
+      if (refined.x.size() == held.n()) {
+        polished.x = held.expand(newton_polish(held, refined.x, options.constraint_tolerance));
+      }
+    }
+    if (polished.x.size() == x.size()) {
+      polished.objective = program.objective(polished.x, nullptr);
+      polished.constraint_violation = constraint_violation(program, polished.x);
+      keep(polished, Algorithm::kSlsqp);
+      bound = std::max(bound, first_order(program, polished.x).lower_bound);
+    }
+  }
   Eigen::VectorXd at = x;
-  for (int run = 0; run < 3 && f - bound > close; ++run) {
+  for (int run = 0; run < 3 && open(); ++run) {
     const Solved refined = solve(program, at, tight);
     if (refined.x.size() != x.size()) break;
     keep(refined, Algorithm::kSlsqp);
@@ -124,7 +171,7 @@ TightBound tight_bound(const Nlp& program, const Eigen::VectorXd& x,
     at = refined.x;
     if (!gained) break;
   }
-  if (f - bound > close) {
+  if (open()) {
     tight.algorithm = Algorithm::kIpopt;
     tight.relative_tolerance = 1e-10;
     const Solved refined = solve(program, x, tight);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/number_text.hpp"
+#include "optimize/nlopt_driver.hpp"
 
 namespace bd::optimize::detail {
 
@@ -98,6 +99,121 @@ FirstOrder first_order(const Program& p, const VectorXd& x, double activity) {
   double lagrangian = f;
   for (Eigen::Index k = 0; k < z.size(); ++k) lagrangian += z[k] * term[static_cast<std::size_t>(k)];
   return {r.cwiseAbs().maxCoeff() / size, bound(r, lagrangian)};
+}
+
+namespace {
+
+// The active rows at x (equalities, inequalities within `activity`, bounds within activity w_j
+// as unit rows) and their values, and the gradient of the Lagrangian with least-squares
+// multipliers
+struct ActiveSet {
+  MatrixXd a;  // rows: active constraints' gradients
+  VectorXd c;  // their values (0 on the set)
+  VectorXd z;  // multipliers
+  VectorXd grad_l;
+};
+
+std::vector<int> active_rows(const Program& p, const VectorXd& x, double activity,
+                             std::vector<int>& bounds) {
+  std::vector<int> rows;
+  if (p.n_ineq() > 0) {
+    VectorXd c;
+    p.inequalities(x, c, nullptr);
+    for (int i = 0; i < c.size(); ++i) {
+      if (c[i] >= -activity) rows.push_back(i);
+    }
+  }
+  bounds.clear();
+  for (int j = 0; j < p.n(); ++j) {
+    const double w = std::isfinite(p.upper()[j] - p.lower()[j]) ? p.upper()[j] - p.lower()[j] : 1;
+    if (x[j] - p.lower()[j] <= activity * w || p.upper()[j] - x[j] <= activity * w) {
+      bounds.push_back(j);
+    }
+  }
+  return rows;
+}
+
+// The rows of a fixed active set at x, and ∇L = ∇f + Aᵀ z at the multipliers z (given, or fitted
+// by least squares when empty)
+ActiveSet active_set(const Program& p, const VectorXd& x, const std::vector<int>& rows,
+                     const std::vector<int>& bounds, const VectorXd* z) {
+  const int n = p.n();
+  const auto m = static_cast<Eigen::Index>(p.n_eq() + rows.size() + bounds.size());
+  ActiveSet s;
+  s.a.setZero(m, n);
+  s.c.setZero(m);
+  Eigen::Index k = 0;
+  VectorXd c;
+  MatrixXd jac;
+  if (p.n_eq() > 0) {
+    p.equalities(x, c, &jac);
+    s.a.topRows(p.n_eq()) = jac;
+    s.c.head(p.n_eq()) = c;
+    k = p.n_eq();
+  }
+  if (!rows.empty()) {
+    p.inequalities(x, c, &jac);
+    for (int i : rows) {
+      s.a.row(k) = jac.row(i);
+      s.c[k++] = c[i];
+    }
+  }
+  for (int j : bounds) {
+    s.a(k, j) = 1;
+    s.c[k++] = 0;  // held where it is
+  }
+  VectorXd g(n);
+  p.objective(x, &g);
+  if (z != nullptr) {
+    s.z = *z;
+  } else if (m == 0) {
+    s.z.resize(0);
+  } else {
+    s.z = s.a.transpose().completeOrthogonalDecomposition().solve(-g);
+  }
+  s.grad_l = g + s.a.transpose() * s.z;
+  return s;
+}
+
+}  // namespace
+
+VectorXd newton_polish(const Program& p, const VectorXd& x0, double constraint_tolerance,
+                       int steps, double activity) {
+  const int n = p.n();
+  VectorXd x = x0, best = x0;
+  double least = stationarity_residual(p, x, activity);
+  std::vector<int> bounds;
+  const std::vector<int> rows = active_rows(p, x, activity, bounds);
+  for (int step = 0; step < steps && least > 0; ++step) {
+    const ActiveSet s = active_set(p, x, rows, bounds, nullptr);
+    const auto m = s.a.rows();
+    // the Lagrangian's Hessian by central differences of its gradient at fixed multipliers
+    MatrixXd h(n, n);
+    for (int j = 0; j < n; ++j) {
+      const double w = std::isfinite(p.upper()[j] - p.lower()[j]) ? p.upper()[j] - p.lower()[j] : 1;
+      const double e = 1e-6 * std::max(w, std::abs(x[j]));
+      VectorXd plus = x, minus = x;
+      plus[j] += e;
+      minus[j] -= e;
+      h.col(j) = (active_set(p, plus, rows, bounds, &s.z).grad_l -
+                  active_set(p, minus, rows, bounds, &s.z).grad_l) / (2 * e);
+    }
+    MatrixXd kkt = MatrixXd::Zero(n + m, n + m);
+    kkt.topLeftCorner(n, n) = 0.5 * (h + h.transpose());
+    kkt.topRightCorner(n, m) = s.a.transpose();
+    kkt.bottomLeftCorner(m, n) = s.a;
+    VectorXd rhs(n + m);
+    rhs << -s.grad_l, -s.c;
+    const VectorXd d = kkt.completeOrthogonalDecomposition().solve(rhs);
+    x = (x + d.head(n)).cwiseMax(p.lower()).cwiseMin(p.upper());
+    if (!x.allFinite()) break;
+    // a step along a curved constraint leaves it violated to second order, which the next
+    // step takes back: only feasible points are kept
+    if (constraint_violation(p, x) > constraint_tolerance) continue;
+    const double r = stationarity_residual(p, x, activity);
+    if (r < least) best = x, least = r;
+  }
+  return best;
 }
 
 Optimality optimality(const std::string& why_not_convex, bool converged, double stationarity,

@@ -114,8 +114,11 @@ struct Solved {
 /// to stationarity_tolerance() (optimize/first_order.hpp) is not taken as converged: the run goes on from there, by the same
 /// algorithm once more and then by another local method (ipopt, or slsqp after ipopt), keeping
 /// each continuation that finds a design no worse; where they still do not hold, the result is
-/// Termination::kStoppedShort with the residual in the message.
-Solved solve(const Program& program, const Eigen::VectorXd& x0, const OptimizeOptions& options);
+/// Termination::kStoppedShort with the residual in the message. Without `to_first_order`, the
+/// solver's end as it is (the first-order conditions not checked: a refinement whose caller
+/// reads them itself).
+Solved solve(const Program& program, const Eigen::VectorXd& x0, const OptimizeOptions& options,
+             bool to_first_order = true);
 /// solve() from the first of `starts` that is feasible, or, when none is, from the least
 /// violated; when that finds no design, from each other start in turn, keeping the first design
 /// found (or the least violated end). Counts and times add up over the runs.

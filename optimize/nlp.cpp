@@ -47,6 +47,10 @@ Eigen::VectorXd Nlp::without_vanishing_counterweights(const Eigen::VectorXd& x,
                                                       double fraction) const {
   return at(x).without_vanishing_counterweights(x, fraction);
 }
+std::vector<int> Nlp::vanishing_counterweight_variables(const Eigen::VectorXd& x,
+                                                       double fraction) const {
+  return at(x).vanishing_counterweight_variables(x, fraction);
+}
 Eigen::VectorXd Nlp::start(bool original) const { return program_->start(original); }
 Eigen::VectorXd Nlp::start_scaled(double fraction) const {
   return program_->start_scaled(fraction);

@@ -242,13 +242,16 @@ Eigen::VectorXd NlpProgram::to_positions(const Eigen::VectorXd& x) const {
   return out;
 }
 
+std::vector<int> NlpProgram::vanishing_counterweight_variables(const Eigen::VectorXd& x,
+                                                               double fraction) const {
+  if (!moments_) return {};
+  return detail::vanishing_counterweight_variables(x, cw_var_, problem_.counterweights, fraction);
+}
+
 Eigen::VectorXd NlpProgram::without_vanishing_counterweights(const Eigen::VectorXd& x,
                                                              double fraction) const {
   Eigen::VectorXd out = x;
-  for (std::size_t c = 0; c < cw_var_.size(); ++c) {
-    const int j = cw_var_[c];
-    if (out(j) < fraction * problem_.counterweights[c].mass_max) out.segment<3>(j).setZero();
-  }
+  for (int j : vanishing_counterweight_variables(x, fraction)) out(j) = 0;
   set_relaxed_variables(out);
   return out;
 }

@@ -84,6 +84,8 @@ class NlpProgram {
   Eigen::VectorXd from_positions(const Eigen::VectorXd& x) const;
   Eigen::VectorXd to_positions(const Eigen::VectorXd& x) const;
   Eigen::VectorXd without_vanishing_counterweights(const Eigen::VectorXd& x, double fraction) const;
+  std::vector<int> vanishing_counterweight_variables(const Eigen::VectorXd& x,
+                                                     double fraction) const;
 
   // Nlp's functions of the same names; x has n() entries (Nlp checks)
   Eigen::VectorXd start(bool original = false) const;

@@ -15,6 +15,7 @@
 #include "optimize/check_inputs.hpp"
 #include "optimize/convex_solve.hpp"
 #include "optimize/first_order.hpp"
+#include "optimize/fixed_variables.hpp"
 #include "optimize/ipopt_driver.hpp"
 #include "optimize/nlopt_driver.hpp"
 #include "optimize/nlp.hpp"
@@ -367,6 +368,55 @@ std::vector<Algorithm> continuations(Algorithm a) {
   return {same, same == Algorithm::kIpopt ? Algorithm::kSlsqp : Algorithm::kIpopt};
 }
 
+// Below this fraction of its mass_max a counterweight at a gradient method's end is taken as
+// vanishing: its mass moment's direction is then round-off (the cone has no gradient at its apex)
+constexpr double kVanishingCounterweight = 1e-6;
+
+// A converged end where counterweights vanish, put on their cones' apex and solved again in the
+// other variables with those held there (FixedVariables: the rest of the problem is smooth, so a
+// few steps settle it), then checked against the whole program's first-order conditions, which at
+// the apex read the cone's subgradient and hold only if no counterweight there would help. True
+// when that design meets them; then it replaces r's. Else r keeps its design (the costs counted).
+bool settle_on_apex(const Program& nlp, const OptimizeOptions& options, double tolerance,
+                    detail::Solved& r) {
+  const std::vector<int> held_at_apex =
+      nlp.vanishing_counterweight_variables(r.x, kVanishingCounterweight);
+  if (held_at_apex.empty()) return false;
+  VectorXd x = nlp.without_vanishing_counterweights(r.x, kVanishingCounterweight);
+  nlp.polish(x);
+  double residual = detail::stationarity_residual(nlp, x);
+  if (residual > tolerance && r.evaluations < options.max_evaluations) {
+    const detail::FixedVariables held(nlp, held_at_apex, x);
+    OptimizeOptions next = options;
+    next.max_evaluations = options.max_evaluations - r.evaluations;
+    const detail::Solved s = run_once(held, held.reduce(x), next);
+    add_costs(s, r);
+    if (s.termination == Termination::kConverged) {
+      x = held.expand(s.x);
+      nlp.polish(x);
+      residual = detail::stationarity_residual(nlp, x);
+    }
+  }
+  if (!(residual <= tolerance)) return false;
+  const double f = nlp.objective(x, nullptr);
+  const double violation = detail::constraint_violation(nlp, x);
+  if (!(violation <= options.constraint_tolerance) ||
+      f > r.objective + options.relative_tolerance * std::max(std::abs(r.objective), 1.0)) {
+    return false;
+  }
+  const std::size_t count = held_at_apex.size() / 3;
+  r.message += "; the first-order conditions held to " + text::digits(r.stationarity, 2) +
+               " only where it stopped, where " + std::to_string(count) + " counterweight" +
+               (count == 1 ? "" : "s") + " vanished; with " + (count == 1 ? "it" : "them") +
+               " taken away and the rest solved again they hold to " +
+               text::digits(residual, 2);
+  r.x = x;
+  r.objective = f;
+  r.constraint_violation = violation;
+  r.stationarity = residual;
+  return true;
+}
+
 // A converged end of a gradient method checked against the first-order conditions, and
 // continued where they do not hold (nlopt_driver.hpp, solve()). Where a degenerate optimum keeps
 // the residual up (many constraints active together, as a peak's rows at a force-balanced
@@ -378,6 +428,7 @@ void ensure_first_order(const Program& nlp, const OptimizeOptions& options, deta
   const double tolerance = detail::stationarity_tolerance(options.relative_tolerance);
   r.stationarity = detail::stationarity_residual(nlp, r.x);
   if (!(r.stationarity > tolerance)) return;
+  if (settle_on_apex(nlp, options, tolerance, r)) return;
   const double first = r.stationarity, f_first = r.objective;
   std::string continued;
   int runs = 0, settled = 0;
@@ -420,7 +471,7 @@ void ensure_first_order(const Program& nlp, const OptimizeOptions& options, deta
 }  // namespace
 
 detail::Solved detail::solve(const Program& nlp, const VectorXd& x0,
-                             const OptimizeOptions& options) {
+                             const OptimizeOptions& options, bool to_first_order) {
   if (options.check_gradients && nlp.has_gradients()) {
     // a wrong derivative would mislead every gradient method: stop before solving (Ceres)
     if (std::string e = check_gradients(nlp, x0); !e.empty()) {
@@ -435,7 +486,7 @@ detail::Solved detail::solve(const Program& nlp, const VectorXd& x0,
     }
   }
   Solved r = run_once(nlp, x0, options);
-  ensure_first_order(nlp, options, r);
+  if (to_first_order) ensure_first_order(nlp, options, r);
   return r;
 }
 

@@ -1077,13 +1077,17 @@ VectorXd PlanarNlp::to_positions(const VectorXd& x) const {
   return out;
 }
 
+std::vector<int> PlanarNlp::vanishing_counterweight_variables(const VectorXd& x,
+                                                              double fraction) const {
+  if (!impl_->moments) return {};
+  return detail::vanishing_counterweight_variables(x, impl_->cw_var, impl_->p.counterweights,
+                                                   fraction);
+}
+
 VectorXd PlanarNlp::without_vanishing_counterweights(const VectorXd& x, double fraction) const {
   const Impl& m = *impl_;
   VectorXd out = x;
-  for (std::size_t c = 0; c < m.cw_var.size(); ++c) {
-    const int v = m.cw_var[c];
-    if (out[v] < fraction * m.p.counterweights[c].mass_max) out.segment<3>(v).setZero();
-  }
+  for (int j : vanishing_counterweight_variables(x, fraction)) out[j] = 0;
   for (const detail::RelaxedCounterweight& r : m.relaxed_cw) r.set_tight(out);
   return out;
 }

@@ -80,6 +80,22 @@ class Program {
   /// 0.31 x the original's, at most 0.0001 x"; empty when the program has no such words (a
   /// message then gives the scaled value).
   virtual std::string constraint_text(int /*i*/, const Eigen::VectorXd& /*x*/) const { return {}; }
+  /// In mass-moment variables (kMassMoments, kRelaxation), the variables (mass and mass moment,
+  /// three each) of the counterweights whose mass at x is below `fraction` of their mass_max: a
+  /// solver's end near a cone's apex, where the direction of a vanishing mass moment is
+  /// round-off. None in position variables, which have no apex (a counterweight without mass
+  /// has a position that changes nothing: holding it anywhere would make a false stationary
+  /// point). Default: none.
+  virtual std::vector<int> vanishing_counterweight_variables(const Eigen::VectorXd& /*x*/,
+                                                             double /*fraction*/) const {
+    return {};
+  }
+  /// x with those counterweights taken away (their variables 0, the variables that only bound
+  /// them set for it): put on the cone's apex itself. Default, and in position variables: x.
+  virtual Eigen::VectorXd without_vanishing_counterweights(const Eigen::VectorXd& x,
+                                                           double /*fraction*/) const {
+    return x;
+  }
 };
 
 }  // namespace bd::optimize
