@@ -876,21 +876,20 @@ Trajectory simulate_free(const Model& model, const FreeScene& scene,
 FreeState free_state(const Model& model, const Trajectory& run, std::size_t i) {
   const Linkage& l = model.linkage();
   const Series& table = run.table;
+  const auto value = [&](const std::string& column) {
+    return table.at(i, static_cast<std::size_t>(table.column(column)));
+  };
   FreeState out;
-  out.t = table.at(i, static_cast<std::size_t>(table.column("t")));
+  out.t = value("t");
   if (run.state_size > 0 && (i + 1) * run.state_size <= run.states.size()) {
     const auto first = run.states.begin() + static_cast<std::ptrdiff_t>(i * run.state_size);
     out.y.assign(first, first + static_cast<std::ptrdiff_t>(run.state_size));
   }
   out.angle.reserve(l.links.size());
-  for (const Link& link : l.links) {
-    out.angle.push_back(table.at(i, static_cast<std::size_t>(table.column("theta_" + link.name))));
-  }
+  for (const Link& link : l.links) out.angle.push_back(value("theta_" + link.name));
   out.x.reserve(l.nodes.size());
   for (const Node& n : l.nodes) {
-    out.x.push_back(n.ground ? n.position
-                             : Vec2(table.at(i, static_cast<std::size_t>(table.column("x_" + n.name))),
-                                    table.at(i, static_cast<std::size_t>(table.column("y_" + n.name)))));
+    out.x.push_back(n.ground ? n.position : Vec2(value("x_" + n.name), value("y_" + n.name)));
   }
   return out;
 }
@@ -898,8 +897,7 @@ FreeState free_state(const Model& model, const Trajectory& run, std::size_t i) {
 std::optional<FreeState> free_state_from(const Model& model, const SimulateOptions& options,
                                          const FreeState& from, double t, Series& row) {
   const bool dae = options.route == Route::kDae;
-  const std::size_t size =
-      2 * static_cast<std::size_t>(dae ? model.system().n : model.inputs());
+  const std::size_t size = 2 * static_cast<std::size_t>(dae ? model.system().n : model.inputs());
   const Linkage& l = model.linkage();
   if (!(t >= from.t) || from.y.size() != size || from.angle.size() != l.links.size() ||
       from.x.size() != l.nodes.size()) {
@@ -919,7 +917,8 @@ std::optional<FreeState> free_state_from(const Model& model, const SimulateOptio
       if (!reduced_state(m, from.t, from.y.data())) return std::nullopt;
       m.root_sign = normalised_determinant(ws) > 0 ? 1.0 : -1.0;
     }
-    integrators::Problem problem = free_problem(options, from.y, t, m, dae ? dae_rhs : reduced_rhs);
+    integrators::Problem problem =
+        free_problem(options, from.y, t, m, dae ? dae_rhs : reduced_rhs);
     problem.t0 = from.t;
     if (!dae) problem.root = reduced_root;
     integrators::Integration integration(problem);
