@@ -127,7 +127,8 @@ Integration::Integration(const Problem& p)
                    ? Package::kCvode
                    : Package::kArkode),
       stop_at_outputs_(p.integrator == Integrator::kErk6 || p.integrator == Integrator::kErk8),
-      max_steps_(p.max_steps) {
+      max_steps_(p.max_steps),
+      t_(p.t0) {
   assert(p.absolute_tolerance.size() == p.y0.size());
   check_setup(SUNContext_Create(nullptr, &context_), "SUNContext_Create");
   y_ = vector_of(p.y0, context_, "N_VNew_Serial");
@@ -155,7 +156,7 @@ void Integration::set_up_cvode(const Problem& p) {
   memory_ = CVodeCreate(bdf ? CV_BDF : CV_ADAMS, context_);
   check_allocated(memory_, "CVodeCreate");
   check_setup(CVodeSetErrHandlerFn(memory_, keep_error, &error_text_), "CVodeSetErrHandlerFn");
-  check_setup(CVodeInit(memory_, p.rhs, 0.0, y_), "CVodeInit");
+  check_setup(CVodeInit(memory_, p.rhs, p.t0, y_), "CVodeInit");
   check_setup(CVodeSetUserData(memory_, p.user_data), "CVodeSetUserData");
   check_setup(CVodeSVtolerances(memory_, p.tolerance, atol_), "CVodeSVtolerances");
   if (bdf) {
@@ -216,7 +217,7 @@ const double* Integration::sensitivity(int i) const {
 
 void Integration::set_up_arkode(const Problem& p) {
   assert(p.projection == nullptr);
-  memory_ = ERKStepCreate(p.rhs, 0.0, y_, context_);
+  memory_ = ERKStepCreate(p.rhs, p.t0, y_, context_);
   check_allocated(memory_, "ERKStepCreate");
   check_setup(ERKStepSetErrHandlerFn(memory_, keep_error, &error_text_), "ERKStepSetErrHandlerFn");
   check_setup(ERKStepSetUserData(memory_, p.user_data), "ERKStepSetUserData");
@@ -242,7 +243,7 @@ void Integration::set_up_ida(const Problem& p) {
   memory_ = IDACreate(context_);
   check_allocated(memory_, "IDACreate");
   check_setup(IDASetErrHandlerFn(memory_, keep_error, &error_text_), "IDASetErrHandlerFn");
-  check_setup(IDAInit(memory_, p.residual, 0.0, y_, yp_), "IDAInit");
+  check_setup(IDAInit(memory_, p.residual, p.t0, y_, yp_), "IDAInit");
   check_setup(IDASetUserData(memory_, p.user_data), "IDASetUserData");
   check_setup(IDASVtolerances(memory_, p.tolerance, atol_), "IDASVtolerances");
   // the algebraic components (multipliers) take no part in the local error test: in an

@@ -35,12 +35,15 @@ using ProjectionFn = int (*)(sunrealtype t, N_Vector y, N_Vector correction, sun
 /// F(t, y, y') of a DAE as IDA calls it; return values as RhsFn.
 using ResidualFn = int (*)(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void* user_data);
 
-/// What to integrate from t = 0 and how.
+/// What to integrate from t0 and how.
 struct Problem {
   Integrator integrator = Integrator::kCvodeAdams;
-  std::vector<double> y0;                  // initial state
+  std::vector<double> y0;                  // state at t0
   std::vector<double> absolute_tolerance;  // per component, as y0
   double tolerance = 1e-10;                // relative, all components
+  /// [s] the start: a restart of a run at one of its instants (a planar free run's peak search,
+  /// core/planar/simulate.hpp) integrates in the run's own time, which its loads depend on
+  double t0{};
   double t_end{};                          // the run never steps past it [s]
   long max_steps = 1000000;                // steps over the whole run
   void* user_data{};                       // passed to every callback
@@ -52,7 +55,7 @@ struct Problem {
   double fixed_step{};
   // kIda only
   ResidualFn residual{};
-  std::vector<double> yp0;         // y'(0), consistent with y0 (F(0, y0, yp0) = 0)
+  std::vector<double> yp0;         // y'(t0), consistent with y0 (F(t0, y0, yp0) = 0)
   std::vector<bool> differential;  // false: algebraic, excluded from the error test
   double initial_step{};           // [s]; 0: IDA's own estimate
   /// kCvodeAdams and kCvodeBdf only: CVODES' forward sensitivities s_i = dy/dp_i of the state
@@ -74,7 +77,7 @@ struct Problem {
 /// An integration in progress. Not copyable or movable (SUNDIALS keeps pointers into it).
 class Integration {
  public:
-  /// Sets the integrator up at t = 0.
+  /// Sets the integrator up at t = t0.
   /// @throws std::runtime_error naming the SUNDIALS call if the setup fails (with a problem that
   ///         core builds, only by running out of memory).
   explicit Integration(const Problem& problem);

@@ -132,7 +132,9 @@ Peak resolved_peak(std::span<const double> t, std::span<const double> x, double 
   constexpr std::size_t kMaxCandidates = 64;
   for (std::size_t k = 0; k < candidates.size() && k < kMaxCandidates; ++k) {
     const Candidate& c = candidates[k];
-    if (c.upper < best.value) break;  // sorted: none of the rest can win
+    // sorted: none of the rest can rise above the best (a quantity that is constant over its
+    // samples, such as a free scene's drive effort of 0, has no candidate to refine)
+    if (c.upper <= best.value) break;
     if (!(c.b > c.a)) continue;
     brent_maximise(f, c.a, c.b, kPeakTimeTolerance * (c.b - c.a), best);
   }

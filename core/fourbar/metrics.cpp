@@ -4,9 +4,10 @@
 #include <array>
 #include <cmath>
 #include <functional>
-#include <map>
 #include <numbers>
 #include <optional>
+
+#include "core/detail/known_instants.hpp"
 
 namespace bd::core {
 
@@ -153,29 +154,16 @@ Metrics metrics(const FourBar& model, const DrivenScene& scene, const Trajectory
 
 Metrics metrics(const FourBar& model, const Trajectory& trajectory, const SimulateOptions& options,
                 PeakList* peaks) {
-  // each instant integrated from the latest instant known before it: a sample of the run or an
-  // instant an earlier search computed (Brent's steps close in on a peak, so each integration
-  // is short), every quantity's search sharing them
-  std::map<double, DynamicsSample> known;
-  const std::vector<double>& t = trajectory.t;
+  // each instant integrated from the latest instant known before it
+  detail::KnownInstants<DynamicsSample> known(trajectory.t);
   return with_peaks(
       trajectory, 0.0,
-      [&](double s) -> std::optional<DynamicsSample> {
-        if (t.empty() || !(s >= t.front()) || !(s <= t.back())) return std::nullopt;
-        const auto i = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), s) -
-                                                t.begin()) - 1;
-        double t0 = t[i];
-        const DynamicsSample* from = &trajectory.samples[i];
-        if (auto k = known.upper_bound(s); k != known.begin()) {
-          --k;
-          if (k->first > t0) {
-            t0 = k->first;
-            from = &k->second;
-          }
-        }
-        auto r = free_sample_from(model, options, t0, *from, s);
-        if (r && s > t0) known.emplace(s, *r);
-        return r;
+      [&](double s) {
+        return known.at(
+            s, [&](std::size_t i) -> const DynamicsSample& { return trajectory.samples[i]; },
+            [&](double t0, const DynamicsSample& from, double t) {
+              return free_sample_from(model, options, t0, from, t);
+            });
       },
       peaks);
 }

@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
+#include <span>
+#include <utility>
 
+#include "core/detail/known_instants.hpp"
 #include "core/detail/sensitivity.hpp"
 
 namespace bd::core::planar {
@@ -132,32 +136,69 @@ Eigen::MatrixXd metric_gradients(const std::vector<ColumnMetric>& metrics,
   return g;
 }
 
-std::vector<Peak> sampled_peaks(const std::vector<ColumnMetric>& metrics, const Series& table) {
-  std::vector<Peak> out(metrics.size());
-  const std::vector<double> values = metric_values(metrics, table);
-  const std::vector<std::vector<int>> columns = metric_columns(metrics, table);
-  const int tc = table.column("t");
-  for (std::size_t k = 0; k < metrics.size(); ++k) {
-    out[k] = {values[k], 0.0};
-    if (metrics[k].statistic != Statistic::kMax) continue;
-    for (std::size_t i = 0; i < table.rows(); ++i) {
-      if (magnitude(columns[k], table.row(i)) == values[k]) {
-        out[k].t = tc >= 0 ? table.at(i, static_cast<std::size_t>(tc)) : 0.0;
-        break;
-      }
+namespace {
+
+// The positions of row i of a run's table, every node (ground nodes where they are drawn).
+class RowPositions {
+ public:
+  RowPositions(const Model& model, const Series& table) : nodes_(model.linkage().nodes) {
+    xy_.assign(nodes_.size(), {-1, -1});
+    for (std::size_t n = 0; n < nodes_.size(); ++n) {
+      if (!nodes_[n].ground)
+        xy_[n] = {table.column("x_" + nodes_[n].name), table.column("y_" + nodes_[n].name)};
     }
+  }
+  Vec2 at(const Series& table, std::size_t i, std::size_t n) const {
+    return nodes_[n].ground ? nodes_[n].position
+                            : Vec2(table.at(i, static_cast<std::size_t>(xy_[n].first)),
+                                   table.at(i, static_cast<std::size_t>(xy_[n].second)));
+  }
+  std::vector<Vec2> row(const Series& table, std::size_t i) const {
+    std::vector<Vec2> x(nodes_.size());
+    for (std::size_t n = 0; n < nodes_.size(); ++n) x[n] = at(table, i, n);
+    return x;
+  }
+
+ private:
+  const std::vector<Node>& nodes_;
+  std::vector<std::pair<int, int>> xy_;
+};
+
+// The metrics over the run's table (sample times t), every peak resolved between the samples by
+// `row_at(s)`: the whole row at time s, or null where it cannot be evaluated.
+template <class RowAt>
+std::vector<double> resolved_values(const std::vector<ColumnMetric>& metrics, const Series& table,
+                                    const std::vector<double>& t, double period,
+                                    const RowAt& row_at, std::vector<Peak>* peaks) {
+  std::vector<double> out = metric_values(metrics, table);
+  if (peaks) peaks->assign(metrics.size(), Peak{});
+  const std::size_t rows = table.rows();
+  if (rows == 0) return out;
+  const std::vector<std::vector<int>> columns = metric_columns(metrics, table);
+  std::vector<double> x(rows);
+  for (std::size_t k = 0; k < metrics.size(); ++k) {
+    if (metrics[k].statistic != Statistic::kMax) {
+      if (peaks) (*peaks)[k] = {out[k], 0.0};
+      continue;
+    }
+    for (std::size_t i = 0; i < rows; ++i) x[i] = magnitude(columns[k], table.row(i));
+    const Peak p = resolved_peak(t, x, period, [&](double s) {
+      const double* row = row_at(s);
+      return row ? magnitude(columns[k], {row, table.width()}) : std::nan("");
+    });
+    out[k] = p.value;
+    if (peaks) (*peaks)[k] = p;
   }
   return out;
 }
 
+}  // namespace
+
 std::vector<double> metric_values(const Model& model, const DrivenScene& scene,
                                   const std::vector<ColumnMetric>& metrics, const Trajectory& run,
                                   std::vector<Peak>* peaks) {
-  std::vector<double> out = metric_values(metrics, run.table);
-  if (peaks) peaks->assign(metrics.size(), Peak{});
   const Series& table = run.table;
   const std::size_t rows = table.rows();
-  if (rows == 0) return out;
   const Linkage& l = model.linkage();
   const std::vector<double> t = table.column_values("t");
   const std::vector<double> start = scene.start.empty() ? drawn_inputs(model) : scene.start;
@@ -171,62 +212,85 @@ std::vector<double> metric_values(const Model& model, const DrivenScene& scene,
       period = 2 * std::numbers::pi / std::abs(scene.speeds[k]) * scene.revolutions;
   }
   if (moving != 1 || scene.duration > 0 || !run.ok()) period = 0;
-  // the positions of row i, every node (the guess of a position solve)
-  std::vector<std::pair<int, int>> xy(l.nodes.size(), {-1, -1});
-  for (std::size_t n = 0; n < l.nodes.size(); ++n) {
-    if (!l.nodes[n].ground)
-      xy[n] = {table.column("x_" + l.nodes[n].name), table.column("y_" + l.nodes[n].name)};
-  }
-  auto positions = [&](std::size_t i) {
-    std::vector<Vec2> x(l.nodes.size());
-    for (std::size_t n = 0; n < l.nodes.size(); ++n) {
-      x[n] = l.nodes[n].ground ? l.nodes[n].position
-                               : Vec2(table.at(i, static_cast<std::size_t>(xy[n].first)),
-                                      table.at(i, static_cast<std::size_t>(xy[n].second)));
-    }
-    return x;
-  };
+  const RowPositions positions(model, table);
   Workspace ws(model);
   Series row;
   row.columns = table.columns;
   std::vector<double> z(start.size());
   const std::vector<double> zero(start.size(), 0.0);
-  const std::vector<std::vector<int>> columns = metric_columns(metrics, table);
   const double h = rows > 1 ? t[1] - t[0] : 0.0;
-  // the whole row at time s, by the inverse dynamics from the nearest sample's positions; empty
+  // the whole row at time s, by the inverse dynamics from the nearest sample's positions; none
   // where it cannot be evaluated or lands away from the samples' branch
   double cached_t = std::nan("");
-  auto row_at = [&](double s) -> bool {
-    if (s == cached_t) return !row.values.empty();
-    cached_t = s;
-    row.values.clear();
-    const double u = period > 0 ? std::fmod(s - t[0] + period, period) + t[0] : s;
-    const auto i = static_cast<std::size_t>(
-        std::clamp(std::round((u - t[0]) / (h > 0 ? h : 1.0)), 0.0, static_cast<double>(rows - 1)));
-    const std::vector<Vec2> guess = positions(i);
-    for (std::size_t k = 0; k < z.size(); ++k) z[k] = start[k] + scene.speeds[k] * s;
-    if (!solve_position(model, ws, guess, z)) return false;
-    for (std::size_t n = 0; n < guess.size(); ++n) {
-      if ((ws.instant.x[n] - guess[n]).norm() > 0.25 * model.length_scale()) return false;
+  auto row_at = [&](double s) -> const double* {
+    if (s != cached_t) {
+      cached_t = s;
+      row.values.clear();
+      const double u = period > 0 ? std::fmod(s - t[0] + period, period) + t[0] : s;
+      const auto i = static_cast<std::size_t>(std::clamp(
+          std::round((u - t[0]) / (h > 0 ? h : 1.0)), 0.0, static_cast<double>(rows - 1)));
+      const std::vector<Vec2> guess = positions.row(table, i);
+      for (std::size_t k = 0; k < z.size(); ++k) z[k] = start[k] + scene.speeds[k] * s;
+      if (!solve_position(model, ws, guess, z)) return nullptr;
+      for (std::size_t n = 0; n < guess.size(); ++n) {
+        if ((ws.instant.x[n] - guess[n]).norm() > 0.25 * model.length_scale()) return nullptr;
+      }
+      if (!inverse_dynamics(model, ws, s, scene.speeds, zero)) return nullptr;
+      append_row(model, ws.instant, row);
     }
-    if (!inverse_dynamics(model, ws, s, scene.speeds, zero)) return false;
-    append_row(model, ws.instant, row);
-    return true;
+    return row.values.empty() ? nullptr : row.values.data();
   };
-  for (std::size_t k = 0; k < metrics.size(); ++k) {
-    if (metrics[k].statistic != Statistic::kMax) {
-      if (peaks) (*peaks)[k] = {out[k], 0.0};
-      continue;
+  return resolved_values(metrics, table, t, period, row_at, peaks);
+}
+
+std::vector<double> metric_values(const Model& model, const SimulateOptions& options,
+                                  const std::vector<ColumnMetric>& metrics, const Trajectory& run,
+                                  std::vector<Peak>* peaks) {
+  const Series& table = run.table;
+  const std::vector<double> t = table.column_values("t");
+  const RowPositions positions(model, table);
+  const double reach = 0.25 * model.length_scale();
+  // a known instant: the run's state there and its row
+  struct Known {
+    FreeState state;
+    std::vector<double> row;
+  };
+  core::detail::KnownInstants<Known> known(t);
+  const auto sample = [&](std::size_t i) {
+    const std::span<const double> r = table.row(i);
+    return Known{free_state(model, run, i), std::vector<double>(r.begin(), r.end())};
+  };
+  Series row;
+  row.columns = table.columns;
+  // the run continued from `from` at t0 to s; none where it cannot be, or where it lands on
+  // another assembly than the run's: a node further from where the samples around s have it
+  // than a quarter of the linkage's size beyond the samples' own step
+  const auto integrate = [&](double t0, const Known& from, double s) -> std::optional<Known> {
+    if (s == t0) return from;
+    row.values.clear();
+    std::optional<FreeState> state = free_state_from(model, options, from.state, s, row);
+    if (!state) return std::nullopt;
+    const auto i =
+        static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), s) - t.begin()) - 1;
+    const std::size_t j = std::min(i + 1, t.size() - 1);
+    for (std::size_t n = 0; n < state->x.size(); ++n) {
+      const Vec2 a = positions.at(table, i, n), b = positions.at(table, j, n);
+      const double off = std::min((state->x[n] - a).norm(), (state->x[n] - b).norm());
+      if (off > reach + (b - a).norm()) return std::nullopt;
     }
-    std::vector<double> x(rows);
-    for (std::size_t i = 0; i < rows; ++i) x[i] = magnitude(columns[k], table.row(i));
-    const Peak p = resolved_peak(t, x, period, [&](double s) {
-      return row_at(s) ? magnitude(columns[k], row.row(0)) : std::nan("");
-    });
-    out[k] = p.value;
-    if (peaks) (*peaks)[k] = p;
-  }
-  return out;
+    return Known{std::move(*state), row.values};
+  };
+  // the instant row_at() gave last, for the next quantity's search
+  double last_t = std::nan("");
+  std::optional<Known> last;
+  const auto row_at = [&](double s) -> const double* {
+    if (s != last_t) {
+      last_t = s;
+      last = known.at(s, sample, integrate);
+    }
+    return last ? last->row.data() : nullptr;
+  };
+  return resolved_values(metrics, table, t, 0.0, row_at, peaks);
 }
 
 }  // namespace bd::core::planar

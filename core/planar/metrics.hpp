@@ -30,11 +30,9 @@ struct ColumnMetric {
 std::vector<ColumnMetric> metric_table(const Model& model);
 
 /// The table's values over the rows of `table` (0 for a table without rows): peaks are the
-/// largest samples.
+/// largest samples (the optimiser's objectives, for speed; a run's reported metrics resolve
+/// them, below).
 std::vector<double> metric_values(const std::vector<ColumnMetric>& metrics, const Series& table);
-
-/// Where each metric's largest sample lies (RMS rows: their value and t = 0).
-std::vector<Peak> sampled_peaks(const std::vector<ColumnMetric>& metrics, const Series& table);
 
 /// The table's values over a driven run of `model` in `scene` (the run's samples in
 /// `run.table`), with every peak resolved between the samples: maximised over time by the exact
@@ -43,6 +41,18 @@ std::vector<Peak> sampled_peaks(const std::vector<ColumnMetric>& metrics, const 
 /// neighbour is the first); any other run is resolved within its time span. `peaks`, when given,
 /// receives per metric where its peak lies (RMS rows: the value and t = 0).
 std::vector<double> metric_values(const Model& model, const DrivenScene& scene,
+                                  const std::vector<ColumnMetric>& metrics, const Trajectory& run,
+                                  std::vector<Peak>* peaks = nullptr);
+
+/// The table's values over a free run `run` = simulate_free(model, scene, options), with every
+/// peak resolved between the samples: maximised over time by the run continued to each instant
+/// by its own route, integrator and tolerances (free_state_from(), core/planar/simulate.hpp),
+/// from the latest instant known before it (a sample, or an instant an earlier step of any
+/// quantity's search computed), so that it no longer depends on the sample count. An instant
+/// the integration cannot reach, or where a node lies away from where the samples around it
+/// have it (another assembly), is skipped: the peak is then never below the largest sample.
+/// `peaks` as above. A run without states (Trajectory::states) keeps its largest samples.
+std::vector<double> metric_values(const Model& model, const SimulateOptions& options,
                                   const std::vector<ColumnMetric>& metrics, const Trajectory& run,
                                   std::vector<Peak>* peaks = nullptr);
 

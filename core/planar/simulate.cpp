@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <utility>
 
 #include "core/detail/sensitivity.hpp"
@@ -599,11 +600,14 @@ integrators::Problem free_problem(const SimulateOptions& options, const std::vec
   return problem;
 }
 
-// a trajectory with the model's columns and room for the scene's samples
-Trajectory empty_table(const Model& model, const FreeScene& scene) {
+// a trajectory with the model's columns, `state_size` numbers of state per sample, and room for
+// the scene's samples
+Trajectory empty_table(const Model& model, const FreeScene& scene, std::size_t state_size) {
   Trajectory out;
   out.table.columns = columns(model);
   out.table.values.reserve(static_cast<std::size_t>(scene.samples) * out.table.width());
+  out.state_size = state_size;
+  out.states.reserve(static_cast<std::size_t>(scene.samples) * state_size);
   return out;
 }
 
@@ -644,6 +648,7 @@ void sample_run(const Model& model, Motion& m, integrators::Integration& integra
       break;
     }
     append_row(model, m.ws->instant, out.table);
+    out.states.insert(out.states.end(), integration.y(), integration.y() + out.state_size);
   }
   out.steps = integration.steps();
   out.rhs_evaluations = m.evaluations;
@@ -713,7 +718,7 @@ Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scen
                         const std::vector<double>& start, const std::vector<double>& rates,
                         const SimulateOptions& options, StateSensitivities* sens) {
   const int dof = model.inputs();
-  Trajectory out = empty_table(model, scene);
+  Trajectory out = empty_table(model, scene, 2 * static_cast<std::size_t>(dof));
   Motion m = motion(model, ws, Route::kReduced, options);
   m.cache = ws.instant.x;
   std::vector<double> y0 = start;
@@ -747,6 +752,7 @@ Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scen
   }
   m.root_sign = normalised_determinant(ws) > 0 ? 1.0 : -1.0;
   append_row(model, ws.instant, out.table);
+  out.states.insert(out.states.end(), y0.begin(), y0.end());
 
   integrators::Problem problem = free_problem(options, y0, scene.duration, m, reduced_rhs);
   problem.root = reduced_root;
@@ -778,7 +784,7 @@ Trajectory free_dae(const Model& model, Workspace& ws, const FreeScene& scene,
                     const std::vector<double>& start, const std::vector<double>& rates,
                     const SimulateOptions& options) {
   const System& s = model.system();
-  Trajectory out = empty_table(model, scene);
+  Trajectory out = empty_table(model, scene, 2 * static_cast<std::size_t>(s.n));
   Motion m = motion(model, ws, Route::kDae, options);
   // the start: positions assembled, velocities from the inputs' rates
   if (auto ok = inverse_dynamics(model, ws, 0.0, rates, std::vector<double>(rates.size(), 0.0));
@@ -799,6 +805,7 @@ Trajectory free_dae(const Model& model, Workspace& ws, const FreeScene& scene,
     return out;
   }
   append_row(model, ws.instant, out.table);
+  out.states.insert(out.states.end(), y0.begin(), y0.end());
 
   const integrators::Problem problem = free_problem(options, y0, scene.duration, m, dae_rhs);
   integrators::Integration integration(problem);
@@ -864,6 +871,76 @@ Trajectory simulate_free(const Model& model, const FreeScene& scene,
   return options.route == Route::kDae
              ? free_dae(model, ws, scene, start, rates, options)
              : free_reduced(model, ws, scene, start, rates, options, nullptr);
+}
+
+FreeState free_state(const Model& model, const Trajectory& run, std::size_t i) {
+  const Linkage& l = model.linkage();
+  const Series& table = run.table;
+  const auto value = [&](const std::string& column) {
+    return table.at(i, static_cast<std::size_t>(table.column(column)));
+  };
+  FreeState out;
+  out.t = value("t");
+  if (run.state_size > 0 && (i + 1) * run.state_size <= run.states.size()) {
+    const auto first = run.states.begin() + static_cast<std::ptrdiff_t>(i * run.state_size);
+    out.y.assign(first, first + static_cast<std::ptrdiff_t>(run.state_size));
+  }
+  out.angle.reserve(l.links.size());
+  for (const Link& link : l.links) out.angle.push_back(value("theta_" + link.name));
+  out.x.reserve(l.nodes.size());
+  for (const Node& n : l.nodes) {
+    out.x.push_back(n.ground ? n.position : Vec2(value("x_" + n.name), value("y_" + n.name)));
+  }
+  return out;
+}
+
+std::optional<FreeState> free_state_from(const Model& model, const SimulateOptions& options,
+                                         const FreeState& from, double t, Series& row) {
+  const bool dae = options.route == Route::kDae;
+  const std::size_t size = 2 * static_cast<std::size_t>(dae ? model.system().n : model.inputs());
+  const Linkage& l = model.linkage();
+  if (!(t >= from.t) || from.y.size() != size || from.angle.size() != l.links.size() ||
+      from.x.size() != l.nodes.size()) {
+    return std::nullopt;
+  }
+  Workspace ws(model);
+  Motion m = motion(model, ws, options.route, options);
+  // the angles and positions continue from the state's (every evaluation continues the last)
+  ws.instant.angle = from.angle;
+  ws.instant.x = from.x;
+  m.cache = from.x;
+  FreeState out{t, from.y, {}, {}};
+  if (t > from.t) {
+    if (!dae) {
+      // the side of the limit determinant the run keeps, as the run takes it at its start
+      ++m.evaluations;
+      if (!reduced_state(m, from.t, from.y.data())) return std::nullopt;
+      m.root_sign = normalised_determinant(ws) > 0 ? 1.0 : -1.0;
+    }
+    integrators::Problem problem =
+        free_problem(options, from.y, t, m, dae ? dae_rhs : reduced_rhs);
+    problem.t0 = from.t;
+    if (!dae) problem.root = reduced_root;
+    integrators::Integration integration(problem);
+    if (integration.advance(t, true) != integrators::Integration::Outcome::kReached) {
+      return std::nullopt;
+    }
+    out.y.assign(integration.y(), integration.y() + size);
+  }
+  // the instant at t as the run evaluates a sample; the angles continue the last evaluation's,
+  // which lies within a step before t (the integration stops there)
+  if (dae) {
+    std::vector<double> y = out.y;
+    project(model, ws, y.data());
+    if (!dae_instant(m, t, y.data())) return std::nullopt;
+  } else if (const std::vector<double> last = ws.instant.angle;
+             !reduced_sample(m, t, out.y.data(), last)) {
+    return std::nullopt;
+  }
+  append_row(model, ws.instant, row);
+  out.angle = ws.instant.angle;
+  out.x = ws.instant.x;
+  return out;
 }
 
 FreeSensitivities simulate_free_sensitivities(const Model& model, const FreeScene& scene,

@@ -13,6 +13,7 @@
 ///   constraints' saddle-point system with Baumgarte stabilisation, every output sample projected
 ///   onto the constraints. It passes through limit positions, as the mechanism does; it stops
 ///   only where the constraints themselves lose rank (a lock-up or bifurcation).
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,15 @@ struct Trajectory {
   SimulationStatus status = SimulationStatus::kNotRun;
   std::string message = "simulate was not called";
   long steps{}, rhs_evaluations{};
+  /// A free run's integrator state at each sample, `state_size` numbers per row of `table`: the
+  /// inputs and their rates (z, ż) on the reduced route, every node coordinate and its rate
+  /// (q, q̇) on the dae route, as integrated (before the sample's projection). Empty for a driven
+  /// run. Kept beside the table, not as columns (the files' columns do not change), so that the
+  /// run can be continued from any sample exactly (free_state()): the table's inputs and their
+  /// rates would restart the reduced route, but not the dae route, whose node velocities near a
+  /// limit position the inputs' rates do not determine.
+  std::vector<double> states;
+  std::size_t state_size{};
   bool ok() const { return status == SimulationStatus::kCompleted; }
 };
 
@@ -95,6 +105,30 @@ void append_row(const Model& model, const Instant& in, Series& table);
 Trajectory simulate_driven(const Model& model, const DrivenScene& scene);
 Trajectory simulate_free(const Model& model, const FreeScene& scene,
                          const SimulateOptions& options = {});
+
+/// A free run's state at one instant: what its integration continues from.
+struct FreeState {
+  double t{};                 // [s]
+  std::vector<double> y;      // the integrator's state (Trajectory::states)
+  std::vector<double> angle;  // every link's angle, continuous in time [rad]
+  std::vector<Vec2> x;        // every node's position [m] (the reduced route's first guess)
+};
+
+/// The state at sample i < run.table.rows() of the free run `run` (its states, and its row's
+/// angles and positions); y is empty where the run kept no states.
+FreeState free_state(const Model& model, const Trajectory& run, std::size_t i);
+
+/// The free motion continued from `from` (a sample of a run, free_state(), or an instant computed
+/// so) to t >= from.t by the route, integrator and tolerances of `options` (the run's own), in
+/// one integration in the run's time (the drives' efforts depend on it) whose last step ends at
+/// t; the instant there evaluated as the run evaluates its samples (the dae route's projected
+/// onto the constraints) and appended to `row` as a row of columns(model). Exact to the
+/// integration tolerance, as the run's samples are; the state at t is returned for a later
+/// continuation. None where the state does not fit the route, the integration fails, or the
+/// reduced route reaches a limit position. Used to locate a free run's peaks between its samples
+/// (core/planar/metrics.hpp).
+std::optional<FreeState> free_state_from(const Model& model, const SimulateOptions& options,
+                                         const FreeState& from, double t, Series& row);
 
 /// A free run with the first derivatives of its samples with respect to mass parameters.
 struct FreeSensitivities {

@@ -27,17 +27,24 @@ core::Trajectory closed_form(const Study& study, const MethodChoice& method,
   return core::simulate_driven(study.fourbar(), std::get<core::DrivenScene>(study.scene), options);
 }
 
-core::planar::Trajectory general_engine(const core::planar::Model& model, const Scene& scene,
-                                        const MethodChoice& method, const Tolerances& tolerances) {
-  if (const auto* driven = std::get_if<core::planar::DrivenScene>(&scene)) {
-    return core::planar::simulate_driven(model, *driven);
-  }
+// how the general engine integrates a free scene by the method, at the tolerances
+core::planar::SimulateOptions free_options(const MethodChoice& method,
+                                           const Tolerances& tolerances) {
   core::planar::SimulateOptions options;
   options.route = method.route();
   options.integrator = method.integrator;
   options.tolerance = tolerances.relative;
   options.absolute_tolerance = tolerances.absolute;
-  return core::planar::simulate_free(model, std::get<core::planar::FreeScene>(scene), options);
+  return options;
+}
+
+core::planar::Trajectory general_engine(const core::planar::Model& model, const Scene& scene,
+                                        const MethodChoice& method, const Tolerances& tolerances) {
+  if (const auto* driven = std::get_if<core::planar::DrivenScene>(&scene)) {
+    return core::planar::simulate_driven(model, *driven);
+  }
+  return core::planar::simulate_free(model, std::get<core::planar::FreeScene>(scene),
+                                     free_options(method, tolerances));
 }
 
 // a four-bar scene as the general engine's: the crank the one input
@@ -105,6 +112,7 @@ void stop_at_non_finite(core::planar::Trajectory& r) {
       r.message = non_finite_message(t, "", table.columns[k], v);
       r.status = core::SimulationStatus::kIntegratorFailed;
       table.values.resize(i * width);
+      r.states.resize(std::min(r.states.size(), i * r.state_size));
       return;
     }
   }
@@ -250,8 +258,10 @@ MetricList metric_list(const Study& study, const Simulation& simulation) {
   if (const auto* driven = std::get_if<core::planar::DrivenScene>(&study.scene)) {
     values = core::planar::metric_values(model, *driven, table, simulation.planar, &peaks);
   } else {
-    values = core::planar::metric_values(table, simulation.planar.table);
-    peaks = core::planar::sampled_peaks(table, simulation.planar.table);
+    // the run continued between its samples as it was integrated
+    values = core::planar::metric_values(
+        model, free_options(simulation.method, simulation.tolerances), table, simulation.planar,
+        &peaks);
   }
   MetricList list;
   for (std::size_t k = 0; k < table.size(); ++k) {

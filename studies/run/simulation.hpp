@@ -74,7 +74,9 @@ Simulation simulate(const Study& study, const MethodChoice& method, const Tolera
 /// every peak is resolved between the samples by the exact inverse dynamics (core/peaks.hpp; a
 /// four-bar's by its closed form, the mass matrix's when the run took the general engine); in a
 /// four-bar's free scene by the state integrated from the sample before each instant
-/// (core::free_sample_from()); in a planar linkage's free scene a peak is the largest sample.
+/// (core::free_sample_from()); in a planar linkage's free scene by the run continued from its
+/// state at the latest known instant before each instant, on its route
+/// (core::planar::free_state_from()).
 MetricList metric_list(const Study& study, const Simulation& simulation);
 /// A four-bar's run's metrics, as metric_list() computes them, with where their peaks lie.
 core::Metrics fourbar_metrics(const Study& study, const Simulation& simulation,

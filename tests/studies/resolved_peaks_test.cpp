@@ -8,12 +8,15 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
+#include <variant>
 #include <vector>
 
 #include "core/fourbar/dynamics.hpp"
 #include "core/fourbar/metrics.hpp"
 #include "core/fourbar/samples.hpp"
 #include "core/fourbar/simulate.hpp"
+#include "core/planar/from_fourbar.hpp"
 #include "core/planar/metrics.hpp"
 #include "core/planar/simulate.hpp"
 #include "core/peaks.hpp"
@@ -100,6 +103,19 @@ TEST(ResolvedPeaks, FourBarDrivenPeaksMatchA100000SampleBruteForce) {
   }
 }
 
+// a planar metric's magnitude in every row of a table
+std::vector<double> magnitudes(const core::Series& table, const cp::ColumnMetric& metric) {
+  std::vector<int> c;
+  for (const std::string& name : metric.columns) c.push_back(table.column(name));
+  std::vector<double> x(table.rows());
+  for (std::size_t j = 0; j < x.size(); ++j) {
+    const double a = table.at(j, static_cast<std::size_t>(c[0]));
+    const double b = c.size() > 1 ? table.at(j, static_cast<std::size_t>(c[1])) : 0.0;
+    x[j] = std::hypot(a, b);
+  }
+  return x;
+}
+
 TEST(ResolvedPeaks, PlanarDrivenPeaksMatchA100000SampleBruteForce) {
   Rng rng(160);
   for (int trial = 0; trial < 3; ++trial) {
@@ -122,14 +138,7 @@ TEST(ResolvedPeaks, PlanarDrivenPeaksMatchA100000SampleBruteForce) {
     const double period = 2 * std::numbers::pi / std::abs(scene.speeds[0]);
     for (std::size_t k = 0; k < table.size(); ++k) {
       if (table[k].statistic != core::Statistic::kMax) continue;
-      std::vector<int> c;
-      for (const std::string& name : table[k].columns) c.push_back(fine.table.column(name));
-      std::vector<double> x(fine.table.rows());
-      for (std::size_t j = 0; j < x.size(); ++j) {
-        const double a = fine.table.at(j, static_cast<std::size_t>(c[0]));
-        const double bb = c.size() > 1 ? fine.table.at(j, static_cast<std::size_t>(c[1])) : 0.0;
-        x[j] = std::hypot(a, bb);
-      }
+      const std::vector<double> x = magnitudes(fine.table, table[k]);
       const Brute b = parabola_peak(x, period / kBrute);
       // a peak of round-off (a force that vanishes) has no place to be found
       const double scale = b.value + 1e-9 * resolved[0];
@@ -230,6 +239,68 @@ TEST(ResolvedPeaks, FourBarFreePeaksMatchA100000SampleRun) {
   }
 }
 
+// A planar linkage's free run's peaks, located between 41 samples by continuing the run from the
+// latest known instant before each instant (core::planar::free_state_from()), against a separate
+// run of 100 001 samples refined by the parabola, as the four-bar's above (both at a tolerance
+// of 1e-12). Three runs: the paper four-bar drawn as a planar linkage swinging under gravity
+// (reduced route); the same driven by a harmonic motor torque, which depends on time, so that
+// each restart must integrate in the run's own time (from t0, not from 0); and the triple rocker
+// on the dae route, which passes its limit positions inside the 8 s (its crank reverses).
+TEST(ResolvedPeaks, PlanarFreePeaksMatchA100000SampleRun) {
+  for (int variant = 0; variant < 3; ++variant) {
+    const core::FourBar fb =
+        variant == 2 ? core::samples::triple_rocker() : core::samples::paper_fourbar();
+    cp::Linkage l = cp::linkage_of(fb, variant == 2 ? 0.0 : 0.3);
+    if (variant < 2) l.loads.gravity = Vec2(0, -9.81);
+    if (variant == 1) l.inputs[0].effort = testing::planar::harmonic(0.0, 40.0, 1.3, 0.4);
+    l = cp::make_linkage(l);
+    const cp::Model model(l);
+    cp::SimulateOptions options;
+    options.route = variant == 2 ? cp::Route::kDae : cp::Route::kReduced;
+    options.tolerance = 1e-12;
+    options.absolute_tolerance = 1e-14;
+    cp::FreeScene scene;
+    scene.rates = {variant == 2 ? 1.0 : 2.0};
+    scene.duration = variant == 2 ? 8.0 : 2.0;
+    scene.samples = 41;
+    const cp::Trajectory coarse = cp::simulate_free(model, scene, options);
+    ASSERT_TRUE(coarse.ok()) << coarse.message;
+    const std::vector<cp::ColumnMetric> table = cp::metric_table(model);
+    std::vector<core::Peak> peaks;
+    const std::vector<double> resolved = cp::metric_values(model, options, table, coarse, &peaks);
+    const std::vector<double> sampled = cp::metric_values(table, coarse.table);
+    cp::FreeScene fine_scene = scene;
+    fine_scene.samples = kBrute + 1;
+    const cp::Trajectory fine = cp::simulate_free(model, fine_scene, options);
+    ASSERT_TRUE(fine.ok()) << fine.message;
+    if (variant == 2) {
+      // the crank reverses inside the run: it passes a limit position
+      const std::vector<double> omega = fine.table.column_values("omega_crank");
+      ASSERT_LT(*std::min_element(omega.begin(), omega.end()) *
+                    *std::max_element(omega.begin(), omega.end()),
+                0.0);
+    }
+    const double h = scene.duration / kBrute;
+    bool coarse_was_short = false;
+    for (std::size_t k = 0; k < table.size(); ++k) {
+      if (table[k].statistic != core::Statistic::kMax) continue;
+      const std::vector<double> x = magnitudes(fine.table, table[k]);
+      if (x[0] == 0.0 && *std::max_element(x.begin(), x.end()) == 0.0) continue;  // no drive
+      const Brute b = open_parabola_peak(x, h);
+      EXPECT_NEAR(resolved[k], b.value, 1e-9 * b.value) << table[k].name << " variant " << variant;
+      EXPECT_GE(resolved[k], sampled[k]) << table[k].name << " variant " << variant;
+      // where: an instant where the fine run reaches the peak (the nearest fine sample is within
+      // h/2, below the peak by ~x'' h² / 8, ~1e-9 of it)
+      const auto j = static_cast<std::size_t>(std::lround(peaks[k].t / h));
+      ASSERT_LT(j, x.size()) << table[k].name;
+      EXPECT_NEAR(x[j], b.value, 1e-7 * b.value) << table[k].name << " variant " << variant;
+      if (resolved[k] - sampled[k] > 1e-6 * resolved[k]) coarse_was_short = true;
+    }
+    // 41 samples fall short of the peaks: the refinement is what closes the gap
+    EXPECT_TRUE(coarse_was_short) << "variant " << variant;
+  }
+}
+
 // a study: summary.json's peaks come with where they are, and the sample count no longer
 // decides them
 TEST(ResolvedPeaks, StudyPeaksDoNotDependOnTheSampleCount) {
@@ -253,6 +324,41 @@ TEST(ResolvedPeaks, StudyPeaksDoNotDependOnTheSampleCount) {
     } else {
       EXPECT_FALSE(a[k].t) << a[k].name;
     }
+  }
+}
+
+// a planar free study, on either route: its reported peaks (metric_list, the run's own route,
+// integrator and tolerance) do not depend on the sample count. At a tolerance of 1e-12 the two
+// runs' integrations agree to ~1e-11 of the values; their largest samples do not.
+TEST(ResolvedPeaks, PlanarFreeStudyPeaksDoNotDependOnTheSampleCount) {
+  for (const studies::Method method : {studies::Method::kTruss, studies::Method::kTrussDae}) {
+    std::vector<double> sampled[2];
+    auto run = [&](int samples, std::vector<double>& largest) {
+      studies::Study study =
+          studies::load_study(BD_SOURCE_DIR "/studies/examples/stephenson-sixbar-free.yaml");
+      study.method = method;
+      study.tolerance = 1e-12;
+      std::get<cp::FreeScene>(study.scene).samples = samples;
+      const studies::RunResult r = studies::compute_study(study);
+      EXPECT_TRUE(r.ok());
+      largest = cp::metric_values(cp::metric_table(cp::Model(study.planar())), r.planar.table);
+      return r.metric_list;
+    };
+    const studies::MetricList a = run(61, sampled[0]), b = run(601, sampled[1]);
+    ASSERT_EQ(a.size(), b.size());
+    bool samples_decided = false;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      if (!a[k].name.ends_with("_max")) continue;
+      if (std::abs(sampled[0][k] - sampled[1][k]) > 1e-6 * b[k].value) samples_decided = true;
+      EXPECT_NEAR(a[k].value, b[k].value, 1e-9 * b[k].value)
+          << a[k].name << " " << studies::to_string(method);
+      ASSERT_TRUE(a[k].t && b[k].t) << a[k].name;
+      if (!a[k].name.starts_with("tau")) {  // a constant torque is largest everywhere
+        EXPECT_NEAR(*a[k].t, *b[k].t, 1e-4) << a[k].name << " " << studies::to_string(method);
+      }
+    }
+    // the largest samples of the two runs differ: the resolution is what makes them agree
+    EXPECT_TRUE(samples_decided) << studies::to_string(method);
   }
 }
 
