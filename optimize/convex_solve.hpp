@@ -90,7 +90,7 @@ struct TightBound {
   double value = std::numeric_limits<double>::quiet_NaN();
   Eigen::VectorXd better;
   double objective = std::numeric_limits<double>::quiet_NaN();  // at `better`
-  Algorithm by = Algorithm::kSlsqp;                               // the run that reached it
+  std::string by;  // the refinement that reached it, in words ("slsqp", "ipopt", ...)
 };
 
 /// The best Lagrangian bound (first_order()) of a convex program near x. The bound is as tight as
@@ -121,7 +121,7 @@ TightBound tight_bound(const Nlp& program, const Eigen::VectorXd& x,
   tight.relative_tolerance = 1e-14;
   tight.check_gradients = false;
   const double f = program.objective(x, nullptr), close = 1e-7 * std::max(std::abs(f), 1.0);
-  const auto keep = [&](const Solved& refined, Algorithm by) {
+  const auto keep = [&](const Solved& refined, const std::string& by) {
     if (!found_design(refined.termination) ||
         !(refined.constraint_violation <= options.constraint_tolerance)) {
       return;
@@ -156,7 +156,10 @@ TightBound tight_bound(const Nlp& program, const Eigen::VectorXd& x,
     if (polished.x.size() == x.size()) {
       polished.objective = program.objective(polished.x, nullptr);
       polished.constraint_violation = constraint_violation(program, polished.x);
-      keep(polished, Algorithm::kSlsqp);
+      keep(polished, held_at_apex.empty()
+                           ? "Newton steps on the active set"
+                           : "slsqp with the vanishing counterweights held on the apex, then "
+                             "Newton steps on the active set");
       bound = std::max(bound, first_order(program, polished.x).lower_bound);
     }
   }
@@ -164,7 +167,7 @@ TightBound tight_bound(const Nlp& program, const Eigen::VectorXd& x,
   for (int run = 0; run < 3 && open(); ++run) {
     const Solved refined = solve(program, at, tight);
     if (refined.x.size() != x.size()) break;
-    keep(refined, Algorithm::kSlsqp);
+    keep(refined, "slsqp");
     const double next = first_order(program, refined.x).lower_bound;
     const bool gained = next > bound + 1e-12 * std::max(std::abs(bound), 1.0);
     bound = std::max(bound, next);
@@ -176,7 +179,7 @@ TightBound tight_bound(const Nlp& program, const Eigen::VectorXd& x,
     tight.relative_tolerance = 1e-10;
     const Solved refined = solve(program, x, tight);
     if (refined.x.size() == x.size()) {
-      keep(refined, Algorithm::kIpopt);
+      keep(refined, "ipopt");
       bound = std::max(bound, first_order(program, refined.x).lower_bound);
     }
   }
@@ -270,7 +273,7 @@ ConvexAwareSolve solve_convex_aware(const Nlp& nlp, const Problem& problem,
       const double f = nlp.objective(x, nullptr);
       if (f < solved.objective && constraint_violation(nlp, x) <= options.constraint_tolerance) {
         const double residual = first_order(*convex, convex->from_positions(x)).residual;
-        solved.message += "; the lower bound's refinement (" + std::string(to_string(tight.by)) +
+        solved.message += "; the lower bound's refinement (" + tight.by +
                           " on the convex problem) went on to a design " +
                           text::digits(solved.objective - f, 2) +
                           " lower in the objective, which is returned";
