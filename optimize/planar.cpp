@@ -218,7 +218,7 @@ struct PlanarNlp::Impl {
   };
   std::vector<Row> rows;
 
-  void build_regressor();
+  void build_regressor(bool checks_only);
   void set_up_variables();
   void set_up_constraints();
   void check_balance_reachable(const MatrixXd& Z, const VectorXd& z0,
@@ -283,7 +283,7 @@ struct PlanarNlp::Impl {
   }
 };
 
-void PlanarNlp::Impl::build_regressor() {
+void PlanarNlp::Impl::build_regressor(bool checks_only) {
   const cp::Linkage& l = p.original;
   std::set<std::string> used;
   for (const cp::ColumnMetric& m : table)
@@ -312,6 +312,16 @@ void PlanarNlp::Impl::build_regressor() {
     outputs[c] = {Eigen::Map<const VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())),
                   MatrixXd::Zero(samples, nq)};
   }
+  for (std::size_t k = 0; k < l.links.size(); ++k) {
+    if (q0[P::link_mass(static_cast<int>(k))] <= 0) {
+      throw InputError("link " + l.links[k].name +
+                       " has no mass: give it one to optimise the linkage");
+    }
+  }
+  if (checks_only) {
+    balance_conditions(base);
+    return;
+  }
   // one column per parameter: the outputs are affine in q, so a difference is exact (to
   // round-off); a link's J is raised with its first moments so that its inertia stays >= 0
   for (int i = 0; i < nq; ++i) {
@@ -323,10 +333,6 @@ void PlanarNlp::Impl::build_regressor() {
       const double L = cp::element_length(l, k);
       const int which = i - 4 * k;
       step = which == 0 ? m : which == 3 ? m * L * L : m * L;
-      if (which == 0 && q0[P::link_mass(k)] <= 0) {
-        throw InputError("link " + l.links[static_cast<std::size_t>(k)].name +
-                         " has no mass: give it one to optimise the linkage");
-      }
       const double lift = which == 1 || which == 2 ? 4 * m * L * L : 0.0;
       lo[P::link_J(k)] += lift;
       hi[P::link_J(k)] += lift;
@@ -669,6 +675,13 @@ void PlanarNlp::Impl::q_of(const VectorXd& x, VectorXd& q, MatrixXd* J, bool pos
 }
 
 PlanarNlp::PlanarNlp(const DesignProblem& problem, CounterweightVariablesAs as)
+    : PlanarNlp(problem, as, false) {}
+
+void PlanarNlp::check(const DesignProblem& problem) {
+  const PlanarNlp checked(problem, CounterweightVariablesAs::kPositions, true);
+}
+
+PlanarNlp::PlanarNlp(const DesignProblem& problem, CounterweightVariablesAs as, bool checks_only)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.p = problem;
@@ -685,7 +698,7 @@ PlanarNlp::PlanarNlp(const DesignProblem& problem, CounterweightVariablesAs as)
   for (std::size_t k = 0; k < l.links.size(); ++k)
     m.length = std::max(m.length, cp::element_length(l, static_cast<int>(k)));
   m.table = cp::metric_table(cp::Model(l));
-  m.build_regressor();
+  m.build_regressor(checks_only);
   // the normalisers: the original's value of each metric in the objective or a limit
   m.weight.assign(m.table.size(), 0.0);
   auto normaliser = [&](const std::string& name, const char* list, int index) {

@@ -108,6 +108,12 @@ class PlanarNlp final : public Program {
   explicit PlanarNlp(const DesignProblem& problem,
                      CounterweightVariablesAs as = CounterweightVariablesAs::kPositions);
   ~PlanarNlp() override;
+  /// The constructor's checks (an invalid problem, an original that cannot run in the scene, a
+  /// link without mass, force balance out of reach, a normaliser that is zero) at the cost of
+  /// the original's run alone, without the regressor's runs of perturbed designs (two per mass
+  /// parameter): what a study's validation needs. Nothing is kept.
+  /// @throws bd::InputError as the constructor does.
+  static void check(const DesignProblem& problem);
   PlanarNlp(const PlanarNlp&) = delete;
   PlanarNlp& operator=(const PlanarNlp&) = delete;
 
@@ -178,6 +184,8 @@ class PlanarNlp final : public Program {
 
  private:
   struct Impl;
+  // checks_only: the original's run and the checks, no regressor columns (check())
+  PlanarNlp(const DesignProblem& problem, CounterweightVariablesAs as, bool checks_only);
   /// A free scene's evaluation at x (optimize/planar.cpp).
   struct Evaluation;
   Evaluation simulated(const Eigen::VectorXd& x, bool gradient) const;

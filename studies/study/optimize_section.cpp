@@ -195,7 +195,7 @@ class OptimizeReader {
       r_.fail(marks.algorithm, "optimize.algorithm: " + p->text());
     }
     try {
-      const op::PlanarNlp nlp(problem);  // the original run; its metrics are the normalisers
+      op::PlanarNlp::check(problem);  // the original run; its metrics are the normalisers
     } catch (const InputError& err) {
       if (const auto& f = err.field()) {
         if (const auto mark = at(*f)) r_.fail(*mark, f->joined(path_of(*f)));
@@ -216,7 +216,7 @@ class OptimizeReader {
       };
       if (const Problem f = p.validate()) fail_at(*f, f->text());
       try {
-        const op::PlanarNlp nlp(p);
+        op::PlanarNlp::check(p);
       } catch (const InputError& err) {
         if (err.field()) fail_at(*err.field(), err.what());
         r_.fail(e.key_mark, "optimize: " + std::string(err.what()));
@@ -225,7 +225,7 @@ class OptimizeReader {
       op::DesignProblem q = problem;
       q.objective = {op::Term{req.pareto->second, 1.0}};
       try {
-        const op::PlanarNlp nlp(q);
+        op::PlanarNlp::check(q);
       } catch (const InputError& err) {
         const auto& f = err.field();
         if (f && f->field == "objective") {
