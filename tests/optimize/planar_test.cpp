@@ -537,14 +537,19 @@ TEST(PlanarOptimize, AnInfeasibleLimitIsSaidInTheMetricsUnits) {
   EXPECT_NE(r.brief_report().find("not verified"), std::string::npos);
 }
 
-TEST(PlanarOptimize, MistakesAreNamed) {
-  Rng rng(504);
-  const cp::Linkage l = unloaded(slider_crank(rng, true), false);
+// a slider-crank without loads, a counterweight on its crank, least RMS shaking force
+op::DesignProblem slider_crank_problem(unsigned seed) {
+  Rng rng(seed);
   op::DesignProblem p;
-  p.original = l;
+  p.original = unloaded(slider_crank(rng, true), false);
   p.scene = scene_of(100, 36);
   p.counterweights = {{0, 1.0, 0.1}};
   p.objective = {{"Fsh_rms", 1.0}};
+  return p;
+}
+
+TEST(PlanarOptimize, MistakesAreNamed) {
+  const op::DesignProblem p = slider_crank_problem(504);
   auto text = [&](const op::DesignProblem& q) {
     const Problem e = q.validate();
     return e ? e->text() : std::string("valid");
@@ -581,13 +586,7 @@ TEST(PlanarOptimize, MistakesAreNamed) {
 // Watt six-bar's validation took 0.13 s, 97 % of it those runs): it must refuse what the
 // constructor refuses, with the same words, and pass what it passes.
 TEST(PlanarOptimize, CheckRefusesWhatTheProgramRefusesFromTheOriginalsRunAlone) {
-  Rng rng(505);
-  const cp::Linkage l = unloaded(slider_crank(rng, true), false);
-  op::DesignProblem p;
-  p.original = l;
-  p.scene = scene_of(100, 36);
-  p.counterweights = {{0, 1.0, 0.1}};
-  p.objective = {{"Fsh_rms", 1.0}};
+  const op::DesignProblem p = slider_crank_problem(505);
   auto outcome = [](auto&& make) -> std::string {
     try {
       make();
