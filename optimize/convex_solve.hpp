@@ -37,9 +37,13 @@ inline Vec2 position_of(double mass, const Vec2& moment, double distance_max) {
   return r;
 }
 
-/// The variables (mass and mass moment or position) of the counterweights whose mass at x is
-/// below `fraction` of their mass_max (Program::vanishing_counterweight_variables()); `first` holds
-/// each counterweight's first variable, its mass.
+/// Below this fraction of its mass_max a counterweight at a solver's end is taken as vanishing:
+/// its mass moment's direction is then round-off (the cone has no gradient at its apex).
+inline constexpr double kVanishingCounterweight = 1e-6;
+
+/// The variables (mass and mass moment) of the counterweights whose mass at x is below
+/// `fraction` of their mass_max (Program::vanishing_counterweight_variables(), in mass-moment
+/// variables); `first` holds each counterweight's first variable, its mass.
 template <class Counterweight>
 std::vector<int> vanishing_counterweight_variables(const Eigen::VectorXd& x,
                                                    const std::vector<int>& first,
@@ -101,11 +105,11 @@ struct TightBound {
 /// subgradient can), where that leaves it more than 1e-7 of the objective's size below the best
 /// design known, at x taken on by Newton steps on its active set (newton_polish(); where
 /// counterweights vanish, after an SLSQP run to 1e-14 with them held on the apex), and where
-/// even that leaves it open, at the ends of up to three SLSQP runs on from x to a relative tolerance of
-/// 1e-14 (each restart renews its Hessian), and, where these leave it more than 1e-7 of the
-/// objective's size below f(x), at the end of an Ipopt run to 1e-10 (its interior path reaches
-/// an optimum on the cone's apex, where SLSQP's steps turn with the round-off). Each is a bound;
-/// the largest is kept. The runs' feasible ends are designs too: the best, where it is below
+/// even that leaves it open, at the ends of up to three SLSQP runs on from x to a relative
+/// tolerance of 1e-14 (each restart renews its Hessian), and, where these leave it more than 1e-7
+/// of the objective's size below f(x), at the end of an Ipopt run to 1e-10 (its interior path
+/// reaches an optimum on the cone's apex, where SLSQP's steps turn with the round-off). Each is a
+/// bound; the largest is kept. The runs' feasible ends are designs too: the best, where it is below
 /// f(x), comes back as `better` (a solver that stalled short of a convex optimum, as MMA can,
 /// is taken on to it).
 template <class Nlp>
@@ -115,7 +119,8 @@ TightBound tight_bound(const Nlp& program, const Eigen::VectorXd& x,
   double& bound = out.value;
   bound = std::max(
       first_order(program, x).lower_bound,
-      first_order(program, program.without_vanishing_counterweights(x, 1e-6)).lower_bound);
+      first_order(program, program.without_vanishing_counterweights(x, kVanishingCounterweight))
+          .lower_bound);
   OptimizeOptions tight = options;
   tight.algorithm = Algorithm::kSlsqp;
   tight.relative_tolerance = 1e-14;
@@ -139,13 +144,15 @@ TightBound tight_bound(const Nlp& program, const Eigen::VectorXd& x,
     // Newton steps on the active set's conditions (newton_polish()); first, where counterweights
     // vanish, those held on their cones' apex and the rest solved again (FixedVariables: smooth
     // there). The bound at the end is the whole program's, the apex read by the cone's subgradient
-    const std::vector<int> held_at_apex = program.vanishing_counterweight_variables(x, 1e-6);
+    const std::vector<int> held_at_apex =
+        program.vanishing_counterweight_variables(x, kVanishingCounterweight);
     Solved polished;
     polished.termination = Termination::kConverged;
     if (held_at_apex.empty()) {
       polished.x = newton_polish(program, x, options.constraint_tolerance);
     } else {
-      const Eigen::VectorXd snapped = program.without_vanishing_counterweights(x, 1e-6);
+      const Eigen::VectorXd snapped =
+          program.without_vanishing_counterweights(x, kVanishingCounterweight);
       const FixedVariables held(program, held_at_apex, snapped);
       const Solved refined = solve(held, held.reduce(snapped), tight, false);
       polished.termination = refined.termination;

@@ -18,12 +18,22 @@ double stationarity_residual(const Program& p, const VectorXd& x, double activit
   return first_order(p, x, activity).residual;
 }
 
-FirstOrder first_order(const Program& p, const VectorXd& x, double activity) {
-  const int n = p.n();
+namespace {
+
+// each variable's unit: its box width, 1 where the box is unbounded or empty
+VectorXd box_widths(const Program& p) {
   VectorXd w = (p.upper() - p.lower()).cwiseAbs();
-  for (int j = 0; j < n; ++j) {
+  for (Eigen::Index j = 0; j < w.size(); ++j) {
     if (!std::isfinite(w[j]) || w[j] == 0) w[j] = 1;
   }
+  return w;
+}
+
+}  // namespace
+
+FirstOrder first_order(const Program& p, const VectorXd& x, double activity) {
+  const int n = p.n();
+  const VectorXd w = box_widths(p);
   VectorXd g(n);
   const double f = p.objective(x, &g);
   const VectorXd gw = w.cwiseProduct(g);
@@ -124,9 +134,9 @@ std::vector<int> active_rows(const Program& p, const VectorXd& x, double activit
     }
   }
   bounds.clear();
+  const VectorXd w = box_widths(p);
   for (int j = 0; j < p.n(); ++j) {
-    const double w = std::isfinite(p.upper()[j] - p.lower()[j]) ? p.upper()[j] - p.lower()[j] : 1;
-    if (x[j] - p.lower()[j] <= activity * w || p.upper()[j] - x[j] <= activity * w) {
+    if (x[j] - p.lower()[j] <= activity * w[j] || p.upper()[j] - x[j] <= activity * w[j]) {
       bounds.push_back(j);
     }
   }
@@ -184,14 +194,14 @@ VectorXd newton_polish(const Program& p, const VectorXd& x0, double constraint_t
   double least = stationarity_residual(p, x, activity);
   std::vector<int> bounds;
   const std::vector<int> rows = active_rows(p, x, activity, bounds);
+  const VectorXd w = box_widths(p);
   for (int step = 0; step < steps && least > 0; ++step) {
     const ActiveSet s = active_set(p, x, rows, bounds, nullptr);
     const auto m = s.a.rows();
     // the Lagrangian's Hessian by central differences of its gradient at fixed multipliers
     MatrixXd h(n, n);
     for (int j = 0; j < n; ++j) {
-      const double w = std::isfinite(p.upper()[j] - p.lower()[j]) ? p.upper()[j] - p.lower()[j] : 1;
-      const double e = 1e-6 * std::max(w, std::abs(x[j]));
+      const double e = 1e-6 * std::max(w[j], std::abs(x[j]));
       VectorXd plus = x, minus = x;
       plus[j] += e;
       minus[j] -= e;

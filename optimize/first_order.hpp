@@ -71,12 +71,12 @@ Optimality optimality(const std::string& why_not_convex, bool converged, double 
 ///   [A  0 ] [dz] = - [c_A      ]
 /// with H the Hessian of the Lagrangian by central differences of its exact gradient (the
 /// multipliers z by least squares at each point); of the points reached, the one of least
-/// stationarity residual among those within `constraint_tolerance` of feasible is returned. For a certificate, not a search: where a solver's own end
-/// meets the conditions to ~1e-6 only (NLopt's SLSQP stops when its steps stop changing the
-/// objective, which near a minimum of a flat direction happens first), a few such steps take
-/// them to round-off, as an interior-point method's last iterations would, without its cost.
-/// (A polish of this kind is the last step of OSQP's solves.) At most `steps` steps; x itself
-/// when none helped.
+/// stationarity residual among those within `constraint_tolerance` of feasible is returned.
+/// For a certificate, not a search: where a solver's own end meets the conditions to ~1e-6
+/// only (NLopt's SLSQP stops when its steps stop changing the objective, which near a minimum
+/// of a flat direction happens first), a few such steps take them to round-off, as an
+/// interior-point method's last iterations would, without its cost. (A polish of this kind is the
+/// last step of OSQP's solves.) At most `steps` steps; x itself when none helped.
 Eigen::VectorXd newton_polish(const Program& program, const Eigen::VectorXd& x,
                               double constraint_tolerance, int steps = 4,
                               double activity = kActivity);

@@ -75,7 +75,9 @@ class FixedVariables final : public Program {
                                 Eigen::VectorXd& c, Eigen::MatrixXd& jac) const override {
     // the whole gradient, with zeros for the fixed variables (whose cones are on their apex)
     Eigen::VectorXd whole = Eigen::VectorXd::Zero(base_.n());
-    for (std::size_t k = 0; k < free_.size(); ++k) whole[free_[k]] = g[static_cast<Eigen::Index>(k)];
+    for (std::size_t k = 0; k < free_.size(); ++k) {
+      whole[free_[k]] = g[static_cast<Eigen::Index>(k)];
+    }
     rows(y, c, &jac, [&](const Eigen::VectorXd& x, Eigen::VectorXd& cc, Eigen::MatrixXd* j) {
       base_.first_order_inequalities(x, whole, cc, *j);
     });

@@ -150,8 +150,8 @@ class Nlp final : public Program {
   /// start_at().
   Eigen::VectorXd to_positions(const Eigen::VectorXd& x) const;
   /// x with each counterweight whose mass is below `fraction` of its mass_max taken away
-  /// (mass and mass moment 0; in position variables x itself): a solver's end near the apex, where the
-  /// direction of a vanishing mass moment is round-off, put on the apex itself.
+  /// (mass and mass moment 0; in position variables x itself): a solver's end near the apex,
+  /// where the direction of a vanishing mass moment is round-off, put on the apex itself.
   Eigen::VectorXd without_vanishing_counterweights(const Eigen::VectorXd& x,
                                                    double fraction) const override;
   std::vector<int> vanishing_counterweight_variables(const Eigen::VectorXd& x,

@@ -368,10 +368,6 @@ std::vector<Algorithm> continuations(Algorithm a) {
   return {same, same == Algorithm::kIpopt ? Algorithm::kSlsqp : Algorithm::kIpopt};
 }
 
-// Below this fraction of its mass_max a counterweight at a gradient method's end is taken as
-// vanishing: its mass moment's direction is then round-off (the cone has no gradient at its apex)
-constexpr double kVanishingCounterweight = 1e-6;
-
 // A converged end where counterweights vanish, put on their cones' apex and solved again in the
 // other variables with those held there (FixedVariables: the rest of the problem is smooth, so a
 // few steps settle it), then checked against the whole program's first-order conditions, which at
@@ -380,9 +376,9 @@ constexpr double kVanishingCounterweight = 1e-6;
 bool settle_on_apex(const Program& nlp, const OptimizeOptions& options, double tolerance,
                     detail::Solved& r) {
   const std::vector<int> held_at_apex =
-      nlp.vanishing_counterweight_variables(r.x, kVanishingCounterweight);
+      nlp.vanishing_counterweight_variables(r.x, detail::kVanishingCounterweight);
   if (held_at_apex.empty()) return false;
-  VectorXd x = nlp.without_vanishing_counterweights(r.x, kVanishingCounterweight);
+  VectorXd x = nlp.without_vanishing_counterweights(r.x, detail::kVanishingCounterweight);
   nlp.polish(x);
   double residual = detail::stationarity_residual(nlp, x);
   if (residual > tolerance && r.evaluations < options.max_evaluations) {
