@@ -125,6 +125,11 @@ TightBound tight_bound(const Nlp& program, const Eigen::VectorXd& x,
   tight.algorithm = Algorithm::kSlsqp;
   tight.relative_tolerance = 1e-14;
   tight.check_gradients = false;
+  // a refinement polishes a converged end: near a regular Karush-Kuhn-Tucker point SLSQP and
+  // Ipopt converge superlinearly, in tens of iterations; where the conditions cannot be met
+  // (a degenerate end: constraints whose gradients are dependent, multipliers without bound)
+  // more iterations do not close the gap, and a run to the user's budget cost seconds each
+  tight.max_evaluations = refinement_evaluations(program, options.max_evaluations);
   const double f = program.objective(x, nullptr), close = 1e-7 * std::max(std::abs(f), 1.0);
   const auto keep = [&](const Solved& refined, const std::string& by) {
     if (!found_design(refined.termination) ||

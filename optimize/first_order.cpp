@@ -1,9 +1,9 @@
 #include "optimize/first_order.hpp"
 
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <Eigen/QR>
 #include <vector>
 
 #include "core/number_text.hpp"
@@ -103,11 +103,12 @@ FirstOrder first_order(const Program& p, const VectorXd& x, double activity) {
   for (Eigen::Index k = 0; k < z.size(); ++k) {
     if (z[k] < lower[k] - 1e-12 * scale) signs = false;
   }
-  if (!signs) z = bounded_least_squares(A, -gw, lower, z.cwiseMax(lower));
+  if (!signs) z = bounded_least_squares(A, -gw, lower);
   z = z.cwiseMax(lower);  // a bounded solve's round-off below a floor would void the bound
   const VectorXd r = gw + A * z;
   double lagrangian = f;
-  for (Eigen::Index k = 0; k < z.size(); ++k) lagrangian += z[k] * term[static_cast<std::size_t>(k)];
+  for (Eigen::Index k = 0; k < z.size(); ++k)
+    lagrangian += z[k] * term[static_cast<std::size_t>(k)];
   return {r.cwiseAbs().maxCoeff() / size, bound(r, lagrangian)};
 }
 
@@ -187,8 +188,8 @@ ActiveSet active_set(const Program& p, const VectorXd& x, const std::vector<int>
 
 }  // namespace
 
-VectorXd newton_polish(const Program& p, const VectorXd& x0, double constraint_tolerance,
-                       int steps, double activity) {
+VectorXd newton_polish(const Program& p, const VectorXd& x0, double constraint_tolerance, int steps,
+                       double activity) {
   const int n = p.n();
   VectorXd x = x0, best = x0;
   double least = stationarity_residual(p, x, activity);
@@ -206,7 +207,8 @@ VectorXd newton_polish(const Program& p, const VectorXd& x0, double constraint_t
       plus[j] += e;
       minus[j] -= e;
       h.col(j) = (active_set(p, plus, rows, bounds, &s.z).grad_l -
-                  active_set(p, minus, rows, bounds, &s.z).grad_l) / (2 * e);
+                  active_set(p, minus, rows, bounds, &s.z).grad_l) /
+                 (2 * e);
     }
     MatrixXd kkt = MatrixXd::Zero(n + m, n + m);
     kkt.topLeftCorner(n, n) = 0.5 * (h + h.transpose());
@@ -226,6 +228,85 @@ VectorXd newton_polish(const Program& p, const VectorXd& x0, double constraint_t
   return best;
 }
 
+VectorXd bounded_least_squares(const MatrixXd& A, const VectorXd& b, const VectorXd& lower) {
+  const Eigen::Index m = A.cols();
+  // y = z - lower >= 0 on the bounded components; the free ones (lower -inf) are y itself
+  std::vector<bool> free(static_cast<std::size_t>(m)), passive(static_cast<std::size_t>(m));
+  VectorXd shift = VectorXd::Zero(m);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    free[i] = passive[i] = !std::isfinite(lower[k]);
+    if (!free[i]) shift[k] = lower[k];
+  }
+  const VectorXd rhs = b - A * shift;
+  VectorXd y = VectorXd::Zero(m);
+  // the least-squares solution on the passive columns, 0 elsewhere (rank-revealing: the
+  // passive columns may be dependent, as the rows of one peak nearly are)
+  const auto solve_passive = [&] {
+    std::vector<Eigen::Index> cols;
+    for (Eigen::Index k = 0; k < m; ++k) {
+      if (passive[static_cast<std::size_t>(k)]) cols.push_back(k);
+    }
+    VectorXd s = VectorXd::Zero(m);
+    if (cols.empty()) return s;
+    MatrixXd ap(A.rows(), static_cast<Eigen::Index>(cols.size()));
+    for (std::size_t c = 0; c < cols.size(); ++c)
+      ap.col(static_cast<Eigen::Index>(c)) = A.col(cols[c]);
+    const VectorXd sp = ap.completeOrthogonalDecomposition().solve(rhs);
+    for (std::size_t c = 0; c < cols.size(); ++c) s[cols[c]] = sp[static_cast<Eigen::Index>(c)];
+    return s;
+  };
+  if (std::find(free.begin(), free.end(), true) != free.end()) y = solve_passive();
+  // a component enters only where the residual's gradient clearly points into its half-space
+  const double tolerance = 10 * std::numeric_limits<double>::epsilon() *
+                           std::max(1.0, static_cast<double>(std::max(A.rows(), m))) *
+                           std::max(A.cwiseAbs().maxCoeff(), 1e-300) *
+                           std::max(rhs.cwiseAbs().maxCoeff(), 1e-300);
+  // a column whose least-squares value comes out <= 0 as it enters (round-off, on nearly
+  // dependent columns) is barred until the point moves
+  std::vector<bool> barred(static_cast<std::size_t>(m));
+  for (Eigen::Index outer = 0; outer < 3 * m + 10; ++outer) {
+    const VectorXd w = A.transpose() * (rhs - A * y);
+    Eigen::Index enter = -1;
+    double largest = tolerance;
+    for (Eigen::Index k = 0; k < m; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      if (!passive[i] && !barred[i] && w[k] > largest) largest = w[k], enter = k;
+    }
+    if (enter < 0) break;
+    passive[static_cast<std::size_t>(enter)] = true;
+    for (Eigen::Index inner = 0; inner <= m; ++inner) {
+      const VectorXd s = solve_passive();
+      if (inner == 0 && !(s[enter] > 0)) {
+        passive[static_cast<std::size_t>(enter)] = false;
+        barred[static_cast<std::size_t>(enter)] = true;
+        break;
+      }
+      std::fill(barred.begin(), barred.end(), false);
+      // the step towards s as far as every bounded passive component stays >= 0
+      double alpha = 1;
+      Eigen::Index blocking = -1;
+      for (Eigen::Index k = 0; k < m; ++k) {
+        const auto i = static_cast<std::size_t>(k);
+        if (passive[i] && !free[i] && !(s[k] > 0)) {
+          const double a = y[k] / (y[k] - s[k]);  // y_k > 0 >= s_k here: 0 <= a < 1
+          if (a < alpha) alpha = a, blocking = k;
+        }
+      }
+      y += alpha * (s - y);
+      if (blocking < 0) break;
+      for (Eigen::Index k = 0; k < m; ++k) {
+        const auto i = static_cast<std::size_t>(k);
+        if (passive[i] && !free[i] && (k == blocking || !(y[k] > 0))) passive[i] = false, y[k] = 0;
+      }
+    }
+  }
+  for (Eigen::Index k = 0; k < m; ++k) {
+    if (!free[static_cast<std::size_t>(k)]) y[k] = std::max(y[k], 0.0);
+  }
+  return y + shift;
+}
+
 Optimality optimality(const std::string& why_not_convex, bool converged, double stationarity,
                       double relative_tolerance) {
   if (!why_not_convex.empty()) return {false, "not proven global: " + why_not_convex};
@@ -240,8 +321,8 @@ Optimality optimality(const std::string& why_not_convex, bool converged, double 
   if (!(stationarity <= tolerance)) {
     return {false, "not proven global: " + convex +
                        ", but the design meets the first-order conditions only to " +
-                       text::digits(stationarity, 2) + " (tolerance " +
-                       text::digits(tolerance, 2) + ")"};
+                       text::digits(stationarity, 2) + " (tolerance " + text::digits(tolerance, 2) +
+                       ")"};
   }
   return {true, "global: " + convex + ", and the design meets the first-order conditions to " +
                     text::digits(stationarity, 2) + " (tolerance " + text::digits(tolerance, 2) +

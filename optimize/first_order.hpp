@@ -7,10 +7,10 @@
 /// (1 where a bound is infinite), the active set is every equality, every inequality with
 /// c_i >= -activity and every bound within activity · w_j of x. The multipliers
 ///   min || w ∘ (∇f + Σ λ_i ∇c_i + Σ ν_k ∇h_k - μ_lower + μ_upper) ||,  λ, μ >= 0
-/// are fitted by least squares (bounded least squares, NLopt, where some come out of the wrong
-/// sign), and the residual's largest entry, divided by the largest of |f|, the scaled
-/// gradient's largest entry and 1 (the objectives are normalised: 1 per unit weight at the
-/// original design), is the stationarity residual: the objective's relative rate of
+/// are fitted by least squares (bounded_least_squares() where some come out of the wrong sign),
+/// and the residual's largest entry, divided by the largest of |f|, the scaled gradient's
+/// largest entry and 1 (the objectives are normalised: 1 per unit weight at the original
+/// design), is the stationarity residual: the objective's relative rate of
 /// decrease, per whole box width, along the best direction that the active constraints allow to
 /// first order. It is 0 at a Karush-Kuhn-Tucker point and of order one far from one.
 ///
@@ -18,6 +18,7 @@
 /// when the objective changes by less than δ relative is within δ of a minimum of curvature H
 /// where the gradient is about sqrt(2 H δ), so that is what a converged end can show.
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -31,6 +32,17 @@ inline constexpr double kActivity = 1e-6;
 /// The tolerance of the stationarity residual for a solver's relative tolerance.
 inline double stationarity_tolerance(double relative_tolerance) {
   return std::sqrt(relative_tolerance);
+}
+
+/// The evaluations a run by SLSQP or Ipopt that goes on from a converged end may take (a
+/// continuation where the first-order conditions do not hold there, a lower bound's
+/// refinement): 20 per variable and 20 more, within the budget left (`max_evaluations`). Near a
+/// regular Karush-Kuhn-Tucker point these converge superlinearly, in tens of iterations; at a
+/// degenerate end (constraints whose gradients are dependent, multipliers without bound, as at
+/// the tightest point of a Pareto front) more iterations do not help, and a run to a budget of
+/// thousands cost tens of seconds where hundreds of constraints are active.
+inline int refinement_evaluations(const Program& program, int max_evaluations) {
+  return std::min(max_evaluations, 20 * (program.n() + 1));
 }
 
 /// The stationarity residual at x (see above), for a program with gradients.
@@ -81,9 +93,15 @@ Eigen::VectorXd newton_polish(const Program& program, const Eigen::VectorXd& x,
                               double constraint_tolerance, int steps = 4,
                               double activity = kActivity);
 
-/// min ½ |A z - b|² subject to z_i >= lower_i (lower_i may be -infinity), by NLopt's SLSQP on
-/// the bound-constrained quadratic, from z0 (within the bounds).
+/// min ½ |A z - b|² subject to z_i >= lower_i (lower_i may be -infinity: free), by the active-set
+/// method of Lawson and Hanson (Solving Least Squares Problems, 1974, ch. 23), the free
+/// variables held in its passive set throughout. Its cost grows with the number of columns it
+/// takes in, at most about the rank of A: a peak's hundreds of active rows at a balanced design
+/// (columns nearly parallel, n = a handful of variables) cost a few small solves, where a
+/// general solver on the quadratic in all columns costs seconds and may stop short. Exact to
+/// round-off: Aᵀ(A z - b) vanishes on the free and the inactive components and is >= 0 (to
+/// round-off) on those at their bound.
 Eigen::VectorXd bounded_least_squares(const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
-                                      const Eigen::VectorXd& lower, const Eigen::VectorXd& z0);
+                                      const Eigen::VectorXd& lower);
 
 }  // namespace bd::optimize::detail

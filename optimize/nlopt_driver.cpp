@@ -501,45 +501,6 @@ DriverOutcome multistart(const Program& nlp, const VectorXd& x0, const OptimizeO
 
 }  // namespace
 
-namespace {
-
-struct LeastSquares {
-  const MatrixXd* A;
-  const VectorXd* b;
-  VectorXd r;
-};
-
-double least_squares_cb(unsigned n, const double* z, double* grad, void* data) {
-  auto& ls = *static_cast<LeastSquares*>(data);
-  ls.r = *ls.A * Eigen::Map<const VectorXd>(z, n) - *ls.b;
-  if (grad) Eigen::Map<VectorXd>(grad, n) = ls.A->transpose() * ls.r;
-  return 0.5 * ls.r.squaredNorm();
-}
-
-}  // namespace
-
-VectorXd bounded_least_squares(const MatrixXd& A, const VectorXd& b, const VectorXd& lower,
-                               const VectorXd& z0) {
-  const unsigned n = static_cast<unsigned>(A.cols());
-  VectorXd z = z0;
-  LeastSquares ls{&A, &b, {}};
-  nlopt_opt opt = nlopt_create(NLOPT_LD_SLSQP, n);
-  if (!opt) return z;
-  nlopt_set_lower_bounds(opt, lower.data());
-  nlopt_set_min_objective(opt, least_squares_cb, &ls);
-  nlopt_set_ftol_rel(opt, 1e-15);
-  nlopt_set_xtol_rel(opt, 1e-15);
-  nlopt_set_maxeval(opt, 20 * static_cast<int>(n) + 200);
-  double f = 0;
-  VectorXd trial = z;
-  // any outcome leaves a point within the bounds; the caller measures its residual itself
-  if (nlopt_optimize(opt, trial.data(), &f) >= 0 || trial.allFinite()) {
-    if (trial.allFinite()) z = trial.cwiseMax(lower);
-  }
-  nlopt_destroy(opt);
-  return z;
-}
-
 DriverOutcome solve_with_nlopt(const Program& nlp, const VectorXd& x0,
                                const OptimizeOptions& options) {
   if (options.algorithm == Algorithm::kMlsl) return multistart(nlp, x0, options);

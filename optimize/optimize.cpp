@@ -232,7 +232,8 @@ Problem check_algorithm(const DesignProblem& problem, const OptimizeOptions& opt
   // (optimize/free_nlp.cpp), but not on the opened loop's DAE
   const bool opened = std::holds_alternative<core::FreeScene>(problem.scene) &&
                       problem.formulation == core::Formulation::kOpenedLoop;
-  return check_algorithm(options, opened ? "a free scene on the opened loop (method opened-loop)" : "",
+  return check_algorithm(options,
+                         opened ? "a free scene on the opened loop (method opened-loop)" : "",
                          "the method mass-matrix or complex-masses", problem.force_balance);
 }
 
@@ -368,6 +369,15 @@ std::vector<Algorithm> continuations(Algorithm a) {
   return {same, same == Algorithm::kIpopt ? Algorithm::kSlsqp : Algorithm::kIpopt};
 }
 
+// The evaluations a run that goes on from a converged end may take, of the `left` in the budget:
+// SLSQP and Ipopt converge superlinearly near a regular end, so a polish by them is capped
+// (refinement_evaluations()); MMA converges linearly, and MLSL searches again: they take what is
+// left.
+int continuation_budget(const Program& nlp, Algorithm a, int left) {
+  const bool superlinear = a == Algorithm::kSlsqp || a == Algorithm::kIpopt;
+  return superlinear ? detail::refinement_evaluations(nlp, left) : left;
+}
+
 // A converged end where counterweights vanish, put on their cones' apex and solved again in the
 // other variables with those held there (FixedVariables: the rest of the problem is smooth, so a
 // few steps settle it), then checked against the whole program's first-order conditions, which at
@@ -384,7 +394,8 @@ bool settle_on_apex(const Program& nlp, const OptimizeOptions& options, double t
   if (residual > tolerance && r.evaluations < options.max_evaluations) {
     const detail::FixedVariables held(nlp, held_at_apex, x);
     OptimizeOptions next = options;
-    next.max_evaluations = options.max_evaluations - r.evaluations;
+    next.max_evaluations =
+        continuation_budget(held, options.algorithm, options.max_evaluations - r.evaluations);
     const detail::Solved s = run_once(held, held.reduce(x), next);
     add_costs(s, r);
     if (s.termination == Termination::kConverged) {
@@ -404,8 +415,7 @@ bool settle_on_apex(const Program& nlp, const OptimizeOptions& options, double t
   r.message += "; the first-order conditions held to " + text::digits(r.stationarity, 2) +
                " only where it stopped, where " + std::to_string(count) + " counterweight" +
                (count == 1 ? "" : "s") + " vanished; with " + (count == 1 ? "it" : "them") +
-               " taken away and the rest solved again they hold to " +
-               text::digits(residual, 2);
+               " taken away and the rest solved again they hold to " + text::digits(residual, 2);
   r.x = x;
   r.objective = f;
   r.constraint_violation = violation;
@@ -418,7 +428,8 @@ bool settle_on_apex(const Program& nlp, const OptimizeOptions& options, double t
 // the residual up (many constraints active together, as a peak's rows at a force-balanced
 // design), runs that go on from the point, end converged themselves and change the objective by
 // less than the tolerance (relative to the objective's size, 1 for the original design) settle
-// it: converged. A continuation stopped by the evaluation budget settles nothing.
+// it: converged. A continuation stopped by its evaluation budget (refinement_evaluations():
+// a continuation polishes, it does not search again) settles nothing.
 void ensure_first_order(const Program& nlp, const OptimizeOptions& options, detail::Solved& r) {
   if (!nlp.has_gradients() || r.termination != Termination::kConverged) return;
   const double tolerance = detail::stationarity_tolerance(options.relative_tolerance);
@@ -432,7 +443,7 @@ void ensure_first_order(const Program& nlp, const OptimizeOptions& options, deta
     if (r.evaluations >= options.max_evaluations) break;
     OptimizeOptions next = options;
     next.algorithm = a;
-    next.max_evaluations = options.max_evaluations - r.evaluations;
+    next.max_evaluations = continuation_budget(nlp, a, options.max_evaluations - r.evaluations);
     detail::Solved s = run_once(nlp, r.x, next);
     add_costs(s, r);
     ++runs;
@@ -466,8 +477,8 @@ void ensure_first_order(const Program& nlp, const OptimizeOptions& options, deta
 
 }  // namespace
 
-detail::Solved detail::solve(const Program& nlp, const VectorXd& x0,
-                             const OptimizeOptions& options, bool to_first_order) {
+detail::Solved detail::solve(const Program& nlp, const VectorXd& x0, const OptimizeOptions& options,
+                             bool to_first_order) {
   if (options.check_gradients && nlp.has_gradients()) {
     // a wrong derivative would mislead every gradient method: stop before solving (Ceres)
     if (std::string e = check_gradients(nlp, x0); !e.empty()) {
@@ -509,7 +520,8 @@ detail::Solved detail::solve_from(const Program& nlp, const std::vector<VectorXd
   for (std::size_t i : order) {
     Solved s = solve(nlp, starts[i], options);
     add_costs(s, costs);
-    if (!have || found_design(s.termination) || s.constraint_violation < best.constraint_violation) {
+    if (!have || found_design(s.termination) ||
+        s.constraint_violation < best.constraint_violation) {
       best = std::move(s);
     }
     have = true;
