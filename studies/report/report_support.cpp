@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 
@@ -414,10 +415,11 @@ std::string inline_svg(std::string svg, const std::string& prefix) {
 
 }  // namespace
 
-// runs gnuplot once for all charts; returns each chart's inline SVG, in order
-std::vector<std::string> draw(const std::string& gnuplot, const std::string& datablocks,
-                              const std::vector<Chart>& charts) {
-  TempDir tmp;
+namespace {
+
+// The gnuplot script of `charts` after the data blocks, each writing <id>.svg into `dir`.
+std::string chart_script(const std::string& datablocks, std::span<const Chart> charts,
+                         const fs::path& dir) {
   std::string script =
       "set datafile separator ','\nset grid\nset key outside right top\n"
       "set encoding utf8\n";
@@ -426,40 +428,78 @@ std::vector<std::string> draw(const std::string& gnuplot, const std::string& dat
     script += "reset\nset datafile separator ','\nset grid\nset key outside right top\n";
     script += std::string("set terminal svg size 900,") + (c.square ? "600" : "420") +
               " dynamic noenhanced font 'sans,12' background rgb 'white'\n";
-    script += "set output " + gp_string((tmp.path() / (c.id + ".svg")).string()) + "\n";
+    script += "set output " + gp_string((dir / (c.id + ".svg")).string()) + "\n";
     script += c.commands + "\nunset output\n";
   }
-  const fs::path script_file = tmp.path() / "report.gp";
+  return script;
+}
+
+// Runs gnuplot on `script` (written into dir as `name`); empty when it succeeded, else what went
+// wrong in one line: the exit status and gnuplot's first error line.
+std::string run_gnuplot(const std::string& gnuplot, const std::string& script,
+                        const fs::path& dir, const std::string& name) {
+  const fs::path script_file = dir / (name + ".gp");
   {
     std::ofstream out(script_file, std::ios::binary);
     out << script;
     if (!out) throw std::runtime_error("cannot write " + script_file.string());
   }
-  const fs::path err_file = tmp.path() / "gnuplot-stderr.txt";
+  const fs::path err_file = dir / (name + "-stderr.txt");
   const std::string cmd = sh_quote(gnuplot) + " " + sh_quote(script_file.string()) +
                           " </dev/null >/dev/null 2>" + sh_quote(err_file.string());
   const int status = std::system(cmd.c_str());
-  if (status != 0) {
-    std::string err;
-    try {
-      err = read_file(err_file);
-    } catch (const std::exception&) {
-    }
-    // the line that says what went wrong
-    std::string first;
-    std::istringstream lines(err);
-    for (std::string line; std::getline(lines, line);) {
-      if (line.find_first_not_of(" \t^") == std::string::npos) continue;
-      first = line;
-      if (line.find("line ") != std::string::npos) break;
-    }
-    throw std::runtime_error("gnuplot failed (" + gnuplot + ", status " + std::to_string(status) +
-                             ")" + (first.empty() ? std::string() : ": " + first));
+  if (status == 0) return "";
+  std::string err;
+  try {
+    err = read_file(err_file);
+  } catch (const std::exception&) {
   }
+  // the line that says what went wrong
+  std::string first;
+  std::istringstream lines(err);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find_first_not_of(" \t^") == std::string::npos) continue;
+    first = line;
+    if (line.find("line ") != std::string::npos) break;
+  }
+  return "gnuplot failed (" + gnuplot + ", status " + std::to_string(status) + ")" +
+         (first.empty() ? std::string() : ": " + first);
+}
+
+}  // namespace
+
+// Runs gnuplot once for all charts; returns each chart's inline SVG, in order. Where that run
+// fails, each chart is drawn by a run of its own, so that data one chart cannot draw (every value
+// of a curve undefined, say) costs that chart only: it is replaced by a notice that says why.
+std::vector<std::string> draw(const std::string& gnuplot, const std::string& datablocks,
+                              const std::vector<Chart>& charts) {
+  TempDir tmp;
+  const std::string failed = run_gnuplot(gnuplot, chart_script(datablocks, charts, tmp.path()),
+                                         tmp.path(), "report");
   std::vector<std::string> svgs;
-  for (const Chart& c : charts) {
-    svgs.push_back(inline_svg(read_file(tmp.path() / (c.id + ".svg")), c.id));
+  if (failed.empty()) {
+    for (const Chart& c : charts) {
+      svgs.push_back(inline_svg(read_file(tmp.path() / (c.id + ".svg")), c.id));
+    }
+    return svgs;
   }
+  std::size_t drawn = 0;
+  for (const Chart& c : charts) {
+    const std::string why = run_gnuplot(
+        gnuplot, chart_script(datablocks, std::span<const Chart>(&c, 1), tmp.path()), tmp.path(),
+        c.id);
+    const fs::path svg = tmp.path() / (c.id + ".svg");
+    if (why.empty() && fs::exists(svg)) {
+      svgs.push_back(inline_svg(read_file(svg), c.id));
+      ++drawn;
+    } else {
+      svgs.push_back("<p class=\"notice\">This chart could not be drawn from the run's data (" +
+                     esc(why.empty() ? "gnuplot wrote no picture" : why) +
+                     "); its numbers are in the data files.</p>");
+    }
+  }
+  // no chart drawn at all: gnuplot itself does not work here
+  if (drawn == 0 && !charts.empty()) throw std::runtime_error(failed);
   return svgs;
 }
 

@@ -93,8 +93,11 @@ struct Chart {
   bool square = false;  // taller canvas (equal-axis plots)
 };
 /// Runs `gnuplot` once for all charts, after `datablocks` (gnuplot text defining $name data
-/// blocks, may be empty); returns each chart's inline SVG, in order.
-/// @throws std::runtime_error if gnuplot fails (with its first error line) or writes no SVG.
+/// blocks, may be empty); returns each chart's inline SVG, in order. Where that run fails, each
+/// chart is drawn by a run of its own, and a chart gnuplot cannot draw from its data (every value
+/// of a curve undefined, say) is an HTML notice with gnuplot's reason in place of its SVG.
+/// @throws std::runtime_error when no chart can be drawn (gnuplot itself fails; its first error
+/// line) or a run that succeeded wrote no SVG.
 std::vector<std::string> draw(const std::string& gnuplot, const std::string& datablocks,
                               const std::vector<Chart>& charts);
 

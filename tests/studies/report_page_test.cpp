@@ -1,8 +1,9 @@
 // What a machine designer reads on the report page: a long run's page stays a few MB (its charts
 // draw a decimated set of samples, the data files keep all), a value that is round-off of its
 // quantity's scale shows as 0 (never 6.123e-17), a driven run's hodograph is closed by its
-// periodic end, tables carry their units, the harmonic bars are harmonics.csv's numbers, and a
-// Pareto run without a single design still gets its page.
+// periodic end, tables carry their units, the harmonic bars are harmonics.csv's numbers, a
+// Pareto run without a single design still gets its page, and a chart gnuplot cannot draw costs
+// that chart only.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -212,6 +213,27 @@ TEST_F(ReportPageTest, HarmonicBarsAreTheNumbersOfHarmonicsCsv) {
   if (find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
   EXPECT_FALSE(svg_of(html, "chart-harmonics-original").empty());
   EXPECT_FALSE(svg_of(html, "chart-harmonics-balanced").empty());
+}
+
+// Data that one chart cannot draw (every value of its curve undefined: gnuplot stops the whole
+// script at it) costs that chart only: it becomes a notice with gnuplot's reason, the other
+// charts are drawn, and the page is written. A gnuplot that draws nothing at all still fails.
+TEST(ReportPage, AChartGnuplotCannotDrawIsANoticeAndTheOthersAreDrawn) {
+  const std::string gnuplot = find_gnuplot();
+  if (gnuplot.empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
+  const std::string blocks =
+      "$good << EOD\n0,1\n1,2\n2,0.5\nEOD\n$bad << EOD\n0,\n1,\n2,\nEOD\n";
+  const std::vector<report_support::Chart> charts = {
+      {"first", "first", "", "plot $good using 1:2 with lines title 'a'"},
+      {"undefined", "undefined", "", "plot $bad using 1:2 with lines title 'b'"},
+      {"last", "last", "", "plot $good using 1:2 with points title 'c'"}};
+  const std::vector<std::string> svgs = report_support::draw(gnuplot, blocks, charts);
+  ASSERT_EQ(svgs.size(), 3u);
+  EXPECT_EQ(svgs[0].rfind("<svg", 0), 0u);
+  EXPECT_EQ(svgs[2].rfind("<svg", 0), 0u);
+  EXPECT_EQ(svgs[1].rfind("<p class=\"notice\">This chart could not be drawn", 0), 0u) << svgs[1];
+  EXPECT_NE(svgs[1].find("undefined"), std::string::npos) << "gnuplot's reason: " << svgs[1];
+  EXPECT_THROW(report_support::draw("/bin/false", blocks, charts), std::runtime_error);
 }
 
 // the driven paper four-bar with counterweights to optimise and a front of 3 points
