@@ -27,6 +27,7 @@ void brent_maximise(const QuantityAt& f, double a, double b, double tol, Peak& b
   double x = a + kGolden * (b - a), w = x, v = x;
   double fx = g(x), fw = fx, fv = fx;
   double d = 0.0, e = 0.0;
+  int quiet_steps = 0;
   for (int iter = 0; iter < 200; ++iter) {
     const double m = 0.5 * (a + b);
     const double tol1 = tol + 1e-15 * std::abs(x), tol2 = 2 * tol1;
@@ -53,6 +54,16 @@ void brent_maximise(const QuantityAt& f, double a, double b, double tol, Peak& b
     }
     const double u = std::abs(d) >= tol1 ? x + d : x + (d > 0 ? tol1 : -tol1);
     const double fu = g(u);
+    // the value is what is wanted: near a smooth maximum, a parabolic step's change of the value
+    // is about the value's remaining error (f''(x - x*)²/2), so two steps in a row that change
+    // it by under kPeakValueTolerance of its size leave the largest value found within about
+    // that of the peak (the time then good to about the square root of it); the bracket need not
+    // close. Golden steps (a kink, a step far from the parabola's) never stop it.
+    if (!golden && std::abs(fu - fx) <= kPeakValueTolerance * std::abs(fx)) {
+      if (++quiet_steps >= 2) break;
+    } else {
+      quiet_steps = 0;
+    }
     if (fu <= fx) {
       (u < x ? b : a) = x;
       v = w;
