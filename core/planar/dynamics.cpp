@@ -23,6 +23,9 @@ constexpr double kPi = 3.14159265358979323846;
 // the position is then exact to round-off (the previous step was ~1e-8 of the scale or less)
 constexpr double kNewtonStep = 1e-14;
 constexpr int kNewtonIterations = 40;
+// a constraint residual below this fraction of the length scale is round-off of the closure
+// equations (lengths and coordinates of that size): Newton stops there when its steps stagnate
+constexpr double kRoundOffResidual = 16 * std::numeric_limits<double>::epsilon();
 // a last Newton step below this (times the linkage's size) leaves the Jacobian unchanged to
 // round-off: its factorisation is kept
 constexpr double kRefactorStep = 4 * std::numeric_limits<double>::epsilon();
@@ -361,6 +364,9 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
   in.x = guess;
   detail::q_from_nodes(s, in.x, ws.q);
   const double step_limit = kNewtonStep * model.length_scale();
+  // the residual at round-off: below it Newton cannot improve the position further
+  const double round_off = kRoundOffResidual * model.length_scale();
+  double previous_step = std::numeric_limits<double>::infinity();
   for (int it = 0; it < kNewtonIterations; ++it) {
     detail::constraint_values(s, in.x, ws.target, ws.g);
     detail::constraint_jacobian(s, in.x, s.rows, ws.G);
@@ -386,6 +392,14 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
     ws.q -= ws.step;
     detail::nodes_from_q(s, ws.q, in.x);
     const double last_step = ws.step.cwiseAbs().maxCoeff();
+    // near a singular position (a dead centre a hair's breadth away) the step at round-off is
+    // the condition number times round-off, above step_limit: where the residual the step was
+    // solved from was at round-off and the step no longer halves, the position is as exact as
+    // the constraints can say
+    const bool stagnant = last_step > step_limit && last_step > 0.5 * previous_step &&
+                          ws.g.cwiseAbs().maxCoeff() <= round_off;
+    previous_step = last_step;
+    if (stagnant) return solved();
     if (last_step <= step_limit) {
       // the rates and accelerations need the factorisation at the solution, not at the iterate
       // before it (up to step_limit away: a relative error of 1e-14 in every rate, which an

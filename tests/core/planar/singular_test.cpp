@@ -70,6 +70,43 @@ TEST(Singular, DrivenAwayFromNearADeadCentreStaysOnTheDrawnBranch) {
   }
 }
 
+// Assembly a hair's breadth from a dead centre: the Jacobian's condition number there grows like
+// 1/sqrt of the distance, so Newton's last steps are round-off times it (1e-12 of the length at
+// 1e-9 of the stroke), above the step at which it stops elsewhere (1e-14). It stops where the
+// closure residual is at round-off and its steps no longer halve (regression: at 1e-5 of the
+// stroke one build's round-off kept the steps at 2e-14 and assembly failed). The piston must sit
+// where asked and every link keep its length, to round-off.
+TEST(Singular, AssemblesAHairsBreadthFromADeadCentre) {
+  Rng rng(402);
+  int assembled = 0;
+  for (int i = 0; i < 12; ++i) {
+    const cp::Linkage l = driven_by_piston(slider_crank(rng, coin(rng)));
+    const Stroke st = stroke_of(l);
+    const cp::Model m(l);
+    const double r = node_distance(l, 0, 1), rod = node_distance(l, 1, 2);
+    for (double fraction : {1e-5, 1e-7, 1e-9}) {
+      for (bool at_lo : {true, false}) {
+        const double s =
+            at_lo ? st.lo + fraction * (st.hi - st.lo) : st.hi - fraction * (st.hi - st.lo);
+        cp::Workspace w(m);
+        const auto ok = cp::assemble(m, w, {s});
+        ASSERT_TRUE(ok) << "slider-crank #" << i << " at " << fraction << " of the stroke from its "
+                        << (at_lo ? "inner" : "outer") << " dead centre: " << ok.error().detail;
+        const std::vector<Vec2>& x = w.instant.x;
+        const double size = m.length_scale();
+        EXPECT_NEAR((x[1] - x[0]).norm(), r, 1e-13 * size);
+        EXPECT_NEAR((x[2] - x[1]).norm(), rod, 1e-13 * size);
+        const cp::Slider& g = l.sliders[0];
+        const Vec2 u = (g.to - g.from).normalized();
+        EXPECT_NEAR(u.dot(x[2] - g.from), s, 1e-13 * size);
+        EXPECT_NEAR(cross2(u, x[2] - g.from), 0.0, 1e-13 * size);
+        ++assembled;
+      }
+    }
+  }
+  EXPECT_EQ(assembled, 72);
+}
+
 // What a driven run stopped at a singular position must show: the status, a message naming the
 // time and the input's value at the first sample it could not evaluate, every sample before it
 // (at the scene's times), nothing non-finite. Returns the index of that sample.
