@@ -485,10 +485,13 @@ std::vector<std::string> draw(const std::string& gnuplot, const std::string& dat
   }
   std::size_t drawn = 0;
   for (const Chart& c : charts) {
+    // the failed run may have left this chart's picture, whole or cut short: never taken
+    const fs::path svg = tmp.path() / (c.id + ".svg");
+    std::error_code ec;
+    fs::remove(svg, ec);
     const std::string why = run_gnuplot(
         gnuplot, chart_script(datablocks, std::span<const Chart>(&c, 1), tmp.path()), tmp.path(),
         c.id);
-    const fs::path svg = tmp.path() / (c.id + ".svg");
     if (why.empty() && fs::exists(svg)) {
       svgs.push_back(inline_svg(read_file(svg), c.id));
       ++drawn;
