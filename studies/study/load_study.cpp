@@ -317,7 +317,9 @@ YAML::Node one_document(const std::string& text, const Reporter& r) {
   }
   if (marks.starts.size() > 1) {
     const YAML::Mark& at = marks.starts[1];
-    const std::size_t pos = at.pos >= 0 ? static_cast<std::size_t>(at.pos) : text.size();
+    // a mark past the text (never expected of UTF-8 text) is taken as its end
+    const std::size_t pos =
+        at.pos >= 0 ? std::min(static_cast<std::size_t>(at.pos), text.size()) : text.size();
     if (text.compare(pos, 3, "---") == 0 || text.compare(pos, 1, "%") == 0) {
       r.fail(at, "a study file holds one YAML document; found a second one (after '---')");
     }
@@ -332,10 +334,31 @@ YAML::Node one_document(const std::string& text, const Reporter& r) {
   }
 }
 
+// A study file is UTF-8 text. yaml-cpp reads a text that starts with a UTF-16 or UTF-32 byte
+// order mark, or with a NUL byte in its first four, as UTF-16 or UTF-32, and its marks then count
+// decoded characters, not the file's bytes and lines: a NUL byte (which UTF-8 text never holds
+// and UTF-16 text always does) or such a mark is refused where it is.
+void check_utf8_text(const std::string& text, const Reporter& r) {
+  const auto starts = [&](std::string_view bom) { return text.compare(0, bom.size(), bom) == 0; };
+  if (starts("\xFE\xFF") || starts("\xFF\xFE") || starts(std::string_view("\0\0\xFE\xFF", 4))) {
+    r.fail(YAML::Mark(), "the study file is not UTF-8 text (it starts with a UTF-16 or UTF-32 "
+                         "byte order mark); save it as UTF-8");
+  }
+  const std::size_t nul = text.find('\0');
+  if (nul == std::string::npos) return;
+  const std::size_t line_start = text.rfind('\n', nul);
+  YAML::Mark at;
+  at.line = static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(nul), '\n'));
+  at.column = static_cast<int>(line_start == std::string::npos ? nul : nul - line_start - 1);
+  r.fail(at, "the study file is not UTF-8 text: it holds a NUL byte here (a binary file, or "
+             "text saved as UTF-16 or UTF-32?); save it as UTF-8");
+}
+
 }  // namespace
 
 Study parse_study(const std::string& yaml_text, const std::string& source_name) {
   const Reporter r(source_name);
+  check_utf8_text(yaml_text, r);
   const YAML::Node root = one_document(yaml_text, r);
   Study study = internal::parse_study_tree(root, source_name);
   // each point of a sweep is this text with its values set (point_study())

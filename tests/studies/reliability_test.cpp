@@ -64,6 +64,21 @@ TEST(HostileStudyText, OnlyADocumentMarkerStartsASecondDocument) {
   EXPECT_NO_THROW(parse_study(kDriven + "...\n", "s.yaml"));
 }
 
+// Found by the long fuzz run: a text starting with '"' and a NUL byte is read by yaml-cpp as
+// UTF-16, its marks count decoded characters, and one of them, past the text's end, made the
+// loader's look at the text throw std::out_of_range (a crash). A study file is UTF-8 text: a NUL
+// byte or a UTF-16/UTF-32 byte order mark is refused where it is.
+TEST(HostileStudyText, NulBytesAndUtf16AreRefusedWhereTheyAre) {
+  expect_study_error(std::string("\"\0act: 1\n", 10), "s.yaml", 1, 2, "not UTF-8 text");
+  expect_study_error(edited(kDriven, "frame: 3.2", std::string("frame: 3\0.2", 11)), "s.yaml", 4,
+                     11, "holds a NUL byte here");
+  expect_study_error("\xFF\xFEn\0a\0", "s.yaml", 1, 1, "byte order mark");
+  expect_study_error("\xFE\xFF\0n\0a", "s.yaml", 1, 1, "byte order mark");
+  // UTF-8, its byte order mark included, is read as before
+  EXPECT_NO_THROW(parse_study("\xEF\xBB\xBF" + kDriven, "s.yaml"));
+  EXPECT_NO_THROW(parse_study("# M\xC3\xBChle\n" + kDriven, "s.yaml"));
+}
+
 // Finding 7: a key or value holding a newline or a NUL is escaped, the message stays one line
 TEST(HostileStudyText, ControlCharactersInKeysAndValuesKeepTheMessageOnOneLine) {
   expect_study_error(kDriven + "\"col\\nour\": red\n", "s.yaml", 10, 1,
