@@ -25,7 +25,6 @@ class SweepDisplay {
 
   Mode mode_;
   std::chrono::steady_clock::time_point last_;
-  bool first_ = true;
   std::size_t drawn_ = 0;  // width of the bar line last drawn
 };
 

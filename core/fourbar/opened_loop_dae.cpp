@@ -30,7 +30,6 @@ namespace {
 
 using Mat23 = Eigen::Matrix<double, 2, 3>;
 
-constexpr int kStates = 6;  // theta1..3 [rad], omega1..3 [rad/s]
 // GGL: the six states, then lambda = RA3 [N] and the multiplier mu of the closure [1/(m s)]
 constexpr int kGglStates = 10;
 // Gauss-Newton iterations of one projection onto the closure; from an integrator step off the
