@@ -10,6 +10,7 @@
 /// table's own metrics as the total metrics below.
 #include <cmath>
 #include <cstddef>
+#include <span>
 
 namespace bd::core {
 
@@ -57,6 +58,18 @@ class RmsAccumulator {
   double scale_ = 0.0;   // the largest |x| so far
   double scaled_ = 0.0;  // Σ (x / scale_)²
 };
+
+/// The RMS of the magnitudes x, as RmsAccumulator gives it (the same bits): the plain sum in one
+/// pass, the scaled one only where a square leaves double's range.
+inline double rms_of(std::span<const double> x) {
+  if (x.empty()) return 0.0;
+  double plain = 0.0;
+  for (const double v : x) plain += v * v;
+  if (std::isfinite(plain) && plain > 0) return std::sqrt(plain / static_cast<double>(x.size()));
+  RmsAccumulator scaled;
+  for (const double v : x) scaled.add(v);
+  return scaled.rms();
+}
 
 /// One of the total shaking force's and moment's metrics (inertial and static parts together).
 struct TotalMetricInfo {

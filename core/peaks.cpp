@@ -15,19 +15,43 @@ double value_at(const QuantityAt& f, double t) {
   return std::isnan(v) ? -std::numeric_limits<double>::infinity() : v;
 }
 
+// Three known values of f: the sampled local maximum (t, x) inside the bracket and its
+// neighbours at the bracket's ends.
+struct KnownPoints {
+  double ta, xa, t, x, tb, xb;
+};
+
 // Brent's method (golden section with parabolic steps, as in Brent 1973, ch. 5) maximising f on
-// [a, b] to the time tolerance `tol`; `best` is raised to every value it evaluates
-void brent_maximise(const QuantityAt& f, double a, double b, double tol, Peak& best) {
+// [a, b] to the time tolerance `tol`; `best` is raised to every value it evaluates. With `known`
+// (a, b its ends), the search starts from the samples instead of a golden-section point: x the
+// sampled maximum, w and v its neighbours, and the first step is the vertex of their parabola
+// (as if the step before had spanned the bracket), so no evaluation is spent where the samples
+// already tell.
+void brent_maximise(const QuantityAt& f, double a, double b, double tol, Peak& best,
+                    const KnownPoints* known = nullptr) {
   constexpr double kGolden = 0.3819660112501051;  // (3 - sqrt 5) / 2
   auto g = [&](double t) {  // minimised: -f
     const double v = value_at(f, t);
     if (v > best.value) best = {v, t};
     return -v;
   };
-  double x = a + kGolden * (b - a), w = x, v = x;
-  double fx = g(x), fw = fx, fv = fx;
+  double x, w, v, fx, fw, fv;
   double d = 0.0, e = 0.0;
-  int quiet_steps = 0;
+  if (known) {
+    const bool a_better = known->xa >= known->xb;
+    x = known->t;
+    fx = -known->x;
+    w = a_better ? known->ta : known->tb;
+    fw = -(a_better ? known->xa : known->xb);
+    v = a_better ? known->tb : known->ta;
+    fv = -(a_better ? known->xb : known->xa);
+    e = b - a;
+    d = 0.5 * (b - a);
+  } else {
+    x = w = v = a + kGolden * (b - a);
+    fx = fw = fv = g(x);
+  }
+  double last_change = std::numeric_limits<double>::infinity();  // of the last parabolic step
   for (int iter = 0; iter < 200; ++iter) {
     const double m = 0.5 * (a + b);
     const double tol1 = tol + 1e-15 * std::abs(x), tol2 = 2 * tol1;
@@ -55,15 +79,16 @@ void brent_maximise(const QuantityAt& f, double a, double b, double tol, Peak& b
     const double u = std::abs(d) >= tol1 ? x + d : x + (d > 0 ? tol1 : -tol1);
     const double fu = g(u);
     // the value is what is wanted: near a smooth maximum, a parabolic step's change of the value
-    // is about the value's remaining error (f''(x - x*)²/2), so two steps in a row that change
-    // it by under kPeakValueTolerance of its size leave the largest value found within about
-    // that of the peak (the time then good to about the square root of it); the bracket need not
-    // close. Golden steps (a kink, a step far from the parabola's) never stop it.
-    if (!golden && std::abs(fu - fx) <= kPeakValueTolerance * std::abs(fx)) {
-      if (++quiet_steps >= 2) break;
-    } else {
-      quiet_steps = 0;
-    }
+    // is about the value's remaining error (f''(x - x*)²/2), so a step that changes it by under
+    // kPeakValueTolerance of its size, right after one under kPeakSettlingTolerance, leaves the
+    // largest value found within about that of the peak (the time then good to about the square
+    // root of it); the bracket need not close. Golden steps (a kink, a step far from the
+    // parabola's) never end it.
+    const double change =
+        golden ? std::numeric_limits<double>::infinity()
+               : (fu == fx ? 0.0 : std::abs(fu - fx) / std::abs(fx));
+    if (change <= kPeakValueTolerance && last_change <= kPeakSettlingTolerance) break;
+    last_change = change;
     if (fu <= fx) {
       (u < x ? b : a) = x;
       v = w;
@@ -90,6 +115,9 @@ void brent_maximise(const QuantityAt& f, double a, double b, double tol, Peak& b
 struct Candidate {
   double upper{};  // a generous bound of the peak within the bracket
   double a{}, b{};  // the bracket [s]
+  double xa{}, x{}, xb{};  // the samples at a, inside (at t) and at b, where both ends are samples
+  double t{};
+  bool interior{};  // both neighbours known: the search starts from the three samples
 };
 
 }  // namespace
@@ -104,40 +132,28 @@ Peak resolved_peak(std::span<const double> t, std::span<const double> x, double 
   if (n == 0) return {0.0, 0.0};
   if (n < 3 || !f) return best;
   const bool periodic = period > 0;
-  // the neighbours of sample i (across the period's end when periodic), or none at an open end
+  // A sample no neighbour rises above is a candidate; a smooth peak between its neighbours rises
+  // above it by at most about an eighth of the drop to the lower neighbour, so the whole drop is
+  // a generous bound (at an open end, where one neighbour is missing, at least 1e-3 of the
+  // value). A candidate whose bound does not exceed the largest sample cannot win.
   std::vector<Candidate> candidates;
-  for (std::size_t i = 0; i < n; ++i) {
-    const bool first = i == 0, last = i + 1 == n;
-    double ta = 0, tb = 0, xa = 0, xb = 0;
-    bool has_a = true, has_b = true;
-    if (first) {
-      has_a = periodic;
-      if (periodic) {
-        ta = t[n - 1] - period;
-        xa = x[n - 1];
-      }
-    } else {
-      ta = t[i - 1];
-      xa = x[i - 1];
-    }
-    if (last) {
-      has_b = periodic;
-      if (periodic) {
-        tb = t[0] + period;
-        xb = x[0];
-      }
-    } else {
-      tb = t[i + 1];
-      xb = x[i + 1];
-    }
-    if ((has_a && xa > x[i]) || (has_b && xb > x[i])) continue;  // not a local maximum
-    // a smooth peak between the neighbours rises above x[i] by at most about an eighth of the
-    // drop to the lower neighbour; the whole drop is a generous bound
+  auto consider = [&](std::size_t i, bool has_a, double ta, double xa, bool has_b, double tb,
+                      double xb) {
+    if ((has_a && xa > x[i]) || (has_b && xb > x[i])) return;  // not a local maximum
     const double drop = x[i] - std::min(has_a ? xa : x[i], has_b ? xb : x[i]);
     double upper = x[i] + drop;
     if (!has_a || !has_b) upper = x[i] + std::max(drop, std::abs(x[i]) * 1e-3);
-    candidates.push_back({upper, has_a ? ta : t[i], has_b ? tb : t[i]});
+    if (!(upper > best.value)) return;
+    candidates.push_back({upper, has_a ? ta : t[i], has_b ? tb : t[i], xa, x[i], xb, t[i],
+                          has_a && has_b});
+  };
+  // the ends: neighbours across the period's end when periodic, none at an open end
+  consider(0, periodic, t[n - 1] - period, x[n - 1], true, t[1], x[1]);
+  for (std::size_t i = 1; i + 1 < n; ++i) {
+    if (x[i - 1] > x[i] || x[i + 1] > x[i]) continue;  // the common case, decided at once
+    consider(i, true, t[i - 1], x[i - 1], true, t[i + 1], x[i + 1]);
   }
+  consider(n - 1, true, t[n - 2], x[n - 2], periodic, t[0] + period, x[0]);
   std::sort(candidates.begin(), candidates.end(),
             [](const Candidate& p, const Candidate& q) { return p.upper > q.upper; });
   constexpr std::size_t kMaxCandidates = 64;
@@ -147,7 +163,9 @@ Peak resolved_peak(std::span<const double> t, std::span<const double> x, double 
     // samples, such as a free scene's drive effort of 0, has no candidate to refine)
     if (c.upper <= best.value) break;
     if (!(c.b > c.a)) continue;
-    brent_maximise(f, c.a, c.b, kPeakTimeTolerance * (c.b - c.a), best);
+    const KnownPoints known{c.a, c.xa, c.t, c.x, c.b, c.xb};
+    brent_maximise(f, c.a, c.b, kPeakTimeTolerance * (c.b - c.a), best,
+                   c.interior && c.t > c.a && c.t < c.b ? &known : nullptr);
   }
   // a periodic time from the bracket across the end, back into [t0, t0 + period)
   if (periodic && best.t < t[0]) best.t += period;

@@ -20,10 +20,13 @@ using QuantityAt = std::function<double(double t)>;
 /// Relative tolerance to which a bracket's maximiser is located in time; the peak's value, whose
 /// error goes with the square of the time's, is then good to round-off.
 inline constexpr double kPeakTimeTolerance = 1e-10;
-/// The search also ends, before the bracket closes to kPeakTimeTolerance, once two parabolic
-/// steps in a row change the value by less than this relative to it (near a smooth maximum a
-/// step's change is about the value's remaining error): the value is then good to about this.
+/// The search also ends, before the bracket closes to kPeakTimeTolerance, once a parabolic step
+/// changes the value by less than this relative to it, right after a parabolic step that changed
+/// it by less than kPeakSettlingTolerance (near a smooth maximum a step's change is about the
+/// value's remaining error, and parabolic steps converge superlinearly, so the second confirms
+/// the first is not a chance): the value is then good to about kPeakValueTolerance.
 inline constexpr double kPeakValueTolerance = 1e-14;
+inline constexpr double kPeakSettlingTolerance = 1e-12;
 
 /// The peak of x over the samples x[i] = f(t[i]) (t increasing). Every sampled local maximum whose
 /// parabola through it and its neighbours could reach the largest sample is refined by Brent's

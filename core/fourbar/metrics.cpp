@@ -1,11 +1,13 @@
 #include "core/fourbar/metrics.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <functional>
 #include <numbers>
 #include <optional>
+#include <span>
+#include <utility>
+#include <vector>
 
 #include "core/detail/known_instants.hpp"
 
@@ -18,59 +20,63 @@ const MetricInfo* metric_info(std::string_view name) {
   return nullptr;
 }
 
-double magnitude(const DynamicsSample& s, Quantity quantity) {
-  switch (quantity) {
-    case Quantity::kShakingForce:
-      return core::magnitude(s.Fsh_inertial.x(), s.Fsh_inertial.y());
-    case Quantity::kShakingMoment:
-      return std::abs(s.Msh_inertial);
-    case Quantity::kDriveTorque:
-      return std::abs(s.tau);
-    case Quantity::kReactionA0:
-      return core::magnitude(s.RA0.x(), s.RA0.y());
-    case Quantity::kReactionA3:
-      return core::magnitude(s.RA3.x(), s.RA3.y());
+namespace {
+
+constexpr Quantity kQuantities[] = {Quantity::kShakingForce, Quantity::kShakingMoment,
+                                    Quantity::kDriveTorque, Quantity::kReactionA0,
+                                    Quantity::kReactionA3};
+constexpr std::size_t kOutputCount = std::size(kOutputMetrics);
+
+// Every sample's magnitudes, computed once for the RMS, the peaks and their search: a column
+// per quantity of the table, then one per row of kOutputMetrics.
+class SampleMagnitudes {
+ public:
+  explicit SampleMagnitudes(const std::vector<DynamicsSample>& samples)
+      : n_(samples.size()), v_((std::size(kQuantities) + kOutputCount) * n_) {
+    for (std::size_t i = 0; i < n_; ++i) {
+      const DynamicsSample& s = samples[i];
+      for (std::size_t q = 0; q < std::size(kQuantities); ++q)
+        v_[q * n_ + i] = magnitude(s, kQuantities[q]);
+      for (std::size_t k = 0; k < kOutputCount; ++k)
+        v_[(std::size(kQuantities) + k) * n_ + i] = kOutputMetrics[k].magnitude(s);
+    }
   }
-  return 0.0;
+  std::span<const double> of(Quantity quantity) const {
+    return column(static_cast<std::size_t>(
+        std::find(std::begin(kQuantities), std::end(kQuantities), quantity) -
+        std::begin(kQuantities)));
+  }
+  std::span<const double> output(std::size_t k) const {
+    return column(std::size(kQuantities) + k);
+  }
+
+ private:
+  std::span<const double> column(std::size_t c) const { return {v_.data() + c * n_, n_}; }
+  std::size_t n_;
+  std::vector<double> v_;
+};
+
+double statistic_of(std::span<const double> x, Statistic statistic) {
+  if (statistic == Statistic::kRms) return rms_of(x);
+  double peak = 0.0;
+  for (const double v : x) peak = std::max(peak, v);
+  return peak;
 }
 
-Metrics metrics(const Trajectory& trajectory) {
+Metrics metrics_of(const SampleMagnitudes& magnitudes) {
   Metrics m;
-  const auto& samples = trajectory.samples;
-  if (samples.empty()) return m;
-  // per row of the table and of the outputs' metrics: the RMS (without overflow) or the running
-  // maximum (peak)
-  std::array<RmsAccumulator, kMetricCount> rms{};
-  std::array<double, kMetricCount> peak{};
-  std::array<RmsAccumulator, std::size(kOutputMetrics)> output_rms{};
-  std::array<double, std::size(kOutputMetrics)> output_peak{};
-  for (const DynamicsSample& s : samples) {
-    for (std::size_t k = 0; k < kMetricCount; ++k) {
-      const double x = magnitude(s, kMetricTable[k].quantity);
-      if (kMetricTable[k].statistic == Statistic::kRms) {
-        rms[k].add(x);
-      } else {
-        peak[k] = std::max(peak[k], x);
-      }
-    }
-    for (std::size_t k = 0; k < output_rms.size(); ++k) {
-      const double x = kOutputMetrics[k].magnitude(s);
-      if (kOutputMetrics[k].statistic == Statistic::kRms) {
-        output_rms[k].add(x);
-      } else {
-        output_peak[k] = std::max(output_peak[k], x);
-      }
-    }
-  }
-  for (std::size_t k = 0; k < kMetricCount; ++k) {
-    const MetricInfo& info = kMetricTable[k];
-    m.*info.field = info.statistic == Statistic::kRms ? rms[k].rms() : peak[k];
-  }
-  for (std::size_t k = 0; k < output_rms.size(); ++k) {
-    const OutputMetricInfo& info = kOutputMetrics[k];
-    m.*info.field = info.statistic == Statistic::kRms ? output_rms[k].rms() : output_peak[k];
-  }
+  for (const MetricInfo& info : kMetricTable)
+    m.*info.field = statistic_of(magnitudes.of(info.quantity), info.statistic);
+  for (std::size_t k = 0; k < kOutputCount; ++k)
+    m.*kOutputMetrics[k].field = statistic_of(magnitudes.output(k), kOutputMetrics[k].statistic);
   return m;
+}
+
+}  // namespace
+
+Metrics metrics(const Trajectory& trajectory) {
+  if (trajectory.samples.empty()) return {};
+  return metrics_of(SampleMagnitudes(trajectory.samples));
 }
 
 namespace {
@@ -80,26 +86,32 @@ namespace {
 Metrics with_peaks(const Trajectory& trajectory, double period,
                    const std::function<std::optional<DynamicsSample>(double)>& sample_at,
                    PeakList* peaks) {
-  Metrics m = metrics(trajectory);
   const std::vector<DynamicsSample>& samples = trajectory.samples;
   if (peaks) {
     peaks->table.assign(kMetricCount, Peak{});
     peaks->output.assign(std::size(kOutputMetrics), Peak{});
   }
-  if (samples.empty()) return m;
-  // the sample at time s, computed once for every quantity's search
-  double cached_t = std::nan("");
-  std::optional<DynamicsSample> cached;
+  if (samples.empty()) return {};
+  const SampleMagnitudes magnitudes(samples);
+  Metrics m = metrics_of(magnitudes);
+  // the samples at the instants asked for, the last kCached of them kept: quantities whose
+  // searches ask for the same instants (the total and the inertial shaking force of a scene
+  // without weights or loads, whose samples are the same) compute each instant once
+  constexpr std::size_t kCached = 64;
+  std::vector<std::pair<double, std::optional<DynamicsSample>>> cache;
+  cache.reserve(kCached);  // never reallocated: references into it stay valid
+  std::size_t oldest = 0;
   auto at = [&](double s) -> const std::optional<DynamicsSample>& {
-    if (s != cached_t) {
-      cached_t = s;
-      cached = sample_at(s);
+    for (const auto& [t, d] : cache) {
+      if (t == s) return d;
     }
-    return cached;
+    if (cache.size() < kCached) return cache.emplace_back(s, sample_at(s)).second;
+    auto& slot = cache[oldest];
+    oldest = (oldest + 1) % kCached;
+    slot = {s, sample_at(s)};
+    return slot.second;
   };
-  std::vector<double> x(samples.size());
-  auto resolve = [&](auto magnitude_of) {
-    for (std::size_t i = 0; i < samples.size(); ++i) x[i] = magnitude_of(samples[i]);
+  auto resolve = [&](std::span<const double> x, auto magnitude_of) {
     QuantityAt f;
     if (sample_at) {
       f = [&](double s) {
@@ -115,7 +127,8 @@ Metrics with_peaks(const Trajectory& trajectory, double period,
       if (peaks) peaks->table[k] = {m.*info.field, 0.0};
       continue;
     }
-    const Peak p = resolve([&](const DynamicsSample& d) { return magnitude(d, info.quantity); });
+    const Peak p = resolve(magnitudes.of(info.quantity),
+                           [&](const DynamicsSample& d) { return magnitude(d, info.quantity); });
     m.*info.field = p.value;
     if (peaks) peaks->table[k] = p;
   }
@@ -125,7 +138,7 @@ Metrics with_peaks(const Trajectory& trajectory, double period,
       if (peaks) peaks->output[k] = {m.*info.field, 0.0};
       continue;
     }
-    const Peak p = resolve(info.magnitude);
+    const Peak p = resolve(magnitudes.output(k), info.magnitude);
     m.*info.field = p.value;
     if (peaks) peaks->output[k] = p;
   }

@@ -78,7 +78,22 @@ inline constexpr std::size_t kMetricCount = std::size(kMetricTable);
 const MetricInfo* metric_info(std::string_view name);
 
 /// The magnitude of `quantity` at one sample.
-double magnitude(const DynamicsSample& sample, Quantity quantity);
+inline double magnitude(const DynamicsSample& s, Quantity quantity) {
+  switch (quantity) {
+    case Quantity::kShakingForce:
+      return core::magnitude(s.Fsh_inertial.x(), s.Fsh_inertial.y());
+    case Quantity::kShakingMoment:
+      return std::abs(s.Msh_inertial);
+    case Quantity::kDriveTorque:
+      return std::abs(s.tau);
+    case Quantity::kReactionA0:
+      return core::magnitude(s.RA0.x(), s.RA0.y());
+    case Quantity::kReactionA3:
+      return core::magnitude(s.RA3.x(), s.RA3.y());
+  }
+  return 0.0;
+}
+
 
 /// A metric every output lists after the table's, which the optimiser does not take: the total
 /// shaking force and moment (core::kTotalMetrics, in its order), then the peaks of the joint

@@ -76,6 +76,13 @@ void stop_at_non_finite(core::Trajectory& r) {
   for (std::size_t i = 0; i < r.samples.size(); ++i) {
     const core::DynamicsSample& s = r.samples[i];
     const core::FourBarState& q = s.state;
+    // the common case in one pass: 0 * v is 0 for every finite v, NaN for an infinity or a NaN
+    const double any = 0.0 * ((i < r.t.size() ? r.t[i] : 0.0) + q.theta1 + q.theta2 + q.theta3 +
+                              q.omega1 + q.omega2 + q.omega3 + q.alpha1 + q.alpha2 + q.alpha3) +
+                       0.0 * (s.RA0.x() + s.RA0.y() + s.RA3.x() + s.RA3.y() + s.RC1.x() +
+                              s.RC1.y() + s.RC3.x() + s.RC3.y() + s.Fsh.x() + s.Fsh.y() + s.Msh +
+                              s.tau);
+    if (any == 0.0) continue;
     const std::pair<const char*, double> values[] = {
         {"t", i < r.t.size() ? r.t[i] : 0.0},
         {"theta1", q.theta1}, {"theta2", q.theta2}, {"theta3", q.theta3},

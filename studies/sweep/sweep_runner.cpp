@@ -88,7 +88,8 @@ void second_design_cells(std::string& row, const MetricList* metrics, const Metr
     row += ",";
     for (const MetricValue& m : *metrics) {
       if (m.name == c.name) {
-        row += text::exact(m.value);
+        char buf[32];
+        row += text::exact_chars(m.value, buf);
         break;
       }
     }
@@ -121,7 +122,11 @@ SweepRow sweep_row(const Study& base, int index, std::span<const double> values)
   try {
     const Study study = detail::sweep_point_study(base, values);
     const RunResult r = compute_study(study, ComputeParts{.harmonics = false});
-    for (const MetricValue& m : r.metric_list) body += "," + text::exact(m.value);
+    char buf[32];
+    for (const MetricValue& m : r.metric_list) {
+      body += ',';
+      body += text::exact_chars(m.value, buf);
+    }
     if (base.balance || base.planar_balance) {
       const bool have = r.balanced && (study.balance || r.balanced->design);
       const auto [mass, inertia] = have ? added(study, r) : std::pair<double, double>{};
