@@ -6,7 +6,6 @@
 #include <numbers>
 #include <optional>
 #include <span>
-#include <utility>
 #include <vector>
 
 #include "core/detail/known_instants.hpp"
@@ -94,22 +93,15 @@ Metrics with_peaks(const Trajectory& trajectory, double period,
   if (samples.empty()) return {};
   const SampleMagnitudes magnitudes(samples);
   Metrics m = metrics_of(magnitudes);
-  // the samples at the instants asked for, the last kCached of them kept: quantities whose
-  // searches ask for the same instants (the total and the inertial shaking force of a scene
-  // without weights or loads, whose samples are the same) compute each instant once
-  constexpr std::size_t kCached = 64;
-  std::vector<std::pair<double, std::optional<DynamicsSample>>> cache;
-  cache.reserve(kCached);  // never reallocated: references into it stay valid
-  std::size_t oldest = 0;
+  // the sample at time s, computed once for every quantity's search
+  double cached_t = std::nan("");
+  std::optional<DynamicsSample> cached;
   auto at = [&](double s) -> const std::optional<DynamicsSample>& {
-    for (const auto& [t, d] : cache) {
-      if (t == s) return d;
+    if (s != cached_t) {
+      cached_t = s;
+      cached = sample_at(s);
     }
-    if (cache.size() < kCached) return cache.emplace_back(s, sample_at(s)).second;
-    auto& slot = cache[oldest];
-    oldest = (oldest + 1) % kCached;
-    slot = {s, sample_at(s)};
-    return slot.second;
+    return cached;
   };
   auto resolve = [&](std::span<const double> x, auto magnitude_of) {
     QuantityAt f;
