@@ -3,6 +3,7 @@
 // interrupted sweep. The points and each point's study come from sweep.cpp, the report from
 // sweep_report.cpp.
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -308,12 +309,16 @@ std::string row_problem(const std::string& line, std::size_t i, std::size_t colu
 
 // sweep.csv opened for appending: each row goes out in one write(2), so a kill leaves at most
 // one line cut short; a row that cannot be written whole (a full disk, a file-size limit) is
-// taken back, so the file ends with whole rows
+// taken back, so the file ends with whole rows. The file's length is kept here (this is its
+// only writer) rather than asked of the kernel for every row.
 class RowFile {
  public:
   explicit RowFile(fs::path file) : file_(std::move(file)) {
     fd_ = ::open(file_.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
     if (fd_ < 0) fail("cannot open");
+    struct stat st {};
+    if (::fstat(fd_, &st) != 0) fail("cannot open");
+    end_ = st.st_size;
   }
   RowFile(const RowFile&) = delete;
   RowFile& operator=(const RowFile&) = delete;
@@ -322,7 +327,7 @@ class RowFile {
   }
 
   void append(const std::string& row) {
-    const off_t before = ::lseek(fd_, 0, SEEK_END);
+    const off_t before = end_;
     const char* p = row.data();
     std::size_t left = row.size();
     while (left > 0) {  // one write unless the kernel takes less (a full disk)
@@ -330,7 +335,7 @@ class RowFile {
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0) {
         const int saved = errno == 0 ? ENOSPC : errno;  // write(2) taking 0 bytes: no space
-        if (before >= 0 && ::ftruncate(fd_, before) != 0) {
+        if (::ftruncate(fd_, before) != 0) {
           // the row stays cut short (--resume drops it); the error said is the write's
         }
         errno = saved;
@@ -339,6 +344,7 @@ class RowFile {
       p += n;
       left -= static_cast<std::size_t>(n);
     }
+    end_ += static_cast<off_t>(row.size());
   }
 
   void close() {
@@ -356,6 +362,7 @@ class RowFile {
   }
   fs::path file_;
   int fd_ = -1;
+  off_t end_ = 0;  // the file's length: where the next row starts
 };
 
 }  // namespace
