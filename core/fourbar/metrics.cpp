@@ -91,8 +91,9 @@ Metrics with_peaks(const Trajectory& trajectory, double period,
     peaks->output.assign(std::size(kOutputMetrics), Peak{});
   }
   if (samples.empty()) return {};
+  // the RMS rows from the samples' magnitudes, the peak rows by their searches
   const SampleMagnitudes magnitudes(samples);
-  Metrics m = metrics_of(magnitudes);
+  Metrics m;
   // the sample at time s, computed once for every quantity's search
   double cached_t = std::nan("");
   std::optional<DynamicsSample> cached;
@@ -116,6 +117,7 @@ Metrics with_peaks(const Trajectory& trajectory, double period,
   for (std::size_t k = 0; k < kMetricCount; ++k) {
     const MetricInfo& info = kMetricTable[k];
     if (info.statistic != Statistic::kMax) {
+      m.*info.field = rms_of(magnitudes.of(info.quantity));
       if (peaks) peaks->table[k] = {m.*info.field, 0.0};
       continue;
     }
@@ -127,6 +129,7 @@ Metrics with_peaks(const Trajectory& trajectory, double period,
   for (std::size_t k = 0; k < std::size(kOutputMetrics); ++k) {
     const OutputMetricInfo& info = kOutputMetrics[k];
     if (info.statistic != Statistic::kMax) {
+      m.*info.field = rms_of(magnitudes.output(k));
       if (peaks) peaks->output[k] = {m.*info.field, 0.0};
       continue;
     }

@@ -76,29 +76,30 @@ void stop_at_non_finite(core::Trajectory& r) {
   for (std::size_t i = 0; i < r.samples.size(); ++i) {
     const core::DynamicsSample& s = r.samples[i];
     const core::FourBarState& q = s.state;
-    // the common case in one pass: 0 * v is 0 for every finite v, NaN for an infinity or a NaN
-    const double any = 0.0 * ((i < r.t.size() ? r.t[i] : 0.0) + q.theta1 + q.theta2 + q.theta3 +
-                              q.omega1 + q.omega2 + q.omega3 + q.alpha1 + q.alpha2 + q.alpha3) +
-                       0.0 * (s.RA0.x() + s.RA0.y() + s.RA3.x() + s.RA3.y() + s.RC1.x() +
-                              s.RC1.y() + s.RC3.x() + s.RC3.y() + s.Fsh.x() + s.Fsh.y() + s.Msh +
-                              s.tau);
+    // every number of the sample, and below its column's name (one list, in the same order)
+    const double values[] = {i < r.t.size() ? r.t[i] : 0.0,
+                             q.theta1, q.theta2, q.theta3, q.omega1, q.omega2, q.omega3,
+                             q.alpha1, q.alpha2, q.alpha3, s.RA0.x(), s.RA0.y(), s.RA3.x(),
+                             s.RA3.y(), s.RC1.x(), s.RC1.y(), s.RC3.x(), s.RC3.y(), s.Fsh.x(),
+                             s.Fsh.y(), s.Msh, s.tau};
+    static constexpr const char* kNames[] = {
+        "t",    "theta1", "theta2", "theta3", "omega1", "omega2", "omega3", "alpha1",
+        "alpha2", "alpha3", "RA0x", "RA0y", "RA3x", "RA3y", "RC1x", "RC1y",
+        "RC3x", "RC3y",   "Fshx",   "Fshy",   "Msh",    "tau"};
+    static_assert(std::size(kNames) == std::size(values));
+    // the common case in one branch-free pass: 0 * v is 0 for every finite v, NaN for an
+    // infinity or a NaN; the names are looked at only where that fails
+    double any = 0.0;
+    for (const double v : values) any += 0.0 * v;
     if (any == 0.0) continue;
-    const std::pair<const char*, double> values[] = {
-        {"t", i < r.t.size() ? r.t[i] : 0.0},
-        {"theta1", q.theta1}, {"theta2", q.theta2}, {"theta3", q.theta3},
-        {"omega1", q.omega1}, {"omega2", q.omega2}, {"omega3", q.omega3},
-        {"alpha1", q.alpha1}, {"alpha2", q.alpha2}, {"alpha3", q.alpha3},
-        {"RA0x", s.RA0.x()},  {"RA0y", s.RA0.y()},  {"RA3x", s.RA3.x()},
-        {"RA3y", s.RA3.y()},  {"RC1x", s.RC1.x()},  {"RC1y", s.RC1.y()},
-        {"RC3x", s.RC3.x()},  {"RC3y", s.RC3.y()},  {"Fshx", s.Fsh.x()},
-        {"Fshy", s.Fsh.y()},  {"Msh", s.Msh},       {"tau", s.tau}};
-    for (const auto& [name, v] : values) {
+    for (std::size_t k = 0; k < std::size(values); ++k) {
+      const double v = values[k];
       if (std::isfinite(v)) continue;
       const double t = i < r.t.size() ? r.t[i] : 0.0;
       const std::string where = std::isfinite(q.theta1)
                                     ? ", theta1 = " + text::digits(q.theta1, 10) + " rad"
                                     : std::string();
-      r.message = non_finite_message(t, where, name, v);
+      r.message = non_finite_message(t, where, kNames[k], v);
       r.status = core::SimulationStatus::kIntegratorFailed;
       r.samples.resize(i);
       r.t.resize(std::min(r.t.size(), i));

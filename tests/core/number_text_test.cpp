@@ -53,7 +53,8 @@ TEST(NumberText, ExactIsPrintfs17gByteForByte) {
     EXPECT_EQ(std::string(out.data(), out.size()), got);
   }
   EXPECT_EQ(differ, 0);
-  EXPECT_EQ(exact(std::numeric_limits<double>::quiet_NaN()), printf_17g(std::numeric_limits<double>::quiet_NaN()));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(exact(nan), printf_17g(nan));
 }
 
 }  // namespace
