@@ -126,16 +126,19 @@ Peak resolved_peak(std::span<const double> t, std::span<const double> x, double 
                    const QuantityAt& f) {
   const std::size_t n = std::min(t.size(), x.size());
   Peak best{-std::numeric_limits<double>::infinity(), 0.0};
-  for (std::size_t i = 0; i < n; ++i) {
-    if (x[i] > best.value) best = {x[i], t[i]};
+  if (n < 3 || !f) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (x[i] > best.value) best = {x[i], t[i]};
+    }
+    return n == 0 ? Peak{0.0, 0.0} : best;
   }
-  if (n == 0) return {0.0, 0.0};
-  if (n < 3 || !f) return best;
   const bool periodic = period > 0;
   // A sample no neighbour rises above is a candidate; a smooth peak between its neighbours rises
   // above it by at most about an eighth of the drop to the lower neighbour, so the whole drop is
   // a generous bound (at an open end, where one neighbour is missing, at least 1e-3 of the
-  // value). A candidate whose bound does not exceed the largest sample cannot win.
+  // value). A candidate whose bound does not exceed the largest sample cannot win: those below
+  // the largest sample so far are left out at once, the rest once the largest is known (below).
+  // The largest sample is found in the same pass.
   std::vector<Candidate> candidates;
   auto consider = [&](std::size_t i, bool has_a, double ta, double xa, bool has_b, double tb,
                       double xb) {
@@ -148,11 +151,15 @@ Peak resolved_peak(std::span<const double> t, std::span<const double> x, double 
                           has_a && has_b});
   };
   // the ends: neighbours across the period's end when periodic, none at an open end
+  // (the first largest sample is an end or a sample no neighbour rises above)
+  if (x[0] > best.value) best = {x[0], t[0]};
   consider(0, periodic, t[n - 1] - period, x[n - 1], true, t[1], x[1]);
   for (std::size_t i = 1; i + 1 < n; ++i) {
     if (x[i - 1] > x[i] || x[i + 1] > x[i]) continue;  // the common case, decided at once
+    if (x[i] > best.value) best = {x[i], t[i]};
     consider(i, true, t[i - 1], x[i - 1], true, t[i + 1], x[i + 1]);
   }
+  if (x[n - 1] > best.value) best = {x[n - 1], t[n - 1]};
   consider(n - 1, true, t[n - 2], x[n - 2], periodic, t[0] + period, x[0]);
   std::sort(candidates.begin(), candidates.end(),
             [](const Candidate& p, const Candidate& q) { return p.upper > q.upper; });

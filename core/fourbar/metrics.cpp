@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <span>
 #include <vector>
 
 #include "core/detail/known_instants.hpp"
+#include "core/fourbar/detail/instant_dynamics.hpp"
 
 namespace bd::core {
 
@@ -21,38 +23,39 @@ const MetricInfo* metric_info(std::string_view name) {
 
 namespace {
 
-constexpr Quantity kQuantities[] = {Quantity::kShakingForce, Quantity::kShakingMoment,
-                                    Quantity::kDriveTorque, Quantity::kReactionA0,
-                                    Quantity::kReactionA3};
+// the Quantity values are 0, 1, ..., kQuantityCount - 1, the last kReactionA3 (as for
+// OutputQuantity)
+constexpr std::size_t kQuantityCount = static_cast<std::size_t>(Quantity::kReactionA3) + 1;
+static_assert(static_cast<std::size_t>(OutputQuantity::kJointA2) + 1 == kOutputQuantityCount);
 constexpr std::size_t kOutputCount = std::size(kOutputMetrics);
 
 // Every sample's magnitudes, computed once for the RMS, the peaks and their search: a column
-// per quantity of the table, then one per row of kOutputMetrics.
+// per Quantity, then one per OutputQuantity (a magnitude two metrics summarise, such as the
+// total shaking force's RMS and peak, is computed once).
 class SampleMagnitudes {
  public:
   explicit SampleMagnitudes(const std::vector<DynamicsSample>& samples)
-      : n_(samples.size()), v_((std::size(kQuantities) + kOutputCount) * n_) {
+      : n_(samples.size()), v_(new double[(kQuantityCount + kOutputQuantityCount) * n_]) {
+    double* const out = v_.get();
     for (std::size_t i = 0; i < n_; ++i) {
       const DynamicsSample& s = samples[i];
-      for (std::size_t q = 0; q < std::size(kQuantities); ++q)
-        v_[q * n_ + i] = magnitude(s, kQuantities[q]);
-      for (std::size_t k = 0; k < kOutputCount; ++k)
-        v_[(std::size(kQuantities) + k) * n_ + i] = kOutputMetrics[k].magnitude(s);
+      for (std::size_t q = 0; q < kQuantityCount; ++q)
+        out[q * n_ + i] = magnitude(s, static_cast<Quantity>(q));
+      for (std::size_t q = 0; q < kOutputQuantityCount; ++q)
+        out[(kQuantityCount + q) * n_ + i] = magnitude(s, static_cast<OutputQuantity>(q));
     }
   }
   std::span<const double> of(Quantity quantity) const {
-    return column(static_cast<std::size_t>(
-        std::find(std::begin(kQuantities), std::end(kQuantities), quantity) -
-        std::begin(kQuantities)));
+    return column(static_cast<std::size_t>(quantity));
   }
   std::span<const double> output(std::size_t k) const {
-    return column(std::size(kQuantities) + k);
+    return column(kQuantityCount + static_cast<std::size_t>(kOutputMetrics[k].quantity));
   }
 
  private:
-  std::span<const double> column(std::size_t c) const { return {v_.data() + c * n_, n_}; }
+  std::span<const double> column(std::size_t c) const { return {v_.get() + c * n_, n_}; }
   std::size_t n_;
-  std::vector<double> v_;
+  std::unique_ptr<double[]> v_;  // left uninitialised: every value is written above
 };
 
 double statistic_of(std::span<const double> x, Statistic statistic) {
@@ -133,7 +136,8 @@ Metrics with_peaks(const Trajectory& trajectory, double period,
       if (peaks) peaks->output[k] = {m.*info.field, 0.0};
       continue;
     }
-    const Peak p = resolve(magnitudes.output(k), info.magnitude);
+    const Peak p = resolve(magnitudes.output(k),
+                           [&](const DynamicsSample& d) { return magnitude(d, info.quantity); });
     m.*info.field = p.value;
     if (peaks) peaks->output[k] = p;
   }
@@ -150,12 +154,23 @@ Metrics metrics(const FourBar& model, const DrivenScene& scene, const Trajectory
                 Formulation formulation, PeakList* peaks) {
   const double period =
       trajectory.ok() ? 2 * std::numbers::pi / std::abs(scene.omega1) * scene.revolutions : 0.0;
+  // the instants as simulate_driven() computes its samples, the model's constants once
+  const detail::DynamicsConstants constants = detail::dynamics_constants(model);
+  detail::ClosedInstant instant;
   return with_peaks(
       trajectory, period,
       [&](double s) -> std::optional<DynamicsSample> {
-        const auto d = inverse_dynamics(model, scene.theta1 + scene.omega1 * s, scene.omega1, 0.0,
-                                        formulation);
-        return d ? std::optional<DynamicsSample>(*d) : std::nullopt;
+        const double theta1 = scene.theta1 + scene.omega1 * s;
+        if (constants.counter_rotations) {
+          const auto d = inverse_dynamics(model, theta1, scene.omega1, 0.0, formulation);
+          return d ? std::optional<DynamicsSample>(*d) : std::nullopt;
+        }
+        std::optional<DynamicsSample> d(std::in_place);
+        if (detail::driven_instant_at(model, constants, theta1, detail::crank_vector(model, theta1),
+                                      scene.omega1, formulation, instant, *d)) {
+          return std::nullopt;
+        }
+        return d;
       },
       peaks);
 }

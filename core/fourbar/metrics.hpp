@@ -95,6 +95,30 @@ inline double magnitude(const DynamicsSample& s, Quantity quantity) {
 }
 
 
+/// The magnitude an output metric (kOutputMetrics) summarises, one value per sample.
+enum class OutputQuantity {
+  kTotalShakingForce,   // |F̄sh|, weights and loads included [N]
+  kTotalShakingMoment,  // |Msh|, weights and loads included [N m]
+  kJointA1,             // |F̄A1| [N]
+  kJointA2,             // |F̄A2| [N]
+};
+inline constexpr std::size_t kOutputQuantityCount = 4;
+
+/// The magnitude of `quantity` at one sample.
+inline double magnitude(const DynamicsSample& s, OutputQuantity quantity) {
+  switch (quantity) {
+    case OutputQuantity::kTotalShakingForce:
+      return core::magnitude(s.Fsh.x(), s.Fsh.y());
+    case OutputQuantity::kTotalShakingMoment:
+      return std::abs(s.Msh);
+    case OutputQuantity::kJointA1:
+      return core::magnitude(s.FA1.x(), s.FA1.y());
+    case OutputQuantity::kJointA2:
+      return core::magnitude(s.FA2.x(), s.FA2.y());
+  }
+  return 0.0;
+}
+
 /// A metric every output lists after the table's, which the optimiser does not take: the total
 /// shaking force and moment (core::kTotalMetrics, in its order), then the peaks of the joint
 /// forces between moving links.
@@ -104,21 +128,21 @@ struct OutputMetricInfo {
   const char* words;
   Statistic statistic;
   double Metrics::*field;
-  double (*magnitude)(const DynamicsSample&);
+  OutputQuantity quantity;
 };
 inline constexpr OutputMetricInfo kOutputMetrics[] = {
     {kTotalMetrics[0].name, kTotalMetrics[0].unit, kTotalMetrics[0].words, Statistic::kRms,
-     &Metrics::Fsh_total_rms, [](const DynamicsSample& s) { return magnitude(s.Fsh.x(), s.Fsh.y()); }},
+     &Metrics::Fsh_total_rms, OutputQuantity::kTotalShakingForce},
     {kTotalMetrics[1].name, kTotalMetrics[1].unit, kTotalMetrics[1].words, Statistic::kMax,
-     &Metrics::Fsh_total_max, [](const DynamicsSample& s) { return magnitude(s.Fsh.x(), s.Fsh.y()); }},
+     &Metrics::Fsh_total_max, OutputQuantity::kTotalShakingForce},
     {kTotalMetrics[2].name, kTotalMetrics[2].unit, kTotalMetrics[2].words, Statistic::kRms,
-     &Metrics::Msh_total_rms, [](const DynamicsSample& s) { return std::abs(s.Msh); }},
+     &Metrics::Msh_total_rms, OutputQuantity::kTotalShakingMoment},
     {kTotalMetrics[3].name, kTotalMetrics[3].unit, kTotalMetrics[3].words, Statistic::kMax,
-     &Metrics::Msh_total_max, [](const DynamicsSample& s) { return std::abs(s.Msh); }},
+     &Metrics::Msh_total_max, OutputQuantity::kTotalShakingMoment},
     {"FA1_max", "N", "peak of the joint force |FA1| (crank on coupler)", Statistic::kMax,
-     &Metrics::FA1_max, [](const DynamicsSample& s) { return magnitude(s.FA1.x(), s.FA1.y()); }},
+     &Metrics::FA1_max, OutputQuantity::kJointA1},
     {"FA2_max", "N", "peak of the joint force |FA2| (coupler on rocker)", Statistic::kMax,
-     &Metrics::FA2_max, [](const DynamicsSample& s) { return magnitude(s.FA2.x(), s.FA2.y()); }},
+     &Metrics::FA2_max, OutputQuantity::kJointA2},
 };
 
 /// Where the peaks of a run lie: per row of kMetricTable (RMS rows: their value and t = 0),

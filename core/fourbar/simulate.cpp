@@ -532,11 +532,17 @@ Trajectory simulate_driven(const FourBar& model, const DrivenScene& scene,
       std::abs(scene.omega1) * period / static_cast<double>(per_revolution) <= kMaxUnwrapStep;
   double turns2 = 0.0, turns3 = 0.0;        // whole turns added to the wrapped angles
   double previous2 = 0.0, previous3 = 0.0;  // the previous sample's wrapped angles [rad]
+  // The samples zeroed at once (the outputs a sample does not set, such as the counter-rotation
+  // shafts' forces of a model without them, stay zero) rather than one by one as each is added,
+  // and the closed instant, which close_instant() fills whole, kept from sample to sample: a
+  // short block zeroed per sample cost more than any other step of the loop.
+  out.samples.assign(samples, DynamicsSample{});
+  ClosedInstant instant;
   for (std::size_t j = 0; j < samples; ++j) {
     const double t = period * static_cast<double>(j) / static_cast<double>(per_revolution);
     const double theta1 = scene.theta1 + scene.omega1 * t;
     ++out.rhs_evaluations;
-    DynamicsSample& sample = out.samples.emplace_back();
+    DynamicsSample& sample = out.samples[j];
     std::optional<DynamicsError> error;
     if (constants.counter_rotations) {
       const auto one = inverse_dynamics(model, theta1, scene.omega1, 0.0, options.formulation);
@@ -545,22 +551,13 @@ Trajectory simulate_driven(const FourBar& model, const DrivenScene& scene,
       } else {
         error = one.error();
       }
-    } else {
-      ClosedInstant instant;
-      std::optional<Failure> failure =
-          close_instant(model, theta1, crank.l1(theta1), scene.omega1, instant);
-      if (!failure) {
-        failure = dynamics_at(model, constants, instant, CrankInput::inverse(0.0),
-                              options.formulation, sample);
-      }
-      if (failure) {
-        error = failure->error();
-      } else {  // set_derived_outputs() from the link vectors the instant holds
-        derived_outputs_at(constants.derived, instant.l1, instant.l2, instant.l3, sample);
-      }
+    } else if (const std::optional<Failure> failure =
+                   driven_instant_at(model, constants, theta1, crank.l1(theta1), scene.omega1,
+                                     options.formulation, instant, sample)) {
+      error = failure->error();
     }
     if (error) {
-      out.samples.pop_back();
+      out.samples.resize(j);
       fail(out, *error, t, theta1);
       break;
     }

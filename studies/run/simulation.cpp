@@ -88,11 +88,20 @@ void stop_at_non_finite(core::Trajectory& r) {
         "RC3x", "RC3y",   "Fshx",   "Fshy",   "Msh",    "tau"};
     static_assert(std::size(kNames) == std::size(values));
     // the common case in one branch-free pass: 0 * v is 0 for every finite v, NaN for an
-    // infinity or a NaN; the names are looked at only where that fails
-    double any = 0.0;
-    for (const double v : values) any += 0.0 * v;
-    if (any == 0.0) continue;
-    for (std::size_t k = 0; k < std::size(values); ++k) {
+    // infinity or a NaN; the names are looked at only where that fails (four sums side by
+    // side, so that the additions need not wait for each other)
+    constexpr std::size_t kCount = std::size(values);
+    double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
+    std::size_t k = 0;
+    for (; k + 4 <= kCount; k += 4) {
+      a0 += 0.0 * values[k];
+      a1 += 0.0 * values[k + 1];
+      a2 += 0.0 * values[k + 2];
+      a3 += 0.0 * values[k + 3];
+    }
+    for (; k < kCount; ++k) a0 += 0.0 * values[k];
+    if ((a0 + a1) + (a2 + a3) == 0.0) continue;
+    for (k = 0; k < kCount; ++k) {
       const double v = values[k];
       if (std::isfinite(v)) continue;
       const double t = i < r.t.size() ? r.t[i] : 0.0;

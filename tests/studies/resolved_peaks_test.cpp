@@ -229,7 +229,7 @@ TEST(ResolvedPeaks, FourBarFreePeaksMatchA100000SampleRun) {
       const core::OutputMetricInfo& info = core::kOutputMetrics[k];
       if (info.statistic != core::Statistic::kMax) continue;
       std::vector<double> x(fine.samples.size());
-      for (std::size_t j = 0; j < x.size(); ++j) x[j] = info.magnitude(fine.samples[j]);
+      for (std::size_t j = 0; j < x.size(); ++j) x[j] = core::magnitude(fine.samples[j], info.quantity);
       const Brute b = open_parabola_peak(x, h);
       EXPECT_NEAR(resolved.*info.field, b.value, 1e-9 * b.value)
           << info.name << " variant " << variant;

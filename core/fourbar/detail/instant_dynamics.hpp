@@ -104,4 +104,20 @@ inline std::optional<Failure> dynamics_at(const FourBar& model, const DynamicsCo
   return mass_matrix_at(model, c.mass_matrix, instant, input, out);
 }
 
+/// A driven instant (constant crank speed omega1 [rad/s]) at crank angle theta1 [rad] with
+/// crank vector l̄1 = l1·(cos theta1, sin theta1) [m]: the loop closed into `instant` (which
+/// close_instant() fills whole, so one may serve many instants), formulation f's inverse
+/// dynamics and the derived outputs from the instant's link vectors into `out`. The outputs a
+/// model without counter-rotations does not have (their shafts' forces) are left as they are in
+/// `out`: zero in a new sample. Model without counter-rotations.
+inline std::optional<Failure> driven_instant_at(const FourBar& model, const DynamicsConstants& c,
+                                                double theta1, const Xy& l1, double omega1,
+                                                Formulation f, ClosedInstant& instant,
+                                                DynamicsSample& out) {
+  std::optional<Failure> failure = close_instant(model, theta1, l1, omega1, instant);
+  if (!failure) failure = dynamics_at(model, c, instant, CrankInput::inverse(0.0), f, out);
+  if (!failure) derived_outputs_at(c.derived, instant.l1, instant.l2, instant.l3, out);
+  return failure;
+}
+
 }  // namespace bd::core::detail
