@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -38,32 +39,36 @@ namespace {
 // split at line ends outside quotes (a message may hold one); a last record without its line end
 // was cut short by a kill and is left out. `header` gets the first record, `record` every other,
 // with its number (2 for the first row).
-bool for_each_record(const fs::path& p,
-                     const std::function<void(std::vector<std::string>)>& header,
-                     const std::function<void(std::vector<std::string>, std::size_t)>& record) {
+bool for_each_record(
+    const fs::path& p, const std::function<void(const std::vector<std::string>&)>& header,
+    const std::function<void(const std::vector<std::string>&, std::size_t)>& record) {
   std::ifstream in(p, std::ios::binary);
   if (!in) throw std::runtime_error("cannot read " + p.string());
   std::string rec;
+  std::vector<std::string> fields;  // reused from record to record
   bool quoted = false;
   std::size_t n = 0;
   std::vector<char> buf(1 << 16);
   while (in.read(buf.data(), static_cast<std::streamsize>(buf.size())) || in.gcount() > 0) {
     const auto got = static_cast<std::size_t>(in.gcount());
+    std::size_t start = 0;  // of the record's part in this block
     for (std::size_t k = 0; k < got; ++k) {
       const char c = buf[k];
       if (c == '"') quoted = !quoted;  // "" inside a quoted field toggles twice
-      if (c != '\n' || quoted) {
-        rec += c;
-        continue;
-      }
+      if (c != '\n' || quoted) continue;
+      rec.append(buf.data() + start, k - start);
+      start = k + 1;
       ++n;
       if (n == 1) {
-        header(csv_fields(rec));
+        csv_fields(rec, fields);
+        header(fields);
       } else if (!rec.empty() && rec != "\r") {
-        record(csv_fields(rec), n);
+        csv_fields(rec, fields);
+        record(fields, n);
       }
       rec.clear();
     }
+    rec.append(buf.data() + start, got - start);
   }
   if (n == 0) throw std::runtime_error(p.string() + " has no complete header line");
   return !rec.empty();
@@ -71,10 +76,10 @@ bool for_each_record(const fs::path& p,
 
 // a field as a finite number, else nothing
 std::optional<double> number(const std::string& field) {
-  if (field.empty()) return std::nullopt;
-  char* end = nullptr;
-  const double v = std::strtod(field.c_str(), &end);
-  if (end == field.c_str() || *end != '\0' || !std::isfinite(v)) return std::nullopt;
+  double v = 0.0;
+  const char* end = field.data() + field.size();
+  const auto [stop, error] = std::from_chars(field.data(), end, v);
+  if (error != std::errc() || stop != end || !std::isfinite(v)) return std::nullopt;
   return v;
 }
 
@@ -136,11 +141,25 @@ constexpr std::size_t kGridCells = 40;   // a heat map's cells per axis, at most
 constexpr double kNoiseFloor = 1e-9;
 
 struct Sweep {
+  // moved, never copied: `tallies` point into `scale` and `best`, whose nodes move with them
+  Sweep() = default;
+  Sweep(Sweep&&) = default;
+  Sweep(const Sweep&) = delete;
+  Sweep& operator=(const Sweep&) = delete;
+
   Json info;  // sweep.json
   SweepCsv csv;
   std::string sampling;  // how the charted rows were chosen, when not all ("" when all)
   std::map<std::string, Best> best;     // by series column, over every row
   std::map<std::string, double> scale;  // by metric name: largest |value| of any of its series
+  // per series that sweep.csv has: its column, and where take_row() counts it
+  struct Tally {
+    std::size_t column;
+    bool second;  // of the second design
+    double* scale;
+    Best* best;
+  };
+  std::vector<Tally> tallies;
   std::vector<std::pair<double, double>> range;  // each parameter's least and largest value
   // the sample charted: every keep_stride-th point, or on a large grid every grid_step[j]-th
   // value of each parameter (grid_ny: the second parameter's values, > 0 then)
@@ -196,7 +215,7 @@ struct Sweep {
 void check_header(Sweep& s, const fs::path& csv_file, const fs::path& json_file,
                   const Study& study);
 void choose_sample(Sweep& s, std::size_t points);
-void take_row(Sweep& s, std::vector<std::string> row);
+void take_row(Sweep& s, const std::vector<std::string>& row);
 
 Sweep load_sweep(const Study& study, const fs::path& dir) {
   const fs::path json_file = dir / "sweep.json";
@@ -233,8 +252,8 @@ Sweep load_sweep(const Study& study, const fs::path& dir) {
   }
   bool have_header = false;
   s.csv.cut_short = for_each_record(
-      csv_file, [&](std::vector<std::string> h) { s.csv.header = std::move(h); },
-      [&](std::vector<std::string> row, std::size_t n) {
+      csv_file, [&](const std::vector<std::string>& h) { s.csv.header = h; },
+      [&](const std::vector<std::string>& row, std::size_t n) {
         if (!have_header) {
           check_header(s, csv_file, json_file, study);
           have_header = true;
@@ -245,7 +264,7 @@ Sweep load_sweep(const Study& study, const fs::path& dir) {
                                    " has " + std::to_string(row.size()) + " fields, the header " +
                                    std::to_string(s.csv.header.size()));
         }
-        take_row(s, std::move(row));
+        take_row(s, row);
       });
   if (!have_header) check_header(s, csv_file, json_file, study);
   return s;
@@ -297,6 +316,13 @@ void check_header(Sweep& s, const fs::path& csv_file, const fs::path& json_file,
   }
   s.range.assign(s.params.size(), {std::numeric_limits<double>::infinity(),
                                    -std::numeric_limits<double>::infinity()});
+  for (const Metric& m : s.metrics) {
+    for (const Series& se : m.series) {
+      if (const auto c = s.col(se.column)) {
+        s.tallies.push_back({*c, se.second, &s.scale[m.id], &s.best[se.column]});
+      }
+    }
+  }
 }
 
 // Which rows the charts draw: all of a sweep of up to kChartRows points; of a larger grid of two
@@ -330,9 +356,10 @@ void choose_sample(Sweep& s, std::size_t points) {
 }
 
 // one row of sweep.csv: counted, ranked, and kept when charted
-void take_row(Sweep& s, std::vector<std::string> row) {
+void take_row(Sweep& s, const std::vector<std::string>& row) {
   ++s.csv.total;
-  const bool ok = row[s.status_col] == "ok";
+  const std::string& status = row[s.status_col];
+  const bool ok = status == "ok";
   if (!ok) {
     ++s.csv.failed;
     if (s.csv.failed_rows.size() < kFailedRows) s.csv.failed_rows.push_back(row);
@@ -343,21 +370,15 @@ void take_row(Sweep& s, std::vector<std::string> row) {
       s.range[j].second = std::max(s.range[j].second, *x);
     }
   }
-  for (const Metric& m : s.metrics) {
-    for (const Series& se : m.series) {
-      if (!(row[s.status_col] == "ok" || (!se.second && row[s.status_col] == "no-optimum"))) {
-        continue;
-      }
-      const auto c = s.col(se.column);
-      const auto v = c ? number(row[*c]) : std::nullopt;
-      if (!v) continue;
-      double& scale = s.scale[m.id];
-      scale = std::max(scale, std::abs(*v));
-      Best& b = s.best[se.column];
-      if (*v < b.value) {
-        b.value = *v;
-        b.row = row;
-      }
+  const bool no_optimum = !ok && status == "no-optimum";
+  for (const Sweep::Tally& t : s.tallies) {
+    if (!(ok || (!t.second && no_optimum))) continue;
+    const auto v = number(row[t.column]);
+    if (!v) continue;
+    *t.scale = std::max(*t.scale, std::abs(*v));
+    if (*v < t.best->value) {
+      t.best->value = *v;
+      t.best->row = row;
     }
   }
   // charted?
@@ -369,7 +390,7 @@ void take_row(Sweep& s, std::vector<std::string> row) {
   } else if (s.keep_stride > 1) {
     keep = i % s.keep_stride == 0;
   }
-  if (keep) s.csv.rows.push_back(std::move(row));
+  if (keep) s.csv.rows.push_back(row);
 }
 
 // ---------------------------------------------------------------------------------------------

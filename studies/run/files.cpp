@@ -265,28 +265,51 @@ std::string csv_line_field(std::string text) {
 // NaN and infinities are no data: an empty field (issue 17)
 std::string csv_number(double v) { return std::isfinite(v) ? text::exact(v) : std::string(); }
 
-std::vector<std::string> csv_fields(const std::string& line) {
-  std::vector<std::string> out(1);
+void csv_fields(std::string_view line, std::vector<std::string>& out) {
+  std::size_t k = 0;  // the field being read
+  auto next_field = [&]() -> std::string& {
+    if (k == out.size()) return out.emplace_back();
+    out[k].clear();
+    return out[k];
+  };
+  std::string* field = &next_field();
   bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        out.back() += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        out.back() += c;
+  const std::size_t n = line.size();
+  for (std::size_t i = 0; i < n;) {
+    if (quoted) {  // up to the closing quote; "" is a quote
+      const std::size_t q = line.find('"', i);
+      if (q == std::string_view::npos) {
+        field->append(line.substr(i));
+        break;
       }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      out.emplace_back();
-    } else if (c != '\r') {
-      out.back() += c;
+      field->append(line.substr(i, q - i));
+      if (q + 1 < n && line[q + 1] == '"') {
+        *field += '"';
+        i = q + 2;
+      } else {
+        quoted = false;
+        i = q + 1;
+      }
+      continue;
     }
+    std::size_t j = i;  // up to the next comma or quote; a carriage return is left out
+    while (j < n && line[j] != ',' && line[j] != '"' && line[j] != '\r') ++j;
+    field->append(line.substr(i, j - i));
+    if (j == n) break;
+    if (line[j] == ',') {
+      ++k;
+      field = &next_field();
+    } else if (line[j] == '"') {
+      quoted = true;
+    }
+    i = j + 1;
   }
+  out.resize(k + 1);
+}
+
+std::vector<std::string> csv_fields(const std::string& line) {
+  std::vector<std::string> out;
+  csv_fields(line, out);
   return out;
 }
 

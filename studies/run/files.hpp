@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace bd::studies {
@@ -75,7 +76,10 @@ std::string csv_line_field(std::string text);
 /// value).
 std::string csv_number(double v);
 
-/// The fields of one CSV line (RFC 4180 quoting; a trailing '\r' is dropped).
+/// The fields of one CSV line (RFC 4180 quoting; a carriage return outside quotes is dropped).
 std::vector<std::string> csv_fields(const std::string& line);
+/// The same into `out`, whose strings are reused (no allocation per field when reading many
+/// lines of one file into the same vector).
+void csv_fields(std::string_view line, std::vector<std::string>& out);
 
 }  // namespace bd::studies
