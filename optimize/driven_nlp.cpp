@@ -96,7 +96,17 @@ class DrivenNlp final : public NlpProgram {
     return trajectory_of(inertial(x, false).q);
   }
   core::Metrics metrics(const VectorXd& x) const override {
-    return core::metrics(trajectory_of(inertial(x, false).q));
+    const VecQ q = inertial(x, false).q;
+    core::Metrics m = core::metrics(trajectory_of(q));
+    // the peaks over the samples and the problem's peak angles, as the program bounds them
+    if (instants_ > samples_) {
+      for (const core::MetricInfo& info : core::kMetricTable) {
+        if (info.statistic != core::Statistic::kMax) continue;
+        const auto metric = metric_named(info.name);
+        if (metric) m.*info.field = peak(group_of(*metric), q);
+      }
+    }
+    return m;
   }
 
  private:
@@ -128,10 +138,11 @@ class DrivenNlp final : public NlpProgram {
   const core::DrivenScene& scene() const { return std::get<core::DrivenScene>(problem_.scene); }
 
   std::array<int, std::size(kMetrics)> bound_var_{};  // -1 unless a peak objective term
-  int samples_{};
-  std::vector<double> theta1_;       // the crank angle of each sample
-  std::array<MatrixXd, kGroups> A_;  // (rows·samples) x kQ, sample-major
-  std::array<MatrixXd, kGroups> R_;  // R of a QR of A: |A q| = |R q|
+  int samples_{};   // the scene's samples: the RMS metrics' instants
+  int instants_{};  // the peaks': the samples, then the problem's peak angles
+  std::vector<double> theta1_;       // the crank angle of each instant
+  std::array<MatrixXd, kGroups> A_;  // (rows·instants) x kQ, instant-major
+  std::array<MatrixXd, kGroups> R_;  // R of a QR of the samples' rows of A: |A q| = |R q|
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -185,13 +196,15 @@ void DrivenNlp::add_bound_variables() {
 }
 
 std::string DrivenNlp::at_sample(int i) const {
-  return " at sample " + std::to_string(i) +
-         " (theta1 = " + text::digits(theta1_[static_cast<std::size_t>(i)], 6) + " rad)";
+  const std::string angle =
+      "theta1 = " + text::digits(theta1_[static_cast<std::size_t>(i)], 6) + " rad";
+  if (i >= samples_) return " at a resolved peak (" + angle + ")";
+  return " at sample " + std::to_string(i) + " (" + angle + ")";
 }
 
 std::vector<std::string> DrivenNlp::peak_limit_names(const std::string& name) const {
   std::vector<std::string> names;
-  for (int i = 0; i < samples_; ++i) names.push_back(name + at_sample(i));
+  for (int i = 0; i < instants_; ++i) names.push_back(name + at_sample(i));
   return names;
 }
 
@@ -201,11 +214,11 @@ void DrivenNlp::add_peak_bounds() {
     const int t = bound_var_[metric_index(m)];
     if (t < 0) continue;
     std::vector<std::string> names;
-    for (int i = 0; i < samples_; ++i) {
-      names.push_back(std::string("|") + to_string(m) + "| sample" + at_sample(i) +
-                      " <= bound on " + to_string(m));
+    for (int i = 0; i < instants_; ++i) {
+      names.push_back(std::string("|") + to_string(m) + "|" + at_sample(i) + " <= bound on " +
+                      to_string(m));
     }
-    add_block({Block::Kind::kPeakBound, -1, m, 0.0, t, samples_}, std::move(names));
+    add_block({Block::Kind::kPeakBound, -1, m, 0.0, t, instants_}, std::move(names));
   }
 }
 
@@ -227,6 +240,8 @@ void DrivenNlp::build_regressor() {
     const double t = period * static_cast<double>(i) / static_cast<double>(per_revolution);
     theta1_[static_cast<std::size_t>(i)] = scene().theta1 + scene().omega1 * t;
   }
+  theta1_.insert(theta1_.end(), problem_.peak_angles.begin(), problem_.peak_angles.end());
+  instants_ = static_cast<int>(theta1_.size());
 
   // the base
   const core::CounterRotations& discs = problem_.original.counter_rotations;
@@ -240,8 +255,8 @@ void DrivenNlp::build_regressor() {
   q0(kOne) = 1.0;
   const std::vector<int> columns = regressor_columns();
 
-  MatrixXd Y = MatrixXd::Zero(kOutputs * samples_, kQ);
-  for (int i = 0; i < samples_; ++i) {
+  MatrixXd Y = MatrixXd::Zero(kOutputs * instants_, kQ);
+  for (int i = 0; i < instants_; ++i) {
     // the link angles (the same for every q)
     const double th1 = theta1_[static_cast<std::size_t>(i)];
     const auto pose = core::solve_position(problem_.original, th1);
@@ -276,17 +291,18 @@ std::vector<int> DrivenNlp::regressor_columns() const {
   return columns;
 }
 
-// per output group: its rows of the samples' outputs Y, and R of their QR (|A q|² = |R q|² as
-// a sum of squares, so an RMS never comes out negative and stays accurate near 0)
+// per output group: its rows of the instants' outputs Y, and R of a QR of the samples' rows
+// (|A q|² = |R q|² as a sum of squares, so an RMS never comes out negative and stays accurate
+// near 0)
 void DrivenNlp::factor(const MatrixXd& Y) {
   for (int g = 0; g < kGroups; ++g) {
     const int rows = kGroupRows[g];
-    A_[g].resize(rows * samples_, kQ);
-    for (int i = 0; i < samples_; ++i) {
+    A_[g].resize(rows * instants_, kQ);
+    for (int i = 0; i < instants_; ++i) {
       A_[g].middleRows(rows * i, rows) = Y.middleRows(kOutputs * i + kGroupFirst[g], rows);
     }
-    const Eigen::HouseholderQR<MatrixXd> qr(A_[g]);
-    const int r = std::min<int>(static_cast<int>(A_[g].rows()), kQ);
+    const Eigen::HouseholderQR<MatrixXd> qr(A_[g].topRows(rows * samples_));
+    const int r = std::min<int>(rows * samples_, kQ);
     R_[g] = qr.matrixQR().topRows(r).triangularView<Eigen::Upper>();
   }
 }
@@ -375,7 +391,7 @@ VecQ DrivenNlp::box_bounds() const {
   return qmax;
 }
 
-// t_max for each bound variable: max over samples of Σ_rows Σ_j |A_ij| qmax_j with qmax the
+// t_max for each bound variable: max over instants of Σ_rows Σ_j |A_ij| qmax_j with qmax the
 // box_bounds(), so no design in the box has a larger peak (linear form: a larger smoothed peak
 // sqrt(peak² + δ²)).
 void DrivenNlp::bound_peaks() {
@@ -386,7 +402,7 @@ void DrivenNlp::bound_peaks() {
     const int g = group_of(m), rows = kGroupRows[g];
     const VectorXd row_bounds = A_[g].cwiseAbs() * qmax;
     double worst = 0;
-    for (int i = 0; i < samples_; ++i)
+    for (int i = 0; i < instants_; ++i)
       worst = std::max(worst, row_bounds.segment(rows * i, rows).sum());
     if (linear_) worst = std::hypot(worst, eps_ * original(m));  // t >= sqrt(|y_i|² + δ²)
     upper_(t) = worst * (1 + 1e-9) + std::numeric_limits<double>::min();  // round-off margin
@@ -410,7 +426,7 @@ double DrivenNlp::peak(int g, const VecQ& q) const {
   const VectorXd y = A_[g] * q;
   const int rows = kGroupRows[g];
   double worst = 0;
-  for (int i = 0; i < samples_; ++i) {
+  for (int i = 0; i < instants_; ++i) {
     worst = std::max(worst, rows == 1 ? std::abs(y(i)) : y.segment(rows * i, rows).norm());
   }
   return worst;
@@ -421,14 +437,15 @@ double DrivenNlp::reaction_metric(const VectorXd& x, Metric m) const {
   return is_peak(m) ? peak(group_of(m), q) : std::sqrt(rms_squared(group_of(m), q));
 }
 
-// every sample's outputs from the regressor, at the instants of core::simulate_driven
+// every sample's outputs from the regressor, at the instants of core::simulate_driven (the
+// problem's peak angles are not samples)
 core::Trajectory DrivenNlp::trajectory_of(const VecQ& q) const {
   const double period = 2.0 * std::numbers::pi / std::abs(scene().omega1);
   core::Trajectory t;
   t.samples.resize(static_cast<std::size_t>(samples_));
   t.t.resize(static_cast<std::size_t>(samples_));
   std::array<VectorXd, kGroups> y;
-  for (int g = 0; g < kGroups; ++g) y[g] = A_[g] * q;
+  for (int g = 0; g < kGroups; ++g) y[g] = A_[g].topRows(kGroupRows[g] * samples_) * q;
   for (int i = 0; i < samples_; ++i) {
     const auto j = static_cast<std::size_t>(i);
     t.t[j] = period * static_cast<double>(i) / static_cast<double>(scene().samples);

@@ -54,7 +54,13 @@ NlpProgram::NlpProgram(const DesignProblem& p, CounterweightVariablesAs as)
                                     (driven ? "driven" : "free") +
                                     " scene: " + trajectory.message});
   }
-  original_metrics_ = core::metrics(trajectory);
+  // with resolve_peaks, a driven scene's peaks resolved between the samples, as the exchange
+  // steps bound the optimum's (optimize()): a limit's "x original" is then the motion's peak
+  const auto* driven = std::get_if<core::DrivenScene>(&problem_.scene);
+  original_metrics_ = driven && problem_.resolve_peaks
+                          ? core::metrics(problem_.original, *driven, trajectory,
+                                          problem_.formulation, nullptr)
+                          : core::metrics(trajectory);
   check_normalisers();
   set_up_design_variables();
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <utility>
@@ -326,6 +327,24 @@ void verify(const DesignProblem& problem, OptimizeResult& r) {
     return;
   }
   r.verified = core::metrics(trajectory);
+  // the peaks over the same instants as the optimiser's: the samples and the peak angles
+  if (const auto* scene = std::get_if<core::DrivenScene>(&problem.scene)) {
+    for (const double angle : problem.peak_angles) {
+      const auto d = core::inverse_dynamics(r.design, angle, scene->omega1, 0.0,
+                                            simulate.formulation);
+      if (!d) {
+        r.verification_error = std::numeric_limits<double>::infinity();
+        r.message += "; verification by " + std::string(core::to_string(simulate.formulation)) +
+                     " failed: " + d.error().what();
+        return;
+      }
+      for (const core::MetricInfo& info : core::kMetricTable) {
+        if (info.statistic != core::Statistic::kMax) continue;
+        r.verified.*info.field =
+            std::max(r.verified.*info.field, core::magnitude(*d, info.quantity));
+      }
+    }
+  }
   r.verification_error = verification_error(r.metrics, r.verified, r.design.frame_length);
 }
 
@@ -533,41 +552,141 @@ detail::Solved detail::solve_from(const Program& nlp, const std::vector<VectorXd
   return best;
 }
 
+namespace {
+
+// at most this many exchange rounds (each a solve more); they end sooner as a rule, once the
+// optimum's resolved peaks are bounded (three or four rounds)
+constexpr int kMaxExchangeRounds = 8;
+// a resolved peak above the peak over the program's instants by more than this, relative, adds
+// crank angles (the resolved peaks are good to about 1e-14)
+constexpr double kPeakExchangeTolerance = 1e-9;
+// at most this many angles added around one peak in one round
+constexpr int kMaxAnglesPerPeak = 64;
+
+// The program's instants as crank angles: the scene's samples and the peak angles so far.
+std::vector<double> instant_angles(const DesignProblem& problem, const core::DrivenScene& scene) {
+  const int samples = scene.samples * scene.revolutions;
+  const double period = 2.0 * std::numbers::pi / std::abs(scene.omega1);
+  std::vector<double> angles;
+  for (int i = 0; i < samples; ++i) {
+    const double t = period * static_cast<double>(i) / static_cast<double>(scene.samples);
+    angles.push_back(scene.theta1 + scene.omega1 * t);
+  }
+  // the motion's end (the first sample of the next revolution) closes the last interval
+  angles.push_back(scene.theta1 + scene.omega1 * period * scene.revolutions);
+  angles.insert(angles.end(), problem.peak_angles.begin(), problem.peak_angles.end());
+  std::sort(angles.begin(), angles.end());
+  return angles;
+}
+
+// The crank angles a next round bounds the peak at, for each peak metric of the objective
+// (weight > 0) and of the limits whose resolved peak at the optimum (core::metrics(), searched
+// between the samples) rises above the peak over the program's instants by more than
+// kPeakExchangeTolerance: the peak's own angle and an even grid over the interval of instants
+// around it. Near a smooth peak the excess goes with the square of the interval, so m
+// intervals take it down m² times: m is chosen for the excess to fall to a tenth of the
+// tolerance (at most kMaxAnglesPerPeak), so that the next optimum, whose peak moves a little,
+// finds instants close around it. Empty in a free scene, for a design that is no result or
+// cannot be run, when the instants hold the peaks, and without problem.resolve_peaks.
+std::vector<double> short_peak_angles(const DesignProblem& problem, const Nlp& nlp,
+                                      const detail::Solved& solved) {
+  const auto* scene = std::get_if<core::DrivenScene>(&problem.scene);
+  if (!problem.resolve_peaks || !scene || !found_design(solved.termination)) return {};
+  std::vector<Metric> used;
+  for (const Term& t : problem.objective) {
+    if (t.weight > 0 && is_peak(t.metric)) used.push_back(t.metric);
+  }
+  for (const Limit& l : problem.limits) {
+    if (is_peak(l.metric)) used.push_back(l.metric);
+  }
+  if (used.empty()) return {};
+  const core::FourBar design = nlp.design(solved.x);
+  core::SimulateOptions simulate;
+  simulate.formulation = problem.formulation;
+  const core::Trajectory run = core::simulate_driven(design, *scene, simulate);
+  if (!run.ok()) return {};
+  core::PeakList peaks;
+  const core::Metrics resolved = core::metrics(design, *scene, run, problem.formulation, &peaks);
+  const core::Metrics bounded = nlp.metrics(solved.x);
+  const std::vector<double> instants = instant_angles(problem, *scene);
+  std::vector<double> added;
+  for (Metric m : used) {
+    const double excess = value(resolved, m) / value(bounded, m) - 1;
+    if (!(excess > kPeakExchangeTolerance)) continue;
+    double angle = scene->theta1 + scene->omega1 * peaks.table[static_cast<std::size_t>(m)].t;
+    added.push_back(angle);
+    // the interval of instants around it (the angles increase with time when omega1 < 0 too,
+    // sorted)
+    const auto right = std::upper_bound(instants.begin(), instants.end(), angle);
+    if (right == instants.begin() || right == instants.end()) continue;
+    const double a = *(right - 1), b = *right;
+    const int intervals = static_cast<int>(
+        std::min<double>(kMaxAnglesPerPeak, std::ceil(std::sqrt(10 * excess / kPeakExchangeTolerance))));
+    for (int j = 1; j < intervals; ++j) {
+      added.push_back(a + (b - a) * static_cast<double>(j) / static_cast<double>(intervals));
+    }
+  }
+  return added;
+}
+
+}  // namespace
+
 OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& options,
                         const std::vector<VectorXd>& designs) {
   detail::check_inputs(problem, options);
-  const Nlp nlp(problem);
-  throw_if(check_algorithm(problem, options));
-  const detail::ConvexAwareSolve solve = detail::solve_convex_aware(nlp, problem, designs, options);
-  const detail::Solved& solved = solve.solved;
-  const detail::Optimality& optimality = solve.optimality;
-
-  OptimizeResult r;
-  r.global = optimality.global && found_design(solved.termination);
-  r.optimality = optimality.words;
-  r.lower_bound = solve.bound.value;
-  r.lower_bound_source = solve.bound.words;
-  r.starts = solved.starts;
-  r.starts_at_best = solved.starts_at_best;
-  r.algorithm = options.algorithm;
-  r.termination = solved.termination;
-  r.message = solved.message;
-  r.x = solved.x;
-  r.iterations = solved.iterations;
-  r.evaluations = solved.evaluations;
-  r.seconds = solved.seconds;
-  r.objective = solved.objective;
-  r.constraint_violation = solved.constraint_violation;
-  // the optimum as a design, as the optimiser evaluated it, then verified
-  r.design = nlp.design(r.x);
-  r.counterweights = nlp.counterweights(r.x);
-  r.metrics = nlp.metrics(r.x);
-  if (solved.gradient_check_failed) {
-    r.verification_error = std::numeric_limits<double>::quiet_NaN();  // not verified
+  // The exchange step: solve on the samples (and the peak angles found so far); where a peak of
+  // the optimum resolved between the samples rises above what the program bounded, add its
+  // crank angle and solve again from that optimum, until the program bounds the motion's peaks.
+  DesignProblem exchanged = problem;
+  std::vector<VectorXd> starts = designs;
+  int iterations = 0, evaluations = 0;
+  double seconds = 0;
+  for (int round = 0;; ++round) {
+    const Nlp nlp(exchanged);
+    throw_if(check_algorithm(exchanged, options));
+    const detail::ConvexAwareSolve solve =
+        detail::solve_convex_aware(nlp, exchanged, starts, options);
+    const detail::Solved& solved = solve.solved;
+    iterations += solved.iterations;
+    evaluations += solved.evaluations;
+    seconds += solved.seconds;
+    const std::vector<double> added = round < kMaxExchangeRounds
+                                          ? short_peak_angles(exchanged, nlp, solved)
+                                          : std::vector<double>{};
+    if (!added.empty()) {
+      exchanged.peak_angles.insert(exchanged.peak_angles.end(), added.begin(), added.end());
+      starts.insert(starts.begin(), solved.x);
+      continue;
+    }
+    const detail::Optimality& optimality = solve.optimality;
+    OptimizeResult r;
+    r.global = optimality.global && found_design(solved.termination);
+    r.optimality = optimality.words;
+    r.lower_bound = solve.bound.value;
+    r.lower_bound_source = solve.bound.words;
+    r.starts = solved.starts;
+    r.starts_at_best = solved.starts_at_best;
+    r.algorithm = options.algorithm;
+    r.termination = solved.termination;
+    r.message = solved.message;
+    r.x = solved.x;
+    r.iterations = iterations;
+    r.evaluations = evaluations;
+    r.seconds = seconds;
+    r.objective = solved.objective;
+    r.constraint_violation = solved.constraint_violation;
+    r.peak_angles = exchanged.peak_angles;
+    // the optimum as a design, as the optimiser evaluated it, then verified
+    r.design = nlp.design(r.x);
+    r.counterweights = nlp.counterweights(r.x);
+    r.metrics = nlp.metrics(r.x);
+    if (solved.gradient_check_failed) {
+      r.verification_error = std::numeric_limits<double>::quiet_NaN();  // not verified
+      return r;
+    }
+    verify(exchanged, r);
     return r;
   }
-  verify(problem, r);
-  return r;
 }
 
 }  // namespace bd::optimize

@@ -159,6 +159,11 @@ struct OptimizeResult {
   /// mlsl: its local runs, and how many ended feasible at the best value (to 1e-6 of the
   /// objective's size); 0 and 0 for the single-start methods.
   int starts{}, starts_at_best{};
+  /// Driven scenes: the crank angles [rad] where the optimum's peaks are bounded besides the
+  /// samples (the problem's peak_angles, then those the exchange step added: resolved peaks of
+  /// an optimum that rose above its sampled ones). `metrics` and `verified` take their peaks
+  /// over the samples and these angles.
+  std::vector<double> peak_angles;
   /// One line for the console and summary.json.
   std::string brief_report() const;
   bool ok() const { return found_design(termination); }

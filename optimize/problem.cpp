@@ -294,6 +294,16 @@ Problem check_limits(const DesignProblem& p) {
 
 Problem DesignProblem::validate() const {
   if (Problem e = check_original_and_scene(*this)) return e;
+  for (std::size_t i = 0; i < peak_angles.size(); ++i) {
+    if (!std::holds_alternative<core::DrivenScene>(scene)) {
+      return FieldError{"peak_angles", static_cast<int>(i),
+                        ": crank angles for the peaks are for driven scenes only"};
+    }
+    if (!std::isfinite(peak_angles[i])) {
+      return FieldError{"peak_angles", static_cast<int>(i),
+                        "must be finite rad, got " + text::digits(peak_angles[i], 6)};
+    }
+  }
   if (counterweights.empty() && link_parameters.empty()) {
     return FieldError{"", -1,
                       "no design variables: give at least one counterweight or link parameter"};

@@ -131,10 +131,25 @@ struct DesignProblem {
   /// min(ε, ε²/(2r)) above r, so the objective is within ε · Σ weights above the exact sum
   /// (optimize/nlp.hpp has the bound on the optimum).
   double smoothing = kDefaultSmoothing;
+  /// Driven scenes: bound the motion's peaks, not the samples' (off: the samples', as the
+  /// metrics of a run without resolved peaks). On, optimize() runs exchange steps: where a
+  /// peak of the objective or of a limit, resolved between the samples at the optimum, rises
+  /// above the peak the program bounded (by more than 1e-9 of it), crank angles around it are
+  /// added to peak_angles and the problem is solved again from that optimum; and the original's
+  /// peaks that normalise the objective and the limits ("x original") are its resolved ones.
+  /// Not yet the default: on degenerate minimax optima (several peaks equal) the solvers meet
+  /// the first-order conditions less well among the added angles' nearly equal rows, so a
+  /// convex problem's optimum is then often not certified global, and each round is a solve.
+  bool resolve_peaks = false;
+  /// Driven scenes: crank angles [rad] at which the peaks (of the objective and of the limits)
+  /// are bounded besides the scene's samples (the exchange steps add to them). The RMS metrics
+  /// stay the scene's samples'.
+  std::vector<double> peak_angles;
   /// Empty when valid, else the first problem; text() says it in words, e.g.
   /// "counterweights[1].link must be 1 (crank) or 3 (rocker), got 2". Its field:
   /// - "original" (core's complaint about the design in the message), "scene.omega1" and the
-  ///   scene's other fields, "formulation", "tolerance", "objective_form", "smoothing";
+  ///   scene's other fields, "formulation", "tolerance", "objective_form", "smoothing",
+///   "peak_angles" (index: the angle that is not finite, or any in a free scene);
   /// - no field when there is no design variable; "objective" (no index) when the objective as
   ///   a whole is wrong (no term, no positive weight);
   /// - a list field with the element's index when the element is wrong as a whole: a second
