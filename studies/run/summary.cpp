@@ -341,6 +341,9 @@ Json optimize_json(const Study& study, const RunResult& result) {
   Json j = problem_json(req, result.method);
   add_solver_fields(j, r, o);
   const bool found = o.found();
+  // how the peaks were bounded, and the crank angles besides the samples where they were
+  j["peaks"] = req.resolve_peaks ? "resolved" : "sampled";
+  j["peak_angles"] = r.peak_angles;
   j["counterweights"] = found ? optimum_counterweights_json(req, r.counterweights) : Json::array();
   if (found) {
     j["added_mass"] = added_mass(study.fourbar(), r.design);

@@ -33,6 +33,9 @@ struct OptimizeRequest {
   std::vector<optimize::Term> objective;                         // in the order of the file
   std::vector<optimize::Limit> limits;                           // in the order of the file
   bool force_balance = false;  // eq. 57 as equalities (full shaking-force balance)
+  /// optimize.peaks: resolved (true) bounds the motion's peaks (exchange steps, driven scenes:
+  /// optimize::DesignProblem::resolve_peaks), sampled (false, the default) the samples'
+  bool resolve_peaks = false;
   optimize::OptimizeOptions options;
   std::optional<ParetoRequest> pareto;
 };

@@ -33,10 +33,23 @@ class OptimizeReader {
     OptimizeRequest req;
     const MapReader o(r_, e.value, "optimize", e.key_mark,
                       "(algorithm, objective, constraints, variables, max_evaluations, starts, "
-                      "tolerance, pareto)");
+                      "tolerance, peaks, pareto)");
     o.check_keys({"algorithm", "objective", "constraints", "variables", "max_evaluations",
-                  "starts", "tolerance", "pareto"});
+                  "starts", "tolerance", "peaks", "pareto"});
     const SolverMarks marks = read_solver(o, e.key_mark, is_free(study.scene), req.options);
+    if (const MapReader::Entry* k = o.find("peaks")) {
+      const std::string how = read_text(r_, *k, "optimize.peaks");
+      if (how != "resolved" && how != "sampled") {
+        r_.fail(mark_of(k->value, k->key_mark),
+                "optimize.peaks must be resolved or sampled, got '" + how + "'");
+      }
+      req.resolve_peaks = how == "resolved";
+      if (req.resolve_peaks && is_free(study.scene)) {
+        r_.fail(mark_of(k->value, k->key_mark),
+                "optimize.peaks: resolved is for driven scenes (a free scene's peaks are its "
+                "samples' in the optimiser)");
+      }
+    }
     read_objective(o.require("objective", "the metrics to minimise, each with a weight"), study,
                    req);
     if (const MapReader::Entry* c = o.find("constraints")) read_constraints(*c, study, req);

@@ -146,6 +146,7 @@ optimize::DesignProblem design_problem(const Study& study) {
   p.formulation = method.formulation;
   p.tolerance = study.tolerance;
   set_request(p, r);
+  p.resolve_peaks = r.resolve_peaks;
   return p;
 }
 

@@ -585,7 +585,12 @@ TEST(LoadStudy, OptimizeSectionReadsEveryKey) {
   EXPECT_EQ(p.formulation, choose_method(s).formulation);
   EXPECT_EQ(p.tolerance, s.tolerance);
   EXPECT_TRUE(p.force_balance);
+  EXPECT_FALSE(p.resolve_peaks);  // peaks: sampled, the default
   EXPECT_FALSE(p.validate());
+  const Study resolved = parse_study(
+      opt_edit("  tolerance: 1.0e-7\n", "  tolerance: 1.0e-7\n  peaks: resolved\n"), "study.yaml");
+  EXPECT_TRUE(resolved.optimize->resolve_peaks);
+  EXPECT_TRUE(design_problem(resolved).resolve_peaks);
 }
 
 TEST(LoadStudy, OptimizeDefaults) {
@@ -625,7 +630,10 @@ TEST(LoadStudy, OptimizeMistakesAreReportedWhereTheyAre) {
       "RA3_max, added_mass";
   expect_error(opt_edit("  tolerance: 1.0e-7\n", "  tolerence: 1.0e-7\n"), 32, 3,
                "unknown key 'tolerence' in optimize; allowed keys: algorithm, objective, "
-               "constraints, variables, max_evaluations, starts, tolerance, pareto");
+               "constraints, variables, max_evaluations, starts, tolerance, peaks, pareto");
+  // peaks: sampled or resolved, at the key's value
+  expect_error(opt_edit("  tolerance: 1.0e-7\n", "  tolerance: 1.0e-7\n  peaks: exact\n"), 33, 10,
+               "optimize.peaks must be resolved or sampled, got 'exact'");
   // starts: mlsl's local runs, an error with another algorithm, at the key's value
   expect_error(opt_edit("  tolerance: 1.0e-7\n", "  tolerance: 1.0e-7\n  starts: 4\n"), 33, 11,
                "optimize.starts is the number of local runs of the multistart mlsl; algorithm "
@@ -730,6 +738,13 @@ TEST(LoadStudy, OptimizeMetricsAFreeSceneCannotHave) {
                    "optimize:\n  algorithm: cobyla\n  objective: {Msh_rms: 1}\n"
                    "  constraints: {tau_max: 2}\n  variables: {counterweights: {crank: }}\n",
                21, 17, "optimize.constraints.tau_max: a free scene has no drive torque");
+  // the motion's peaks are bounded in driven scenes only
+  expect_error(kBase +
+                   "optimize:\n  algorithm: cobyla\n  peaks: resolved\n  objective: {Msh_max: 1}\n"
+                   "  variables: {counterweights: {crank: }}\n",
+               20, 10,
+               "optimize.peaks: resolved is for driven scenes (a free scene's peaks are its "
+               "samples' in the optimiser)");
 }
 
 TEST(LoadStudy, GradientAlgorithmInAFreeSceneOnTheOpenedLoopIsAnErrorAtAlgorithm) {
