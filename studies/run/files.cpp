@@ -147,25 +147,28 @@ std::string non_finite_at(const nlohmann::ordered_json& j, const std::string& at
   return {};
 }
 
-// the number of lines of `text` and what is wrong with it as a CSV data file ("" when whole)
-std::string csv_text_problem(const std::string& text, std::size_t* rows) {
+// the number of rows of the CSV data file `file` and what is wrong with it ("" when whole),
+// read line by line: a run's timeseries of 10^7 samples is some 5 GB, never held whole
+std::string csv_file_problem(const fs::path& file, std::size_t* rows) {
   *rows = 0;
-  if (text.empty()) return "empty";
-  if (text.back() != '\n') return "its last line is cut short (no line end)";
-  std::size_t fields = 0;
-  std::size_t line_no = 0;
-  for (std::size_t at = 0; at < text.size();) {
-    const std::size_t end = text.find('\n', at);
-    const std::size_t n = csv_fields(text.substr(at, end - at)).size();
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + file.string());
+  std::string line;
+  std::vector<std::string> fields;  // reused from line to line
+  std::size_t header_fields = 0, line_no = 0;
+  while (std::getline(in, line)) {
+    // getline stops at the file's end without a line end only on a last line cut short
+    if (in.eof()) return "its last line is cut short (no line end)";
+    csv_fields(line, fields);
     ++line_no;
     if (line_no == 1) {
-      fields = n;
-    } else if (n != fields) {
-      return "line " + std::to_string(line_no) + " has " + std::to_string(n) + " fields, the header " +
-             std::to_string(fields) + " (cut short)";
+      header_fields = fields.size();
+    } else if (fields.size() != header_fields) {
+      return "line " + std::to_string(line_no) + " has " + std::to_string(fields.size()) +
+             " fields, the header " + std::to_string(header_fields) + " (cut short)";
     }
-    at = end + 1;
   }
+  if (line_no == 0) return "empty";
   *rows = line_no - 1;
   return {};
 }
@@ -215,7 +218,7 @@ std::string run_folder_problem(const fs::path& dir) {
     const fs::path file = dir / name;
     if (!fs::exists(file, ec)) continue;
     std::size_t rows = 0;
-    if (const std::string why = csv_text_problem(read_file(file), &rows); !why.empty()) {
+    if (const std::string why = csv_file_problem(file, &rows); !why.empty()) {
       return file.string() + ": " + why;
     }
     for (const auto& [csv, run] : series) {
