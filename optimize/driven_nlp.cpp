@@ -198,7 +198,7 @@ void DrivenNlp::add_bound_variables() {
 std::string DrivenNlp::at_sample(int i) const {
   const std::string angle =
       "theta1 = " + text::digits(theta1_[static_cast<std::size_t>(i)], 6) + " rad";
-  if (i >= samples_) return " at a resolved peak (" + angle + ")";
+  if (i >= samples_) return " near a resolved peak (" + angle + ")";
   return " at sample " + std::to_string(i) + " (" + angle + ")";
 }
 

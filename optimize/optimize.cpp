@@ -275,6 +275,10 @@ const char* to_string(Termination t) {
 
 std::string OptimizeResult::brief_report() const {
   std::string s = solver_report(*this);
+  if (!peak_angles.empty()) {
+    s += ", peaks bounded at " + std::to_string(peak_angles.size()) +
+         " crank angles besides the samples";
+  }
   if (termination == Termination::kNotRun || std::isnan(verification_error)) {
     s += ", not verified";
   } else {
@@ -613,15 +617,15 @@ std::vector<double> short_peak_angles(const DesignProblem& problem, const Nlp& n
   for (Metric m : used) {
     const double excess = value(resolved, m) / value(bounded, m) - 1;
     if (!(excess > kPeakExchangeTolerance)) continue;
-    double angle = scene->theta1 + scene->omega1 * peaks.table[static_cast<std::size_t>(m)].t;
+    const double angle =
+        scene->theta1 + scene->omega1 * peaks.table[static_cast<std::size_t>(m)].t;
     added.push_back(angle);
-    // the interval of instants around it (the angles increase with time when omega1 < 0 too,
-    // sorted)
+    // the interval of instants around it (sorted by angle, whatever the sense of rotation)
     const auto right = std::upper_bound(instants.begin(), instants.end(), angle);
     if (right == instants.begin() || right == instants.end()) continue;
     const double a = *(right - 1), b = *right;
-    const int intervals = static_cast<int>(
-        std::min<double>(kMaxAnglesPerPeak, std::ceil(std::sqrt(10 * excess / kPeakExchangeTolerance))));
+    const int intervals = static_cast<int>(std::min<double>(
+        kMaxAnglesPerPeak, std::ceil(std::sqrt(10 * excess / kPeakExchangeTolerance))));
     for (int j = 1; j < intervals; ++j) {
       added.push_back(a + (b - a) * static_cast<double>(j) / static_cast<double>(intervals));
     }
@@ -635,25 +639,30 @@ OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& opt
                         const std::vector<VectorXd>& designs) {
   detail::check_inputs(problem, options);
   // The exchange step: solve on the samples (and the peak angles found so far); where a peak of
-  // the optimum resolved between the samples rises above what the program bounded, add its
-  // crank angle and solve again from that optimum, until the program bounds the motion's peaks.
+  // the optimum resolved between the samples rises above what the program bounded, add crank
+  // angles around it and solve again from that optimum, until the program bounds the motion's
+  // peaks. The rounds share options.max_evaluations.
   DesignProblem exchanged = problem;
   std::vector<VectorXd> starts = designs;
   int iterations = 0, evaluations = 0;
   double seconds = 0;
   for (int round = 0;; ++round) {
     const Nlp nlp(exchanged);
-    throw_if(check_algorithm(exchanged, options));
+    if (round == 0) throw_if(check_algorithm(problem, options));
+    OptimizeOptions budget = options;
+    budget.max_evaluations = options.max_evaluations - evaluations;
     const detail::ConvexAwareSolve solve =
-        detail::solve_convex_aware(nlp, exchanged, starts, options);
+        detail::solve_convex_aware(nlp, exchanged, starts, budget);
     const detail::Solved& solved = solve.solved;
     iterations += solved.iterations;
     evaluations += solved.evaluations;
     seconds += solved.seconds;
-    const std::vector<double> added = round < kMaxExchangeRounds
-                                          ? short_peak_angles(exchanged, nlp, solved)
-                                          : std::vector<double>{};
-    if (!added.empty()) {
+    const std::vector<double> added = short_peak_angles(exchanged, nlp, solved);
+    // the next round needs evaluations left (mlsl: one per local run at least)
+    const int left = options.max_evaluations - evaluations;
+    const bool another = round < kMaxExchangeRounds &&
+                         left >= (options.algorithm == Algorithm::kMlsl ? options.starts : 1);
+    if (!added.empty() && another) {
       exchanged.peak_angles.insert(exchanged.peak_angles.end(), added.begin(), added.end());
       starts.insert(starts.begin(), solved.x);
       continue;
@@ -669,6 +678,20 @@ OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& opt
     r.algorithm = options.algorithm;
     r.termination = solved.termination;
     r.message = solved.message;
+    if (!added.empty()) {  // a peak still rises above its bound by more than the tolerance
+      const std::string where =
+          exchanged.peak_angles.empty()
+              ? "the samples only"
+              : "the samples and " + std::to_string(exchanged.peak_angles.size()) +
+                    " more crank angles";
+      r.message += (round < kMaxExchangeRounds
+                        ? "; the evaluation budget was spent before every resolved peak was "
+                          "bounded (the peaks are bounded at "
+                        : "; after " + std::to_string(kMaxExchangeRounds + 1) +
+                              " solves a resolved peak still rose above its bound (the peaks "
+                              "are bounded at ") +
+                   where + ")";
+    }
     r.x = solved.x;
     r.iterations = iterations;
     r.evaluations = evaluations;

@@ -28,7 +28,7 @@ class OptimizeReader {
   explicit OptimizeReader(const Reporter& r) : r_(r) {}
 
   // optimize: {algorithm, objective, constraints, variables, max_evaluations, starts, tolerance,
-  // pareto}
+  // peaks, pareto}
   OptimizeRequest read_optimize(const MapReader::Entry& e, const Study& study) {
     OptimizeRequest req;
     const MapReader o(r_, e.value, "optimize", e.key_mark,
@@ -37,19 +37,7 @@ class OptimizeReader {
     o.check_keys({"algorithm", "objective", "constraints", "variables", "max_evaluations",
                   "starts", "tolerance", "peaks", "pareto"});
     const SolverMarks marks = read_solver(o, e.key_mark, is_free(study.scene), req.options);
-    if (const MapReader::Entry* k = o.find("peaks")) {
-      const std::string how = read_text(r_, *k, "optimize.peaks");
-      if (how != "resolved" && how != "sampled") {
-        r_.fail(mark_of(k->value, k->key_mark),
-                "optimize.peaks must be resolved or sampled, got '" + how + "'");
-      }
-      req.resolve_peaks = how == "resolved";
-      if (req.resolve_peaks && is_free(study.scene)) {
-        r_.fail(mark_of(k->value, k->key_mark),
-                "optimize.peaks: resolved is for driven scenes (a free scene's peaks are its "
-                "samples' in the optimiser)");
-      }
-    }
+    req.resolve_peaks = read_peaks(o, study, false);
     read_objective(o.require("objective", "the metrics to minimise, each with a weight"), study,
                    req);
     if (const MapReader::Entry* c = o.find("constraints")) read_constraints(*c, study, req);
@@ -71,17 +59,18 @@ class OptimizeReader {
   }
 
   // a planar linkage's optimize: {algorithm, objective, constraints, variables, max_evaluations,
-  // starts, tolerance, pareto}
+  // starts, tolerance, peaks, pareto}
   PlanarOptimizeRequest read_planar_optimize(const MapReader::Entry& e, const Study& study) {
     namespace op = optimize::planar;
     PlanarOptimizeRequest req;
     const core::planar::Linkage& linkage = study.planar();
     const MapReader o(r_, e.value, "optimize", e.key_mark,
                       "(algorithm, objective, constraints, variables, max_evaluations, starts, "
-                      "tolerance, pareto)");
+                      "tolerance, peaks, pareto)");
     o.check_keys({"algorithm", "objective", "constraints", "variables", "max_evaluations",
-                  "starts", "tolerance", "pareto"});
+                  "starts", "tolerance", "peaks", "pareto"});
     const SolverMarks marks = read_solver(o, e.key_mark, is_free(study.scene), req.options);
+    read_peaks(o, study, true);  // sampled only, as yet
     table_ = core::planar::metric_table(core::planar::Model(linkage));
 
     // objective: {metric: weight}
@@ -299,6 +288,29 @@ class OptimizeReader {
   };
 
   // algorithm, max_evaluations, starts, tolerance; each mark defaults to the section's
+  // optimize.peaks: sampled (false, the default) or resolved (true; a four-bar's driven scene)
+  bool read_peaks(const MapReader& o, const Study& study, bool planar) {
+    const MapReader::Entry* k = o.find("peaks");
+    if (!k) return false;
+    const std::string how = read_text(r_, *k, "optimize.peaks");
+    const YAML::Mark at = mark_of(k->value, k->key_mark);
+    if (how != "resolved" && how != "sampled") {
+      r_.fail(at, "optimize.peaks must be resolved or sampled, got '" + how + "'");
+    }
+    if (how == "sampled") return false;
+    if (planar) {
+      r_.fail(at,
+              "optimize.peaks: resolved is not available for general planar linkages yet (their "
+              "optimiser bounds the peaks at the samples: give more samples, or peaks: sampled)");
+    }
+    if (is_free(study.scene)) {
+      r_.fail(at,
+              "optimize.peaks: resolved is for driven scenes (a free scene's peaks are its "
+              "samples' in the optimiser)");
+    }
+    return true;
+  }
+
   SolverMarks read_solver(const MapReader& o, const YAML::Mark& section, bool free_scene,
                           optimize::OptimizeOptions& options) {
     SolverMarks marks{section, section, section, section, section};

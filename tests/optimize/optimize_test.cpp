@@ -144,7 +144,8 @@ void add_peak_angles(LeastSquares& ls, const core::FourBar& model, double omega1
     ASSERT_TRUE(base.has_value());
     Eigen::Matrix<double, 2, 4> A;
     for (int j = 0; j < 4; ++j) {
-      const auto d = core::inverse_dynamics(with_unit_counterweight(model, j), angle, omega1, 0.0, kF);
+      const auto d =
+          core::inverse_dynamics(with_unit_counterweight(model, j), angle, omega1, 0.0, kF);
       ASSERT_TRUE(d.has_value());
       A.col(j) = d->Fsh - base->Fsh;
     }
@@ -644,6 +645,27 @@ TEST(Optimize, APeakObjectiveBoundsTheMotionsPeakNotTheSamples) {
     EXPECT_GE(at.peak(trial), r.metrics.Fsh_max * (1 - 1e-9)) << trial.transpose();
     EXPECT_GE(dense.peak(trial), r.metrics.Fsh_max * (1 - 1e-5)) << trial.transpose();
   }
+}
+
+// The exchange rounds share the evaluation budget: a budget the first solve spends leaves the
+// peaks bounded at the samples, and the message says so.
+TEST(Optimize, ExchangeRoundsShareTheEvaluationBudget) {
+  DesignProblem p = counterweight_problem();
+  core::DrivenScene coarse = one_revolution();
+  coarse.samples = 24;
+  p.scene = coarse;
+  p.objective = {Term{Metric::kFshMax, 1.0}};
+  p.resolve_peaks = true;
+  OptimizeOptions o;
+  o.algorithm = Algorithm::kCobyla;
+  o.max_evaluations = 100;
+  const OptimizeResult r = optimize(p, o);
+  EXPECT_LE(r.evaluations, 100);
+  EXPECT_TRUE(r.peak_angles.empty());
+  EXPECT_NE(r.message.find("the evaluation budget was spent before every resolved peak was "
+                           "bounded (the peaks are bounded at the samples only)"),
+            std::string::npos)
+      << r.message;
 }
 
 // What is convex and what is not, decided from the regressor: the shaking force reads only the

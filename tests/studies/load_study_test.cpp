@@ -632,8 +632,8 @@ TEST(LoadStudy, OptimizeMistakesAreReportedWhereTheyAre) {
                "unknown key 'tolerence' in optimize; allowed keys: algorithm, objective, "
                "constraints, variables, max_evaluations, starts, tolerance, peaks, pareto");
   // peaks: sampled or resolved, at the key's value
-  expect_error(opt_edit("  tolerance: 1.0e-7\n", "  tolerance: 1.0e-7\n  peaks: exact\n"), 33, 10,
-               "optimize.peaks must be resolved or sampled, got 'exact'");
+  expect_error(opt_edit("  tolerance: 1.0e-7\n", "  tolerance: 1.0e-7\n  peaks: exact\n"), 33,
+               10, "optimize.peaks must be resolved or sampled, got 'exact'");
   // starts: mlsl's local runs, an error with another algorithm, at the key's value
   expect_error(opt_edit("  tolerance: 1.0e-7\n", "  tolerance: 1.0e-7\n  starts: 4\n"), 33, 11,
                "optimize.starts is the number of local runs of the multistart mlsl; algorithm "

@@ -62,6 +62,12 @@ TEST(PlanarOptimizeStudy, MistakesAreOneLineAtTheirPlace) {
                "unknown algorithm 'newton' in optimize.algorithm");
   expect_error(section(kObjective + kVariables + "  tolerance: 2\n"), 25, 14,
                "optimize.tolerance must be > 0 and < 1");
+  // the peaks: bounded at the samples, as yet (peaks: sampled is the default, and accepted)
+  expect_error(section(kObjective + kVariables + "  peaks: resolved\n"), 25, 10,
+               "optimize.peaks: resolved is not available for general planar linkages yet");
+  expect_error(section(kObjective + kVariables + "  peaks: every\n"), 25, 10,
+               "optimize.peaks must be resolved or sampled, got 'every'");
+  EXPECT_NO_THROW(parse_study(section(kObjective + kVariables + "  peaks: sampled\n"), "e.yaml"));
   // objective and constraints: the linkage's metrics by name
   expect_error(section("  objective: {Msh: 1}\n" + kVariables), 21, 15,
                "unknown metric 'Msh' in optimize.objective; expected one of Fsh_rms, Fsh_max, "
