@@ -595,14 +595,21 @@ TEST(Optimize, PeakUnderABudgetIsGlobalAndNoNearbyDesignBeatsIt) {
 // optimum to the peaks' smoothing), and against random designs within the budget, which do no
 // better over the samples and the added angles (the test's own simulations of unit
 // counterweights) nor over 3600 samples beyond a discretisation's undershoot.
-TEST(Optimize, APeakObjectiveBoundsTheMotionsPeakNotTheSamples) {
-  constexpr auto kF = core::Formulation::kMassMatrix;
+// the least Fsh_max on 24 samples a revolution, the motion's peaks bounded
+DesignProblem coarse_peak_problem() {
   DesignProblem p = counterweight_problem();
   core::DrivenScene coarse = one_revolution();
   coarse.samples = 24;
   p.scene = coarse;
   p.objective = {Term{Metric::kFshMax, 1.0}};
   p.resolve_peaks = true;
+  return p;
+}
+
+TEST(Optimize, APeakObjectiveBoundsTheMotionsPeakNotTheSamples) {
+  constexpr auto kF = core::Formulation::kMassMatrix;
+  DesignProblem p = coarse_peak_problem();
+  const core::DrivenScene coarse = std::get<core::DrivenScene>(p.scene);
   const Eigen::Vector4d full = minimiser(assemble(p.original, one_revolution()), 1e300);
   const double M = 0.5 * (full.head<2>().norm() + full.tail<2>().norm());
   p.limits = {Limit{Metric::kAddedMass, M}};
@@ -650,12 +657,7 @@ TEST(Optimize, APeakObjectiveBoundsTheMotionsPeakNotTheSamples) {
 // The exchange rounds share the evaluation budget: a budget the first solve spends leaves the
 // peaks bounded at the samples, and the message says so.
 TEST(Optimize, ExchangeRoundsShareTheEvaluationBudget) {
-  DesignProblem p = counterweight_problem();
-  core::DrivenScene coarse = one_revolution();
-  coarse.samples = 24;
-  p.scene = coarse;
-  p.objective = {Term{Metric::kFshMax, 1.0}};
-  p.resolve_peaks = true;
+  const DesignProblem p = coarse_peak_problem();
   OptimizeOptions o;
   o.algorithm = Algorithm::kCobyla;
   o.max_evaluations = 100;
