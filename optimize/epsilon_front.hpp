@@ -18,8 +18,9 @@ namespace bd::optimize::detail {
 ///   bool is_mass(Metric m) const;                    // added_mass: its bound may be <= 0
 /// Returns (ε, result) per point: minimise `first` subject to the base constraints and
 /// second <= ε, ε spaced from the loosest useful bound down to the tightest reachable one. Each
-/// point starts from its neighbour's design where that meets its bound, else from the design
-/// that minimises `second` alone (which meets every bound of the front), else as a lone solve.
+/// point starts from its neighbour's design where that meets its bound (the first point: the
+/// loose end's design, which meets it and minimises `first` there), else from the design that
+/// minimises `second` alone (which meets every bound of the front), else as a lone solve.
 template <class Front>
 std::vector<std::pair<double, typename Front::Result>> epsilon_front(const Front& f,
                                                                      typename Front::Metric first,
@@ -55,7 +56,14 @@ std::vector<std::pair<double, typename Front::Result>> epsilon_front(const Front
     auto p = f.minimising(first);
     f.limit(p, second, epsilon);
     std::vector<const Result*> warm;
-    if (!front.empty()) warm.push_back(&front.back().second);
+    // the loose end's design, not the second's minimiser, starts the front: from the latter a
+    // local method can stay where `first` is no better than the original's (a counterweight of
+    // no mass, whose place then has no gradient), and every later point starts from there
+    if (!front.empty()) {
+      warm.push_back(&front.back().second);
+    } else if (loose.ok()) {
+      warm.push_back(&loose);
+    }
     warm.push_back(&best_second);
     front.emplace_back(epsilon, f.solve(p, warm));
   }
