@@ -617,6 +617,11 @@ TEST(Optimize, APeakObjectiveBoundsTheMotionsPeakNotTheSamples) {
   SCOPED_TRACE(r.brief_report() + " | " + r.message);
   ASSERT_TRUE(r.ok());
   ASSERT_FALSE(r.peak_angles.empty()) << "24 samples hold the optimum's peaks";
+  // the console's line counts them
+  EXPECT_NE(r.brief_report().find(", peaks bounded at " + std::to_string(r.peak_angles.size()) +
+                                  " crank angles besides the samples"),
+            std::string::npos)
+      << r.brief_report();
   // the peak bounded is the design's resolved peak
   const core::Trajectory run = core::simulate_driven(r.design, coarse, {.formulation = kF});
   ASSERT_TRUE(run.ok()) << run.message;
