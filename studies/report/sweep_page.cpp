@@ -161,10 +161,10 @@ struct Sweep {
   };
   std::vector<Tally> tallies;
   std::vector<std::pair<double, double>> range;  // each parameter's least and largest value
-  // the sample charted: every keep_stride-th point, or on a large grid every grid_step[j]-th
-  // value of each parameter (grid_ny: the second parameter's values, > 0 then)
+  // the sample charted: every keep_stride-th point, or on a large grid the values of each
+  // parameter whose grid_keep[j][index] is set (grid_ny: the second parameter's values, > 0 then)
   std::size_t keep_stride = 1, grid_ny = 0;
-  std::size_t grid_step[2] = {1, 1};
+  std::vector<char> grid_keep[2];
   std::vector<Parameter> params;
   std::string design;           // grid, random, lhs
   std::string second;           // column prefix of the second design: "balanced_", "optimized_", ""
@@ -326,27 +326,35 @@ void check_header(Sweep& s, const fs::path& csv_file, const fs::path& json_file,
 }
 
 // Which rows the charts draw: all of a sweep of up to kChartRows points; of a larger grid of two
-// parameters every k-th value of each (at most kGridCells per axis); else every k-th point
-// (random and LHS points come in random order, so the sample is as random as the design).
+// parameters at most kGridCells values of each, evenly spread from the first value to the last
+// (both always drawn: the edge of a design space is where optima often lie); else every k-th
+// point (random and LHS points come in random order, so the sample is as random as the design).
 void choose_sample(Sweep& s, std::size_t points) {
   s.keep_stride = 1;
   if (points <= kChartRows) return;
   if (s.params.size() == 2 && s.design == "grid" && !s.params[0].values.empty() &&
       !s.params[1].values.empty()) {
     s.grid_ny = s.params[1].values.size();
+    std::string counts[2];
     for (std::size_t j = 0; j < 2; ++j) {
       Parameter& p = s.params[j];
       const std::size_t n = p.values.size();
-      const std::size_t k = (n + kGridCells - 1) / kGridCells;
-      s.grid_step[j] = k;
+      const std::size_t m = std::min(n, kGridCells);
+      s.grid_keep[j].assign(n, 0);
       std::vector<double> kept;
-      for (std::size_t i = 0; i < n; i += k) kept.push_back(p.values[i]);
+      for (std::size_t t = 0; t < m; ++t) {
+        // index t (n - 1) / (m - 1), rounded: distinct for distinct t as n >= m
+        const std::size_t i = m == 1 ? 0 : (t * (n - 1) + (m - 1) / 2) / (m - 1);
+        s.grid_keep[j][i] = 1;
+        kept.push_back(p.values[i]);
+      }
       p.values = std::move(kept);
+      counts[j] = std::to_string(m) + " of the " + std::to_string(n) + " values";
     }
-    s.sampling = "one in every " + std::to_string(s.grid_step[0]) + " values of " +
-                 s.params[0].path + " and one in every " + std::to_string(s.grid_step[1]) +
-                 " of " + s.params[1].path + " (" + std::to_string(s.params[0].values.size()) +
-                 " x " + std::to_string(s.params[1].values.size()) + " of the grid's points)";
+    s.sampling = counts[0] + " of " + s.params[0].path + " and " + counts[1] + " of " +
+                 s.params[1].path + ", each from its first value to its last (" +
+                 std::to_string(s.params[0].values.size()) + " x " +
+                 std::to_string(s.params[1].values.size()) + " of the grid's points)";
     return;
   }
   s.keep_stride = (points + kChartRows - 1) / kChartRows;
@@ -386,7 +394,8 @@ void take_row(Sweep& s, const std::vector<std::string>& row) {
   const std::size_t i = index && *index >= 0 ? static_cast<std::size_t>(*index) : 0;
   bool keep = true;
   if (s.grid_ny > 0) {
-    keep = (i / s.grid_ny) % s.grid_step[0] == 0 && (i % s.grid_ny) % s.grid_step[1] == 0;
+    const std::size_t ix = i / s.grid_ny, iy = i % s.grid_ny;
+    keep = ix < s.grid_keep[0].size() && s.grid_keep[0][ix] && s.grid_keep[1][iy];
   } else if (s.keep_stride > 1) {
     keep = i % s.keep_stride == 0;
   }

@@ -672,7 +672,7 @@ TEST_F(SweepReportTest, LargeGridIsSampledForTheChartsAndRankedWhole) {
     for (std::size_t c = 0; c < metrics; ++c) {
       const bool balanced_force = header[3 + c].rfind("balanced_Fsh", 0) == 0;
       // a bowl with its least value at point 151 (x index 1, y index 1: off the sample, which
-      // keeps every 4th value from index 0); the balanced force 1e-14 N of round-off
+      // keeps indices 0, 4, 8, 11, ..., 149); the balanced force 1e-14 N of round-off
       const double v = balanced_force ? 1e-14 * (1 + std::sin(double(i)))
                                       : 10 + (x - xs[1]) * (x - xs[1]) + (y - ys[1]) * (y - ys[1]);
       row += "," + g17(v);
@@ -697,9 +697,11 @@ TEST_F(SweepReportTest, LargeGridIsSampledForTheChartsAndRankedWhole) {
                                                  "zero to round-off")))
       << best;
   if (gnuplot_.empty()) return;
-  EXPECT_NE(html.find("Drawn: one in every 4 values of linkage.coupler.mass and one in every 4 "
-                      "of linkage.coupler.s (38 x 38 of the grid's points) of sweep.csv's 22500 "
-                      "rows"),
+  // 40 values a side, the last ones included (every 4th value from the first stopped at the
+  // 148th of 150: 38 x 38, the grid's far edges left out)
+  EXPECT_NE(html.find("Drawn: 40 of the 150 values of linkage.coupler.mass and 40 of the 150 "
+                      "values of linkage.coupler.s, each from its first value to its last (40 x 40 "
+                      "of the grid's points) of sweep.csv's 22500 rows"),
             std::string::npos);
   EXPECT_NE(html.find("coupler mass m2 [kg]"), std::string::npos);  // axes in an engineer's words
   EXPECT_NE(html.find("every value zero to round-off"), std::string::npos);
