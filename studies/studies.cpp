@@ -3,7 +3,9 @@
 #include <exception>
 #include <system_error>
 
+#include "core/input_error.hpp"
 #include "studies/report/report.hpp"
+#include "studies/run/files.hpp"
 
 namespace bd::studies {
 
@@ -25,6 +27,12 @@ std::optional<std::string> try_write_report(const Study& study, const fs::path& 
 }
 
 RunResult run_study(const Study& study, const fs::path& out_dir) {
+  // a folder holding an unfinished sweep is not overwritten by a single run (its rows would be
+  // lost, or mixed with this run's files); a finished one is replaced (write_run())
+  if (const std::string why = unfinished_sweep(out_dir, -1); !why.empty()) {
+    throw InputError(why + ": continue it with `balance-design run SWEEP-STUDY --out " +
+                     out_dir.string() + " --resume`, or write this run elsewhere with --out");
+  }
   // compute first: an invalid scene throws before anything is created on disk
   RunResult result = compute_study(study);
   write_run(study, result, out_dir);

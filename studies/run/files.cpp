@@ -201,6 +201,39 @@ std::string sweep_folder_problem(const fs::path& dir) {
   return {};
 }
 
+std::optional<SweepInFolder> sweep_in_folder(const fs::path& dir) {
+  std::error_code ec;
+  const fs::path json = dir / "sweep.json", csv = dir / "sweep.csv";
+  const bool has_json = fs::exists(json, ec), has_csv = fs::exists(csv, ec);
+  if (!has_json && !has_csv) return std::nullopt;
+  SweepInFolder s;
+  if (has_json) {
+    const nlohmann::ordered_json j = json_object(json);
+    if (!j.is_discarded() && j.contains("points") && j["points"].is_number_integer()) {
+      s.points = j["points"].get<long>();
+    }
+  }
+  std::ifstream in(csv, std::ios::binary);
+  std::string line;
+  long lines = 0;
+  while (std::getline(in, line) && !in.eof()) ++lines;  // a last line without '\n' is cut short
+  s.rows = std::max(0L, lines - 1);
+  return s;
+}
+
+std::string unfinished_sweep(const fs::path& dir, long points_if_unknown) {
+  const std::optional<SweepInFolder> sweep = sweep_in_folder(dir);
+  if (!sweep) return {};
+  if (sweep->points < 0 && points_if_unknown < 0) {
+    return dir.string() + " holds a sweep (" + std::to_string(sweep->rows) +
+           " points done) without a readable sweep.json";
+  }
+  const long points = sweep->points >= 0 ? sweep->points : points_if_unknown;
+  if (sweep->rows >= points) return {};
+  return dir.string() + " holds an unfinished sweep (" + std::to_string(sweep->rows) + " of " +
+         std::to_string(points) + " points)";
+}
+
 std::string run_folder_problem(const fs::path& dir) {
   const fs::path summary_file = dir / "summary.json";
   const nlohmann::ordered_json summary = json_object(summary_file);

@@ -3,6 +3,7 @@
 /// split one way for every writer and reader (timeseries, comparison, sweep and bench files).
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <string_view>
@@ -53,6 +54,21 @@ void check_json_numbers(const nlohmann::ordered_json& j, const std::filesystem::
 /// many rows as summary.json's samples. A file cut short (a copy interrupted, another program
 /// filling the disk) shows here, before `balance-design report` draws from it.
 std::string run_folder_problem(const std::filesystem::path& dir);
+
+/// The sweep a folder holds: the complete rows of its sweep.csv (lines after the header) and
+/// the points its sweep.json names (-1 when it names none or is unreadable).
+struct SweepInFolder {
+  long rows{};
+  long points{-1};
+};
+
+/// The sweep in `dir`, when it holds sweep.json or sweep.csv; sweep.csv is read line by line.
+std::optional<SweepInFolder> sweep_in_folder(const std::filesystem::path& dir);
+
+/// "DIR holds an unfinished sweep (k of n points)" when `dir` holds a sweep with fewer complete
+/// rows than its points (`points_if_unknown` when sweep.json names none; if that is negative, a
+/// sweep without a readable sweep.json counts as unfinished), else "".
+std::string unfinished_sweep(const std::filesystem::path& dir, long points_if_unknown);
 
 /// The same for a sweep's folder: sweep.json parses. (A last line of sweep.csv cut short is an
 /// interrupted sweep's, which its page shows and --resume drops.)

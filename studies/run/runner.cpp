@@ -465,11 +465,16 @@ std::string optimized_yaml(const Study& study, const OptimizedRun& run) {
   const char* pivots[] = {"", "A0", "", "A3"};
   for (const optimize::PlacedCounterweight& p : r.counterweights) {
     const balance::Counterweight& c = p.counterweight;
-    std::snprintf(line, sizeof line,
-                  "The %s carries a counterweight of %.6g kg at %.6g m from %s (%s).\n",
-                  core::link_name(p.link), c.mass, c.distance,
-                  p.link == 1 || p.link == 3 ? pivots[p.link] : "its pivot",
-                  where_written(written));
+    if (!(c.mass > 0)) {
+      std::snprintf(line, sizeof line, "The %s carries no counterweight (its mass is 0).\n",
+                    core::link_name(p.link));
+    } else {
+      std::snprintf(line, sizeof line,
+                    "The %s carries a counterweight of %.6g kg at %.6g m from %s (%s).\n",
+                    core::link_name(p.link), c.mass, c.distance,
+                    p.link == 1 || p.link == 3 ? pivots[p.link] : "its pivot",
+                    where_written(written));
+    }
     header += line;
   }
   header +=
@@ -684,6 +689,9 @@ void write_run(const Study& study, RunResult& result, const fs::path& out_dir) {
   for (const char* name : kRunFiles) {
     if (names.front() != name) names.emplace_back(name);
   }
+  // a finished sweep's files (run_study() refuses a folder holding an unfinished one)
+  names.emplace_back("sweep.json");
+  names.emplace_back("sweep.csv");
   for (const std::string& name : names) {
     if (fs::remove(out_dir / name, ec); ec) {
       throw std::runtime_error("cannot remove the earlier run's " + (out_dir / name).string() +

@@ -419,17 +419,8 @@ Existing existing_rows(const Study& study, const fs::path& out_dir, const SweepR
   e.complete_size = lines.complete_size();
   if (!options.resume) {
     // a finished sweep is replaced; an unfinished one only on request
-    int folder_points = n;
-    if (old_summary && (*old_summary)["points"].is_number_integer()) {
-      folder_points = (*old_summary)["points"].get<int>();
-    }
-    long rows = 0;
-    while (rows < folder_points && lines.next(line)) ++rows;
-    if (rows < folder_points) {
-      throw InputError(out_dir.string() + " holds an unfinished sweep (" + std::to_string(rows) +
-                       " of " + std::to_string(folder_points) +
-                       " points): pass --resume to continue it, or remove the folder to start "
-                       "over");
+    if (const std::string why = unfinished_sweep(out_dir, n); !why.empty()) {
+      throw InputError(why + ": pass --resume to continue it, or remove the folder to start over");
     }
     return e;
   }
@@ -475,6 +466,14 @@ void start_files(const Study& study, const fs::path& out_dir, const SweepResult&
                              ec.message());
   }
   remove_stale_temporaries(out_dir);  // of a sweep killed here before
+  // a single run's files: the folder holds one sweep and nothing of another study
+  for (const char* name : kRunFiles) {
+    if (std::string_view(name) == "study.yaml") continue;  // written below
+    if (fs::remove(out_dir / name, ec); ec) {
+      throw std::runtime_error("cannot remove the earlier run's " + (out_dir / name).string() +
+                               ": " + ec.message());
+    }
+  }
   // the study itself, which `balance-design report DIR` reads from the folder
   if (study.sweep) write_text_file(study.sweep->study_text, out_dir / "study.yaml");
   write_text_file(sweep_json(study, result.points, counts), result.summary);
@@ -715,6 +714,7 @@ SweepResult write_sweep(const Study& study, const fs::path& out_dir, const Sweep
   report_progress(written, true);
 
   result.done = written;
+  result.elapsed_s = counts.elapsed_s;
   result.resumed = kept;
   result.failed = counts.failed;
   result.interrupted = written < n;

@@ -494,6 +494,35 @@ TEST_F(SweepRunner, ResumeRefusesAnotherDesignOrAlteredRows) {
   // a finished one is replaced
   EXPECT_EQ(message(study, dir_ / "full", quiet()), "no error");
   EXPECT_EQ(read(dir_ / "full" / "sweep.csv"), full);
+
+  // a single run of the base study into a sweep's folder: refused while the sweep is unfinished
+  // (its rows kept, no file of the run written), replacing it once finished; and a sweep into a
+  // single run's folder leaves none of the run's files: a folder never holds two studies' files
+  Study plain = study;
+  plain.sweep.reset();
+  try {
+    run_study(plain, p);
+    ADD_FAILURE() << "a single run overwrote an unfinished sweep";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              p.string() + " holds an unfinished sweep (3 of 9 points): continue it with "
+                           "`balance-design run SWEEP-STUDY --out " +
+                  p.string() + " --resume`, or write this run elsewhere with --out");
+  }
+  EXPECT_EQ(lines(read(p / "sweep.csv")).size(), 4u);
+  EXPECT_FALSE(fs::exists(p / "summary.json"));
+  EXPECT_FALSE(fs::exists(p / "timeseries.csv"));
+  run_study(plain, dir_ / "full");
+  EXPECT_FALSE(fs::exists(dir_ / "full" / "sweep.csv"));
+  EXPECT_FALSE(fs::exists(dir_ / "full" / "sweep.json"));
+  EXPECT_TRUE(fs::exists(dir_ / "full" / "summary.json"));
+  run_sweep(study, dir_ / "full", quiet());
+  EXPECT_EQ(read(dir_ / "full" / "sweep.csv"), full);
+  for (const char* name : kRunFiles) {
+    if (std::string_view(name) != "study.yaml") {
+      EXPECT_FALSE(fs::exists(dir_ / "full" / name)) << name;
+    }
+  }
 }
 
 TEST_F(SweepRunner, StopKeepsAPrefixAndResumeCompletesIt) {
