@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <thread>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -86,7 +87,9 @@ Outputs (in DIR, default results/<name>/ with <name> the study's `name`):
   mpirun -np N balance-design run STUDY.yaml shares a sweep's points among N processes (on one
   machine or a cluster; --threads is then per process) with the same sweep.csv, byte for byte;
   --resume works with any N (docs/scaling.md).
-  Files are written under a temporary name and renamed, so none is ever half-written.
+  Files are written under a temporary name and renamed, so none is ever half-written; only
+  sweep.csv grows row by row, and a sweep killed mid-row may leave its last line cut short,
+  which the page shows and --resume drops.
 
 The study-file format is described in docs/study-format.md; examples are in studies/examples/.
 )";
@@ -244,7 +247,7 @@ struct RunArgs {
   std::string study;
   std::string out;
   bool resume = false;            // sweeps: continue the sweep in the output folder
-  int threads = 0;                // sweeps: parallel points (0: the study's, else one per core)
+  int threads = -1;  // sweeps: parallel points (0: one per core; -1, not given: the study's)
   std::string progress = "auto";  // sweeps: auto | bar | lines | none
 };
 
@@ -292,6 +295,22 @@ void print_warnings(const std::vector<std::string>& warnings) {
     std::fprintf(stderr, "balance-design: warning: %s\n", w.c_str());
 }
 
+// one counterweight's line: "  NAME  counterweight[ (SHAPE)] M kg at [x, y] m from PIVOT (d m)[,
+// radius r m]", or "  NAME  no counterweight (0 kg)" for none; NAME in a column `width` wide
+void print_counterweight(const std::string& name, int width, const bd::balance::Counterweight& c,
+                         const std::string& pivot, const char* shape = nullptr) {
+  if (!(c.mass > 0)) {
+    std::printf("  %-*s  no counterweight (0 kg)\n", width, name.c_str());
+    return;
+  }
+  std::printf("  %-*s  counterweight%s%s%s %.6g kg at [%.6g, %.6g] m from %s (%.6g m)", width,
+              name.c_str(), shape ? " (" : "", shape ? shape : "", shape ? ")" : "", c.mass + 0.0,
+              c.position.x() + 0.0, c.position.y() + 0.0,  // + 0.0: no "-0"
+              pivot.c_str(), c.distance);
+  if (c.radius > 0) std::printf(", radius %.6g m", c.radius);
+  std::printf("\n");
+}
+
 // the balanced design: what was added, and before / after / ratio of the main metrics
 void print_balance(const st::Study& study, const st::RunResult& r) {
   const bd::balance::BalancedDesign& b = *study.balance;
@@ -309,12 +328,8 @@ void print_balance(const st::Study& study, const st::RunResult& r) {
   const char* pivots[] = {"A0", "A3"};
   for (int i = 0; i < 2; ++i) {
     if (!cws[i]->has_value()) continue;
-    const bd::balance::Counterweight& c = **cws[i];
-    std::printf("  %-7s  counterweight (%s) %.6g kg at [%.6g, %.6g] m from %s (%.6g m)", sides[i],
-                bd::balance::to_string(specs[i]->shape), c.mass, c.position.x(), c.position.y(),
-                pivots[i], c.distance);
-    if (c.radius > 0) std::printf(", radius %.6g m", c.radius);
-    std::printf("\n");
+    print_counterweight(sides[i], 7, **cws[i], pivots[i],
+                        bd::balance::to_string(specs[i]->shape));
   }
   const bd::core::CounterRotation* discs[] = {&b.model.counter_rotations.crank,
                                               &b.model.counter_rotations.rocker};
@@ -339,18 +354,8 @@ void print_planar_counterweights(const bd::core::planar::Linkage& l,
                                  const std::vector<bd::balance::planar::LinkCounterweight>& cws,
                                  int width) {
   for (const bd::balance::planar::LinkCounterweight& c : cws) {
-    const bd::balance::Counterweight& w = c.counterweight;
-    if (!(w.mass > 0)) {
-      std::printf("  %-*s  no counterweight (0 kg)\n", width,
-                  l.links[static_cast<std::size_t>(c.link)].name.c_str());
-      continue;
-    }
-    std::printf("  %-*s  counterweight %.6g kg at [%.6g, %.6g] m from %s (%.6g m)", width,
-                l.links[static_cast<std::size_t>(c.link)].name.c_str(), w.mass + 0.0,
-                w.position.x() + 0.0, w.position.y() + 0.0,  // + 0.0: no "-0"
-                l.nodes[static_cast<std::size_t>(c.pivot)].name.c_str(), w.distance);
-    if (w.radius > 0) std::printf(", radius %.6g m", w.radius);
-    std::printf("\n");
+    print_counterweight(l.links[static_cast<std::size_t>(c.link)].name, width, c.counterweight,
+                        l.nodes[static_cast<std::size_t>(c.pivot)].name);
   }
 }
 
@@ -431,12 +436,8 @@ void print_optimize(const st::Study& study, const st::RunResult& r) {
   std::printf("           %s\n", o.optimality.c_str());
   print_lower_bound(o.objective, o.lower_bound, o.lower_bound_source);
   for (const bd::optimize::PlacedCounterweight& p : o.counterweights) {
-    const bd::balance::Counterweight& c = p.counterweight;
-    std::printf("  %-7s  counterweight %.6g kg at [%.6g, %.6g] m from %s (%.6g m)",
-                bd::core::link_name(p.link), c.mass, c.position.x(), c.position.y(),
-                p.link == 1 ? "A0" : "A3", c.distance);
-    if (c.radius > 0) std::printf(", radius %.6g m", c.radius);
-    std::printf("\n");
+    print_counterweight(bd::core::link_name(p.link), 7, p.counterweight,
+                        p.link == 1 ? "A0" : "A3");
   }
   std::printf("  verified with %s: largest relative difference %.3g\n",
               bd::core::to_string(o.verified_with), o.verification_error);
@@ -622,7 +623,7 @@ bool shares_starts(const st::Study& study) {
 // a rank's threads in an MPI job: --threads, else sweep.threads, else its share of the machine
 int sweep_threads(const st::Study& study, const RunArgs& args) {
   if (args.threads > 0) return args.threads;
-  if (study.sweep->threads > 0) return study.sweep->threads;
+  if (args.threads < 0 && study.sweep->threads > 0) return study.sweep->threads;
   return g_mpi->default_threads();
 }
 
@@ -630,12 +631,13 @@ int sweep_threads(const st::Study& study, const RunArgs& args) {
 int run_sweep_study(const st::Study& study, const RunArgs& args, const fs::path& out) {
   st::SweepOptions options;
   options.resume = args.resume;
-  options.threads = args.threads;
+  // --threads 0, like sweep.threads: 0, is one per core, whatever the study says
+  options.threads = args.threads == 0 ? std::max(1, static_cast<int>(std::thread::hardware_concurrency()))
+                                      : std::max(args.threads, 0);
   bd::cli::SweepDisplay display(bd::cli::SweepDisplay::mode_named(args.progress));
   options.progress = [&display](const st::SweepProgress& p) { display.show(p); };
   options.stop = &g_stop_sweep;
   catch_stop_signals();
-  const auto start = std::chrono::steady_clock::now();
   st::SweepResult r;
   try {
     // in an MPI job, the other ranks take points too (their rows come back to this one)
@@ -650,8 +652,6 @@ int run_sweep_study(const st::Study& study, const RunArgs& args, const fs::path&
     say_error(args.study + ": " + e.what());
     return kExitBadInput;
   }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   print_warnings(r.warnings);
   std::fflush(stderr);
@@ -660,7 +660,7 @@ int run_sweep_study(const st::Study& study, const RunArgs& args, const fs::path&
   const fs::path page = out / "report.html";
   std::printf("%s: sweep %s, %d of %d points%s, %d failed, %.1f s; wrote %s, %s%s\n",
               study.name.c_str(), r.complete() ? "complete" : "interrupted", r.done, r.points,
-              resumed.c_str(), r.failed, seconds, r.csv.string().c_str(),
+              resumed.c_str(), r.failed, r.elapsed_s, r.csv.string().c_str(),
               r.summary.filename().string().c_str(), fs::exists(page) ? ", report.html" : "");
   std::fflush(stdout);
   if (r.interrupted) {
@@ -762,9 +762,9 @@ void add_run_options(CLI::App& cmd, RunArgs& args) {
                "sweeps: continue the sweep in DIR where it stopped (its rows are kept, the "
                "missing points run)");
   cmd.add_option("--threads", args.threads,
-                 "sweeps: points run in parallel (default: the study's sweep.threads, else one "
-                 "per core)")
-      ->check(CLI::Range(1, 1024))
+                 "sweeps: points run in parallel, 0 for one per core (default: the study's "
+                 "sweep.threads, else one per core)")
+      ->check(CLI::Range(0, 1024))
       ->type_name("N");
   cmd.add_option("--progress", args.progress,
                  "sweeps: progress on stderr: auto (a bar on a terminal, else a line every 10 s), "

@@ -36,6 +36,14 @@ std::pair<double, double> rate_eta(const studies::SweepProgress& p) {
   return {rate, (p.points - p.done) / rate};
 }
 
+// "ETA ..." while the sweep runs; at its last call "done", or "stopped" when points are left (a
+// stop or Ctrl-C: no time is left to wait for)
+std::string eta_text(const studies::SweepProgress& p, double eta, const char* unknown,
+                     std::string (*text)(double)) {
+  if (p.finished) return p.done >= p.points ? "done" : "stopped";
+  return "ETA " + (eta < 0 ? std::string(unknown) : text(eta));
+}
+
 double percent(const studies::SweepProgress& p) {
   return p.points > 0 ? 100.0 * p.done / p.points : 100.0;
 }
@@ -78,10 +86,10 @@ void SweepDisplay::draw_bar(const studies::SweepProgress& p) {
   const int filled =
       p.points > 0 ? static_cast<int>(kWidth * static_cast<long>(p.done) / p.points) : kWidth;
   std::string text =
-      fmt::format("  sweep [{}{}]  {}/{}  {:.1f}%   {:.1f} points/s  ETA {}",
+      fmt::format("  sweep [{}{}]  {}/{}  {:.1f}%   {:.1f} points/s  {}",
                   std::string(static_cast<std::size_t>(filled), '#'),
                   std::string(static_cast<std::size_t>(kWidth - filled), '.'), p.done, p.points,
-                  percent(p), rate, eta < 0 ? "-:--" : clock_text(eta));
+                  percent(p), rate, eta_text(p, eta, "-:--", clock_text));
   const std::size_t width = text.size();
   if (width < drawn_) text.append(drawn_ - width, ' ');  // clear the longer line before
   drawn_ = width;
@@ -91,8 +99,8 @@ void SweepDisplay::draw_bar(const studies::SweepProgress& p) {
 
 void SweepDisplay::print_line(const studies::SweepProgress& p) const {
   const auto [rate, eta] = rate_eta(p);
-  std::fprintf(stderr, "sweep: %d/%d points (%.1f %%), %.1f points/s, ETA %s\n", p.done, p.points,
-               percent(p), rate, eta < 0 ? "unknown" : duration_text(eta).c_str());
+  std::fprintf(stderr, "sweep: %d/%d points (%.1f %%), %.1f points/s, %s\n", p.done, p.points,
+               percent(p), rate, eta_text(p, eta, "unknown", duration_text).c_str());
   std::fflush(stderr);
 }
 

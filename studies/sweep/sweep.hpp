@@ -146,6 +146,7 @@ struct SweepResult {
   int resumed{};  // rows kept from an earlier run
   int failed{};   // rows whose status is not ok
   bool interrupted = false;
+  double elapsed_s{};                 // this run's points, as sweep.json's elapsed_s [s]
   std::filesystem::path csv;          // out_dir/sweep.csv
   std::filesystem::path summary;      // out_dir/sweep.json
   std::vector<std::string> warnings;  // what went wrong besides the points (the report page)

@@ -212,6 +212,11 @@ TEST_F(SweepCli, InterruptExitsFiveAndKeepsTheRows) {
             std::string::npos)
       << err;
   EXPECT_NE(err.find("stopping once the points running are done"), std::string::npos) << err;
+  // the last progress line says the sweep stopped (no time left to wait for)
+  EXPECT_NE(err.find("sweep: " + n + "/300 points ("), std::string::npos) << err;
+  EXPECT_TRUE(std::regex_search(
+      err, std::regex("sweep: " + n + R"(/300 points \([0-9.]+ %\), [0-9.]+ points/s, stopped\n)")))
+      << err;
   EXPECT_NE(
       read(dir_ / "child-stdout.txt").find("free: sweep interrupted, " + n + " of 300 points"),
       std::string::npos);
@@ -233,7 +238,7 @@ TEST_F(SweepCli, ProgressOutputAndSummaryLine) {
   EXPECT_TRUE(std::regex_match(
       err_, std::regex(R"((sweep: [0-9]+/441 points \([0-9]+\.[0-9] %\), [0-9]+\.[0-9] points/s, )"
                        R"(ETA (unknown|([0-9]+ h )?([0-9]+ min )?[0-9]+ (s|min))\n)*)"
-                       R"(sweep: 441/441 points \(100\.0 %\), [0-9]+\.[0-9] points/s, ETA 0 s\n)")))
+                       R"(sweep: 441/441 points \(100\.0 %\), [0-9]+\.[0-9] points/s, done\n)")))
       << err_;
   EXPECT_TRUE(std::regex_match(
       out_, std::regex(R"(paper-fourbar-sweep: sweep complete, 441 of 441 points, 0 failed, )"
@@ -252,14 +257,16 @@ TEST_F(SweepCli, ProgressOutputAndSummaryLine) {
   EXPECT_TRUE(std::regex_match(
       err_.substr(last),
       std::regex(
-          R"(\r  sweep \[#{20}\]  441/441  100\.0%   [0-9]+\.[0-9] points/s  ETA 0:00 *\n)")))
+          R"(\r  sweep \[#{20}\]  441/441  100\.0%   [0-9]+\.[0-9] points/s  done *\n)")))
       << err_.substr(last);
 
-  ASSERT_EQ(run(example + " --out none --progress none"), 0) << err_;
+  // --threads 0: one per core, as sweep.threads: 0
+  ASSERT_EQ(run(example + " --out none --progress none --threads 0"), 0) << err_;
   EXPECT_TRUE(err_.empty()) << err_;
 
   // the same rows whatever the threads
   EXPECT_EQ(read(dir_ / "bar" / "sweep.csv"), read(dir_ / "res" / "sweep.csv"));
+  EXPECT_EQ(read(dir_ / "none" / "sweep.csv"), read(dir_ / "res" / "sweep.csv"));
 }
 
 TEST_F(SweepCli, ValidatePrintsTheDesignAndWritesNothing) {
@@ -304,7 +311,8 @@ TEST_F(SweepCli, ReportRebuildsTheSweepPage) {
 
 TEST_F(SweepCli, SweepOptionsAreChecked) {
   const std::string example = quote(kExamples + "/paper-fourbar-sweep.yaml");
-  EXPECT_EQ(run(example + " --threads 0"), 2);
+  EXPECT_EQ(run(example + " --threads -1"), 2);
+  EXPECT_EQ(run(example + " --threads 1025"), 2);
   EXPECT_EQ(run(example + " --progress fancy"), 2);
   EXPECT_FALSE(fs::exists(dir_ / "results"));
   // --resume is for sweeps
