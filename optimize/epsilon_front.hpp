@@ -18,9 +18,10 @@ namespace bd::optimize::detail {
 ///   bool is_mass(Metric m) const;                    // added_mass: its bound may be <= 0
 /// Returns (ε, result) per point: minimise `first` subject to the base constraints and
 /// second <= ε, ε spaced from the loosest useful bound down to the tightest reachable one. Each
-/// point starts from its neighbour's design where that meets its bound (the first point: the
-/// loose end's design, which meets it and minimises `first` there), else from the design that
-/// minimises `second` alone (which meets every bound of the front), else as a lone solve.
+/// point starts from its neighbour's design (the first point: the loose end's design, which
+/// meets its bound and minimises `first` there), brought within its bound by feasible_towards()
+/// the design that minimises `second` alone (which meets every bound of the front) in
+/// Front::solve(), else as a lone solve.
 template <class Front>
 std::vector<std::pair<double, typename Front::Result>> epsilon_front(const Front& f,
                                                                      typename Front::Metric first,

@@ -125,6 +125,30 @@ Solved solve(const Program& program, const Eigen::VectorXd& x0, const OptimizeOp
 Solved solve_from(const Program& program, const std::vector<Eigen::VectorXd>& starts,
                   const OptimizeOptions& options);
 
+/// A start for a point of a front from its neighbour's design `from`, which may miss this point's
+/// tighter bound: program.start_at() of the design nearest `from` on the segment to `to` (a
+/// design that meets the bound: the second metric's minimiser) that meets every constraint of
+/// `program`, by bisection on the segment to 2^-30 of it; start_at(from) itself when it is
+/// feasible or `to` is not. Designs are position variables (their first entries; any bound
+/// variables after them are set by start_at()). A local method started there goes on along the
+/// front from the neighbour; started at `to` it can stay where the first metric has no gradient
+/// (a counterweight of no mass, whose place does not matter).
+template <class DesignProgram>
+Eigen::VectorXd feasible_towards(const DesignProgram& program, const Eigen::VectorXd& from,
+                                 const Eigen::VectorXd& to, double tolerance) {
+  const Eigen::Index k = std::min(from.size(), to.size());
+  const Eigen::VectorXd a = from.head(k), d = to.head(k) - a;
+  auto at = [&](double t) { return program.start_at(a + t * d); };
+  auto feasible = [&](double t) { return constraint_violation(program, at(t)) <= tolerance; };
+  if (feasible(0) || !feasible(1)) return at(0);
+  double lo = 0, hi = 1;  // infeasible at lo, feasible at hi
+  for (int i = 0; i < 30; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (feasible(mid) ? hi : lo) = mid;
+  }
+  return at(hi);
+}
+
 /// The feasibility of the point r.x, whatever the solver said: r.constraint_violation, and the
 /// termination and message when they disagree with it (`solver` is the solver's message).
 void check_feasibility(const Program& program, const OptimizeOptions& options,

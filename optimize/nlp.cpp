@@ -34,6 +34,9 @@ const std::vector<std::string>& Nlp::variable_names() const { return program_->v
 const std::vector<std::string>& Nlp::constraint_names() const {
   return program_->constraint_names();
 }
+std::string Nlp::constraint_text(int i, const Eigen::VectorXd& x) const {
+  return program_->constraint_text(i, x);
+}
 bool Nlp::has_gradients() const { return program_->has_gradients(); }
 bool Nlp::free_scene() const { return program_->free_scene(); }
 std::string Nlp::why_not_convex() const { return program_->why_not_convex(); }

@@ -123,6 +123,7 @@ class Nlp final : public Program {
   /// "force balance, crank side (real part)", "Fsh_rms <= 0.2 x original", ...).
   const std::vector<std::string>& variable_names() const override;
   const std::vector<std::string>& constraint_names() const override;  // equalities first
+  std::string constraint_text(int i, const Eigen::VectorXd& x) const override;
   /// True when exact gradients are available (driven scenes; free scenes on the reduced
   /// equation, by forward sensitivities).
   bool has_gradients() const override;

@@ -601,6 +601,48 @@ void NlpProgram::inequalities(const Eigen::VectorXd& x, Eigen::VectorXd& c,
   }
 }
 
+std::string NlpProgram::constraint_text(int i, const Eigen::VectorXd& x) const {
+  if (i < 0 || i >= n_eq_ + n_ineq_) return {};
+  const Inertial in = inertial(x, false);
+  if (i < n_eq_) {  // a force-balance condition (eq. 57), in kg over the original's total mass
+    const Eigen::VectorXd c = balance_ * in.q;
+    return "the condition is off by " + text::digits(c(i) * original_mass_, 6) + " kg (" +
+           text::digits(std::abs(c(i)), 3) + " of the original's total mass)";
+  }
+  int row = n_eq_;
+  for (const Block& b : blocks_) {
+    if (i >= row + b.count) {
+      row += b.count;
+      continue;
+    }
+    switch (b.kind) {
+      case Block::Kind::kEnvelope: {
+        const auto k = static_cast<std::size_t>(b.counterweight);
+        const int j = cw_var_[k];
+        double distance = std::hypot(x(j + 1), x(j + 2));
+        if (moments_) distance = x(j) > 0 ? distance / x(j) : 0.0;
+        return "the counterweight's centre is " + text::digits(distance, 6) +
+               " m from its pivot, at most " +
+               text::digits(problem_.counterweights[k].distance_max, 6) + " m";
+      }
+      case Block::Kind::kAddedMassLimit:
+        return "the added mass is " + text::digits(added_mass(in.q), 6) + " kg, at most " +
+               text::digits(b.value, 6) + " kg";
+      case Block::Kind::kRmsLimit:
+      case Block::Kind::kPeakLimit: {
+        const double value = metric(x, b.metric), was = original(b.metric);
+        return std::string(to_string(b.metric)) + " is " + text::digits(value, 6) + " " +
+               metric_unit(b.metric) + " = " + text::digits(was > 0 ? value / was : 0.0, 4) +
+               " x the original's, at most " + text::digits(b.value, 6) + " x";
+      }
+      case Block::Kind::kPeakBound:
+      case Block::Kind::kRelaxation:
+        return {};
+    }
+  }
+  return {};
+}
+
 void NlpProgram::first_order_inequalities(const Eigen::VectorXd& x, const Eigen::VectorXd& g,
                                           Eigen::VectorXd& c, Eigen::MatrixXd& jac) const {
   inequalities(x, c, &jac);

@@ -105,6 +105,9 @@ class NlpProgram {
   double metric(const Eigen::VectorXd& x, Metric m) const;
   /// The normaliser of a metric: the original's value, for added_mass its total mass [kg].
   double original(Metric m) const;
+  /// Constraint i at x in words with units ("the added mass is 3.2 kg, at most 3 kg"), as
+  /// Program::constraint_text(); "" for a row without words (a relaxation's, a peak bound's).
+  std::string constraint_text(int i, const Eigen::VectorXd& x) const;
 
  protected:
   /// Validates the problem, evaluates the original in its scene (by core's own simulation) and

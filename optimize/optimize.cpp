@@ -633,6 +633,32 @@ std::vector<double> short_peak_angles(const DesignProblem& problem, const Nlp& n
   return added;
 }
 
+// Variables the optimum leaves at round-off from a bound (a counterweight of 1e-35 kg: a
+// solver's end at mass 0, or on a cone's apex) are put on the bound: a counterweight is then
+// exactly none, so that the design, its tables and optimized.yaml say so. Kept when that changes
+// neither the objective nor the constraints' violation beyond round-off.
+constexpr double kOnTheBound = 1e-12;  // of the variable's range (a counterweight's mass_max)
+void snap_to_bounds(const Program& nlp, const OptimizeOptions& options,
+                                   OptimizeResult& r) {
+  VectorXd x = nlp.without_vanishing_counterweights(r.x, kOnTheBound);
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    const double lo = nlp.lower()(i), hi = nlp.upper()(i), near = kOnTheBound * (hi - lo);
+    if (!std::isfinite(near)) continue;
+    if (x(i) != lo && std::abs(x(i) - lo) <= near) x(i) = lo;
+    if (x(i) != hi && std::abs(x(i) - hi) <= near) x(i) = hi;
+  }
+  if (x == r.x) return;
+  const double f = nlp.objective(x, nullptr);
+  const double violation = detail::constraint_violation(nlp, x);
+  if (!(violation <= std::max(r.constraint_violation, options.constraint_tolerance)) ||
+      !(std::abs(f - r.objective) <= 1e-12 * std::max(std::abs(r.objective), 1.0))) {
+    return;
+  }
+  r.x = x;
+  r.objective = f;
+  r.constraint_violation = violation;
+}
+
 }  // namespace
 
 OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& options,
@@ -699,6 +725,7 @@ OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& opt
     r.objective = solved.objective;
     r.constraint_violation = solved.constraint_violation;
     r.peak_angles = exchanged.peak_angles;
+    snap_to_bounds(nlp, options, r);
     // the optimum as a design, as the optimiser evaluated it, then verified
     r.design = nlp.design(r.x);
     r.counterweights = nlp.counterweights(r.x);

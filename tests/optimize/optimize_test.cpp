@@ -48,6 +48,7 @@
 #include <functional>
 #include <numbers>
 #include <ostream>
+#include <regex>
 #include <random>
 #include <string>
 #include <thread>
@@ -1320,6 +1321,14 @@ TEST(Optimize, InfeasibleSpecificationIsReportedWithTheBindingConstraint) {
     EXPECT_FALSE(r.ok());
     EXPECT_GT(r.constraint_violation, 1e-3);
     EXPECT_NE(r.message.find("binding constraint is 'force balance"), std::string::npos);
+    // in kg, the scaled violation times the original's total mass (six digits printed)
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(r.message, m,
+                                  std::regex(R"(': the condition is off by (-?[0-9.e+-]+) kg \()")))
+        << r.message;
+    const double total = core::total_mass(core::make_fourbar(p.original));
+    EXPECT_NEAR(std::abs(std::stod(m[1].str())), r.constraint_violation * total,
+                1e-5 * r.constraint_violation * total);
   }
 }
 
