@@ -149,6 +149,14 @@ Eigen::VectorXd feasible_towards(const DesignProgram& program, const Eigen::Vect
   return at(hi);
 }
 
+/// x with the variables it leaves at round-off from a bound (within 1e-12 of the variable's
+/// range: a counterweight of 1e-35 kg, a solver's end at mass 0 or on a cone's apex) put on the
+/// bound, so that such a counterweight is exactly none in the design, its tables and the study
+/// written; x itself when that changes the objective beyond round-off or the constraints'
+/// violation above max(violation, the tolerance). `objective` and `violation` are x's.
+Eigen::VectorXd snapped_to_bounds(const Program& program, const OptimizeOptions& options,
+                                  const Eigen::VectorXd& x, double objective, double violation);
+
 /// The feasibility of the point r.x, whatever the solver said: r.constraint_violation, and the
 /// termination and message when they disagree with it (`solver` is the solver's message).
 void check_feasibility(const Program& program, const OptimizeOptions& options,

@@ -15,6 +15,7 @@
 #include "core/number_text.hpp"
 #include "optimize/check_inputs.hpp"
 #include "optimize/convex_solve.hpp"
+#include "optimize/detail/peak_exchange.hpp"
 #include "optimize/first_order.hpp"
 #include "optimize/fixed_variables.hpp"
 #include "optimize/ipopt_driver.hpp"
@@ -520,6 +521,28 @@ detail::Solved detail::solve(const Program& nlp, const VectorXd& x0, const Optim
   return r;
 }
 
+// within this fraction of its range from a bound a variable is on it (snapped_to_bounds())
+constexpr double kOnTheBound = 1e-12;
+
+VectorXd detail::snapped_to_bounds(const Program& nlp, const OptimizeOptions& options,
+                                   const VectorXd& x, double objective, double violation) {
+  VectorXd out = nlp.without_vanishing_counterweights(x, kOnTheBound);
+  for (Eigen::Index i = 0; i < out.size(); ++i) {
+    const double lo = nlp.lower()(i), hi = nlp.upper()(i), near = kOnTheBound * (hi - lo);
+    if (!std::isfinite(near)) continue;
+    if (out(i) != lo && std::abs(out(i) - lo) <= near) out(i) = lo;
+    if (out(i) != hi && std::abs(out(i) - hi) <= near) out(i) = hi;
+  }
+  if (out == x) return x;
+  const double f = nlp.objective(out, nullptr);
+  if (!(detail::constraint_violation(nlp, out) <=
+        std::max(violation, options.constraint_tolerance)) ||
+      !(std::abs(f - objective) <= 1e-12 * std::max(std::abs(objective), 1.0))) {
+    return x;
+  }
+  return out;
+}
+
 detail::Solved detail::solve_from(const Program& nlp, const std::vector<VectorXd>& starts,
                                   const OptimizeOptions& options) {
   // the first feasible start, else the least violated
@@ -558,15 +581,6 @@ detail::Solved detail::solve_from(const Program& nlp, const std::vector<VectorXd
 
 namespace {
 
-// at most this many exchange rounds (each a solve more); they end sooner as a rule, once the
-// optimum's resolved peaks are bounded (three or four rounds)
-constexpr int kMaxExchangeRounds = 8;
-// a resolved peak above the peak over the program's instants by more than this, relative, adds
-// crank angles (the resolved peaks are good to about 1e-14)
-constexpr double kPeakExchangeTolerance = 1e-9;
-// at most this many angles added around one peak in one round
-constexpr int kMaxAnglesPerPeak = 64;
-
 // The program's instants as crank angles: the scene's samples and the peak angles so far.
 std::vector<double> instant_angles(const DesignProblem& problem, const core::DrivenScene& scene) {
   const int samples = scene.samples * scene.revolutions;
@@ -586,12 +600,9 @@ std::vector<double> instant_angles(const DesignProblem& problem, const core::Dri
 // The crank angles a next round bounds the peak at, for each peak metric of the objective
 // (weight > 0) and of the limits whose resolved peak at the optimum (core::metrics(), searched
 // between the samples) rises above the peak over the program's instants by more than
-// kPeakExchangeTolerance: the peak's own angle and an even grid over the interval of instants
-// around it. Near a smooth peak the excess goes with the square of the interval, so m
-// intervals take it down m² times: m is chosen for the excess to fall to a tenth of the
-// tolerance (at most kMaxAnglesPerPeak), so that the next optimum, whose peak moves a little,
-// finds instants close around it. Empty in a free scene, for a design that is no result or
-// cannot be run, when the instants hold the peaks, and without problem.resolve_peaks.
+// kPeakExchangeTolerance: detail::add_peak_instants(). Empty in a free scene, for a design that
+// is no result or cannot be run, when the instants hold the peaks, and without
+// problem.resolve_peaks.
 std::vector<double> short_peak_angles(const DesignProblem& problem, const Nlp& nlp,
                                       const detail::Solved& solved) {
   const auto* scene = std::get_if<core::DrivenScene>(&problem.scene);
@@ -616,47 +627,13 @@ std::vector<double> short_peak_angles(const DesignProblem& problem, const Nlp& n
   std::vector<double> added;
   for (Metric m : used) {
     const double excess = value(resolved, m) / value(bounded, m) - 1;
-    if (!(excess > kPeakExchangeTolerance)) continue;
-    const double angle =
-        scene->theta1 + scene->omega1 * peaks.table[static_cast<std::size_t>(m)].t;
-    added.push_back(angle);
-    // the interval of instants around it (sorted by angle, whatever the sense of rotation)
-    const auto right = std::upper_bound(instants.begin(), instants.end(), angle);
-    if (right == instants.begin() || right == instants.end()) continue;
-    const double a = *(right - 1), b = *right;
-    const int intervals = static_cast<int>(std::min<double>(
-        kMaxAnglesPerPeak, std::ceil(std::sqrt(10 * excess / kPeakExchangeTolerance))));
-    for (int j = 1; j < intervals; ++j) {
-      added.push_back(a + (b - a) * static_cast<double>(j) / static_cast<double>(intervals));
-    }
+    if (!(excess > detail::kPeakExchangeTolerance)) continue;
+    // the interval of instants around it sorted by angle, whatever the sense of rotation
+    detail::add_peak_instants(
+        instants, scene->theta1 + scene->omega1 * peaks.table[static_cast<std::size_t>(m)].t,
+        excess, added);
   }
   return added;
-}
-
-// Variables the optimum leaves at round-off from a bound (a counterweight of 1e-35 kg: a
-// solver's end at mass 0, or on a cone's apex) are put on the bound: a counterweight is then
-// exactly none, so that the design, its tables and optimized.yaml say so. Kept when that changes
-// neither the objective nor the constraints' violation beyond round-off.
-constexpr double kOnTheBound = 1e-12;  // of the variable's range (a counterweight's mass_max)
-void snap_to_bounds(const Program& nlp, const OptimizeOptions& options,
-                                   OptimizeResult& r) {
-  VectorXd x = nlp.without_vanishing_counterweights(r.x, kOnTheBound);
-  for (Eigen::Index i = 0; i < x.size(); ++i) {
-    const double lo = nlp.lower()(i), hi = nlp.upper()(i), near = kOnTheBound * (hi - lo);
-    if (!std::isfinite(near)) continue;
-    if (x(i) != lo && std::abs(x(i) - lo) <= near) x(i) = lo;
-    if (x(i) != hi && std::abs(x(i) - hi) <= near) x(i) = hi;
-  }
-  if (x == r.x) return;
-  const double f = nlp.objective(x, nullptr);
-  const double violation = detail::constraint_violation(nlp, x);
-  if (!(violation <= std::max(r.constraint_violation, options.constraint_tolerance)) ||
-      !(std::abs(f - r.objective) <= 1e-12 * std::max(std::abs(r.objective), 1.0))) {
-    return;
-  }
-  r.x = x;
-  r.objective = f;
-  r.constraint_violation = violation;
 }
 
 }  // namespace
@@ -667,76 +644,28 @@ OptimizeResult optimize(const DesignProblem& problem, const OptimizeOptions& opt
   // The exchange step: solve on the samples (and the peak angles found so far); where a peak of
   // the optimum resolved between the samples rises above what the program bounded, add crank
   // angles around it and solve again from that optimum, until the program bounds the motion's
-  // peaks. The rounds share options.max_evaluations.
-  DesignProblem exchanged = problem;
-  std::vector<VectorXd> starts = designs;
-  int iterations = 0, evaluations = 0;
-  double seconds = 0;
-  for (int round = 0;; ++round) {
-    const Nlp nlp(exchanged);
-    if (round == 0) throw_if(check_algorithm(problem, options));
-    OptimizeOptions budget = options;
-    budget.max_evaluations = options.max_evaluations - evaluations;
-    const detail::ConvexAwareSolve solve =
-        detail::solve_convex_aware(nlp, exchanged, starts, budget);
-    const detail::Solved& solved = solve.solved;
-    iterations += solved.iterations;
-    evaluations += solved.evaluations;
-    seconds += solved.seconds;
-    const std::vector<double> added = short_peak_angles(exchanged, nlp, solved);
-    // the next round needs evaluations left (mlsl: one per local run at least)
-    const int left = options.max_evaluations - evaluations;
-    const bool another = round < kMaxExchangeRounds &&
-                         left >= (options.algorithm == Algorithm::kMlsl ? options.starts : 1);
-    if (!added.empty() && another) {
-      exchanged.peak_angles.insert(exchanged.peak_angles.end(), added.begin(), added.end());
-      starts.insert(starts.begin(), solved.x);
-      continue;
-    }
-    const detail::Optimality& optimality = solve.optimality;
-    OptimizeResult r;
-    r.global = optimality.global && found_design(solved.termination);
-    r.optimality = optimality.words;
-    r.lower_bound = solve.bound.value;
-    r.lower_bound_source = solve.bound.words;
-    r.starts = solved.starts;
-    r.starts_at_best = solved.starts_at_best;
-    r.algorithm = options.algorithm;
-    r.termination = solved.termination;
-    r.message = solved.message;
-    if (!added.empty()) {  // a peak still rises above its bound by more than the tolerance
-      const std::string where =
-          exchanged.peak_angles.empty()
-              ? "the samples only"
-              : "the samples and " + std::to_string(exchanged.peak_angles.size()) +
-                    " more crank angles";
-      r.message += (round < kMaxExchangeRounds
-                        ? "; the evaluation budget was spent before every resolved peak was "
-                          "bounded (the peaks are bounded at "
-                        : "; after " + std::to_string(kMaxExchangeRounds + 1) +
-                              " solves a resolved peak still rose above its bound (the peaks "
-                              "are bounded at ") +
-                   where + ")";
-    }
-    r.x = solved.x;
-    r.iterations = iterations;
-    r.evaluations = evaluations;
-    r.seconds = seconds;
-    r.objective = solved.objective;
-    r.constraint_violation = solved.constraint_violation;
-    r.peak_angles = exchanged.peak_angles;
-    snap_to_bounds(nlp, options, r);
-    // the optimum as a design, as the optimiser evaluated it, then verified
-    r.design = nlp.design(r.x);
-    r.counterweights = nlp.counterweights(r.x);
-    r.metrics = nlp.metrics(r.x);
-    if (solved.gradient_check_failed) {
-      r.verification_error = std::numeric_limits<double>::quiet_NaN();  // not verified
-      return r;
-    }
-    verify(exchanged, r);
-    return r;
-  }
+  // peaks (detail::exchange_rounds()).
+  return detail::exchange_rounds<Nlp>(
+      problem, designs, options, &DesignProblem::peak_angles, "crank angles", short_peak_angles,
+      [&](const Nlp&) { throw_if(check_algorithm(problem, options)); },
+      [&](const Nlp& nlp, const DesignProblem& exchanged, const detail::ConvexAwareSolve& solve,
+          const detail::ExchangeTotals& totals) {
+        const detail::Solved& solved = solve.solved;
+        OptimizeResult r;
+        detail::set_solve_fields(r, nlp, solve, options, totals);
+        r.message += totals.shortfall;
+        r.peak_angles = exchanged.peak_angles;
+        // the optimum as a design, as the optimiser evaluated it, then verified
+        r.design = nlp.design(r.x);
+        r.counterweights = nlp.counterweights(r.x);
+        r.metrics = nlp.metrics(r.x);
+        if (solved.gradient_check_failed) {
+          r.verification_error = std::numeric_limits<double>::quiet_NaN();  // not verified
+          return r;
+        }
+        verify(exchanged, r);
+        return r;
+      });
 }
 
 }  // namespace bd::optimize

@@ -15,9 +15,10 @@
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
 #include "optimize/convex_solve.hpp"
-#include "optimize/relaxation.hpp"
+#include "optimize/detail/peak_exchange.hpp"
 #include "optimize/epsilon_front.hpp"
 #include "optimize/nlopt_driver.hpp"
+#include "optimize/relaxation.hpp"
 
 namespace bd::optimize::planar {
 
@@ -162,6 +163,16 @@ Problem DesignProblem::validate() const {
   }
   if (!(smoothing > 0 && smoothing <= 0.1))
     return field("smoothing", -1, "must be in (0, 0.1], got " + text::shortest(smoothing));
+  const bool driven = std::holds_alternative<cp::DrivenScene>(scene);
+  if (resolve_peaks && !driven)
+    return field("resolve_peaks", -1,
+                 ": peaks are resolved by the optimiser in driven scenes only");
+  for (std::size_t i = 0; i < peak_times.size(); ++i) {
+    if (!driven || !std::isfinite(peak_times[i]))
+      return field("peak_times", static_cast<int>(i),
+                   driven ? " must be finite, got " + text::shortest(peak_times[i])
+                          : ": only a driven scene takes added instants");
+  }
   return std::nullopt;
 }
 
@@ -186,13 +197,14 @@ struct PlanarNlp::Impl {
   mutable Evaluation cached;
   std::vector<int> sensitivity_parameters;  // free scenes: the entries of q the design varies
   int nq{}, samples{};
+  int instants{};  // rows of the regressor: the samples, then p.peak_times (peaks only)
   VectorXd q0;
   double mass0{}, length{};
   std::vector<cp::ColumnMetric> table;
   std::vector<double> original;
-  // per output column used by a metric: y = base + B (q - q0), samples x nq
+  // per output column used by a metric: y = base + B (q - q0), instants x nq
   std::map<std::string, std::pair<VectorXd, MatrixXd>> outputs;
-  std::vector<double> times;
+  std::vector<double> times;  // of the instants
   // variables
   int n{};
   VectorXd lower, upper;
@@ -218,6 +230,11 @@ struct PlanarNlp::Impl {
   };
   std::vector<Row> rows;
 
+  // "at t = 0.25 s", or for an added instant "near a resolved peak, t = 0.2513 s"
+  std::string instant_words(int s) const {
+    const std::string t = text::digits(times[static_cast<std::size_t>(s)], s < samples ? 6 : 9);
+    return (s < samples ? "at t = " : "near a resolved peak, t = ") + t + " s";
+  }
   void build_regressor(bool checks_only);
   void set_up_variables();
   void set_up_constraints();
@@ -250,18 +267,18 @@ struct PlanarNlp::Impl {
   double rms2(const Columns& c, VectorXd* grad) const {
     double s = 0;
     if (grad) grad->setZero(n);
-    for (std::size_t i = 0; i < c.y.size(); ++i) {
-      s += c.y[i].squaredNorm();
-      if (grad) *grad += 2.0 * c.dy[i].transpose() * c.y[i];
+    for (std::size_t i = 0; i < c.y.size(); ++i) {  // over the samples, not the added instants
+      s += c.y[i].head(samples).squaredNorm();
+      if (grad) *grad += 2.0 * c.dy[i].topRows(samples).transpose() * c.y[i].head(samples);
     }
     if (grad) *grad /= samples;
     return s / samples;
   }
-  // the largest magnitude over the samples of metric k's columns at q
+  // the largest magnitude over the instants of metric k's columns at q
   double peak(int k, const VectorXd& q) const {
     const Columns c = columns(k, q, nullptr);
     double worst = 0;
-    for (int s = 0; s < samples; ++s) {
+    for (int s = 0; s < instants; ++s) {
       double s2 = 0;
       for (const VectorXd& y : c.y) s2 += y[s] * y[s];
       worst = std::max(worst, std::sqrt(s2));
@@ -288,29 +305,57 @@ void PlanarNlp::Impl::build_regressor(bool checks_only) {
   std::set<std::string> used;
   for (const cp::ColumnMetric& m : table)
     for (const std::string& c : m.columns) used.insert(c);
-  auto run = [&](const VectorXd& q, const char* what) {
-    const cp::Trajectory t = cp::simulate_driven(
-        cp::Model(cp::make_linkage(cp::with_mass_parameters(l, q.data()))),
-        std::get<cp::DrivenScene>(p.scene));
-    if (!t.ok()) throw InputError(std::string(what) + " cannot run in the scene: " + t.message);
-    return t;
+  // a design's run: its table's samples, then its rows at the added instants (p.peak_times)
+  struct Run {
+    cp::Trajectory trajectory;
+    std::vector<std::vector<double>> added;  // per added instant, the whole row
+    std::vector<double> column(const std::string& name) const {
+      std::vector<double> v = trajectory.table.column_values(name);
+      const auto c = static_cast<std::size_t>(trajectory.table.column(name));
+      for (const std::vector<double>& row : added) v.push_back(row[c]);
+      return v;
+    }
   };
-  const cp::Trajectory base =
-      free ? cp::simulate_free(cp::Model(l), std::get<cp::FreeScene>(p.scene), p.simulate)
+  auto run = [&](const VectorXd& q, const char* what) {
+    const cp::Model model(cp::make_linkage(cp::with_mass_parameters(l, q.data())));
+    const cp::DrivenScene& scene = std::get<cp::DrivenScene>(p.scene);
+    Run r{cp::simulate_driven(model, scene), {}};
+    if (!r.trajectory.ok()) {
+      throw InputError(std::string(what) + " cannot run in the scene: " + r.trajectory.message);
+    }
+    cp::DrivenRows at(model, scene, r.trajectory);
+    for (const double s : p.peak_times) {
+      const double* row = at.at(s);
+      if (!row) {
+        throw InputError(std::string(what) + " cannot be evaluated at t = " + text::digits(s, 9) +
+                         " s, an instant added for a peak");
+      }
+      r.added.emplace_back(row, row + r.trajectory.table.width());
+    }
+    return r;
+  };
+  const Run base =
+      free ? Run{cp::simulate_free(cp::Model(l), std::get<cp::FreeScene>(p.scene), p.simulate), {}}
            : run(q0, "the original design");
-  if (free && !base.ok())
-    throw InputError("the original design cannot run in the scene: " + base.message);
-  samples = static_cast<int>(base.table.rows());
-  times = base.table.column_values("t");
-  original = cp::metric_values(table, base.table);
+  if (free && !base.trajectory.ok())
+    throw InputError("the original design cannot run in the scene: " + base.trajectory.message);
+  samples = static_cast<int>(base.trajectory.table.rows());
+  instants = samples + static_cast<int>(base.added.size());
+  times = base.column("t");
+  // the normalisers: the original's metrics, its peaks resolved between the samples when the
+  // optimiser resolves the design's
+  original = p.resolve_peaks && !free
+                 ? cp::metric_values(cp::Model(l), std::get<cp::DrivenScene>(p.scene), table,
+                                     base.trajectory)
+                 : cp::metric_values(table, base.trajectory.table);
   if (free) {  // the balance conditions come from the configurations the original passes through
-    balance_conditions(base);
+    balance_conditions(base.trajectory);
     return;
   }
   for (const std::string& c : used) {
-    const std::vector<double> v = base.table.column_values(c);
+    const std::vector<double> v = base.column(c);
     outputs[c] = {Eigen::Map<const VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())),
-                  MatrixXd::Zero(samples, nq)};
+                  MatrixXd::Zero(instants, nq)};
   }
   for (std::size_t k = 0; k < l.links.size(); ++k) {
     if (q0[P::link_mass(static_cast<int>(k))] <= 0) {
@@ -319,7 +364,7 @@ void PlanarNlp::Impl::build_regressor(bool checks_only) {
     }
   }
   if (checks_only) {
-    balance_conditions(base);
+    balance_conditions(base.trajectory);
     return;
   }
   // one column per parameter: the outputs are affine in q, so a difference is exact (to
@@ -340,15 +385,15 @@ void PlanarNlp::Impl::build_regressor(bool checks_only) {
       step = std::max(q0[i], 1e-3 * mass0);
     }
     hi[i] += step;
-    const cp::Trajectory a = run(lo, "a perturbed design"), b = run(hi, "a perturbed design");
+    const Run a = run(lo, "a perturbed design"), b = run(hi, "a perturbed design");
     for (auto& [name, out] : outputs) {
-      const std::vector<double> ya = a.table.column_values(name), yb = b.table.column_values(name);
-      for (int s = 0; s < samples; ++s)
+      const std::vector<double> ya = a.column(name), yb = b.column(name);
+      for (int s = 0; s < instants; ++s)
         out.second(s, i) =
             (yb[static_cast<std::size_t>(s)] - ya[static_cast<std::size_t>(s)]) / step;
     }
   }
-  balance_conditions(base);
+  balance_conditions(base.trajectory);
 }
 
 // the force-balance conditions: the momentum per unit input rate, in its independent rows
@@ -488,7 +533,7 @@ void PlanarNlp::Impl::set_up_variables() {
   for (std::size_t k = 0; k < table.size(); ++k) {
     if (free || !(weight[k] > 0) || table[k].statistic != core::Statistic::kMax) continue;
     double worst = 0;
-    for (int i = 0; i < samples; ++i) {
+    for (int i = 0; i < instants; ++i) {
       double sum = 0;
       for (const std::string& c : table[k].columns) {
         const auto& [base, B] = outputs.at(c);
@@ -538,11 +583,10 @@ void PlanarNlp::Impl::set_up_constraints() {
     constraint_names.push_back("force balance, condition " + std::to_string(r + 1));
   for (std::size_t k = 0; k < table.size(); ++k) {
     if (bound_var[k] < 0) continue;
-    for (int s = 0; s < samples; ++s) {
+    for (int s = 0; s < instants; ++s) {
       rows.push_back({Row::Kind::kPeakBound, static_cast<int>(k), s, 0.0});
-      constraint_names.push_back("|" + table[k].name +
-                                 "| at t = " + text::digits(times[static_cast<std::size_t>(s)], 6) +
-                                 " s <= bound on " + table[k].name);
+      constraint_names.push_back("|" + table[k].name + "| " + instant_words(s) + " <= bound on " +
+                                 table[k].name);
     }
   }
   for (std::size_t c = 0; c < p.counterweights.size(); ++c) {
@@ -572,12 +616,10 @@ void PlanarNlp::Impl::set_up_constraints() {
       rows.push_back({Row::Kind::kRmsLimit, k, 0, lim.value});
       constraint_names.push_back(what + " x original");
     } else {
-      for (int s = 0; s < (free ? 1 : samples); ++s) {
+      for (int s = 0; s < (free ? 1 : instants); ++s) {
         rows.push_back({Row::Kind::kPeakLimit, k, free ? -1 : s, lim.value});
         constraint_names.push_back(free ? what + " x original"
-                                        : what + " x original at t = " +
-                                              text::digits(times[static_cast<std::size_t>(s)], 6) +
-                                              " s");
+                                        : what + " x original " + instant_words(s));
       }
     }
   }
@@ -1344,6 +1386,10 @@ double verification_error(const std::vector<cp::ColumnMetric>& table, const std:
 
 std::string Result::brief_report() const {
   std::string s = solver_report(*this);
+  if (!peak_times.empty()) {
+    s +=
+        ", peaks bounded at " + std::to_string(peak_times.size()) + " instants besides the samples";
+  }
   if (verified.empty()) return s + ", not verified";
   s += ", verified by simulating it to " + text::digits(verification_error, 2);
   if (!std::isnan(inertial_error)) {
@@ -1415,68 +1461,147 @@ double inertial_error(const cp::Linkage& design, const core::Series& table) {
 
 }  // namespace
 
+namespace {
+
+// the index of metric `name` in the table, or -1
+int table_index(const std::vector<cp::ColumnMetric>& table, const std::string& name) {
+  for (std::size_t k = 0; k < table.size(); ++k)
+    if (table[k].name == name) return static_cast<int>(k);
+  return -1;
+}
+
+// The times a next round bounds the peaks at, as the four-bar's short_peak_angles()
+// (optimize.cpp): for each peak metric of the objective (weight > 0) and of the limits whose
+// resolved peak at the optimum (the engine's inverse dynamics between the samples) rises above
+// the peak over the program's instants by more than kPeakExchangeTolerance,
+// detail::add_peak_instants(). Empty in a free scene, for a design that is no result or cannot
+// be run, when the instants hold the peaks, and without problem.resolve_peaks.
+std::vector<double> short_peak_times(const DesignProblem& problem, const PlanarNlp& nlp,
+                                     const detail::Solved& solved) {
+  const auto* scene = std::get_if<cp::DrivenScene>(&problem.scene);
+  if (!problem.resolve_peaks || !scene || !found_design(solved.termination)) return {};
+  const std::vector<cp::ColumnMetric>& table = nlp.metric_table();
+  std::vector<int> used;
+  auto use = [&](const std::string& name) {
+    const int k = table_index(table, name);
+    if (k >= 0 && table[static_cast<std::size_t>(k)].statistic == core::Statistic::kMax)
+      used.push_back(k);
+  };
+  for (const Term& t : problem.objective)
+    if (t.weight > 0) use(t.metric);
+  for (const Limit& l : problem.limits) use(l.metric);
+  if (used.empty()) return {};
+  const cp::Model model(nlp.design(solved.x));
+  const cp::Trajectory run = cp::simulate_driven(model, *scene);
+  if (!run.ok()) return {};
+  std::vector<core::Peak> peaks;
+  const std::vector<double> resolved = cp::metric_values(model, *scene, table, run, &peaks);
+  const std::vector<double> bounded = nlp.metrics(solved.x);
+  std::vector<double> instants = run.table.column_values("t");
+  // a periodic run's end (its first sample's next turn) closes the last interval
+  if (const double period = cp::DrivenRows(model, *scene, run).period();
+      period > 0 && !instants.empty()) {
+    instants.push_back(instants.front() + period);
+  }
+  instants.insert(instants.end(), problem.peak_times.begin(), problem.peak_times.end());
+  std::sort(instants.begin(), instants.end());
+  std::vector<double> added;
+  for (const int k : used) {
+    const auto i = static_cast<std::size_t>(k);
+    const double excess = resolved[i] / bounded[i] - 1;
+    if (!(excess > detail::kPeakExchangeTolerance)) continue;
+    detail::add_peak_instants(instants, peaks[i].t, excess, added);
+  }
+  return added;
+}
+
+// The peaks of `metrics` (the run's samples') raised to those at the added instants: what the
+// program bounded, evaluated on another run of the same design (the verification's).
+void add_instants_peaks(const cp::Model& model, const cp::DrivenScene& scene,
+                        const cp::Trajectory& run, const std::vector<double>& times,
+                        const std::vector<cp::ColumnMetric>& table, std::vector<double>& metrics) {
+  if (times.empty()) return;
+  cp::DrivenRows rows(model, scene, run);
+  for (const double s : times) {
+    const double* row = rows.at(s);
+    if (!row) continue;
+    for (std::size_t k = 0; k < table.size(); ++k) {
+      if (table[k].statistic != core::Statistic::kMax) continue;
+      double s2 = 0;
+      for (const std::string& c : table[k].columns) {
+        const double v = row[run.table.column(c)];
+        s2 += v * v;
+      }
+      metrics[k] = std::max(metrics[k], std::sqrt(s2));
+    }
+  }
+}
+
+}  // namespace
+
 Result optimize(const DesignProblem& problem, const OptimizeOptions& options,
                 const std::vector<VectorXd>& designs) {
   if (const Problem e = options.validate()) throw InputError("optimize options: " + e->text());
   if (const Problem e = check_algorithm(problem, options)) throw InputError(*e);
-  const PlanarNlp nlp(problem);
-  // a problem convex in the counterweights' masses and mass moments solved in those variables
-  // (optimize/convex_solve.hpp); the original design itself (no counterweight mass) is the last
-  // start: it meets every limit of 1 or more and any added-mass limit >= 0
-  const detail::ConvexAwareSolve solve = detail::solve_convex_aware(nlp, problem, designs, options);
-  const detail::Solved& s = solve.solved;
-  Result r;
-  r.global = solve.optimality.global && found_design(s.termination);
-  r.optimality = solve.optimality.words;
-  r.lower_bound = solve.bound.value;
-  r.lower_bound_source = solve.bound.words;
-  r.starts = s.starts;
-  r.starts_at_best = s.starts_at_best;
-  r.algorithm = options.algorithm;
-  r.termination = s.termination;
-  r.message = s.message;
-  if (s.termination == Termination::kInfeasible && !uses_gradients(options.algorithm) &&
-      s.evaluations >= options.max_evaluations) {
-    r.message += "; the evaluation budget ran out first: raise max_evaluations";
-  } else if (s.termination == Termination::kInfeasible) {
-    // a local solver that finds no feasible design from its starts does not prove there is none
-    r.message += "; another algorithm may find one (" +
-                 other_algorithms(options.algorithm,
-                                  std::holds_alternative<cp::FreeScene>(problem.scene)) +
-                 ")";
-  }
-  r.x = s.x;
-  r.variable_names = nlp.variable_names();
-  r.design_variables = nlp.design_variables();
-  r.objective = s.objective;
-  r.constraint_violation = s.constraint_violation;
-  r.iterations = s.iterations;
-  r.evaluations = s.evaluations;
-  r.seconds = s.seconds;
-  r.design = nlp.design(r.x);
-  r.counterweights = nlp.counterweights(r.x);
-  r.metric_table = nlp.metric_table();
-  r.original = nlp.original_metrics();
-  r.metrics = nlp.metrics(r.x);
-  r.added_mass = nlp.added_mass(r.x);
-  if (!r.ok()) return r;  // no design: nothing to verify
-  // the design simulated by the engine, against the regressor's evaluation; in a free scene by
-  // the other route (dae), against the reduced route's evaluations
-  cp::SimulateOptions other = problem.simulate;
-  other.route = problem.simulate.route == cp::Route::kDae ? cp::Route::kReduced : cp::Route::kDae;
-  const cp::Trajectory t =
-      std::holds_alternative<cp::FreeScene>(problem.scene)
-          ? cp::simulate_free(cp::Model(r.design), std::get<cp::FreeScene>(problem.scene), other)
-          : cp::simulate_driven(cp::Model(r.design), std::get<cp::DrivenScene>(problem.scene));
-  if (!t.ok()) {
-    r.verification_error = std::numeric_limits<double>::infinity();
-    r.message += "; the optimum's simulation failed: " + t.message;
-    return r;
-  }
-  r.verified = cp::metric_values(r.metric_table, t.table);
-  r.verification_error = verification_error(r.metric_table, r.metrics, r.verified);
-  r.inertial_error = inertial_error(r.design, t.table);
-  return r;
+  // The exchange step (problem.resolve_peaks), as the four-bar's: solve on the samples and the
+  // peak times found so far; where a resolved peak of the optimum rises above what the program
+  // bounded, add instants around it and solve again from that optimum
+  // (detail::exchange_rounds()). A problem convex in the counterweights' masses and mass moments
+  // is solved in those variables (optimize/convex_solve.hpp); the original design itself (no
+  // counterweight mass) is the last start: it meets every limit of 1 or more and any
+  // added-mass limit >= 0.
+  return detail::exchange_rounds<PlanarNlp>(
+      problem, designs, options, &DesignProblem::peak_times, "instants", short_peak_times,
+      [](const PlanarNlp&) {},
+      [&](const PlanarNlp& nlp, const DesignProblem& exchanged,
+          const detail::ConvexAwareSolve& solve, const detail::ExchangeTotals& totals) {
+        const detail::Solved& s = solve.solved;
+        Result r;
+        detail::set_solve_fields(r, nlp, solve, options, totals);
+        if (s.termination == Termination::kInfeasible && !uses_gradients(options.algorithm) &&
+            totals.evaluations >= options.max_evaluations) {
+          r.message += "; the evaluation budget ran out first: raise max_evaluations";
+        } else if (s.termination == Termination::kInfeasible) {
+          // a local solver that finds no feasible design from its starts does not prove there is
+          // none
+          r.message += "; another algorithm may find one (" +
+                       other_algorithms(options.algorithm,
+                                        std::holds_alternative<cp::FreeScene>(problem.scene)) +
+                       ")";
+        }
+        r.message += totals.shortfall;
+        r.variable_names = nlp.variable_names();
+        r.design_variables = nlp.design_variables();
+        r.peak_times = exchanged.peak_times;
+        r.design = nlp.design(r.x);
+        r.counterweights = nlp.counterweights(r.x);
+        r.metric_table = nlp.metric_table();
+        r.original = nlp.original_metrics();
+        r.metrics = nlp.metrics(r.x);
+        r.added_mass = nlp.added_mass(r.x);
+        if (!r.ok()) return r;  // no design: nothing to verify
+        // the design simulated by the engine, against the regressor's evaluation (its peaks over
+        // the same instants); in a free scene by the other route (dae), against the reduced route's
+        // evaluations
+        cp::SimulateOptions other = problem.simulate;
+        other.route =
+            problem.simulate.route == cp::Route::kDae ? cp::Route::kReduced : cp::Route::kDae;
+        const cp::Model model(r.design);
+        const auto* driven = std::get_if<cp::DrivenScene>(&problem.scene);
+        const cp::Trajectory t =
+            driven ? cp::simulate_driven(model, *driven)
+                   : cp::simulate_free(model, std::get<cp::FreeScene>(problem.scene), other);
+        if (!t.ok()) {
+          r.verification_error = std::numeric_limits<double>::infinity();
+          r.message += "; the optimum's simulation failed: " + t.message;
+          return r;
+        }
+        r.verified = cp::metric_values(r.metric_table, t.table);
+        if (driven) add_instants_peaks(model, *driven, t, r.peak_times, r.metric_table, r.verified);
+        r.verification_error = verification_error(r.metric_table, r.metrics, r.verified);
+        r.inertial_error = inertial_error(r.design, t.table);
+        return r;
+      });
 }
 
 namespace {

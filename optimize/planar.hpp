@@ -90,6 +90,17 @@ struct DesignProblem {
   std::vector<Limit> limits;
   bool force_balance = false;  // full force balance as equalities
   double smoothing = kDefaultSmoothing;
+  /// Driven scenes: peaks bounded over the motion, not only at the samples (exchange steps, as
+  /// the four-bar's DesignProblem::resolve_peaks): where a peak of the objective or of a limit,
+  /// resolved between the samples at the optimum, rises above the peak the program bounded (by
+  /// more than 1e-9 of it), instants around it are added to peak_times and the problem is solved
+  /// again from that optimum; the original's peaks that normalise the objective and the limits
+  /// are then its resolved ones. Not yet the default (as the four-bar's).
+  bool resolve_peaks = false;
+  /// Driven scenes: times [s] at which the peaks are bounded besides the scene's samples (the
+  /// exchange steps add to them); the RMS metrics stay the samples'. Each must lie within the
+  /// run (0 to its duration).
+  std::vector<double> peak_times;
   /// Empty when valid, else the first problem; its field: "counterweights" or
   /// "link_parameters" with the element's index, "objective" or "limits" with the term's
   /// index, "original" (a link force at a centre of mass), "scene"; e.g. text()
@@ -211,6 +222,10 @@ struct Result {
   std::vector<double> original, metrics;  // as the regressor evaluates them
   double added_mass{};                    // [kg]
   std::vector<double> verified;           // the design simulated by the engine
+  /// Times [s] besides the samples at which the peaks were bounded (the problem's peak_times,
+  /// then those the exchange steps added: resolved peaks of earlier rounds and instants around
+  /// them); `metrics` and `verified` take their peaks over the samples and these.
+  std::vector<double> peak_times;
   double verification_error{};            // largest relative difference metrics vs verified
   /// A second route: the optimum's inertial shaking force and moment from Newton's law on each
   /// body's centre of mass (the balance layer, kinematics alone) against the engine's (its

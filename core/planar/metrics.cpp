@@ -194,53 +194,72 @@ std::vector<double> resolved_values(const std::vector<ColumnMetric>& metrics, co
 
 }  // namespace
 
+struct DrivenRows::State {
+  State(const Model& m, const DrivenScene& sc, const Trajectory& r)
+      : model(m), scene(sc), table(r.table), positions(m, r.table), ws(m) {
+    const Linkage& l = model.linkage();
+    t = table.column_values("t");
+    start = scene.start.empty() ? drawn_inputs(model) : scene.start;
+    // periodic: whole revolutions of the one input that moves, run to the end
+    int moving = 0;
+    for (std::size_t k = 0; k < l.inputs.size() && k < scene.speeds.size(); ++k) {
+      if (scene.speeds[k] == 0) continue;
+      ++moving;
+      if (l.inputs[k].kind == Input::Kind::kAngle)
+        period = 2 * std::numbers::pi / std::abs(scene.speeds[k]) * scene.revolutions;
+    }
+    if (moving != 1 || scene.duration > 0 || !r.ok()) period = 0;
+    row.columns = table.columns;
+    z.resize(start.size());
+    zero.assign(start.size(), 0.0);
+    h = table.rows() > 1 ? t[1] - t[0] : 0.0;
+  }
+  const Model& model;
+  const DrivenScene& scene;
+  const Series& table;
+  RowPositions positions;
+  Workspace ws;
+  Series row;
+  std::vector<double> t, start, z, zero;
+  double period = 0, h = 0;
+  double cached_t = std::nan("");
+};
+
+DrivenRows::DrivenRows(const Model& model, const DrivenScene& scene, const Trajectory& run)
+    : state_(std::make_unique<State>(model, scene, run)) {}
+DrivenRows::~DrivenRows() = default;
+double DrivenRows::period() const { return state_->period; }
+
+const double* DrivenRows::at(double s) {
+  State& st = *state_;
+  const std::size_t rows = st.table.rows();
+  if (rows == 0) return nullptr;
+  if (s != st.cached_t) {
+    st.cached_t = s;
+    st.row.values.clear();
+    const std::vector<double>& t = st.t;
+    const double u = st.period > 0 ? std::fmod(s - t[0] + st.period, st.period) + t[0] : s;
+    const auto i = static_cast<std::size_t>(std::clamp(
+        std::round((u - t[0]) / (st.h > 0 ? st.h : 1.0)), 0.0, static_cast<double>(rows - 1)));
+    const std::vector<Vec2> guess = st.positions.row(st.table, i);
+    for (std::size_t k = 0; k < st.z.size(); ++k) st.z[k] = st.start[k] + st.scene.speeds[k] * s;
+    if (!solve_position(st.model, st.ws, guess, st.z)) return nullptr;
+    for (std::size_t n = 0; n < guess.size(); ++n) {
+      if ((st.ws.instant.x[n] - guess[n]).norm() > 0.25 * st.model.length_scale()) return nullptr;
+    }
+    if (!inverse_dynamics(st.model, st.ws, s, st.scene.speeds, st.zero)) return nullptr;
+    append_row(st.model, st.ws.instant, st.row);
+  }
+  return st.row.values.empty() ? nullptr : st.row.values.data();
+}
+
 std::vector<double> metric_values(const Model& model, const DrivenScene& scene,
                                   const std::vector<ColumnMetric>& metrics, const Trajectory& run,
                                   std::vector<Peak>* peaks) {
-  const Series& table = run.table;
-  const std::size_t rows = table.rows();
-  const Linkage& l = model.linkage();
-  const std::vector<double> t = table.column_values("t");
-  const std::vector<double> start = scene.start.empty() ? drawn_inputs(model) : scene.start;
-  // periodic: whole revolutions of the one input that moves, run to the end
-  double period = 0;
-  int moving = 0;
-  for (std::size_t k = 0; k < l.inputs.size() && k < scene.speeds.size(); ++k) {
-    if (scene.speeds[k] == 0) continue;
-    ++moving;
-    if (l.inputs[k].kind == Input::Kind::kAngle)
-      period = 2 * std::numbers::pi / std::abs(scene.speeds[k]) * scene.revolutions;
-  }
-  if (moving != 1 || scene.duration > 0 || !run.ok()) period = 0;
-  const RowPositions positions(model, table);
-  Workspace ws(model);
-  Series row;
-  row.columns = table.columns;
-  std::vector<double> z(start.size());
-  const std::vector<double> zero(start.size(), 0.0);
-  const double h = rows > 1 ? t[1] - t[0] : 0.0;
-  // the whole row at time s, by the inverse dynamics from the nearest sample's positions; none
-  // where it cannot be evaluated or lands away from the samples' branch
-  double cached_t = std::nan("");
-  auto row_at = [&](double s) -> const double* {
-    if (s != cached_t) {
-      cached_t = s;
-      row.values.clear();
-      const double u = period > 0 ? std::fmod(s - t[0] + period, period) + t[0] : s;
-      const auto i = static_cast<std::size_t>(std::clamp(
-          std::round((u - t[0]) / (h > 0 ? h : 1.0)), 0.0, static_cast<double>(rows - 1)));
-      const std::vector<Vec2> guess = positions.row(table, i);
-      for (std::size_t k = 0; k < z.size(); ++k) z[k] = start[k] + scene.speeds[k] * s;
-      if (!solve_position(model, ws, guess, z)) return nullptr;
-      for (std::size_t n = 0; n < guess.size(); ++n) {
-        if ((ws.instant.x[n] - guess[n]).norm() > 0.25 * model.length_scale()) return nullptr;
-      }
-      if (!inverse_dynamics(model, ws, s, scene.speeds, zero)) return nullptr;
-      append_row(model, ws.instant, row);
-    }
-    return row.values.empty() ? nullptr : row.values.data();
-  };
-  return resolved_values(metrics, table, t, period, row_at, peaks);
+  DrivenRows rows(model, scene, run);
+  const std::vector<double> t = run.table.column_values("t");
+  return resolved_values(
+      metrics, run.table, t, rows.period(), [&rows](double s) { return rows.at(s); }, peaks);
 }
 
 std::vector<double> metric_values(const Model& model, const SimulateOptions& options,

@@ -7,6 +7,7 @@
 /// parts (the columns Fshx_inertial, Fshy_inertial, Msh_inertial); the totals are Fshx, Fshy, Msh.
 /// Each is the magnitude of one column (Msh, tau) or of an x, y pair of columns.
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,28 @@ std::vector<double> metric_values(const std::vector<ColumnMetric>& metrics, cons
 std::vector<double> metric_values(const Model& model, const DrivenScene& scene,
                                   const std::vector<ColumnMetric>& metrics, const Trajectory& run,
                                   std::vector<Peak>* peaks = nullptr);
+
+/// The whole row of a driven run's table at any time s, not only at its samples: the nodes solved
+/// from the nearest sample's (periodic runs: modulo the period, as metric_values() reads them),
+/// then the inverse dynamics at the inputs' values and speeds at s. The model, scene and run are
+/// held by reference and must outlive it.
+class DrivenRows {
+ public:
+  DrivenRows(const Model& model, const DrivenScene& scene, const Trajectory& run);
+  ~DrivenRows();
+  DrivenRows(const DrivenRows&) = delete;
+  DrivenRows& operator=(const DrivenRows&) = delete;
+  /// The row at s (run.table's columns), valid until the next call; null where the position
+  /// cannot be solved or lands away from the samples' branch (a node further than a quarter of
+  /// the linkage's size from the nearest sample's), or the dynamics cannot be evaluated.
+  const double* at(double s);
+  /// The run's period when it is whole revolutions of one moving input run to the end, else 0.
+  double period() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 /// The table's values over a free run `run` = simulate_free(model, scene, options), with every
 /// peak resolved between the samples: maximised over time by the run continued to each instant

@@ -381,6 +381,9 @@ Json planar_optimize_json(const Study& study, const RunResult& result) {
   }
   j["limits"] = limits;
   add_solver_fields(j, r, o);
+  // how the peaks were bounded, and the times besides the samples where they were
+  j["peaks"] = req.resolve_peaks ? "resolved" : "sampled";
+  j["peak_times"] = r.peak_times;
   const bool found = o.found();
   Json cws = Json::array();
   if (found) {

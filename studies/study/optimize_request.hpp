@@ -58,6 +58,9 @@ struct PlanarOptimizeRequest {
   std::vector<optimize::planar::Term> objective;                         // in the file's order
   std::vector<optimize::planar::Limit> limits;                           // in the file's order
   bool force_balance = false;  // the momentum conditions as equalities (full force balance)
+  /// optimize.peaks: resolved (true) bounds the motion's peaks (driven scenes:
+  /// optimize::planar::DesignProblem::resolve_peaks), sampled (false, the default) the samples'
+  bool resolve_peaks = false;
   optimize::OptimizeOptions options;
   std::optional<PlanarParetoRequest> pareto;
 };

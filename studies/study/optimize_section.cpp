@@ -37,7 +37,7 @@ class OptimizeReader {
     o.check_keys({"algorithm", "objective", "constraints", "variables", "max_evaluations",
                   "starts", "tolerance", "peaks", "pareto"});
     const SolverMarks marks = read_solver(o, e.key_mark, is_free(study.scene), req.options);
-    req.resolve_peaks = read_peaks(o, study, false);
+    req.resolve_peaks = read_peaks(o, study);
     read_objective(o.require("objective", "the metrics to minimise, each with a weight"), study,
                    req);
     if (const MapReader::Entry* c = o.find("constraints")) read_constraints(*c, study, req);
@@ -70,7 +70,7 @@ class OptimizeReader {
     o.check_keys({"algorithm", "objective", "constraints", "variables", "max_evaluations",
                   "starts", "tolerance", "peaks", "pareto"});
     const SolverMarks marks = read_solver(o, e.key_mark, is_free(study.scene), req.options);
-    read_peaks(o, study, true);  // sampled only, as yet
+    req.resolve_peaks = read_peaks(o, study);
     table_ = core::planar::metric_table(core::planar::Model(linkage));
 
     // objective: {metric: weight}
@@ -288,8 +288,8 @@ class OptimizeReader {
   };
 
   // algorithm, max_evaluations, starts, tolerance; each mark defaults to the section's
-  // optimize.peaks: sampled (false, the default) or resolved (true; a four-bar's driven scene)
-  bool read_peaks(const MapReader& o, const Study& study, bool planar) {
+  // optimize.peaks: sampled (false, the default) or resolved (true; a driven scene)
+  bool read_peaks(const MapReader& o, const Study& study) {
     const MapReader::Entry* k = o.find("peaks");
     if (!k) return false;
     const std::string how = read_text(r_, *k, "optimize.peaks");
@@ -298,11 +298,6 @@ class OptimizeReader {
       r_.fail(at, "optimize.peaks must be resolved or sampled, got '" + how + "'");
     }
     if (how == "sampled") return false;
-    if (planar) {
-      r_.fail(at,
-              "optimize.peaks: resolved is not available for general planar linkages yet (their "
-              "optimiser bounds the peaks at the samples: give more samples, or peaks: sampled)");
-    }
     if (is_free(study.scene)) {
       r_.fail(at,
               "optimize.peaks: resolved is for driven scenes (a free scene's peaks are its "

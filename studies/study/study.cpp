@@ -98,6 +98,7 @@ void set_request(Problem& p, const Request& r) {
   p.objective = r.objective;
   p.limits = r.limits;
   p.force_balance = r.force_balance;
+  p.resolve_peaks = r.resolve_peaks;
 }
 
 }  // namespace
@@ -146,7 +147,6 @@ optimize::DesignProblem design_problem(const Study& study) {
   p.formulation = method.formulation;
   p.tolerance = study.tolerance;
   set_request(p, r);
-  p.resolve_peaks = r.resolve_peaks;
   return p;
 }
 

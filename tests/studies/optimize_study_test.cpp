@@ -2,18 +2,23 @@
 // look-up by name, the problem and the study of an optimum built from a study.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
 #include "balance/counterweight.hpp"
 #include "core/fourbar/samples.hpp"
 #include "optimize/optimize.hpp"
+#include "studies/run/runner.hpp"
 #include "studies/study/load_study.hpp"
-#include "tests/support/studies.hpp"
 #include "studies/study/method.hpp"
 #include "studies/study/optimize_request.hpp"
 #include "studies/study/study.hpp"
+#include "tests/support/studies.hpp"
+#include "tests/support/text.hpp"
 
 namespace bd::studies {
 namespace {
@@ -189,6 +194,41 @@ TEST(OptimizeStudy, ACounterweightLeftAtNothingIsExactlyNone) {
   // the design is the one evaluated: its rocker is the original's
   EXPECT_EQ(r.design.rocker.mass, study.fourbar().rocker.mass);
   EXPECT_EQ(r.design.rocker.inertia, study.fourbar().rocker.inertia);
+}
+
+// peaks: resolved in a four-bar study: the objective (a peak over the original's, the added mass
+// too small for force balance) is the ratio the tables show, both resolved between the samples, and
+// summary.json says how the peaks were bounded and at which added crank angles.
+TEST(OptimizeStudy, ResolvedPeaksAreWhatTheTablesShow) {
+  std::ifstream in(bd::testing::example_path("weighted-counterweights.yaml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  for (const auto& [from, to] :
+       {std::pair<std::string, std::string>{"  samples: 360", "  samples: 24"},
+        {"    Fsh_rms: 1.0\n    Msh_rms: 1.0\n    tau_rms: 1.0\n",
+         "    Fsh_max: 1.0\n  constraints: {added_mass: 2.0}\n  peaks: resolved\n"}}) {
+    const auto at = yaml.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    yaml.replace(at, from.size(), to);
+  }
+  const Study study = parse_study(yaml, "weighted.yaml");
+  ASSERT_TRUE(study.optimize->resolve_peaks);
+  namespace fs = std::filesystem;
+  const fs::path out = fs::path(BD_BINARY_DIR) / "test-output" / "optimize-study" / "resolved";
+  fs::remove_all(out);
+  RunResult r = compute_study(study);
+  write_run(study, r, out);
+  ASSERT_TRUE(r.ok() && r.optimized && r.optimized->found()) << r.optimized->message();
+  const optimize::OptimizeResult& o = r.optimized->result;
+  ASSERT_FALSE(o.peak_angles.empty());
+  const nlohmann::json j = nlohmann::json::parse(bd::testing::read(out / "summary.json"));
+  EXPECT_EQ(j["optimize"]["peaks"], "resolved");
+  ASSERT_EQ(j["optimize"]["peak_angles"].size(), o.peak_angles.size());
+  EXPECT_EQ(j["optimize"]["peak_angles"][0].get<double>(), o.peak_angles[0]);
+  const double ratio =
+      j["optimized_metrics"]["Fsh_max"].get<double>() / j["metrics"]["Fsh_max"].get<double>();
+  EXPECT_NEAR(o.objective, ratio, 1e-9);  // the smoothed peak: sqrt(r² + ε²), ε = 1e-6
 }
 
 }  // namespace

@@ -1,0 +1,133 @@
+#pragma once
+/// Internal to optimize/: the exchange step shared by the four-bar's and the planar linkage's
+/// optimisers (DesignProblem::resolve_peaks): where a resolved peak of an optimum rises above
+/// the peak the program bounded over its instants (samples and instants added so far), the next
+/// round adds instants around it and solves again.
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "optimize/convex_solve.hpp"
+#include "optimize/optimize.hpp"
+
+namespace bd::optimize::detail {
+
+/// At most this many exchange rounds (each a solve more); they end sooner as a rule, once the
+/// optimum's resolved peaks are bounded (three or four rounds).
+inline constexpr int kMaxExchangeRounds = 8;
+/// A resolved peak above the peak over the program's instants by more than this, relative, adds
+/// instants (the resolved peaks are good to about 1e-14).
+inline constexpr double kPeakExchangeTolerance = 1e-9;
+/// At most this many instants added around one peak in one round.
+inline constexpr int kMaxInstantsPerPeak = 64;
+
+/// Appends to `added` the instants (crank angles, or times) a next round bounds a peak at: its
+/// own instant `at` and an even grid over the interval of `instants` (sorted: the program's
+/// samples, the motion's end and the instants added so far) around it. Near a smooth peak the
+/// excess goes with the square of the interval, so m intervals take it down m² times: m is
+/// chosen for `excess` (the resolved peak over the bounded one, minus 1) to fall to a tenth of
+/// the tolerance, at most kMaxInstantsPerPeak, so that the next optimum, whose peak moves a
+/// little, finds instants close around it. No grid when `at` lies outside the instants.
+inline void add_peak_instants(const std::vector<double>& instants, double at, double excess,
+                              std::vector<double>& added) {
+  added.push_back(at);
+  const auto right = std::upper_bound(instants.begin(), instants.end(), at);
+  if (right == instants.begin() || right == instants.end()) return;
+  const double a = *(right - 1), b = *right;
+  const int intervals = static_cast<int>(std::min<double>(
+      kMaxInstantsPerPeak, std::ceil(std::sqrt(10 * excess / kPeakExchangeTolerance))));
+  for (int j = 1; j < intervals; ++j) {
+    added.push_back(a + (b - a) * static_cast<double>(j) / static_cast<double>(intervals));
+  }
+}
+
+/// What the exchange rounds spent, over all of them, and what the last left undone.
+struct ExchangeTotals {
+  int iterations{}, evaluations{};
+  double seconds{};
+  /// "" when every resolved peak is bounded (or none was asked for); else what to append to the
+  /// solver's message: the budget or the rounds ran out first, and where the peaks are bounded.
+  std::string shortfall;
+};
+
+/// The fields either type's result (OptimizeResult, planar::Result) takes from the last
+/// round's solve: optimality, lower bound, multistart counts, algorithm, termination, message,
+/// the costs over the rounds, and the design variables x (snapped_to_bounds(): a counterweight
+/// left at round-off of nothing is none) with their objective and constraint violation.
+template <class Result, class Program>
+void set_solve_fields(Result& r, const Program& program, const ConvexAwareSolve& solve,
+                      const OptimizeOptions& options, const ExchangeTotals& totals) {
+  const Solved& s = solve.solved;
+  r.global = solve.optimality.global && found_design(s.termination);
+  r.optimality = solve.optimality.words;
+  r.lower_bound = solve.bound.value;
+  r.lower_bound_source = solve.bound.words;
+  r.starts = s.starts;
+  r.starts_at_best = s.starts_at_best;
+  r.algorithm = options.algorithm;
+  r.termination = s.termination;
+  r.message = s.message;
+  r.x = snapped_to_bounds(program, options, s.x, s.objective, s.constraint_violation);
+  const bool snapped = r.x != s.x;
+  r.objective = snapped ? program.objective(r.x, nullptr) : s.objective;
+  r.constraint_violation = snapped ? constraint_violation(program, r.x) : s.constraint_violation;
+  r.iterations = totals.iterations;
+  r.evaluations = totals.evaluations;
+  r.seconds = totals.seconds;
+}
+
+/// The exchange rounds of either linkage type's optimiser: solve `problem` (its Nlp, by
+/// solve_convex_aware() from `starts`); where short_peaks(problem, nlp, solved) names instants
+/// at which a resolved peak rises above its bound, add them to problem.*instants and solve again
+/// from that optimum, at most kMaxExchangeRounds more times, the rounds sharing
+/// options.max_evaluations. Returns finish(nlp, problem, solve, totals) of the last round (the
+/// Nlp lives only as long as the call). on_first(nlp) runs once, after the first Nlp is built
+/// (its checks come first). `what` names the instants in the shortfall ("crank angles").
+template <class Nlp, class Problem, class ShortPeaks, class OnFirst, class Finish>
+auto exchange_rounds(const Problem& problem, std::vector<Eigen::VectorXd> starts,
+                     const OptimizeOptions& options, std::vector<double> Problem::*instants,
+                     const char* what, const ShortPeaks& short_peaks, const OnFirst& on_first,
+                     const Finish& finish) {
+  Problem exchanged = problem;
+  ExchangeTotals totals;
+  for (int round = 0;; ++round) {
+    const Nlp nlp(exchanged);
+    if (round == 0) on_first(nlp);
+    OptimizeOptions budget = options;
+    budget.max_evaluations = options.max_evaluations - totals.evaluations;
+    const ConvexAwareSolve solve = solve_convex_aware(nlp, exchanged, starts, budget);
+    const Solved& solved = solve.solved;
+    totals.iterations += solved.iterations;
+    totals.evaluations += solved.evaluations;
+    totals.seconds += solved.seconds;
+    const std::vector<double> added = short_peaks(exchanged, nlp, solved);
+    // the next round needs evaluations left (mlsl: one per local run at least)
+    const int left = options.max_evaluations - totals.evaluations;
+    const bool another = round < kMaxExchangeRounds &&
+                         left >= (options.algorithm == Algorithm::kMlsl ? options.starts : 1);
+    std::vector<double>& bounded_at = exchanged.*instants;
+    if (!added.empty() && another) {
+      bounded_at.insert(bounded_at.end(), added.begin(), added.end());
+      starts.insert(starts.begin(), solved.x);
+      continue;
+    }
+    if (!added.empty()) {  // a peak still rises above its bound by more than the tolerance
+      const std::string where = bounded_at.empty() ? "the samples only"
+                                                   : "the samples and " +
+                                                         std::to_string(bounded_at.size()) +
+                                                         " more " + what;
+      totals.shortfall = (round < kMaxExchangeRounds
+                              ? "; the evaluation budget was spent before every resolved peak "
+                                "was bounded (the peaks are bounded at "
+                              : "; after " + std::to_string(kMaxExchangeRounds + 1) +
+                                    " solves a resolved peak still rose above its bound (the "
+                                    "peaks are bounded at ") +
+                         where + ")";
+    }
+    return finish(nlp, exchanged, solve, totals);
+  }
+}
+
+}  // namespace bd::optimize::detail
