@@ -234,11 +234,10 @@ void DrivenNlp::build_regressor() {
   const int per_revolution = scene().samples;
   samples_ = per_revolution * scene().revolutions;
   // the instants of core::simulate_driven, operation for operation
-  const double period = 2.0 * std::numbers::pi / std::abs(scene().omega1);
   theta1_.resize(static_cast<std::size_t>(samples_));
   for (int i = 0; i < samples_; ++i) {
-    const double t = period * static_cast<double>(i) / static_cast<double>(per_revolution);
-    theta1_[static_cast<std::size_t>(i)] = scene().theta1 + scene().omega1 * t;
+    theta1_[static_cast<std::size_t>(i)] =
+        scene().theta1 + scene().omega1 * core::driven_sample_time(scene(), i);
   }
   theta1_.insert(theta1_.end(), problem_.peak_angles.begin(), problem_.peak_angles.end());
   instants_ = static_cast<int>(theta1_.size());
@@ -440,7 +439,6 @@ double DrivenNlp::reaction_metric(const VectorXd& x, Metric m) const {
 // every sample's outputs from the regressor, at the instants of core::simulate_driven (the
 // problem's peak angles are not samples)
 core::Trajectory DrivenNlp::trajectory_of(const VecQ& q) const {
-  const double period = 2.0 * std::numbers::pi / std::abs(scene().omega1);
   core::Trajectory t;
   t.samples.resize(static_cast<std::size_t>(samples_));
   t.t.resize(static_cast<std::size_t>(samples_));
@@ -448,7 +446,7 @@ core::Trajectory DrivenNlp::trajectory_of(const VecQ& q) const {
   for (int g = 0; g < kGroups; ++g) y[g] = A_[g].topRows(kGroupRows[g] * samples_) * q;
   for (int i = 0; i < samples_; ++i) {
     const auto j = static_cast<std::size_t>(i);
-    t.t[j] = period * static_cast<double>(i) / static_cast<double>(scene().samples);
+    t.t[j] = core::driven_sample_time(scene(), i);
     core::DynamicsSample& s = t.samples[j];
     s.state.theta1 = theta1_[j];
     s.state.omega1 = scene().omega1;

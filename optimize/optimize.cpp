@@ -583,15 +583,13 @@ namespace {
 
 // The program's instants as crank angles: the scene's samples and the peak angles so far.
 std::vector<double> instant_angles(const DesignProblem& problem, const core::DrivenScene& scene) {
+  // the samples, then the motion's end (the first sample of the next revolution), which closes
+  // the last interval
   const int samples = scene.samples * scene.revolutions;
-  const double period = 2.0 * std::numbers::pi / std::abs(scene.omega1);
   std::vector<double> angles;
-  for (int i = 0; i < samples; ++i) {
-    const double t = period * static_cast<double>(i) / static_cast<double>(scene.samples);
-    angles.push_back(scene.theta1 + scene.omega1 * t);
+  for (int i = 0; i <= samples; ++i) {
+    angles.push_back(scene.theta1 + scene.omega1 * core::driven_sample_time(scene, i));
   }
-  // the motion's end (the first sample of the next revolution) closes the last interval
-  angles.push_back(scene.theta1 + scene.omega1 * period * scene.revolutions);
   angles.insert(angles.end(), problem.peak_angles.begin(), problem.peak_angles.end());
   std::sort(angles.begin(), angles.end());
   return angles;
@@ -626,7 +624,9 @@ std::vector<double> short_peak_angles(const DesignProblem& problem, const Nlp& n
   const std::vector<double> instants = instant_angles(problem, *scene);
   std::vector<double> added;
   for (Metric m : used) {
-    const double excess = value(resolved, m) / value(bounded, m) - 1;
+    // of the original's peak, the objective's and the limits' unit (a peak of a balanced design
+    // may vanish, and 1e-9 of nothing is round-off)
+    const double excess = (value(resolved, m) - value(bounded, m)) / nlp.original(m);
     if (!(excess > detail::kPeakExchangeTolerance)) continue;
     // the interval of instants around it sorted by angle, whatever the sense of rotation
     detail::add_peak_instants(

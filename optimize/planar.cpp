@@ -1508,7 +1508,8 @@ std::vector<double> short_peak_times(const DesignProblem& problem, const PlanarN
   std::vector<double> added;
   for (const int k : used) {
     const auto i = static_cast<std::size_t>(k);
-    const double excess = resolved[i] / bounded[i] - 1;
+    // of the original's peak, as the four-bar's
+    const double excess = (resolved[i] - bounded[i]) / nlp.original_metrics()[i];
     if (!(excess > detail::kPeakExchangeTolerance)) continue;
     detail::add_peak_instants(instants, peaks[i].t, excess, added);
   }

@@ -2,6 +2,8 @@
 /// Scenes: free motion (forward dynamics integrated by a SUNDIALS integrator with error control,
 /// output at the requested instants by the integrator's dense output) and driven motion (constant
 /// crank speed, inverse dynamics per sample, no integration).
+#include <cmath>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,6 +32,14 @@ struct DrivenScene {
   int revolutions{1};  // >= 1
   int samples{360};    // per revolution, >= 1
 };
+
+/// The time [s] of sample j of a driven scene, t_j = j T / samples with T = 2π / |omega1|,
+/// operation for operation as simulate_driven() takes it (so that an optimiser's instants are
+/// the run's, bit for bit); j = samples · revolutions is the motion's periodic end.
+inline double driven_sample_time(const DrivenScene& scene, long long j) {
+  const double period = 2.0 * std::numbers::pi / std::abs(scene.omega1);
+  return period * static_cast<double>(j) / static_cast<double>(scene.samples);
+}
 
 /// How to simulate (Ceres-style options: defaults in place, validate() says what is wrong).
 struct SimulateOptions {

@@ -17,8 +17,9 @@ namespace bd::optimize::detail {
 /// At most this many exchange rounds (each a solve more); they end sooner as a rule, once the
 /// optimum's resolved peaks are bounded (three or four rounds).
 inline constexpr int kMaxExchangeRounds = 8;
-/// A resolved peak above the peak over the program's instants by more than this, relative, adds
-/// instants (the resolved peaks are good to about 1e-14).
+/// A resolved peak above the peak over the program's instants by more than this fraction of the
+/// original's peak (the objective's and the limits' unit) adds instants (the resolved peaks are
+/// good to about 1e-14 of themselves).
 inline constexpr double kPeakExchangeTolerance = 1e-9;
 /// At most this many instants added around one peak in one round.
 inline constexpr int kMaxInstantsPerPeak = 64;
@@ -27,9 +28,9 @@ inline constexpr int kMaxInstantsPerPeak = 64;
 /// own instant `at` and an even grid over the interval of `instants` (sorted: the program's
 /// samples, the motion's end and the instants added so far) around it. Near a smooth peak the
 /// excess goes with the square of the interval, so m intervals take it down m² times: m is
-/// chosen for `excess` (the resolved peak over the bounded one, minus 1) to fall to a tenth of
-/// the tolerance, at most kMaxInstantsPerPeak, so that the next optimum, whose peak moves a
-/// little, finds instants close around it. No grid when `at` lies outside the instants.
+/// chosen for `excess` (the resolved peak minus the bounded one, over the original's) to fall to a
+/// tenth of the tolerance, at most kMaxInstantsPerPeak, so that the next optimum, whose peak moves
+/// a little, finds instants close around it. No grid when `at` lies outside the instants.
 inline void add_peak_instants(const std::vector<double>& instants, double at, double excess,
                               std::vector<double>& added) {
   added.push_back(at);
@@ -102,12 +103,25 @@ auto exchange_rounds(const Problem& problem, std::vector<Eigen::VectorXd> starts
     totals.iterations += solved.iterations;
     totals.evaluations += solved.evaluations;
     totals.seconds += solved.seconds;
-    const std::vector<double> added = short_peaks(exchanged, nlp, solved);
+    const std::vector<double> wanted = short_peaks(exchanged, nlp, solved);
+    // each instant once: two peaks in one interval ask for the same grid
+    std::vector<double>& bounded_at = exchanged.*instants;
+    std::vector<double> added;
+    for (const double a : wanted) {
+      if (std::find(bounded_at.begin(), bounded_at.end(), a) == bounded_at.end() &&
+          std::find(added.begin(), added.end(), a) == added.end()) {
+        added.push_back(a);
+      }
+    }
     // the next round needs evaluations left (mlsl: one per local run at least)
     const int left = options.max_evaluations - totals.evaluations;
     const bool another = round < kMaxExchangeRounds &&
                          left >= (options.algorithm == Algorithm::kMlsl ? options.starts : 1);
-    std::vector<double>& bounded_at = exchanged.*instants;
+    if (!wanted.empty() && added.empty()) {
+      totals.shortfall =
+          "; a resolved peak still rose above its bound, at instants already bounded";
+      return finish(nlp, exchanged, solve, totals);
+    }
     if (!added.empty() && another) {
       bounded_at.insert(bounded_at.end(), added.begin(), added.end());
       starts.insert(starts.begin(), solved.x);

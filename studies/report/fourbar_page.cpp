@@ -413,7 +413,7 @@ std::string fourbar_report_html(const Study& study, const fs::path& dir, const s
                       "Fsh, Msh: shaking force and moment about A0 on the frame; tau: drive "
                       "torque; RA0, RA3: forces on the ground at the bearings. RMS over the "
                       "samples, max of magnitudes.");
-  h += comparison_section(dir, second);
+  h += comparison_section(dir, summary, second);
   h += harmonics_section(dir);
   FourBarCharts c = fourbar_charts(study, dir, second, ts, summary);
   h += animations_section(c.animations);

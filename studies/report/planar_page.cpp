@@ -459,7 +459,7 @@ std::string planar_report_html(const Study& study, const fs::path& dir, const st
                       "drive torques (a slide input's: a force in N); R&lt;name&gt;: forces on the "
                       "frame at a ground node or guide; F&lt;joint&gt;: joint forces on their "
                       "links. RMS over the samples, max of magnitudes.");
-  h += comparison_section(dir, second.design);
+  h += comparison_section(dir, summary, second.design);
   h += harmonics_section(dir);
   std::vector<AnimationFigure> animations;
   const std::vector<CounterweightPart> own =

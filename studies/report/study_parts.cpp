@@ -84,6 +84,19 @@ std::string simulation_section(const Json& summary) {
   return h;
 }
 
+namespace {
+
+// a metric's unit as summary.json's metric_units gives it (the linkage's own table), else by its
+// name (unit_of(): an older summary.json, or a row of comparison.csv that is no metric)
+std::string metric_unit(const Json& summary, const std::string& name) {
+  if (const Json* units = member(summary, "metric_units")) {
+    if (const Json* u = member(*units, name); u && u->is_string()) return u->get<std::string>();
+  }
+  return unit_of(name);
+}
+
+}  // namespace
+
 std::string metrics_section(const Json& summary, const SecondDesign& second,
                             const std::string& notes) {
   std::string h = "<h2>Metrics</h2>\n<table><tr><th>metric</th><th>original</th>";
@@ -105,13 +118,14 @@ std::string metrics_section(const Json& summary, const SecondDesign& second,
         h += (s ? num_cell(text(*s), scale) : "<td></td>") +
              (r ? num_cell(text(*r), 1.0) : "<td></td>");
       }
-      h += "<td>" + esc(unit_of(k)) + "</td></tr>";
+      h += "<td>" + esc(metric_unit(summary, k)) + "</td></tr>";
     }
   }
   return h + "</table>\n<p>" + notes + "</p>\n";
 }
 
-std::string comparison_section(const fs::path& dir, const SecondDesign& second) {
+std::string comparison_section(const fs::path& dir, const Json& summary,
+                               const SecondDesign& second) {
   if (!second.present() || !fs::exists(dir / "comparison.csv")) return "";
   const Csv csv = read_csv(dir / "comparison.csv");
   std::string h =
@@ -126,7 +140,7 @@ std::string comparison_section(const fs::path& dir, const SecondDesign& second) 
     const double scale = std::max(std::abs(std::strtod(row[1].c_str(), nullptr)),
                                   std::abs(std::strtod(row[2].c_str(), nullptr)));
     h += "<tr><th>" + esc(row[0]) + "</th>" + num_cell(row[1], scale) + num_cell(row[2], scale) +
-         num_cell(row[3], 1.0) + "<td>" + esc(unit_of(row[0])) + "</td></tr>";
+         num_cell(row[3], 1.0) + "<td>" + esc(metric_unit(summary, row[0])) + "</td></tr>";
   }
   return h + "</table>\n";
 }

@@ -30,7 +30,8 @@ std::string simulation_section(const Json& summary);
 std::string metrics_section(const Json& summary, const SecondDesign& second,
                             const std::string& notes);
 /// "Comparison" (comparison.csv), when the folder has it.
-std::string comparison_section(const std::filesystem::path& dir, const SecondDesign& second);
+std::string comparison_section(const std::filesystem::path& dir, const Json& summary,
+                               const SecondDesign& second);
 /// "Harmonic orders" (harmonics.csv), when the folder has it: the amplitudes per design and order.
 std::string harmonics_section(const std::filesystem::path& dir);
 /// The balanced or optimised design's section: its summary.json section and its run (or the

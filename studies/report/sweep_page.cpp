@@ -876,12 +876,22 @@ std::string side_by_side(const std::string& title, const std::vector<std::string
 
 // the data line of the least value among `v` (value, data line) pairs, or nothing when it is
 // round-off (at or below `floor`: then no point is less than another)
-std::optional<std::string> minimum_line(const std::vector<std::pair<double, std::string>>& v,
+// Where a two-parameter chart's red circle goes, "x,y": the point of the least value over every
+// row of sweep.csv (the best points table's), which on a large sweep may lie between the points
+// drawn; none when the least of those drawn is zero to round-off.
+std::optional<std::string> minimum_line(const Sweep& s, const Series& se,
+                                        const std::vector<std::pair<double, std::string>>& v,
                                         double floor) {
   std::size_t best = 0;
   for (std::size_t i = 1; i < v.size(); ++i)
     if (v[i].first < v[best].first) best = i;
   if (v[best].first <= floor) return std::nullopt;
+  if (const auto it = s.best.find(se.column);
+      it != s.best.end() && it->second.row && it->second.value > floor) {
+    const std::vector<std::string>& row = *it->second.row;
+    const auto x = number(row[1]), y = number(row[2]);
+    if (x && y) return num(*x) + "," + num(*y);
+  }
   return v[best].second;
 }
 
@@ -940,7 +950,7 @@ void heat_maps(const Sweep& s, Charts& out) {
                  " using 1:2:3:4:5:6 with boxxyerror fs solid 1.0 noborder lc rgb '#c8c8c8' "
                  "notitle";
       }
-      const auto least = values.empty() ? std::nullopt : minimum_line(values, s.floor(m));
+      const auto least = values.empty() ? std::nullopt : minimum_line(s, se, values, s.floor(m));
       if (least) {
         items += ", " + out.block({*least}) +
                  " using 1:2 with points pt 6 ps 2 lw 2 lc rgb '#e00000' notitle";
@@ -952,15 +962,16 @@ void heat_maps(const Sweep& s, Charts& out) {
     }
     if (panels.empty()) continue;
     out.charts.push_back(
-        {"sweep-" + m.id, m.name + " over " + engineer_name(px.path) + " and " + engineer_name(py.path),
+        {"sweep-" + m.id,
+         m.name + " over " + engineer_name(px.path) + " and " + engineer_name(py.path),
          m.name + " (" + m.what +
              ") at each grid point, one rectangle per point reaching "
              "halfway to its neighbours" +
              panels_text(m) +
-             ". Grey: failed points; blank: points not run; red circle: the least value "
-             "(none where every value is round-off: below " +
-             fmt(kNoiseFloor, "%g") + " of the metric's largest, drawn as zero)." +
-             sample_note(s),
+             ". Grey: failed points; blank: points not run; red circle: the least value over "
+             "every point, as the best points table ranks them (none where every value is "
+             "round-off: below " +
+             fmt(kNoiseFloor, "%g") + " of the metric's largest, drawn as zero)." + sample_note(s),
          kPalette + side_by_side(m.name + ": " + m.what, panels), true});
   }
 }
@@ -998,7 +1009,7 @@ void scatter_maps(const Sweep& s, Charts& out) {
         items += std::string(items.empty() ? "" : ", ") + out.block(failed) +
                  " using 1:2 with points pt 2 ps 1.1 lw 2 lc rgb '#808080' notitle";
       }
-      const auto least = values.empty() ? std::nullopt : minimum_line(values, s.floor(m));
+      const auto least = values.empty() ? std::nullopt : minimum_line(s, se, values, s.floor(m));
       if (least) {
         items += ", " + out.block({*least}) +
                  " using 1:2 with points pt 6 ps 2.2 lw 2 lc rgb '#e00000' notitle";
@@ -1009,16 +1020,17 @@ void scatter_maps(const Sweep& s, Charts& out) {
       panels.push_back("set title " + gp_string(se.label + title_note) + cb + p + items);
     }
     if (panels.empty()) continue;
-    out.charts.push_back({"sweep-" + m.id,
-                          m.name + " over " + engineer_name(px.path) + " and " + engineer_name(py.path),
-                          m.name + " (" + m.what + ") at each point of the " +
-                              (s.design == "lhs" ? "Latin-hypercube" : "random") +
-                              " design, by colour" + panels_text(m) +
-                              ". Grey crosses: failed points; red circle: the least value "
-                              "(none where every value is round-off: below " +
-                              fmt(kNoiseFloor, "%g") + " of the metric's largest, drawn as zero)." +
-                              sample_note(s),
-                          kPalette + side_by_side(m.name + ": " + m.what, panels), true});
+    out.charts.push_back(
+        {"sweep-" + m.id,
+         m.name + " over " + engineer_name(px.path) + " and " + engineer_name(py.path),
+         m.name + " (" + m.what + ") at each point of the " +
+             (s.design == "lhs" ? "Latin-hypercube" : "random") + " design, by colour" +
+             panels_text(m) +
+             ". Grey crosses: failed points; red circle: the least value over "
+             "every point, as the best points table ranks them (none where every value is "
+             "round-off: below " +
+             fmt(kNoiseFloor, "%g") + " of the metric's largest, drawn as zero)." + sample_note(s),
+         kPalette + side_by_side(m.name + ": " + m.what, panels), true});
   }
 }
 

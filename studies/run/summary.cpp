@@ -439,6 +439,10 @@ std::string summary_json(const Study& study, const RunResult& result) {
   // a run that stopped early: its metrics cover the samples before the stop only
   j["metrics_partial"] = !result.status().ok();
   j["metrics"] = metrics_json(result.metric_list);
+  // each metric's unit, from the linkage's own table (a slider's drive effort is a force)
+  Json units = Json::object();
+  for (const MetricValue& m : result.metric_list) units[m.name] = m.unit;
+  j["metric_units"] = units;
   j["peaks"] = peaks_json(study, result.metric_list);
   if (result.harmonics) j["harmonics"] = harmonics_json(*result.harmonics);
   if (study.balance && result.balanced) {

@@ -420,6 +420,14 @@ Existing existing_rows(const Study& study, const fs::path& out_dir, const SweepR
   if (!options.resume) {
     // a finished sweep is replaced; an unfinished one only on request
     if (const std::string why = unfinished_sweep(out_dir, n); !why.empty()) {
+      // --resume continues this study's sweep only: another study's is said to be so
+      if (const std::string other =
+              old_summary ? identity_difference(*old_summary, study, n) : std::string();
+          !other.empty()) {
+        throw InputError(why + " of another study (" + other +
+                         "): remove the folder to start over, or write this sweep elsewhere "
+                         "with --out");
+      }
       throw InputError(why + ": pass --resume to continue it, or remove the folder to start over");
     }
     return e;

@@ -285,8 +285,16 @@ TEST(PlanarOptimizeStudy, ResolvedPeaksAreWhatTheTablesShow) {
     const nlohmann::json j = nlohmann::json::parse(bd::testing::read(out / "summary.json"));
     EXPECT_EQ(j["optimize"]["peaks"], resolved ? "resolved" : "sampled");
     EXPECT_EQ(j["optimize"]["peak_times"].size(), p.peak_times.size());
+    // every metric's unit, from the linkage's table: the slider's guide force is in N (the
+    // report's tables read them; by the name alone 'Rpiston' had none)
+    EXPECT_EQ(j["metric_units"]["Rpiston_max"], "N");
+    EXPECT_EQ(j["metric_units"]["Msh_rms"], "N m");
+    EXPECT_EQ(j["metric_units"].size(), j["metrics"].size());
     if (resolved) {
       EXPECT_GT(p.peak_times.size(), 0u);
+      std::vector<double> times = p.peak_times;  // each once
+      std::sort(times.begin(), times.end());
+      EXPECT_EQ(std::adjacent_find(times.begin(), times.end()), times.end());
       EXPECT_EQ(j["optimize"]["peak_times"][0].get<double>(), p.peak_times[0]);
       // the smoothed peak: sqrt(r² + ε²) with ε = 1e-6
       EXPECT_NEAR(p.objective, ratio, 1e-9);

@@ -491,6 +491,15 @@ TEST_F(SweepRunner, ResumeRefusesAnotherDesignOrAlteredRows) {
                    " holds an unfinished sweep (3 of 9 points): pass --resume to continue it, or "
                    "remove the folder to start over");
   EXPECT_EQ(lines(read(p / "sweep.csv")).size(), 4u);
+  // another study's unfinished sweep: --resume would be refused, so the message does not offer it
+  m = message(other, p, quiet());
+  EXPECT_EQ(
+      m.rfind(p.string() + " holds an unfinished sweep (3 of 9 points) of another study (", 0), 0u)
+      << m;
+  EXPECT_NE(m.find("): remove the folder to start over, or write this sweep elsewhere with --out"),
+            std::string::npos)
+      << m;
+  EXPECT_EQ(lines(read(p / "sweep.csv")).size(), 4u);
   // a finished one is replaced
   EXPECT_EQ(message(study, dir_ / "full", quiet()), "no error");
   EXPECT_EQ(read(dir_ / "full" / "sweep.csv"), full);
