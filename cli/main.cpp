@@ -412,15 +412,24 @@ void print_planar_balance(const st::Study& study, const st::RunResult& r) {
   print_comparison(study, r);
 }
 
-// the lower bound of the objective and the optimum's gap above it, or why there is none
-void print_lower_bound(double objective, double bound, const std::string& source) {
+// how good the optimum is (either linkage type's result): proven global or why not, the lower
+// bound of the objective and the optimum's gap above it (or why there is none), and a
+// multistart's local runs that reached the best value
+template <class Result>
+void print_optimality(const Result& o) {
+  std::printf("           %s\n", o.optimality.c_str());
+  if (o.starts > 0) {
+    std::printf("           multistart: %d local runs, %d of them reaching the best value\n",
+                o.starts, o.starts_at_best);
+  }
+  const std::string& source = o.lower_bound_source;
   if (source.empty()) return;
-  if (!std::isfinite(bound)) {
+  if (!std::isfinite(o.lower_bound)) {
     std::printf("           %s\n", source.c_str());
     return;
   }
-  std::printf("           lower bound %.6g (the optimum is %.3g above it), %s\n", bound,
-              objective - bound, source.c_str());
+  std::printf("           lower bound %.6g (the optimum is %.3g above it), %s\n", o.lower_bound,
+              o.objective - o.lower_bound, source.c_str());
 }
 
 // the optimum: how the solver ended, what it added, and before / after / ratio
@@ -433,8 +442,7 @@ void print_optimize(const st::Study& study, const st::RunResult& r) {
   std::printf("           subject to %s\n", st::constraints_text(req).c_str());
   std::printf("           %s\n", o.brief_report().c_str());
   if (!run.found()) return;
-  std::printf("           %s\n", o.optimality.c_str());
-  print_lower_bound(o.objective, o.lower_bound, o.lower_bound_source);
+  print_optimality(o);
   for (const bd::optimize::PlacedCounterweight& p : o.counterweights) {
     print_counterweight(bd::core::link_name(p.link), 7, p.counterweight,
                         p.link == 1 ? "A0" : "A3");
@@ -466,8 +474,7 @@ void print_planar_optimize(const st::Study& study, const st::RunResult& r) {
                                      ? o.message.c_str()
                                      : o.brief_report().c_str());
   if (!run.found()) return;
-  std::printf("           %s\n", o.optimality.c_str());
-  print_lower_bound(o.objective, o.lower_bound, o.lower_bound_source);
+  print_optimality(o);
   int width = 7;
   for (const bd::core::planar::Link& k : study.planar().links)
     width = std::max(width, static_cast<int>(k.name.size()));

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <regex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -265,6 +266,11 @@ TEST_F(MpiSweepCli, MultistartSharedAmongRanksGivesTheSameOptimum) {
   std::ofstream(dir_ / "mlsl.yaml") << study;
   ASSERT_EQ(run("mlsl.yaml --out alone"), 0) << err_;
   const std::string alone_out = out_;
+  // the console says how many local runs reached the best value (the README's promise)
+  EXPECT_TRUE(std::regex_search(
+      out_, std::regex("\n           multistart: 6 local runs, [1-6] of them reaching the best "
+                       "value\n")))
+      << out_;
   ASSERT_EQ(mpirun("mlsl.yaml --out ranks"), 0) << err_;
   // rank 0 alone speaks: the summary of the run in one process, line for line
   EXPECT_EQ(std::count(out_.begin(), out_.end(), '\n'),
