@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <limits>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -282,9 +283,22 @@ std::string json_cell(const Json& v) {
   for (const Json& x : v) objects = objects && x.is_object();
   if (objects) return "<td>" + json_table(v) + "</td>";
   // a list of numbers: round-off of its largest shows as 0
-  double scale = 0;
-  for (const Json& x : v)
-    if (x.is_number()) scale = std::max(scale, std::abs(x.get<double>()));
+  double scale = 0, least = std::numeric_limits<double>::infinity(), largest = -least;
+  std::size_t numbers = 0;
+  for (const Json& x : v) {
+    if (!x.is_number()) continue;
+    ++numbers;
+    scale = std::max(scale, std::abs(x.get<double>()));
+    least = std::min(least, x.get<double>());
+    largest = std::max(largest, x.get<double>());
+  }
+  // a long one (an optimiser's added instants, hundreds): its count and range, the values in
+  // summary.json
+  constexpr std::size_t kListedValues = 12;
+  if (numbers == v.size() && numbers > kListedValues) {
+    return "<td>" + std::to_string(numbers) + " values from " + esc(fmt_scaled(least, scale)) +
+           " to " + esc(fmt_scaled(largest, scale)) + " (each in summary.json)</td>";
+  }
   std::string s;
   for (const Json& x : v) {
     if (x.is_structured()) continue;
