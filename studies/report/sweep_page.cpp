@@ -895,6 +895,13 @@ std::optional<std::string> minimum_line(const Sweep& s, const Series& se,
   return v[best].second;
 }
 
+// what a two-parameter chart's red circle marks (minimum_line()), for its caption
+std::string least_circle_note() {
+  return "red circle: the least value over every point, as the best points table ranks them "
+         "(none where every value is round-off: below " +
+         fmt(kNoiseFloor, "%g") + " of the metric's largest, drawn as zero).";
+}
+
 // two parameters on a grid: a heat map of each metric per design, one rectangle per point
 // spanning halfway to its neighbours
 void heat_maps(const Sweep& s, Charts& out) {
@@ -968,10 +975,8 @@ void heat_maps(const Sweep& s, Charts& out) {
              ") at each grid point, one rectangle per point reaching "
              "halfway to its neighbours" +
              panels_text(m) +
-             ". Grey: failed points; blank: points not run; red circle: the least value over "
-             "every point, as the best points table ranks them (none where every value is "
-             "round-off: below " +
-             fmt(kNoiseFloor, "%g") + " of the metric's largest, drawn as zero)." + sample_note(s),
+             ". Grey: failed points; blank: points not run; " + least_circle_note() +
+             sample_note(s),
          kPalette + side_by_side(m.name + ": " + m.what, panels), true});
   }
 }
@@ -1026,10 +1031,7 @@ void scatter_maps(const Sweep& s, Charts& out) {
          m.name + " (" + m.what + ") at each point of the " +
              (s.design == "lhs" ? "Latin-hypercube" : "random") + " design, by colour" +
              panels_text(m) +
-             ". Grey crosses: failed points; red circle: the least value over "
-             "every point, as the best points table ranks them (none where every value is "
-             "round-off: below " +
-             fmt(kNoiseFloor, "%g") + " of the metric's largest, drawn as zero)." + sample_note(s),
+             ". Grey crosses: failed points; " + least_circle_note() + sample_note(s),
          kPalette + side_by_side(m.name + ": " + m.what, panels), true});
   }
 }
