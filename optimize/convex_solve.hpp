@@ -231,44 +231,14 @@ LowerBound relaxation_bound(const Problem& problem, const Eigen::VectorXd& best,
   return out;
 }
 
-/// Solves `nlp` (position variables) from `designs` (its variables: results' x), then its
-/// natural start with each counterweight's mass scaled by 1, 1/4, ..., 1/256 (the first that
-/// fits an added-mass budget), then the original design (no counterweight: feasible for any
-/// budget >= 0). `problem` is nlp's; where nlp.why_not_convex() is empty the same problem is
-/// also set up in mass-moment variables (Nlp(problem, CounterweightVariablesAs::kMassMoments)).
+/// The optimality and the lower bound of out.solved (a design of `nlp`, position variables):
+/// where the program is convex (`convex`, its mass-moment form, not null; `why_not` empty) the
+/// first-order conditions and the Lagrangian bound, whose refining runs may return a better
+/// design (out.solved then replaced); else the convex relaxation's bound, or why there is none.
 template <class Nlp, class Problem>
-ConvexAwareSolve solve_convex_aware(const Nlp& nlp, const Problem& problem,
-                                    const std::vector<Eigen::VectorXd>& designs,
-                                    const OptimizeOptions& options) {
-  const std::string why_not = nlp.why_not_convex();
-  std::optional<Nlp> convex;
-  if (why_not.empty()) convex.emplace(problem, CounterweightVariablesAs::kMassMoments);
-  const bool in_moments =
-      convex && uses_gradients(options.algorithm) && options.algorithm != Algorithm::kMlsl;
-  const Nlp& program = in_moments ? *convex : nlp;
-  std::vector<Eigen::VectorXd> starts;
-  for (const Eigen::VectorXd& d : designs) starts.push_back(program.from_positions(d));
-  for (double fraction = 1; fraction > 1e-3; fraction /= 4) {
-    starts.push_back(program.start_scaled(fraction));
-  }
-  starts.push_back(program.start(true));
-  ConvexAwareSolve out;
+void certify(const Nlp& nlp, const Problem& problem, const Nlp* convex, const std::string& why_not,
+             const OptimizeOptions& options, ConvexAwareSolve& out) {
   Solved& solved = out.solved;
-  solved = solve_from(program, starts, options);
-  if (in_moments) {
-    // the design in positions, its bound variables tight, and its feasibility there (what a
-    // message says is the returned design's: an infeasible end's mass moments may lie outside
-    // the cone, and in positions they are brought onto it)
-    solved.x = nlp.start_at(convex->to_positions(solved.x));
-    nlp.polish(solved.x);
-    solved.objective = nlp.objective(solved.x, nullptr);
-    std::string solver = solved.message;
-    if (const auto open = solver.rfind(" ["); open != std::string::npos && solver.back() == ']' &&
-                                              solver.starts_with("no feasible design found")) {
-      solver = solver.substr(open + 2, solver.size() - open - 3);
-    }
-    check_feasibility(nlp, options, solver, solved);
-  }
   const bool found = found_design(solved.termination);
   double stationarity = solved.stationarity;
   if (convex && found) {
@@ -319,6 +289,62 @@ ConvexAwareSolve solve_convex_aware(const Nlp& nlp, const Problem& problem,
                                 "), but no design can go below its convex relaxation's lower "
                                 "bound, which the design's objective meets to that"};
   }
+}
+
+/// Solves `nlp` (position variables) from `designs` (its variables: results' x), then its
+/// natural start with each counterweight's mass scaled by 1, 1/4, ..., 1/256 (the first that
+/// fits an added-mass budget), then the original design (no counterweight: feasible for any
+/// budget >= 0). `problem` is nlp's; where nlp.why_not_convex() is empty the same problem is
+/// also set up in mass-moment variables (Nlp(problem, CounterweightVariablesAs::kMassMoments)).
+/// With `with_certificate` the end is certify()'d; without, its optimality and bound are left
+/// unassessed (a round whose design is only a step towards the result: certified() later).
+template <class Nlp, class Problem>
+ConvexAwareSolve solve_convex_aware(const Nlp& nlp, const Problem& problem,
+                                    const std::vector<Eigen::VectorXd>& designs,
+                                    const OptimizeOptions& options, bool with_certificate = true) {
+  const std::string why_not = nlp.why_not_convex();
+  std::optional<Nlp> convex;
+  if (why_not.empty()) convex.emplace(problem, CounterweightVariablesAs::kMassMoments);
+  const bool in_moments =
+      convex && uses_gradients(options.algorithm) && options.algorithm != Algorithm::kMlsl;
+  const Nlp& program = in_moments ? *convex : nlp;
+  std::vector<Eigen::VectorXd> starts;
+  for (const Eigen::VectorXd& d : designs) starts.push_back(program.from_positions(d));
+  for (double fraction = 1; fraction > 1e-3; fraction /= 4) {
+    starts.push_back(program.start_scaled(fraction));
+  }
+  starts.push_back(program.start(true));
+  ConvexAwareSolve out;
+  Solved& solved = out.solved;
+  solved = solve_from(program, starts, options);
+  if (in_moments) {
+    // the design in positions, its bound variables tight, and its feasibility there (what a
+    // message says is the returned design's: an infeasible end's mass moments may lie outside
+    // the cone, and in positions they are brought onto it)
+    solved.x = nlp.start_at(convex->to_positions(solved.x));
+    nlp.polish(solved.x);
+    solved.objective = nlp.objective(solved.x, nullptr);
+    std::string solver = solved.message;
+    if (const auto open = solver.rfind(" ["); open != std::string::npos && solver.back() == ']' &&
+                                              solver.starts_with("no feasible design found")) {
+      solver = solver.substr(open + 2, solver.size() - open - 3);
+    }
+    check_feasibility(nlp, options, solver, solved);
+  }
+  if (with_certificate) certify(nlp, problem, convex ? &*convex : nullptr, why_not, options, out);
+  return out;
+}
+
+/// `solved`, a design of `nlp` from solve_convex_aware() without its certificate, certify()'d.
+template <class Nlp, class Problem>
+ConvexAwareSolve certified(const Nlp& nlp, const Problem& problem, Solved solved,
+                           const OptimizeOptions& options) {
+  ConvexAwareSolve out;
+  out.solved = std::move(solved);
+  const std::string why_not = nlp.why_not_convex();
+  std::optional<Nlp> convex;
+  if (why_not.empty()) convex.emplace(problem, CounterweightVariablesAs::kMassMoments);
+  certify(nlp, problem, convex ? &*convex : nullptr, why_not, options, out);
   return out;
 }
 

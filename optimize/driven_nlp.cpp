@@ -12,6 +12,7 @@
 #include "core/fourbar/kinematics.hpp"
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
+#include "optimize/detail/local_maxima.hpp"
 #include "optimize/nlp_program.hpp"
 
 namespace bd::optimize::detail {
@@ -95,6 +96,7 @@ class DrivenNlp final : public NlpProgram {
   core::Trajectory trajectory(const VectorXd& x) const override {
     return trajectory_of(inertial(x, false).q);
   }
+  std::vector<double> peak_instants(const VectorXd& x, double within) const override;
   core::Metrics metrics(const VectorXd& x) const override {
     const VecQ q = inertial(x, false).q;
     core::Metrics m = core::metrics(trajectory_of(q));
@@ -128,6 +130,7 @@ class DrivenNlp final : public NlpProgram {
   VecOut sample_outputs(const VecQ& q, double th1, double th2, double th3) const;
   core::Trajectory trajectory_of(const VecQ& q) const;
   double rms_squared(int g, const VecQ& q) const;
+  std::vector<double> magnitudes(int g, const VecQ& q) const;  // per instant
   double peak(int g, const VecQ& q) const;
   void rms_limit(const Block& b, const Inertial& in, int row, VectorXd& c, MatrixXd* jac) const;
   void smoothed_peak_bound(const Block& b, const VectorXd& x, GroupOutputs& groups, int row,
@@ -421,14 +424,37 @@ double DrivenNlp::rms_squared(int g, const VecQ& q) const {
   return (R_[g] * q).squaredNorm() / samples_;
 }
 
-double DrivenNlp::peak(int g, const VecQ& q) const {
+std::vector<double> DrivenNlp::magnitudes(int g, const VecQ& q) const {
   const VectorXd y = A_[g] * q;
   const int rows = kGroupRows[g];
-  double worst = 0;
+  std::vector<double> v(static_cast<std::size_t>(instants_));
   for (int i = 0; i < instants_; ++i) {
-    worst = std::max(worst, rows == 1 ? std::abs(y(i)) : y.segment(rows * i, rows).norm());
+    v[static_cast<std::size_t>(i)] = rows == 1 ? std::abs(y(i)) : y.segment(rows * i, rows).norm();
   }
-  return worst;
+  return v;
+}
+
+double DrivenNlp::peak(int g, const VecQ& q) const {
+  const std::vector<double> v = magnitudes(g, q);
+  return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
+}
+
+std::vector<double> DrivenNlp::peak_instants(const VectorXd& x, double within) const {
+  std::vector<Metric> used;
+  for (const Term& t : problem_.objective) {
+    if (t.weight > 0 && is_peak(t.metric)) used.push_back(t.metric);
+  }
+  for (const Limit& l : problem_.limits) {
+    if (is_peak(l.metric)) used.push_back(l.metric);
+  }
+  std::vector<double> out;
+  if (instants_ == samples_) return out;
+  const VecQ q = inertial(x, false).q;
+  for (const Metric m : used) {
+    detail::add_local_maxima(theta1_, magnitudes(group_of(m), q),
+                             static_cast<std::size_t>(samples_), within * original(m), out);
+  }
+  return out;
 }
 
 double DrivenNlp::reaction_metric(const VectorXd& x, Metric m) const {

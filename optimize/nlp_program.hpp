@@ -102,6 +102,10 @@ class NlpProgram {
   std::vector<PlacedCounterweight> counterweights(const Eigen::VectorXd& x) const;
   virtual core::Trajectory trajectory(const Eigen::VectorXd& x) const = 0;
   virtual core::Metrics metrics(const Eigen::VectorXd& x) const = 0;
+  /// Nlp::peak_instants(); the default: none (a free scene has no added instants).
+  virtual std::vector<double> peak_instants(const Eigen::VectorXd& /*x*/, double /*within*/) const {
+    return {};
+  }
   double metric(const Eigen::VectorXd& x, Metric m) const;
   /// The normaliser of a metric: the original's value, for added_mass its total mass [kg].
   double original(Metric m) const;

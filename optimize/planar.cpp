@@ -15,6 +15,7 @@
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
 #include "optimize/convex_solve.hpp"
+#include "optimize/detail/local_maxima.hpp"
 #include "optimize/detail/peak_exchange.hpp"
 #include "optimize/epsilon_front.hpp"
 #include "optimize/nlopt_driver.hpp"
@@ -274,16 +275,21 @@ struct PlanarNlp::Impl {
     if (grad) *grad /= samples;
     return s / samples;
   }
-  // the largest magnitude over the instants of metric k's columns at q
-  double peak(int k, const VectorXd& q) const {
+  // the magnitude of metric k's columns at q at each instant
+  std::vector<double> magnitudes(int k, const VectorXd& q) const {
     const Columns c = columns(k, q, nullptr);
-    double worst = 0;
+    std::vector<double> v(static_cast<std::size_t>(instants));
     for (int s = 0; s < instants; ++s) {
       double s2 = 0;
       for (const VectorXd& y : c.y) s2 += y[s] * y[s];
-      worst = std::max(worst, std::sqrt(s2));
+      v[static_cast<std::size_t>(s)] = std::sqrt(s2);
     }
-    return worst;
+    return v;
+  }
+  // the largest magnitude over the instants of metric k's columns at q
+  double peak(int k, const VectorXd& q) const {
+    const std::vector<double> v = magnitudes(k, q);
+    return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
   }
   // a bound on each |q_j - q0_j| over the variables' box (counterweights within their
   // envelopes, link parameters within their bounds)
@@ -1351,6 +1357,23 @@ std::vector<double> PlanarNlp::metrics(const VectorXd& x) const {
     } else {
       out.push_back(m.peak(static_cast<int>(k), q));
     }
+  }
+  return out;
+}
+
+std::vector<double> PlanarNlp::peak_instants(const VectorXd& x, double within) const {
+  const Impl& m = *impl_;
+  std::vector<double> out;
+  if (m.free || m.instants == m.samples) return out;
+  VectorXd q;
+  m.q_of(x, q, nullptr);
+  for (std::size_t k = 0; k < m.table.size(); ++k) {
+    if (m.table[k].statistic != core::Statistic::kMax) continue;
+    const bool limited = std::any_of(m.p.limits.begin(), m.p.limits.end(),
+                                     [&](const Limit& l) { return l.metric == m.table[k].name; });
+    if (!(m.weight[k] > 0) && !limited) continue;
+    detail::add_local_maxima(m.times, m.magnitudes(static_cast<int>(k), q),
+                             static_cast<std::size_t>(m.samples), within * m.original[k], out);
   }
   return out;
 }

@@ -189,6 +189,10 @@ class PlanarNlp final : public Program {
   /// mass [kg].
   std::vector<double> metrics(const Eigen::VectorXd& x) const;
   double added_mass(const Eigen::VectorXd& x) const;
+  /// The times besides the samples at which a peak the program bounds has a local maximum over
+  /// the program's instants at x, within `within` of the original's peak below its largest
+  /// there, as the four-bar Nlp::peak_instants(). Empty in a free scene.
+  std::vector<double> peak_instants(const Eigen::VectorXd& x, double within) const;
   /// The metric table (names, units) and the original's values.
   const std::vector<cp::ColumnMetric>& metric_table() const;
   const std::vector<double>& original_metrics() const;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "optimize/convex_solve.hpp"
+#include "optimize/detail/local_maxima.hpp"
 #include "optimize/optimize.hpp"
 
 namespace bd::optimize::detail {
@@ -44,6 +45,14 @@ inline void add_peak_instants(const std::vector<double>& instants, double at, do
   }
 }
 
+/// Within this fraction of the original's peak below a design's largest peak, a local maximum
+/// over the dense instants is kept in the lean program (exchange_rounds()); the rows of lower
+/// ones are not active at that design.
+inline constexpr double kLeanPeakWithin = 1e-4;
+
+/// At most this many solves of the lean program (exchange_rounds()).
+inline constexpr int kMaxLeanRounds = 3;
+
 /// What the exchange rounds spent, over all of them, and what the last left undone.
 struct ExchangeTotals {
   int iterations{}, evaluations{};
@@ -51,6 +60,12 @@ struct ExchangeTotals {
   /// "" when every resolved peak is bounded (or none was asked for); else what to append to the
   /// solver's message: the budget or the rounds ran out first, and where the peaks are bounded.
   std::string shortfall;
+
+  void add(const Solved& s) {
+    iterations += s.iterations;
+    evaluations += s.evaluations;
+    seconds += s.seconds;
+  }
 };
 
 /// The fields either type's result (OptimizeResult, planar::Result) takes from the last
@@ -86,6 +101,15 @@ void set_solve_fields(Result& r, const Program& program, const ConvexAwareSolve&
 /// options.max_evaluations. Returns finish(nlp, problem, solve, totals) of the last round (the
 /// Nlp lives only as long as the call). on_first(nlp) runs once, after the first Nlp is built
 /// (its checks come first). `what` names the instants in the shortfall ("crank angles").
+///
+/// The last round's program holds grids of instants around each peak, whose rows are nearly
+/// equal constraints: at a design whose peaks are equal (a minimax optimum) the first-order
+/// conditions are then degenerate, met only to ~1e-2 and slow to bound. So the rounds are solved
+/// without their certificate, and once the peaks are bounded the result is the lean program's:
+/// the samples and one instant per peak of that design (nlp.peak_instants(), the local maxima
+/// over the grids within kLeanPeakWithin), solved from it and certified, where its own resolved
+/// peaks are bounded too (else the last round's, certified). The lean program is a relaxation of
+/// the motion's (fewer instants), so its lower bound holds for the motion's peaks as well.
 template <class Nlp, class Problem, class ShortPeaks, class OnFirst, class Finish>
 auto exchange_rounds(const Problem& problem, std::vector<Eigen::VectorXd> starts,
                      const OptimizeOptions& options, std::vector<double> Problem::*instants,
@@ -93,16 +117,21 @@ auto exchange_rounds(const Problem& problem, std::vector<Eigen::VectorXd> starts
                      const Finish& finish) {
   Problem exchanged = problem;
   ExchangeTotals totals;
+  const auto budget = [&] {
+    OptimizeOptions b = options;
+    b.max_evaluations = options.max_evaluations - totals.evaluations;
+    return b;
+  };
   for (int round = 0;; ++round) {
     const Nlp nlp(exchanged);
     if (round == 0) on_first(nlp);
-    OptimizeOptions budget = options;
-    budget.max_evaluations = options.max_evaluations - totals.evaluations;
-    const ConvexAwareSolve solve = solve_convex_aware(nlp, exchanged, starts, budget);
+    // no certificate for a round (without resolve_peaks the only round is the last)
+    const bool exchanging = problem.resolve_peaks;
+    const ConvexAwareSolve solve =
+        solve_convex_aware(nlp, exchanged, starts, budget(), !exchanging);
     const Solved& solved = solve.solved;
-    totals.iterations += solved.iterations;
-    totals.evaluations += solved.evaluations;
-    totals.seconds += solved.seconds;
+    totals.add(solved);
+    if (!exchanging) return finish(nlp, exchanged, solve, totals);
     const std::vector<double> wanted = short_peaks(exchanged, nlp, solved);
     // each instant once: two peaks in one interval ask for the same grid
     std::vector<double>& bounded_at = exchanged.*instants;
@@ -117,17 +146,15 @@ auto exchange_rounds(const Problem& problem, std::vector<Eigen::VectorXd> starts
     const int left = options.max_evaluations - totals.evaluations;
     const bool another = round < kMaxExchangeRounds &&
                          left >= (options.algorithm == Algorithm::kMlsl ? options.starts : 1);
-    if (!wanted.empty() && added.empty()) {
-      totals.shortfall =
-          "; a resolved peak still rose above its bound, at instants already bounded";
-      return finish(nlp, exchanged, solve, totals);
-    }
     if (!added.empty() && another) {
       bounded_at.insert(bounded_at.end(), added.begin(), added.end());
       starts.insert(starts.begin(), solved.x);
       continue;
     }
-    if (!added.empty()) {  // a peak still rises above its bound by more than the tolerance
+    if (!wanted.empty() && added.empty()) {
+      totals.shortfall =
+          "; a resolved peak still rose above its bound, at instants already bounded";
+    } else if (!added.empty()) {  // a peak still rises above its bound by more than the tolerance
       const std::string where = bounded_at.empty() ? "the samples only"
                                                    : "the samples and " +
                                                          std::to_string(bounded_at.size()) +
@@ -139,8 +166,31 @@ auto exchange_rounds(const Problem& problem, std::vector<Eigen::VectorXd> starts
                                     " solves a resolved peak still rose above its bound (the "
                                     "peaks are bounded at ") +
                          where + ")";
+    } else if (found_design(solved.termination) && bounded_at.size() > (problem.*instants).size()) {
+      // bounded: the lean program, from this design, where it bounds its own peaks too; the
+      // lean optimum's peaks move a little off its instants, so a lean round adds theirs (the
+      // grid's local maxima at that design) and solves again
+      Problem lean = problem;
+      std::vector<double>& lean_at = lean.*instants;
+      Eigen::VectorXd from = solved.x;
+      for (int lean_round = 0; lean_round < kMaxLeanRounds; ++lean_round) {
+        const std::size_t before = lean_at.size();
+        for (const double a : nlp.peak_instants(from, kLeanPeakWithin)) {
+          if (std::find(lean_at.begin(), lean_at.end(), a) == lean_at.end()) lean_at.push_back(a);
+        }
+        if (lean_round > 0 && lean_at.size() == before) break;  // nothing new to bound
+        const Nlp lean_nlp(lean);
+        const ConvexAwareSolve lean_solve =
+            solve_convex_aware(lean_nlp, lean, {solved.x}, budget(), true);
+        totals.add(lean_solve.solved);
+        if (!found_design(lean_solve.solved.termination)) break;
+        if (short_peaks(lean, lean_nlp, lean_solve.solved).empty()) {
+          return finish(lean_nlp, lean, lean_solve, totals);
+        }
+        from = lean_solve.solved.x;
+      }
     }
-    return finish(nlp, exchanged, solve, totals);
+    return finish(nlp, exchanged, certified(nlp, exchanged, solved, budget()), totals);
   }
 }
 

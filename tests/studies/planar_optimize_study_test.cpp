@@ -292,12 +292,13 @@ TEST(PlanarOptimizeStudy, ResolvedPeaksAreWhatTheTablesShow) {
     EXPECT_EQ(j["metric_units"]["Msh_rms"], "N m");
     EXPECT_EQ(j["metric_units"].size(), j["metrics"].size());
     if (resolved) {
-      EXPECT_GT(p.peak_times.size(), 12u);
-      // the page lists them by count and range, not one by one
+      // the lean program's: one instant per peak of the optimum (the grids of the exchange
+      // rounds held 256), each once, listed on the page
+      ASSERT_FALSE(p.peak_times.empty());
+      EXPECT_LE(p.peak_times.size(), 4u);
       write_report(study, out);
       const std::string page = bd::testing::read(out / "report.html");
-      EXPECT_NE(page.find("<td>" + std::to_string(p.peak_times.size()) + " values from "),
-                std::string::npos);
+      EXPECT_NE(page.find("<tr><th>peak_times"), std::string::npos);
       std::vector<double> times = p.peak_times;  // each once
       std::sort(times.begin(), times.end());
       EXPECT_EQ(std::adjacent_find(times.begin(), times.end()), times.end());

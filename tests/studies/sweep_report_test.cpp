@@ -709,3 +709,22 @@ TEST_F(SweepReportTest, LargeGridIsSampledForTheChartsAndRankedWhole) {
 
 }  // namespace
 }  // namespace bd::studies
+
+namespace bd::studies {
+namespace {
+
+// A list of numbers in summary.json (an optimiser's added instants, a sweep's values) shows on
+// the page one by one up to twelve; a longer one by its count and range, the values left to
+// summary.json.
+TEST(ReportCells, ALongListOfNumbersShowsItsCountAndRange) {
+  using report_support::Json;
+  using report_support::json_cell;
+  Json many = Json::array();
+  for (int k = 20; k >= 1; --k) many.push_back(0.5 * k);  // not in order: the range is found
+  EXPECT_EQ(json_cell(many), "<td>20 values from 0.5 to 10 (each in summary.json)</td>");
+  Json few = Json::array({0.25, 2.0, 1.5});
+  EXPECT_EQ(json_cell(few), "<td>0.25, 2, 1.5</td>");
+}
+
+}  // namespace
+}  // namespace bd::studies
