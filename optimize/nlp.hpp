@@ -193,8 +193,8 @@ class Nlp final : public Program {
   /// The crank angles besides the samples at which a peak the program bounds (of the objective,
   /// weight > 0, or of a limit) has a local maximum over the program's instants (its samples and
   /// problem.peak_angles) at x, within `within` of the original's peak below its largest there
-  /// (detail::add_local_maxima()): one angle per peak of a design whose peaks were bounded on
-  /// grids of added angles. Empty in a free scene.
+  /// and the added angles next to those (detail::add_local_maxima()): three angles per peak of
+  /// a design whose peaks were bounded on grids of added angles. Empty in a free scene.
   std::vector<double> peak_instants(const Eigen::VectorXd& x, double within) const;
   /// The value of one metric at x (added_mass included).
   double metric(const Eigen::VectorXd& x, Metric m) const;

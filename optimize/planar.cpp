@@ -165,9 +165,6 @@ Problem DesignProblem::validate() const {
   if (!(smoothing > 0 && smoothing <= 0.1))
     return field("smoothing", -1, "must be in (0, 0.1], got " + text::shortest(smoothing));
   const bool driven = std::holds_alternative<cp::DrivenScene>(scene);
-  if (resolve_peaks && !driven)
-    return field("resolve_peaks", -1,
-                 ": peaks are resolved by the optimiser in driven scenes only");
   for (std::size_t i = 0; i < peak_times.size(); ++i) {
     if (!driven || !std::isfinite(peak_times[i]))
       return field("peak_times", static_cast<int>(i),

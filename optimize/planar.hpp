@@ -90,13 +90,14 @@ struct DesignProblem {
   std::vector<Limit> limits;
   bool force_balance = false;  // full force balance as equalities
   double smoothing = kDefaultSmoothing;
-  /// Driven scenes: peaks bounded over the motion, not only at the samples (exchange steps, as
-  /// the four-bar's DesignProblem::resolve_peaks): where a peak of the objective or of a limit,
-  /// resolved between the samples at the optimum, rises above the peak the program bounded (by
-  /// more than 1e-9 of it), instants around it are added to peak_times and the problem is solved
-  /// again from that optimum; the original's peaks that normalise the objective and the limits
-  /// are then its resolved ones. Not yet the default (as the four-bar's).
-  bool resolve_peaks = false;
+  /// Driven scenes: peaks bounded over the motion, not only at the samples (the default;
+  /// exchange steps, as the four-bar's DesignProblem::resolve_peaks): where a peak of the
+  /// objective or of a limit, resolved between the samples at the optimum, rises above the peak
+  /// the program bounded (by more than 1e-9 of the original's), instants around it are added to
+  /// peak_times and the problem is solved again from that optimum; once bounded, the result is
+  /// the lean program's; the original's peaks that normalise the objective and the limits are
+  /// then its resolved ones. A free scene's peaks are its samples' whatever this says.
+  bool resolve_peaks = true;
   /// Driven scenes: times [s] at which the peaks are bounded besides the scene's samples (the
   /// exchange steps add to them); the RMS metrics stay the samples'. Each must lie within the
   /// run (0 to its duration).

@@ -131,16 +131,16 @@ struct DesignProblem {
   /// min(ε, ε²/(2r)) above r, so the objective is within ε · Σ weights above the exact sum
   /// (optimize/nlp.hpp has the bound on the optimum).
   double smoothing = kDefaultSmoothing;
-  /// Driven scenes: bound the motion's peaks, not the samples' (off: the samples', as the
-  /// metrics of a run without resolved peaks). On, optimize() runs exchange steps: where a
-  /// peak of the objective or of a limit, resolved between the samples at the optimum, rises
-  /// above the peak the program bounded (by more than 1e-9 of it), crank angles around it are
-  /// added to peak_angles and the problem is solved again from that optimum; and the original's
-  /// peaks that normalise the objective and the limits ("x original") are its resolved ones.
-  /// Not yet the default: on degenerate minimax optima (several peaks equal) the solvers meet
-  /// the first-order conditions less well among the added angles' nearly equal rows, so a
-  /// convex problem's optimum is then often not certified global, and each round is a solve.
-  bool resolve_peaks = false;
+  /// Driven scenes: bound the motion's peaks, not the samples' (the default; off: the
+  /// samples', as the metrics of a run without resolved peaks; a free scene's are always its
+  /// samples'). optimize() then runs exchange steps: where a peak of the objective or of a
+  /// limit, resolved between the samples at the optimum, rises above the peak the program
+  /// bounded (by more than 1e-9 of the original's), crank angles around it are added to
+  /// peak_angles and the problem is solved again from that optimum; once bounded, the result is
+  /// the lean program's (the samples and one angle per peak of that design), which is the one
+  /// certified; and the original's peaks that normalise the objective and the limits ("x
+  /// original") are its resolved ones.
+  bool resolve_peaks = true;
   /// Driven scenes: crank angles [rad] at which the peaks (of the objective and of the limits)
   /// are bounded besides the scene's samples (the exchange steps add to them). The RMS metrics
   /// stay the scene's samples'.

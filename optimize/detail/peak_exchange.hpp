@@ -106,10 +106,15 @@ void set_solve_fields(Result& r, const Program& program, const ConvexAwareSolve&
 /// equal constraints: at a design whose peaks are equal (a minimax optimum) the first-order
 /// conditions are then degenerate, met only to ~1e-2 and slow to bound. So the rounds are solved
 /// without their certificate, and once the peaks are bounded the result is the lean program's:
-/// the samples and one instant per peak of that design (nlp.peak_instants(), the local maxima
-/// over the grids within kLeanPeakWithin), solved from it and certified, where its own resolved
-/// peaks are bounded too (else the last round's, certified). The lean program is a relaxation of
-/// the motion's (fewer instants), so its lower bound holds for the motion's peaks as well.
+/// the samples and three instants per peak of that design (nlp.peak_instants(): the local
+/// maxima over the grids within kLeanPeakWithin and their neighbours), solved from it and
+/// certified, where its own resolved peaks are bounded too (up to kMaxLeanRounds, each adding
+/// the instants of the last lean optimum's peaks; else the last round's design, certified). The
+/// lean program is a relaxation of the motion's (fewer instants), so its lower bound holds for
+/// the motion's peaks as well.
+/// A round starts from the last one's optimum moved towards a start that meets the rows just
+/// added, just far enough to meet them too (feasible_towards()): a peak limit's rows at the
+/// added instants are what the last optimum missed.
 template <class Nlp, class Problem, class ShortPeaks, class OnFirst, class Finish>
 auto exchange_rounds(const Problem& problem, std::vector<Eigen::VectorXd> starts,
                      const OptimizeOptions& options, std::vector<double> Problem::*instants,
@@ -125,8 +130,24 @@ auto exchange_rounds(const Problem& problem, std::vector<Eigen::VectorXd> starts
   for (int round = 0;; ++round) {
     const Nlp nlp(exchanged);
     if (round == 0) on_first(nlp);
-    // no certificate for a round (without resolve_peaks the only round is the last)
-    const bool exchanging = problem.resolve_peaks;
+    if (round > 0) {
+      // the last optimum may miss the rows of the instants just added (a peak limit's, its peak
+      // rising above the bound between the samples): without a feasible start nearby a local
+      // method starts at the first feasible one and may stay there (a Pareto front's inner
+      // points ended at the second metric's minimiser); so it moves towards the first later
+      // start, or the original design, that meets them, just far enough to meet them too
+      std::vector<Eigen::VectorXd> towards(starts.begin() + 1, starts.end());
+      towards.push_back(nlp.start(true));
+      for (const Eigen::VectorXd& to : towards) {
+        if (constraint_violation(nlp, nlp.start_at(to)) <= options.constraint_tolerance) {
+          starts.front() = feasible_towards(nlp, starts.front(), to, options.constraint_tolerance);
+          break;
+        }
+      }
+    }
+    // no certificate for a round (without resolve_peaks, or in a free scene, whose peaks are
+    // its samples', the only round is the last)
+    const bool exchanging = problem.resolve_peaks && !nlp.free_scene();
     const ConvexAwareSolve solve =
         solve_convex_aware(nlp, exchanged, starts, budget(), !exchanging);
     const Solved& solved = solve.solved;

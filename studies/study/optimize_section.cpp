@@ -288,10 +288,11 @@ class OptimizeReader {
   };
 
   // algorithm, max_evaluations, starts, tolerance; each mark defaults to the section's
-  // optimize.peaks: sampled (false, the default) or resolved (true; a driven scene)
+  // optimize.peaks: resolved (true, the default in a driven scene) or sampled (false; always
+  // in a free scene)
   bool read_peaks(const MapReader& o, const Study& study) {
     const MapReader::Entry* k = o.find("peaks");
-    if (!k) return false;
+    if (!k) return !is_free(study.scene);
     const std::string how = read_text(r_, *k, "optimize.peaks");
     const YAML::Mark at = mark_of(k->value, k->key_mark);
     if (how != "resolved" && how != "sampled") {

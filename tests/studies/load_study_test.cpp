@@ -585,11 +585,15 @@ TEST(LoadStudy, OptimizeSectionReadsEveryKey) {
   EXPECT_EQ(p.formulation, choose_method(s).formulation);
   EXPECT_EQ(p.tolerance, s.tolerance);
   EXPECT_TRUE(p.force_balance);
-  EXPECT_FALSE(p.resolve_peaks);  // peaks: sampled, the default
+  EXPECT_TRUE(p.resolve_peaks);  // peaks: resolved, the default in a driven scene
   EXPECT_FALSE(p.validate());
   const Study resolved = parse_study(
       opt_edit("  tolerance: 1.0e-7\n", "  tolerance: 1.0e-7\n  peaks: resolved\n"), "study.yaml");
   EXPECT_TRUE(resolved.optimize->resolve_peaks);
+  const Study sampled = parse_study(
+      opt_edit("  tolerance: 1.0e-7\n", "  tolerance: 1.0e-7\n  peaks: sampled\n"), "study.yaml");
+  EXPECT_FALSE(sampled.optimize->resolve_peaks);
+  EXPECT_FALSE(design_problem(sampled).resolve_peaks);
   EXPECT_TRUE(design_problem(resolved).resolve_peaks);
 }
 
@@ -768,6 +772,12 @@ TEST(LoadStudy, GradientAlgorithmInAFreeSceneOnTheOpenedLoopIsAnErrorAtAlgorithm
   EXPECT_EQ(d.optimize->options.algorithm, optimize::Algorithm::kCobyla);
   // a derivative-free method is fine
   EXPECT_NO_THROW(parse_study(moving + "optimize:\n  algorithm: cobyla\n" + section, "study.yaml"));
+  // without the peaks key, a free scene's peaks are its samples' (resolved is the driven default)
+  const Study peak = parse_study(
+      moving + "optimize:\n  objective: {Msh_max: 1}\n  variables: {counterweights: {crank: }}\n",
+      "study.yaml");
+  EXPECT_FALSE(peak.optimize->resolve_peaks);
+  EXPECT_FALSE(design_problem(peak).resolve_peaks);
 }
 
 TEST(LoadStudy, OptimizeNeedsOriginalMetricsToNormaliseBy) {

@@ -63,11 +63,13 @@ TEST(PlanarOptimizeStudy, MistakesAreOneLineAtTheirPlace) {
                "unknown algorithm 'newton' in optimize.algorithm");
   expect_error(section(kObjective + kVariables + "  tolerance: 2\n"), 25, 14,
                "optimize.tolerance must be > 0 and < 1");
-  // the peaks: sampled (the default) or resolved (driven scenes; a free one below)
+  // the peaks: resolved (the default in a driven scene) or sampled (always in a free one, below)
   EXPECT_TRUE(parse_study(section(kObjective + kVariables + "  peaks: resolved\n"), "e.yaml")
                   .planar_optimize->resolve_peaks);
-  EXPECT_FALSE(
+  EXPECT_TRUE(
       parse_study(section(kObjective + kVariables), "e.yaml").planar_optimize->resolve_peaks);
+  EXPECT_FALSE(parse_study(section(kObjective + kVariables + "  peaks: sampled\n"), "e.yaml")
+                   .planar_optimize->resolve_peaks);
   expect_error(section(kObjective + kVariables + "  peaks: every\n"), 25, 10,
                "optimize.peaks must be resolved or sampled, got 'every'");
   EXPECT_NO_THROW(parse_study(section(kObjective + kVariables + "  peaks: sampled\n"), "e.yaml"));
@@ -122,8 +124,9 @@ TEST(PlanarOptimizeStudy, MistakesAreOneLineAtTheirPlace) {
   free.replace(free.find("  type: driven\n"), 15, "  type: free\n  duration: 0.1\n");
   free.erase(free.find("  speeds:"), free.find("  samples:") - free.find("  speeds:"));
   free.insert(free.find("  samples:"), "  rates: [20.0]\n");  // set in motion: Msh_rms > 0
-  EXPECT_NO_THROW(
-      parse_study(free + "optimize:\n  algorithm: slsqp\n" + kObjective + kVariables, "e.yaml"));
+  EXPECT_FALSE(
+      parse_study(free + "optimize:\n  algorithm: slsqp\n" + kObjective + kVariables, "e.yaml")
+          .planar_optimize->resolve_peaks);  // its samples' peaks, without a word
   expect_error(free + "optimize:\n" + kObjective + kVariables + "  peaks: resolved\n", 26, 10,
                "optimize.peaks: resolved is for driven scenes");
   // a balance section beside it
@@ -273,7 +276,7 @@ TEST(PlanarOptimizeStudy, ResolvedPeaksAreWhatTheTablesShow) {
   for (const bool resolved : {true, false}) {
     SCOPED_TRACE(resolved ? "resolved" : "sampled");
     const Study study = parse_study(
-        bd::testing::engine_study(24) + body + (resolved ? "  peaks: resolved\n" : ""), "e.yaml");
+        bd::testing::engine_study(24) + body + (resolved ? "" : "  peaks: sampled\n"), "e.yaml");
     const fs::path out = fs::path(BD_BINARY_DIR) / "test-output" / "planar-optimize" /
                          (resolved ? "resolved" : "sampled");
     fs::remove_all(out);
@@ -292,10 +295,10 @@ TEST(PlanarOptimizeStudy, ResolvedPeaksAreWhatTheTablesShow) {
     EXPECT_EQ(j["metric_units"]["Msh_rms"], "N m");
     EXPECT_EQ(j["metric_units"].size(), j["metrics"].size());
     if (resolved) {
-      // the lean program's: one instant per peak of the optimum (the grids of the exchange
-      // rounds held 256), each once, listed on the page
+      // the default; the lean program's instants: each peak of the optimum with its two
+      // neighbours on the exchange's grid (whose rounds held 256), each once, listed on the page
       ASSERT_FALSE(p.peak_times.empty());
-      EXPECT_LE(p.peak_times.size(), 4u);
+      EXPECT_LE(p.peak_times.size(), 6u);
       write_report(study, out);
       const std::string page = bd::testing::read(out / "report.html");
       EXPECT_NE(page.find("<tr><th>peak_times"), std::string::npos);
