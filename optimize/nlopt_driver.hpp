@@ -157,6 +157,19 @@ Eigen::VectorXd feasible_towards(const DesignProgram& program, const Eigen::Vect
 Eigen::VectorXd snapped_to_bounds(const Program& program, const OptimizeOptions& options,
                                   const Eigen::VectorXd& x, double objective, double violation);
 
+/// x without the counterweights that change nothing the problem reads: each one that has mass at
+/// x is taken away (its mass and its other two variables 0), in turn, where that leaves the
+/// objective within 1e-12 of `objective` (relative; or lowers it) and the constraints' violation
+/// within max(`violation`, the tolerance). A solver leaves such a counterweight where its start
+/// put it (a counterweight on a crank turning at constant speed about the origin moves no drive
+/// torque and no shaking moment about the origin: half its mass_max at half its distance_max), a
+/// mass the designer would pay for and gain nothing by. `said`, when not null, gets what to
+/// append to the message ("; the crank counterweight changed nothing ... and is left out").
+Eigen::VectorXd without_needless_counterweights(const Program& program,
+                                                const OptimizeOptions& options,
+                                                const Eigen::VectorXd& x, double objective,
+                                                double violation, std::string* said);
+
 /// The feasibility of the point r.x, whatever the solver said: r.constraint_violation, and the
 /// termination and message when they disagree with it (`solver` is the solver's message).
 void check_feasibility(const Program& program, const OptimizeOptions& options,

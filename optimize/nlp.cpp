@@ -100,6 +100,8 @@ core::Trajectory Nlp::trajectory(const Eigen::VectorXd& x) const { return at(x).
 double Nlp::metric(const Eigen::VectorXd& x, Metric m) const { return at(x).metric(x, m); }
 
 double Nlp::original(Metric m) const { return program_->original(m); }
+std::vector<int> Nlp::counterweight_mass_variables() const { return program_->cw_var(); }
+
 std::vector<double> Nlp::peak_instants(const Eigen::VectorXd& x, double within) const {
   return at(x).peak_instants(x, within);
 }

@@ -157,6 +157,7 @@ class Nlp final : public Program {
                                                    double fraction) const override;
   std::vector<int> vanishing_counterweight_variables(const Eigen::VectorXd& x,
                                                      double fraction) const override;
+  std::vector<int> counterweight_mass_variables() const override;
 
   /// The objective and, when `grad` is not null, its gradient.
   double objective(const Eigen::VectorXd& x, Eigen::VectorXd* grad) const override;

@@ -102,6 +102,8 @@ class NlpProgram {
   std::vector<PlacedCounterweight> counterweights(const Eigen::VectorXd& x) const;
   virtual core::Trajectory trajectory(const Eigen::VectorXd& x) const = 0;
   virtual core::Metrics metrics(const Eigen::VectorXd& x) const = 0;
+  /// The first variable (the mass) of each counterweight.
+  const std::vector<int>& cw_var() const { return cw_var_; }
   /// Nlp::peak_instants(); the default: none (a free scene has no added instants).
   virtual std::vector<double> peak_instants(const Eigen::VectorXd& /*x*/, double /*within*/) const {
     return {};

@@ -543,6 +543,41 @@ VectorXd detail::snapped_to_bounds(const Program& nlp, const OptimizeOptions& op
   return out;
 }
 
+VectorXd detail::without_needless_counterweights(const Program& program,
+                                                 const OptimizeOptions& options, const VectorXd& x,
+                                                 double objective, double violation,
+                                                 std::string* said) {
+  VectorXd out = x;
+  std::vector<std::string> left_out;
+  const double allowed_violation = std::max(violation, options.constraint_tolerance);
+  for (const int j : program.counterweight_mass_variables()) {
+    if (!(out(j) > 0)) continue;
+    VectorXd trial = out;
+    trial.segment(j, 3).setZero();
+    const double f = program.objective(trial, nullptr);
+    if (!(f <= objective + 1e-12 * std::max(std::abs(objective), 1.0)) ||
+        !(constraint_violation(program, trial) <= allowed_violation)) {
+      continue;
+    }
+    out = trial;
+    objective = std::min(objective, f);
+    std::string name = program.variable_names()[static_cast<std::size_t>(j)];
+    if (const auto at = name.rfind(" mass"); at != std::string::npos) name.resize(at);
+    left_out.push_back(name);
+  }
+  if (said && !left_out.empty()) {
+    std::string names;
+    for (std::size_t i = 0; i < left_out.size(); ++i) {
+      names += (i == 0 ? "" : i + 1 == left_out.size() ? " and " : ", ") + left_out[i];
+    }
+    *said = "; the " + names + " changed" +
+            " nothing the problem reads (objective and constraints the same without " +
+            (left_out.size() == 1 ? "it" : "them") + ") and " +
+            (left_out.size() == 1 ? "is" : "are") + " left out";
+  }
+  return out;
+}
+
 detail::Solved detail::solve_from(const Program& nlp, const std::vector<VectorXd>& starts,
                                   const OptimizeOptions& options) {
   // the first feasible start, else the least violated

@@ -72,9 +72,12 @@ std::vector<ParetoPoint> pareto_front(const DesignProblem& problem, Metric first
                      " of the original design is " + text::digits(nlp.original(second), 6) +
                      ", so no bound relative to it can be set");
   }
+  // each point starts from its neighbour's design: its counterweights stay (OptimizeOptions)
+  OptimizeOptions along = options;
+  along.leave_out_needless_counterweights = false;
   std::vector<ParetoPoint> front;
   for (auto& [epsilon, result] :
-       detail::epsilon_front(FourBarFront{problem, options, nlp}, first, second, points)) {
+       detail::epsilon_front(FourBarFront{problem, along, nlp}, first, second, points)) {
     front.push_back(ParetoPoint{epsilon, std::move(result)});
   }
   return front;

@@ -1358,6 +1358,8 @@ std::vector<double> PlanarNlp::metrics(const VectorXd& x) const {
   return out;
 }
 
+std::vector<int> PlanarNlp::counterweight_mass_variables() const { return impl_->cw_var; }
+
 std::vector<double> PlanarNlp::peak_instants(const VectorXd& x, double within) const {
   const Impl& m = *impl_;
   std::vector<double> out;
@@ -1682,9 +1684,12 @@ std::vector<ParetoPoint> pareto_front(const DesignProblem& problem, const std::s
   check.objective = {Term{first, 1.0}};
   check.limits.push_back(Limit{second, 1.0});
   (void)PlanarNlp(check);
+  // each point starts from its neighbour's design: its counterweights stay (OptimizeOptions)
+  OptimizeOptions along = options;
+  along.leave_out_needless_counterweights = false;
   std::vector<ParetoPoint> front;
   for (auto& [epsilon, result] :
-       detail::epsilon_front(PlanarFront{problem, options}, first, second, points)) {
+       detail::epsilon_front(PlanarFront{problem, along}, first, second, points)) {
     front.push_back(ParetoPoint{epsilon, std::move(result)});
   }
   return front;

@@ -168,6 +168,7 @@ class PlanarNlp final : public Program {
                                                    double fraction) const override;
   std::vector<int> vanishing_counterweight_variables(const Eigen::VectorXd& x,
                                                      double fraction) const override;
+  std::vector<int> counterweight_mass_variables() const override;
   /// start() with each counterweight's mass (and mass moment) scaled by `fraction`.
   Eigen::VectorXd start_scaled(double fraction) const;
 

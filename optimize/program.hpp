@@ -90,6 +90,9 @@ class Program {
                                                              double /*fraction*/) const {
     return {};
   }
+  /// The first variable of each counterweight, its mass (the next two are its position or its
+  /// mass moment), in the problem's order. Default: none.
+  virtual std::vector<int> counterweight_mass_variables() const { return {}; }
   /// x with those counterweights taken away (their variables 0, the variables that only bound
   /// them set for it): put on the cone's apex itself. Default, and in position variables: x.
   virtual Eigen::VectorXd without_vanishing_counterweights(const Eigen::VectorXd& x,

@@ -71,7 +71,8 @@ struct ExchangeTotals {
 /// The fields either type's result (OptimizeResult, planar::Result) takes from the last
 /// round's solve: optimality, lower bound, multistart counts, algorithm, termination, message,
 /// the costs over the rounds, and the design variables x (snapped_to_bounds(): a counterweight
-/// left at round-off of nothing is none) with their objective and constraint violation.
+/// left at round-off of nothing is none; without_needless_counterweights(): nor is one that
+/// changes nothing) with their objective and constraint violation.
 template <class Result, class Program>
 void set_solve_fields(Result& r, const Program& program, const ConvexAwareSolve& solve,
                       const OptimizeOptions& options, const ExchangeTotals& totals) {
@@ -86,6 +87,12 @@ void set_solve_fields(Result& r, const Program& program, const ConvexAwareSolve&
   r.termination = s.termination;
   r.message = s.message;
   r.x = snapped_to_bounds(program, options, s.x, s.objective, s.constraint_violation);
+  if (options.leave_out_needless_counterweights && found_design(s.termination)) {
+    std::string left_out;
+    r.x = without_needless_counterweights(program, options, r.x, s.objective,
+                                          s.constraint_violation, &left_out);
+    r.message += left_out;
+  }
   const bool snapped = r.x != s.x;
   r.objective = snapped ? program.objective(r.x, nullptr) : s.objective;
   r.constraint_violation = snapped ? constraint_violation(program, r.x) : s.constraint_violation;

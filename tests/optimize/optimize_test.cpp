@@ -708,6 +708,40 @@ TEST(Optimize, APeakObjectiveBoundsTheMotionsPeakNotTheSamples) {
   }
 }
 
+// A counterweight that changes nothing the problem reads is left out: the crank turns at constant
+// speed about A0, the origin, so a crank counterweight's centripetal force passes through the
+// moment's reference point and changes no shaking moment, and no other link's motion (driven).
+// The solver left it where its start put it (half its mass_max at half its distance_max: 5 kg of
+// no use); the result now has none, and says so. Checked by core's own simulations: the design
+// with that counterweight has the same RMS shaking moment as without it.
+TEST(Optimize, ACounterweightThatChangesNothingIsLeftOut) {
+  DesignProblem p = counterweight_problem();
+  p.objective = {Term{Metric::kMshRms, 1.0}};
+  const OptimizeResult r = optimize(p, OptimizeOptions{});
+  SCOPED_TRACE(r.brief_report() + " | " + r.message);
+  ASSERT_TRUE(r.ok());
+  ASSERT_EQ(r.counterweights.size(), 2u);
+  EXPECT_EQ(r.counterweights[0].link, 1);
+  EXPECT_EQ(r.counterweights[0].counterweight.mass, 0.0);
+  EXPECT_GT(r.counterweights[1].counterweight.mass, 0.1);  // the rocker's does the work
+  EXPECT_EQ(r.design.crank.mass, p.original.crank.mass);
+  EXPECT_NE(r.message.find("the crank counterweight changed nothing the problem reads "
+                           "(objective and constraints the same without it) and is left out"),
+            std::string::npos);
+  // the start's crank counterweight added to the optimum changes its Msh_rms by round-off only
+  core::FourBar with = r.design;
+  with.crank = balance::merged(
+      with.crank, balance::Counterweight{.mass = 5.0, .position = Vec2(-0.5, 0.0), .distance = 0.5},
+      false);
+  const core::SimulateOptions simulate{.formulation = core::Formulation::kMassMatrix};
+  const double without_it =
+      core::metrics(core::simulate_driven(r.design, one_revolution(), simulate)).Msh_rms;
+  const double with_it =
+      core::metrics(core::simulate_driven(with, one_revolution(), simulate)).Msh_rms;
+  EXPECT_NEAR(with_it, without_it, 1e-12 * without_it);
+  EXPECT_GT(with.crank.mass, r.design.crank.mass + 4.9);
+}
+
 // A minimax optimum: the shaking moment's peak under the budget, which the counterweights trade
 // between its local maxima until they are equal. The exchange rounds' grids of added angles make
 // their rows nearly equal constraints, at which the first-order conditions are degenerate (met

@@ -18,6 +18,9 @@
 #include <vector>
 
 #include "core/number_text.hpp"
+#include "core/planar/metrics.hpp"
+#include "core/planar/simulate.hpp"
+#include "optimize/planar.hpp"
 #include "studies/report/report.hpp"
 #include "studies/run/runner.hpp"
 #include "studies/studies.hpp"
@@ -30,6 +33,7 @@ namespace bd::studies {
 namespace {
 
 namespace fs = std::filesystem;
+namespace cp = bd::core::planar;
 
 // a slider-crank driven by its crank; line numbers below refer to it (the section starts at 20)
 const std::string kEngine = bd::testing::engine_study(72);
@@ -312,6 +316,43 @@ TEST(PlanarOptimizeStudy, ResolvedPeaksAreWhatTheTablesShow) {
       EXPECT_GT(std::abs(p.objective - ratio), 1e-4) << "24 samples held the peaks";
     }
   }
+}
+
+// A counterweight that changes nothing the problem reads is left out (the four-bar's test in
+// tests/optimize/optimize_test.cpp): the engine's crank turns at constant speed about the origin,
+// so a crank counterweight changes no shaking moment about it; the solver used to leave it at its
+// start (half its mass_max). Checked against the engine's own runs with and without it.
+TEST(PlanarOptimizeStudy, ACounterweightThatChangesNothingIsLeftOut) {
+  const Study study = parse_study(bd::testing::engine_study(24) +
+                                      "optimize:\n  objective: {Msh_rms: 1}\n  variables:\n"
+                                      "    counterweights:\n"
+                                      "      crank: {mass_max: 1.0, distance_max: 0.05}\n",
+                                  "e.yaml");
+  const RunResult r = compute_study(study);
+  ASSERT_TRUE(r.ok() && r.optimized && r.optimized->found()) << r.optimized->message();
+  const optimize::planar::Result& p = r.optimized->planar_result;
+  EXPECT_EQ(p.added_mass, 0.0);
+  EXPECT_NE(p.message.find("the crank counterweight changed nothing the problem reads"),
+            std::string::npos)
+      << p.message;
+  EXPECT_NEAR(p.objective, 1.0, 1e-12);
+  // the start's counterweight (0.5 kg at 25 mm) changes the engine's Msh_rms by round-off only
+  const optimize::planar::DesignProblem problem = planar_design_problem(study);
+  optimize::planar::PlanarNlp nlp(problem);
+  Eigen::VectorXd with = nlp.start();
+  Eigen::VectorXd without = with;
+  without.head(3).setZero();
+  const auto msh = [&](const Eigen::VectorXd& x) {
+    const cp::Model model(nlp.design(x));
+    const cp::Trajectory run = cp::simulate_driven(model, std::get<cp::DrivenScene>(problem.scene));
+    EXPECT_TRUE(run.ok()) << run.message;
+    return cp::metric_values(nlp.metric_table(), run.table)[static_cast<std::size_t>(
+        std::find_if(nlp.metric_table().begin(), nlp.metric_table().end(),
+                     [](const cp::ColumnMetric& m) { return m.name == "Msh_rms"; }) -
+        nlp.metric_table().begin())];
+  };
+  EXPECT_GT(with(0), 0.4);
+  EXPECT_NEAR(msh(with), msh(without), 1e-12 * msh(without));
 }
 
 // A user's front on the Stephenson six-bar (counterweights on all five links, force balance, a
