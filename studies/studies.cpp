@@ -1,6 +1,8 @@
 #include "studies/studies.hpp"
 
 #include <exception>
+#include <optional>
+#include <string>
 #include <system_error>
 
 #include "core/input_error.hpp"
@@ -30,7 +32,10 @@ RunResult run_study(const Study& study, const fs::path& out_dir) {
   // a folder holding an unfinished sweep is not overwritten by a single run (its rows would be
   // lost, or mixed with this run's files); a finished one is replaced (write_run())
   if (const std::string why = unfinished_sweep(out_dir, -1); !why.empty()) {
-    throw InputError(why + ": continue it with `balance-design run SWEEP-STUDY --out " +
+    // the sweep's own study file, as sweep.json names it
+    const std::optional<SweepInFolder> sweep = sweep_in_folder(out_dir);
+    const std::string file = sweep && !sweep->source.empty() ? sweep->source : "SWEEP-STUDY";
+    throw InputError(why + ": continue it with `balance-design run " + file + " --out " +
                      out_dir.string() + " --resume`, or write this run elsewhere with --out");
   }
   // compute first: an invalid scene throws before anything is created on disk

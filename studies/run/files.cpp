@@ -212,6 +212,9 @@ std::optional<SweepInFolder> sweep_in_folder(const fs::path& dir) {
     if (!j.is_discarded() && j.contains("points") && j["points"].is_number_integer()) {
       s.points = j["points"].get<long>();
     }
+    if (!j.is_discarded() && j.contains("source") && j["source"].is_string()) {
+      s.source = j["source"].get<std::string>();
+    }
   }
   std::ifstream in(csv, std::ios::binary);
   std::string line;

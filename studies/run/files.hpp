@@ -60,6 +60,7 @@ std::string run_folder_problem(const std::filesystem::path& dir);
 struct SweepInFolder {
   long rows{};
   long points{-1};
+  std::string source;  // the study file sweep.json names ("" when none)
 };
 
 /// The sweep in `dir`, when it holds sweep.json or sweep.csv; sweep.csv is read line by line.

@@ -514,13 +514,33 @@ TEST_F(SweepRunner, ResumeRefusesAnotherDesignOrAlteredRows) {
     ADD_FAILURE() << "a single run overwrote an unfinished sweep";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              p.string() + " holds an unfinished sweep (3 of 9 points): continue it with "
-                           "`balance-design run SWEEP-STUDY --out " +
-                  p.string() + " --resume`, or write this run elsewhere with --out");
+              p.string() +
+                  " holds an unfinished sweep (3 of 9 points): continue it with "
+                  "`balance-design run " +
+                  study.source + " --out " + p.string() +
+                  " --resume`, or write this run elsewhere with --out");
+    EXPECT_FALSE(study.source.empty());  // the sweep's study file, as sweep.json names it
   }
   EXPECT_EQ(lines(read(p / "sweep.csv")).size(), 4u);
   EXPECT_FALSE(fs::exists(p / "summary.json"));
   EXPECT_FALSE(fs::exists(p / "timeseries.csv"));
+  {
+    // where sweep.json names its study file, the advice names it too
+    const fs::path named = dir_ / "named";
+    fs::create_directories(named);
+    std::ofstream(named / "sweep.json")
+        << R"({"study": "s", "source": "studies/my-sweep.yaml", "points": 9})";
+    std::ofstream(named / "sweep.csv") << "point,status\n";
+    try {
+      run_study(plain, named);
+      ADD_FAILURE() << "a single run overwrote an unfinished sweep";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("(0 of 9 points): continue it with `balance-design "
+                                           "run studies/my-sweep.yaml --out "),
+                std::string::npos)
+          << e.what();
+    }
+  }
   run_study(plain, dir_ / "full");
   EXPECT_FALSE(fs::exists(dir_ / "full" / "sweep.csv"));
   EXPECT_FALSE(fs::exists(dir_ / "full" / "sweep.json"));
