@@ -129,10 +129,16 @@ auto exchange_rounds(const Problem& problem, std::vector<Eigen::VectorXd> starts
                      const Finish& finish) {
   Problem exchanged = problem;
   ExchangeTotals totals;
+  // the evaluations left; one at least (NLopt takes none as no limit)
   const auto budget = [&] {
     OptimizeOptions b = options;
-    b.max_evaluations = options.max_evaluations - totals.evaluations;
+    b.max_evaluations = std::max(1, options.max_evaluations - totals.evaluations);
     return b;
+  };
+  // enough left for another solve (mlsl: one evaluation per local run at least)
+  const auto can_solve = [&] {
+    return options.max_evaluations - totals.evaluations >=
+           (options.algorithm == Algorithm::kMlsl ? options.starts : 1);
   };
   for (int round = 0;; ++round) {
     const Nlp nlp(exchanged);
@@ -170,10 +176,7 @@ auto exchange_rounds(const Problem& problem, std::vector<Eigen::VectorXd> starts
         added.push_back(a);
       }
     }
-    // the next round needs evaluations left (mlsl: one per local run at least)
-    const int left = options.max_evaluations - totals.evaluations;
-    const bool another = round < kMaxExchangeRounds &&
-                         left >= (options.algorithm == Algorithm::kMlsl ? options.starts : 1);
+    const bool another = round < kMaxExchangeRounds && can_solve();
     if (!added.empty() && another) {
       bounded_at.insert(bounded_at.end(), added.begin(), added.end());
       starts.insert(starts.begin(), solved.x);
@@ -201,7 +204,7 @@ auto exchange_rounds(const Problem& problem, std::vector<Eigen::VectorXd> starts
       Problem lean = problem;
       std::vector<double>& lean_at = lean.*instants;
       Eigen::VectorXd from = solved.x;
-      for (int lean_round = 0; lean_round < kMaxLeanRounds; ++lean_round) {
+      for (int lean_round = 0; lean_round < kMaxLeanRounds && can_solve(); ++lean_round) {
         const std::size_t before = lean_at.size();
         for (const double a : nlp.peak_instants(from, kLeanPeakWithin)) {
           if (std::find(lean_at.begin(), lean_at.end(), a) == lean_at.end()) lean_at.push_back(a);
@@ -218,7 +221,9 @@ auto exchange_rounds(const Problem& problem, std::vector<Eigen::VectorXd> starts
         from = lean_solve.solved.x;
       }
     }
-    return finish(nlp, exchanged, certified(nlp, exchanged, solved, budget()), totals);
+    // (the certificate's refining runs check a design and are not the solve's: the budget of
+    // a single solve, as the first round's certificate would have had)
+    return finish(nlp, exchanged, certified(nlp, exchanged, solved, options), totals);
   }
 }
 
