@@ -554,6 +554,9 @@ VectorXd detail::without_needless_counterweights(const Program& program,
     if (!(out(j) > 0)) continue;
     VectorXd trial = out;
     trial.segment(j, 3).setZero();
+    // a peak's bound variable tight at the design without it (else a peak it lowers would leave
+    // the objective overstated, and one it raises show only as a violated row)
+    program.polish(trial);
     const double f = program.objective(trial, nullptr);
     if (!(f <= objective + 1e-12 * std::max(std::abs(objective), 1.0)) ||
         !(constraint_violation(program, trial) <= allowed_violation)) {
