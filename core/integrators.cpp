@@ -181,7 +181,16 @@ void Integration::set_up_sensitivities(const Problem& p) {
   sensitivity_count_ = static_cast<int>(s.which.size());
   sensitivities_ = N_VCloneVectorArray(sensitivity_count_, y_);
   check_allocated(sensitivities_, "N_VCloneVectorArray");
-  for (int i = 0; i < sensitivity_count_; ++i) N_VConst(0.0, sensitivities_[i]);
+  assert(s.initial.empty() || s.initial.size() == s.which.size());
+  for (int i = 0; i < sensitivity_count_; ++i) {
+    if (s.initial.empty()) {
+      N_VConst(0.0, sensitivities_[i]);
+      continue;
+    }
+    const std::vector<double>& s0 = s.initial[static_cast<std::size_t>(i)];
+    assert(static_cast<sunindextype>(s0.size()) == N_VGetLength(y_));
+    std::copy(s0.begin(), s0.end(), N_VGetArrayPointer(sensitivities_[i]));
+  }
   parameter_scales_ = s.scales;
   parameter_list_ = s.which;
   // staggered corrector: the state's step is converged first, then the sensitivities' on the

@@ -63,14 +63,17 @@ struct Problem {
   /// reads every parameter from `parameters` (through user_data) at each call: CVODES perturbs
   /// them there to form its centred difference quotients of (df/dy) s_i + df/dp_i (one
   /// directional difference, two right-hand sides per sensitivity), so no Jacobian is written
-  /// by hand. The sensitivities start at 0 (y0 does not depend on p) and take part in the error
-  /// test at their own relative `tolerance` and the state's smallest absolute tolerance divided
-  /// by their scale.
+  /// by hand. The sensitivities start at `initial` (0 where it is empty: y0 does not depend on
+  /// p; a run continued from an instant of another starts at that instant's) and take part in
+  /// the error test at their own relative `tolerance` and the state's smallest absolute
+  /// tolerance divided by their scale.
   struct Sensitivities {
     double* parameters{};        // every parameter the right-hand side reads
     std::vector<int> which;      // the entries differentiated
     std::vector<double> scales;  // their typical magnitudes (CVODES' pbar), > 0, as `which`
     double tolerance = 1e-7;     // relative, of the sensitivities' error test
+    /// s_i(t0), one per entry of `which`, each of y0's size; or empty
+    std::vector<std::vector<double>> initial;
   } sensitivities;
 };
 

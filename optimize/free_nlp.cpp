@@ -65,6 +65,9 @@ class FreeNlp final : public NlpProgram {
     return value(metrics(x), m);
   }
 
+  // with resolve_peaks, the peaks the objective or a limit reads (core::kMetricTable's order):
+  // resolved between the samples (the others are their largest samples)
+  core::MetricMask read_peaks_ = resolved_peak_rows(problem_);
   std::vector<core::LinkParameter> parameters_;  // every mass parameter of each varied link
   std::vector<int> varied_links_;                // their links, in order
 
@@ -112,21 +115,30 @@ FreeNlp::Evaluation FreeNlp::evaluate(const VectorXd& x, bool with_gradient) con
   }
   Evaluation e;
   e.x = x;
+  const core::SimulateOptions options = simulate_options();
+  const core::FourBar model = design(x);
   if (!with_gradient) {
-    const core::Trajectory t = trajectory(x);
-    e.metrics = t.ok() ? core::metrics(t) : infinite_metrics();
+    const core::Trajectory t = simulate(model);
+    e.metrics = !t.ok()                  ? infinite_metrics()
+                : problem_.resolve_peaks ? core::metrics(model, t, options, &read_peaks_)
+                                         : core::metrics(t);
   } else {
-    core::SimulateOptions options;
-    options.formulation = problem_.formulation;
-    options.tolerance = problem_.tolerance;
     const core::FreeSensitivities run = core::simulate_free_sensitivities(
-        design(x), std::get<core::FreeScene>(problem_.scene), parameters_, options);
+        model, std::get<core::FreeScene>(problem_.scene), parameters_, options);
     e.gradient = MatrixXd::Zero(static_cast<Eigen::Index>(core::kMetricCount), n_);
-    if (run.trajectory.ok()) {
+    if (!run.trajectory.ok()) {
+      e.metrics = infinite_metrics();
+    } else if (problem_.resolve_peaks) {
+      core::PeakList peaks;
+      e.metrics = core::metrics(model, run.trajectory, options, &read_peaks_, &peaks);
+      // the others' peaks as metric_gradients(run) takes them: at their largest samples
+      for (std::size_t k = 0; k < core::kMetricCount; ++k) {
+        if (!read_peaks_[k]) peaks.table[k] = core::Peak{};
+      }
+      e.gradient = core::metric_gradients(model, run, options, peaks) * parameter_jacobian(x);
+    } else {
       e.metrics = core::metrics(run.trajectory);
       e.gradient = core::metric_gradients(run) * parameter_jacobian(x);
-    } else {
-      e.metrics = infinite_metrics();
     }
   }
   cached_ = e;

@@ -54,21 +54,27 @@ NlpProgram::NlpProgram(const DesignProblem& p, CounterweightVariablesAs as)
                                     (driven ? "driven" : "free") +
                                     " scene: " + trajectory.message});
   }
-  // with resolve_peaks, a driven scene's peaks resolved between the samples, as the exchange
-  // steps bound the optimum's (optimize()): a limit's "x original" is then the motion's peak
+  // with resolve_peaks, the peaks resolved between the samples, as the exchange steps bound a
+  // driven optimum's (optimize()) and a free scene's program evaluates them: a limit's
+  // "x original" is then the motion's peak
   const auto* driven = std::get_if<core::DrivenScene>(&problem_.scene);
-  original_metrics_ = driven && problem_.resolve_peaks
-                          ? core::metrics(problem_.original, *driven, trajectory,
-                                          problem_.formulation, nullptr)
-                          : core::metrics(trajectory);
+  original_metrics_ = !problem_.resolve_peaks ? core::metrics(trajectory)
+                      : driven ? core::metrics(problem_.original, *driven, trajectory,
+                                               problem_.formulation, nullptr)
+                               : core::metrics(problem_.original, trajectory, simulate_options());
   check_normalisers();
   set_up_design_variables();
 }
 
-core::Trajectory NlpProgram::simulate(const core::FourBar& model) const {
+core::SimulateOptions NlpProgram::simulate_options() const {
   core::SimulateOptions options;
   options.formulation = problem_.formulation;
   options.tolerance = problem_.tolerance;
+  return options;
+}
+
+core::Trajectory NlpProgram::simulate(const core::FourBar& model) const {
+  const core::SimulateOptions options = simulate_options();
   if (const auto* driven = std::get_if<core::DrivenScene>(&problem_.scene)) {
     return core::simulate_driven(model, *driven, options);
   }

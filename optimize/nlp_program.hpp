@@ -150,6 +150,8 @@ class NlpProgram {
 
   /// core's simulation of a model in the problem's scene, formulation and tolerance.
   core::Trajectory simulate(const core::FourBar& model) const;
+  /// The options of simulate() (and of a free scene's runs with sensitivities).
+  core::SimulateOptions simulate_options() const;
   /// q(x), with ∂q/∂x when asked for.
   Inertial inertial(const Eigen::VectorXd& x, bool with_jacobian) const;
   /// The added mass [kg] of the design whose inertial parameters are q.

@@ -331,8 +331,13 @@ void verify(const DesignProblem& problem, OptimizeResult& r) {
                  " failed: " + trajectory.message;
     return;
   }
-  r.verified = core::metrics(trajectory);
-  // the peaks over the same instants as the optimiser's: the samples and the peak angles
+  // the peaks as the optimiser's: a free scene's program resolves those it reads, a driven
+  // scene's bounds them at the samples and the peak angles
+  const bool free = std::holds_alternative<core::FreeScene>(problem.scene);
+  const core::MetricMask resolved = resolved_peak_rows(problem);
+  r.verified = free && problem.resolve_peaks
+                   ? core::metrics(r.design, trajectory, simulate, &resolved)
+                   : core::metrics(trajectory);
   if (const auto* scene = std::get_if<core::DrivenScene>(&problem.scene)) {
     for (const double angle : problem.peak_angles) {
       const auto d = core::inverse_dynamics(r.design, angle, scene->omega1, 0.0,

@@ -194,6 +194,10 @@ struct PlanarNlp::Impl {
   mutable std::mutex cache_mutex;
   mutable Evaluation cached;
   std::vector<int> sensitivity_parameters;  // free scenes: the entries of q the design varies
+  // free scenes with resolve_peaks: the peak metrics the objective or a limit reads (table
+  // indices; the others keep their largest samples), and those rows of the table
+  std::vector<std::size_t> read_peaks;
+  std::vector<cp::ColumnMetric> read_table;
   int nq{}, samples{};
   int instants{};  // rows of the regressor: the samples, then p.peak_times (peaks only)
   VectorXd q0;
@@ -347,10 +351,10 @@ void PlanarNlp::Impl::build_regressor(bool checks_only) {
   times = base.column("t");
   // the normalisers: the original's metrics, its peaks resolved between the samples when the
   // optimiser resolves the design's
-  original = p.resolve_peaks && !free
-                 ? cp::metric_values(cp::Model(l), std::get<cp::DrivenScene>(p.scene), table,
-                                     base.trajectory)
-                 : cp::metric_values(table, base.trajectory.table);
+  original = !p.resolve_peaks ? cp::metric_values(table, base.trajectory.table)
+             : free           ? cp::metric_values(cp::Model(l), p.simulate, table, base.trajectory)
+                    : cp::metric_values(cp::Model(l), std::get<cp::DrivenScene>(p.scene), table,
+                                        base.trajectory);
   if (free) {  // the balance conditions come from the configurations the original passes through
     balance_conditions(base.trajectory);
     return;
@@ -782,6 +786,18 @@ PlanarNlp::PlanarNlp(const DesignProblem& problem, CounterweightVariablesAs as, 
       m.sensitivity_parameters.insert(m.sensitivity_parameters.end(),
                                       {P::link_mass(k), P::link_me(k), P::link_mf(k), P::link_J(k)});
   }
+  if (m.free && m.p.resolve_peaks) {
+    std::vector<bool> read(m.table.size(), false);
+    for (std::size_t k = 0; k < m.table.size(); ++k) read[k] = m.weight[k] > 0;
+    for (const Impl::Row& row : m.rows) {
+      if (row.kind == Impl::Row::Kind::kPeakLimit) read[static_cast<std::size_t>(row.index)] = true;
+    }
+    for (std::size_t k = 0; k < m.table.size(); ++k) {
+      if (!read[k] || m.table[k].statistic != core::Statistic::kMax) continue;
+      m.read_peaks.push_back(k);
+      m.read_table.push_back(m.table[k]);
+    }
+  }
 }
 
 PlanarNlp::~PlanarNlp() = default;
@@ -813,27 +829,51 @@ PlanarNlp::Evaluation PlanarNlp::simulated(const VectorXd& x, bool gradient) con
   const cp::Model model(design(x));
   const cp::FreeScene& scene = std::get<cp::FreeScene>(m.p.scene);
   const std::vector<double> failed(m.table.size(), std::numeric_limits<double>::infinity());
+  // the others' peaks' value 0 in `peaks`: their gradients stay their largest samples'
+  auto values = [&](const cp::Trajectory& t, std::vector<core::Peak>* peaks) {
+    return free_run_metrics(model, t, m.p.simulate, peaks);
+  };
   if (!gradient) {
     const cp::Trajectory t = cp::simulate_free(model, scene, m.p.simulate);
-    e.metrics = t.ok() ? cp::metric_values(m.table, t.table) : failed;
+    e.metrics = t.ok() ? values(t, nullptr) : failed;
   } else {
     const cp::FreeSensitivities run =
         cp::simulate_free_sensitivities(model, scene, m.sensitivity_parameters, m.p.simulate);
     e.gradient = MatrixXd::Zero(static_cast<Eigen::Index>(m.table.size()), m.n);
     e.metrics = failed;
     if (run.trajectory.ok()) {
-      e.metrics = cp::metric_values(m.table, run.trajectory.table);
+      std::vector<core::Peak> peaks;
+      e.metrics = values(run.trajectory, &peaks);
       VectorXd q;
       MatrixXd J;
       m.q_of(x, q, &J);
       MatrixXd dq(static_cast<Eigen::Index>(m.sensitivity_parameters.size()), m.n);
       for (std::size_t j = 0; j < m.sensitivity_parameters.size(); ++j)
         dq.row(static_cast<Eigen::Index>(j)) = J.row(m.sensitivity_parameters[j]);
-      e.gradient = cp::metric_gradients(m.table, run) * dq;
+      e.gradient =
+          (m.read_peaks.empty() ? cp::metric_gradients(m.table, run)
+                                : cp::metric_gradients(model, m.p.simulate, m.table, run, peaks)) *
+          dq;
     }
   }
   m.cached = e;
   return e;
+}
+
+std::vector<double> PlanarNlp::free_run_metrics(const cp::Model& model, const cp::Trajectory& run,
+                                                const cp::SimulateOptions& options,
+                                                std::vector<core::Peak>* peaks) const {
+  const Impl& m = *impl_;
+  std::vector<double> v = cp::metric_values(m.table, run.table);
+  if (peaks) peaks->assign(m.table.size(), core::Peak{});
+  if (m.read_peaks.empty()) return v;
+  std::vector<core::Peak> at;
+  const std::vector<double> r = cp::metric_values(model, options, m.read_table, run, &at);
+  for (std::size_t i = 0; i < m.read_peaks.size(); ++i) {
+    v[m.read_peaks[i]] = r[i];
+    if (peaks) (*peaks)[m.read_peaks[i]] = at[i];
+  }
+  return v;
 }
 
 int PlanarNlp::n() const { return impl_->n; }
@@ -1619,7 +1659,8 @@ Result optimize(const DesignProblem& problem, const OptimizeOptions& options,
           r.message += "; the optimum's simulation failed: " + t.message;
           return r;
         }
-        r.verified = cp::metric_values(r.metric_table, t.table);
+        r.verified = driven ? cp::metric_values(r.metric_table, t.table)
+                            : nlp.free_run_metrics(model, t, other);
         if (driven) add_instants_peaks(model, *driven, t, r.peak_times, r.metric_table, r.verified);
         r.verification_error = verification_error(r.metric_table, r.metrics, r.verified);
         r.inertial_error = inertial_error(r.design, t.table);

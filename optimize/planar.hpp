@@ -90,13 +90,15 @@ struct DesignProblem {
   std::vector<Limit> limits;
   bool force_balance = false;  // full force balance as equalities
   double smoothing = kDefaultSmoothing;
-  /// Driven scenes: peaks bounded over the motion, not only at the samples (the default;
-  /// exchange steps, as the four-bar's DesignProblem::resolve_peaks): where a peak of the
+  /// Peaks bounded over the motion, not only at the samples (the default), as the four-bar's
+  /// DesignProblem::resolve_peaks; the original's peaks that normalise the objective and the
+  /// limits are then its resolved ones. Driven scenes: exchange steps: where a peak of the
   /// objective or of a limit, resolved between the samples at the optimum, rises above the peak
   /// the program bounded (by more than 1e-9 of the original's), instants around it are added to
   /// peak_times and the problem is solved again from that optimum; once bounded, the result is
-  /// the lean program's; the original's peaks that normalise the objective and the limits are
-  /// then its resolved ones. A free scene's peaks are its samples' whatever this says.
+  /// the lean program's. Free scenes: each simulation's peaks of the objective and the limits
+  /// resolved between its samples, their gradients at the peaks' instants
+  /// (PlanarNlp::free_run_metrics(), cp::free_derivatives_at()).
   bool resolve_peaks = true;
   /// Driven scenes: times [s] at which the peaks are bounded besides the scene's samples (the
   /// exchange steps add to them); the RMS metrics stay the samples'. Each must lie within the
@@ -195,6 +197,14 @@ class PlanarNlp final : public Program {
   /// the program's instants at x, within `within` of the original's peak below its largest
   /// there, as the four-bar Nlp::peak_instants(). Empty in a free scene.
   std::vector<double> peak_instants(const Eigen::VectorXd& x, double within) const;
+  /// The metric table's values over a free run of a design (`run` = cp::simulate_free(model, the
+  /// problem's scene, options)) as this program evaluates its designs: the peaks of the
+  /// objective and the limits resolved between the samples (with resolve_peaks), the others
+  /// the largest samples. `peaks`, when given, receives where the resolved ones lie (the
+  /// others' value 0).
+  std::vector<double> free_run_metrics(const cp::Model& model, const cp::Trajectory& run,
+                                       const cp::SimulateOptions& options,
+                                       std::vector<core::Peak>* peaks = nullptr) const;
   /// The metric table (names, units) and the original's values.
   const std::vector<cp::ColumnMetric>& metric_table() const;
   const std::vector<double>& original_metrics() const;

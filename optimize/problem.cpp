@@ -76,6 +76,18 @@ bool is_peak(Metric m) {
   return m != Metric::kAddedMass && info(m).statistic == core::Statistic::kMax;
 }
 
+core::MetricMask resolved_peak_rows(const DesignProblem& problem) {
+  core::MetricMask rows{};
+  if (!problem.resolve_peaks) return rows;
+  for (const Term& t : problem.objective) {
+    if (t.weight > 0 && is_peak(t.metric)) rows[static_cast<std::size_t>(t.metric)] = true;
+  }
+  for (const Limit& l : problem.limits) {
+    if (is_peak(l.metric)) rows[static_cast<std::size_t>(l.metric)] = true;
+  }
+  return rows;
+}
+
 const char* parameter_name(LinkParameterVariable::Parameter p) {
   switch (p) {
     case LinkParameterVariable::Parameter::kMass:

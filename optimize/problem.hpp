@@ -131,15 +131,19 @@ struct DesignProblem {
   /// min(ε, ε²/(2r)) above r, so the objective is within ε · Σ weights above the exact sum
   /// (optimize/nlp.hpp has the bound on the optimum).
   double smoothing = kDefaultSmoothing;
-  /// Driven scenes: bound the motion's peaks, not the samples' (the default; off: the
-  /// samples', as the metrics of a run without resolved peaks; a free scene's are always its
-  /// samples'). optimize() then runs exchange steps: where a peak of the objective or of a
-  /// limit, resolved between the samples at the optimum, rises above the peak the program
-  /// bounded (by more than 1e-9 of the original's), crank angles around it are added to
-  /// peak_angles and the problem is solved again from that optimum; once bounded, the result is
-  /// the lean program's (the samples and one angle per peak of that design), which is the one
-  /// certified; and the original's peaks that normalise the objective and the limits ("x
-  /// original") are its resolved ones.
+  /// Bound the motion's peaks, not the samples' (the default; off: the samples', as the
+  /// metrics of a run without resolved peaks). The original's peaks that normalise the objective
+  /// and the limits ("x original") are then its resolved ones.
+  /// - Driven scenes: optimize() runs exchange steps: where a peak of the objective or of a
+  ///   limit, resolved between the samples at the optimum, rises above the peak the program
+  ///   bounded (by more than 1e-9 of the original's), crank angles around it are added to
+  ///   peak_angles and the problem is solved again from that optimum; once bounded, the result
+  ///   is the lean program's (the samples and the angles around each peak of that design),
+  ///   which is the one certified.
+  /// - Free scenes: each evaluation's simulation has the peaks of the objective and the limits
+  ///   resolved between its samples (core::metrics(model, trajectory, options, resolve)), and
+  ///   their gradients are taken at the peaks' instants (core::free_derivatives_at()); the
+  ///   other peaks stay the samples' (resolved_peak_rows()).
   bool resolve_peaks = true;
   /// Driven scenes: crank angles [rad] at which the peaks (of the objective and of the limits)
   /// are bounded besides the scene's samples (the exchange steps add to them). The RMS metrics
@@ -161,5 +165,11 @@ struct DesignProblem {
   ///   "objective[i].metric" (.weight), "limits[i].metric" (.value).
   bd::Problem validate() const;
 };
+
+/// The rows of core::kMetricTable whose peaks a free scene's program resolves between the
+/// samples (with resolve_peaks): the peak metrics of the objective (positive weight) and of the
+/// limits. Its other peaks are the largest samples'; the optimum's verification evaluates them
+/// alike.
+core::MetricMask resolved_peak_rows(const DesignProblem& problem);
 
 }  // namespace bd::optimize

@@ -84,10 +84,11 @@ Metrics metrics(const Trajectory& trajectory) {
 namespace {
 
 // the metrics with the peaks located: refined between the samples by `sample_at` (the sample at
-// any time, or none) when given, else the largest samples
+// any time, or none) when given, else the largest samples; with `resolve`, only the table's rows
+// it marks are refined (the others and the output metrics are their largest samples)
 Metrics with_peaks(const Trajectory& trajectory, double period,
                    const std::function<std::optional<DynamicsSample>(double)>& sample_at,
-                   PeakList* peaks) {
+                   PeakList* peaks, const MetricMask* resolve = nullptr) {
   const std::vector<DynamicsSample>& samples = trajectory.samples;
   if (peaks) {
     peaks->table.assign(kMetricCount, Peak{});
@@ -107,9 +108,9 @@ Metrics with_peaks(const Trajectory& trajectory, double period,
     }
     return cached;
   };
-  auto resolve = [&](std::span<const double> x, auto magnitude_of) {
+  auto refine = [&](std::span<const double> x, bool refined, auto magnitude_of) {
     QuantityAt f;
-    if (sample_at) {
+    if (sample_at && refined) {
       f = [&](double s) {
         const std::optional<DynamicsSample>& d = at(s);
         return d ? magnitude_of(*d) : std::nan("");
@@ -124,8 +125,8 @@ Metrics with_peaks(const Trajectory& trajectory, double period,
       if (peaks) peaks->table[k] = {m.*info.field, 0.0};
       continue;
     }
-    const Peak p = resolve(magnitudes.of(info.quantity),
-                           [&](const DynamicsSample& d) { return magnitude(d, info.quantity); });
+    const Peak p = refine(magnitudes.of(info.quantity), !resolve || (*resolve)[k],
+                          [&](const DynamicsSample& d) { return magnitude(d, info.quantity); });
     m.*info.field = p.value;
     if (peaks) peaks->table[k] = p;
   }
@@ -136,8 +137,8 @@ Metrics with_peaks(const Trajectory& trajectory, double period,
       if (peaks) peaks->output[k] = {m.*info.field, 0.0};
       continue;
     }
-    const Peak p = resolve(magnitudes.output(k),
-                           [&](const DynamicsSample& d) { return magnitude(d, info.quantity); });
+    const Peak p = refine(magnitudes.output(k), resolve == nullptr,
+                          [&](const DynamicsSample& d) { return magnitude(d, info.quantity); });
     m.*info.field = p.value;
     if (peaks) peaks->output[k] = p;
   }
@@ -177,6 +178,11 @@ Metrics metrics(const FourBar& model, const DrivenScene& scene, const Trajectory
 
 Metrics metrics(const FourBar& model, const Trajectory& trajectory, const SimulateOptions& options,
                 PeakList* peaks) {
+  return metrics(model, trajectory, options, nullptr, peaks);
+}
+
+Metrics metrics(const FourBar& model, const Trajectory& trajectory, const SimulateOptions& options,
+                const MetricMask* resolve, PeakList* peaks) {
   // each instant integrated from the latest instant known before it
   detail::KnownInstants<DynamicsSample> known(trajectory.t);
   return with_peaks(
@@ -188,7 +194,7 @@ Metrics metrics(const FourBar& model, const Trajectory& trajectory, const Simula
               return free_sample_from(model, options, t0, from, t);
             });
       },
-      peaks);
+      peaks, resolve);
 }
 
 }  // namespace bd::core

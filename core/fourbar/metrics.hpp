@@ -3,10 +3,10 @@
 /// summarises and how (RMS over the samples or the largest magnitude). Every layer that names,
 /// orders or computes a metric (the optimiser, the runner's files, sweeps, reports and the
 /// command line) reads this table, so all of them list the metrics in one order.
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <string_view>
-
 #include <vector>
 
 #include "core/fourbar/simulate.hpp"
@@ -174,5 +174,14 @@ Metrics metrics(const FourBar& model, const DrivenScene& scene, const Trajectory
 /// their own (not periodic).
 Metrics metrics(const FourBar& model, const Trajectory& trajectory, const SimulateOptions& options,
                 PeakList* peaks = nullptr);
+
+/// Which rows of core::kMetricTable (in its order) to resolve.
+using MetricMask = std::array<bool, kMetricCount>;
+
+/// The same, resolving only the peaks of the table's rows that `resolve` marks (all where it is
+/// null); the other rows' peaks and every output metric's are their largest samples, as
+/// metrics(trajectory) takes them. For an optimiser that reads a few metrics of many runs.
+Metrics metrics(const FourBar& model, const Trajectory& trajectory, const SimulateOptions& options,
+                const MetricMask* resolve, PeakList* peaks = nullptr);
 
 }  // namespace bd::core

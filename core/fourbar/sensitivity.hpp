@@ -20,6 +20,7 @@
 /// sample's dynamics (no integration) with the step h = 1e-5 relative to the parameter's scale:
 /// truncation ~h² ~ 1e-10, round-off ~eps/h ~ 1e-11, both below the integration's error.
 #include <Eigen/Core>
+#include <optional>
 #include <vector>
 
 #include "core/fourbar/metrics.hpp"
@@ -51,6 +52,10 @@ struct FreeSensitivities {
   /// and their parts, the joint forces), in their units per the parameter's unit. Empty where
   /// the run failed.
   std::vector<std::vector<DynamicsSample>> derivative;
+  /// state_derivative[i][j]: d(theta1, omega1)/d(parameters[j]) at sample i, as the integrator
+  /// carried it (what a continuation of the run from sample i starts from). Empty where the run
+  /// failed.
+  std::vector<std::vector<Vec2>> state_derivative;
   long sensitivity_evaluations{};  // dynamics evaluations for the samples' derivatives
 };
 
@@ -71,5 +76,28 @@ FreeSensitivities simulate_free_sensitivities(const FourBar& model, const FreeSc
 /// that of the largest sample's magnitude, v · dv / |v| (the sample metrics() takes: the first
 /// of equal largest ones; 0 where the magnitude is 0). Needs a completed run.
 Eigen::MatrixXd metric_gradients(const FreeSensitivities& run);
+
+/// The derivatives with respect to run.parameters of the run's sample at any instant t of its
+/// span, not only at its samples: element j is every number of the sample at t differentiated
+/// with respect to parameters[j], as FreeSensitivities::derivative holds them at the samples.
+/// At a sample's time they are that sample's; between samples the run is continued with its
+/// sensitivities from the latest sample before t by `options` (the run's own formulation,
+/// integrator and tolerances) in one integration whose last step ends at t, as
+/// free_sample_from() continues a plain run. `sample`, when given, receives the sample at t (its
+/// link angles as the dynamics gives them, within one turn). None outside the run's span, for a
+/// run without derivatives, or where the continuation or a difference fails.
+std::optional<std::vector<DynamicsSample>> free_derivatives_at(const FourBar& model,
+                                                               const FreeSensitivities& run,
+                                                               const SimulateOptions& options,
+                                                               double t,
+                                                               DynamicsSample* sample = nullptr);
+
+/// The gradients of the metric table's rows over the run with its peaks resolved between the
+/// samples: `peaks` as metrics(model, run.trajectory, options, &peaks) locates them (the run's
+/// own options). A peak's derivative is v · dv / |v| at the instant of its peak
+/// (free_derivatives_at(); where that fails, at the largest sample, as metric_gradients(run));
+/// an RMS's as metric_gradients(run) has it. Needs a completed run.
+Eigen::MatrixXd metric_gradients(const FourBar& model, const FreeSensitivities& run,
+                                 const SimulateOptions& options, const PeakList& peaks);
 
 }  // namespace bd::core

@@ -457,9 +457,17 @@ Trajectory detail::simulate_free_reduced(const FourBar& model, const FreeScene& 
   if (sensitivities != nullptr) {
     sensitivities->parameters = link_parameters(model);
     motion.link_parameters = sensitivities->parameters.data();
-    problem.sensitivities = {sensitivities->parameters.data(), sensitivities->which,
-                             sensitivities->scales, sensitivities->tolerance};
-    sensitivities->state.assign(1, std::vector<Vec2>(sensitivities->which.size(), Vec2::Zero()));
+    problem.sensitivities = {sensitivities->parameters.data(),
+                             sensitivities->which,
+                             sensitivities->scales,
+                             sensitivities->tolerance,
+                             {}};
+    std::vector<Vec2> s0 = sensitivities->initial;
+    if (s0.empty()) s0.assign(sensitivities->which.size(), Vec2::Zero());
+    for (const Vec2& s : sensitivities->initial) {
+      problem.sensitivities.initial.push_back({s.x(), s.y()});
+    }
+    sensitivities->state.assign(1, s0);
   }
   integrators::Integration integration(problem);
   out.status = SimulationStatus::kCompleted;

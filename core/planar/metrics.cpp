@@ -136,6 +136,36 @@ Eigen::MatrixXd metric_gradients(const std::vector<ColumnMetric>& metrics,
   return g;
 }
 
+Eigen::MatrixXd metric_gradients(const Model& model, const SimulateOptions& options,
+                                 const std::vector<ColumnMetric>& metrics,
+                                 const FreeSensitivities& run, const std::vector<Peak>& peaks) {
+  Eigen::MatrixXd g = metric_gradients(metrics, run);
+  const Series& table = run.trajectory.table;
+  if (table.rows() == 0 || run.derivative.size() != run.parameters.size() ||
+      peaks.size() != metrics.size()) {
+    return g;
+  }
+  const std::vector<std::vector<int>> columns = metric_columns(metrics, table);
+  const auto vector_in = [](const std::vector<int>& c, const std::vector<double>& row) {
+    return Vec2(row[static_cast<std::size_t>(c[0])],
+                c.size() > 1 ? row[static_cast<std::size_t>(c[1])] : 0.0);
+  };
+  for (std::size_t k = 0; k < metrics.size(); ++k) {
+    if (metrics[k].statistic != Statistic::kMax || !(peaks[k].value > 0)) continue;
+    const std::optional<InstantDerivatives> d =
+        free_derivatives_at(model, options, run, peaks[k].t);
+    if (!d) continue;  // the largest sample's, as metric_gradients(metrics, run) has it
+    const Vec2 v = vector_in(columns[k], d->row);
+    const double size = core::magnitude(v.x(), v.y());
+    if (!(size > 0)) continue;
+    for (std::size_t j = 0; j < d->derivative.size(); ++j) {
+      g(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) =
+          v.dot(vector_in(columns[k], d->derivative[j])) / size;
+    }
+  }
+  return g;
+}
+
 namespace {
 
 // The positions of row i of a run's table, every node (ground nodes where they are drawn).

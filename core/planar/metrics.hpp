@@ -87,4 +87,13 @@ std::vector<double> metric_values(const Model& model, const SimulateOptions& opt
 Eigen::MatrixXd metric_gradients(const std::vector<ColumnMetric>& metrics,
                                  const FreeSensitivities& run);
 
+/// The same with the peaks resolved between the samples: `peaks` as
+/// metric_values(model, options, metrics, run.trajectory, &peaks) locates them (the run's own
+/// options). A peak's derivative is v · dv / |v| at the instant of its peak
+/// (free_derivatives_at(), core/planar/simulate.hpp; where that fails, at the largest sample);
+/// an RMS's as above.
+Eigen::MatrixXd metric_gradients(const Model& model, const SimulateOptions& options,
+                                 const std::vector<ColumnMetric>& metrics,
+                                 const FreeSensitivities& run, const std::vector<Peak>& peaks);
+
 }  // namespace bd::core::planar

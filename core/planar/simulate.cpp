@@ -662,7 +662,23 @@ struct StateSensitivities {
   double tolerance{};             // relative, of the sensitivities' error test
   std::vector<double> parameters; // π, the model's; CVODES perturbs them in place
   std::vector<Series> derivative; // per entry of `which`: the samples' derivatives
+  // per sample, per entry of `which`, the integrator's d(z, ż)/dπ_j (FreeSensitivities::state)
+  std::vector<double> state;
 };
+
+// the integrator's sensitivities d(z, ż)/dπ_j at its time appended to sens.state (zeros:
+// `integration` null, the start)
+void keep_state_derivatives(StateSensitivities& sens, std::size_t size,
+                            const integrators::Integration* integration) {
+  for (std::size_t j = 0; j < sens.which.size(); ++j) {
+    if (integration == nullptr) {
+      sens.state.insert(sens.state.end(), size, 0.0);
+      continue;
+    }
+    const double* d = integration->sensitivity(static_cast<int>(j));
+    sens.state.insert(sens.state.end(), d, d + size);
+  }
+}
 
 // A sample of the reduced route at (t, y): the dynamics there, the link angles continued from
 // `angles` (a sample's continue the last sample's, not the last evaluation's, which may lie a
@@ -741,6 +757,7 @@ Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scen
   }
   ++m.evaluations;
   if (first) first = reduced_state(m, 0.0, y0.data());
+  if (sens != nullptr) keep_state_derivatives(*sens, y0.size(), nullptr);
   if (first && std::abs(normalised_determinant(ws)) <= kLimitDeterminant) {
     first = Unexpected<PlanarError>(
         PlanarError{PlanarError::Kind::kSingular, "the start is a limit position of the inputs"});
@@ -757,7 +774,8 @@ Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scen
   integrators::Problem problem = free_problem(options, y0, scene.duration, m, reduced_rhs);
   problem.root = reduced_root;
   if (sens != nullptr) {
-    problem.sensitivities = {sens->parameters.data(), sens->which, sens->scales, sens->tolerance};
+    problem.sensitivities = {
+        sens->parameters.data(), sens->which, sens->scales, sens->tolerance, {}};
   }
   integrators::Integration integration(problem);
   const auto where = [&] {
@@ -772,6 +790,7 @@ Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scen
           !ok) {
         return ok;
       }
+      keep_state_derivatives(*sens, y0.size(), &integration);
     }
     auto ok = reduced_sample(m, integration.t(), integration.y(), m.sample_angle);
     if (ok) m.sample_angle = ws.instant.angle;
@@ -859,6 +878,21 @@ double parameter_scale(const Linkage& l, int i) {
   const double length = element_length(l, k);
   const int kind = i - 4 * k;
   return kind == 0 ? m : kind == 3 ? m * length * length : m * length;
+}
+
+// the sensitivities' set-up for `parameters` (checked) of `varied`, a copy of the run's model
+// that the run's right-hand side sets the mass parameters of
+StateSensitivities sensitivity_setup(Model& varied, const std::vector<int>& parameters,
+                                     const SimulateOptions& options) {
+  StateSensitivities sens;
+  sens.model = &varied;
+  for (const int i : parameters) {
+    sens.which.push_back(i);
+    sens.scales.push_back(parameter_scale(varied.linkage(), i));
+  }
+  sens.tolerance = std::max(options.tolerance, core::detail::kSensitivityTolerance);
+  sens.parameters = mass_parameters(varied.linkage());
+  return sens;
 }
 
 }  // namespace
@@ -956,7 +990,6 @@ FreeSensitivities simulate_free_sensitivities(const Model& model, const FreeScen
   const Linkage& l = model.linkage();
   const int count = mass_parameter_count(l);
   std::vector<bool> seen(static_cast<std::size_t>(count), false);
-  StateSensitivities sens;
   for (std::size_t j = 0; j < parameters.size(); ++j) {
     const int i = parameters[j];
     if (i < 0 || i >= count) {
@@ -968,19 +1001,87 @@ FreeSensitivities simulate_free_sensitivities(const Model& model, const FreeScen
       throw InputError(FieldError{"parameters", static_cast<int>(j), "is listed twice"});
     }
     seen[static_cast<std::size_t>(i)] = true;
-    sens.which.push_back(i);
-    sens.scales.push_back(parameter_scale(l, i));
   }
   Model varied = model;
-  sens.model = &varied;
-  sens.tolerance = std::max(options.tolerance, core::detail::kSensitivityTolerance);
-  sens.parameters = mass_parameters(l);
+  StateSensitivities sens = sensitivity_setup(varied, parameters, options);
   Workspace ws(varied);
   const std::vector<double> start = start_of(varied, ws, scene.start, "scene");
   FreeSensitivities out;
   out.parameters = parameters;
   out.trajectory = free_reduced(varied, ws, scene, start, rates, options, &sens);
-  if (out.trajectory.ok()) out.derivative = std::move(sens.derivative);
+  if (out.trajectory.ok()) {
+    out.derivative = std::move(sens.derivative);
+    out.state = std::move(sens.state);
+  }
+  return out;
+}
+
+std::optional<InstantDerivatives> free_derivatives_at(const Model& model,
+                                                      const SimulateOptions& options,
+                                                      const FreeSensitivities& run, double t) {
+  const Trajectory& r = run.trajectory;
+  const std::size_t rows = r.table.rows(), size = r.state_size, count = run.parameters.size();
+  if (rows == 0 || options.route != Route::kReduced || run.derivative.size() != count ||
+      size != 2 * static_cast<std::size_t>(model.inputs()) || r.states.size() != rows * size ||
+      run.state.size() != rows * count * size) {
+    return std::nullopt;
+  }
+  const std::size_t time = static_cast<std::size_t>(r.table.column("t"));
+  if (!(t >= r.table.at(0, time) && t <= r.table.at(rows - 1, time))) return std::nullopt;
+  // the latest sample at or before t
+  std::size_t i = 0;
+  while (i + 1 < rows && r.table.at(i + 1, time) <= t) ++i;
+  InstantDerivatives out;
+  const std::size_t width = r.table.width();
+  auto row_of = [&](const Series& s) {
+    return std::vector<double>(s.values.begin() + static_cast<std::ptrdiff_t>(i * width),
+                               s.values.begin() + static_cast<std::ptrdiff_t>((i + 1) * width));
+  };
+  if (t == r.table.at(i, time)) {
+    out.row = row_of(r.table);
+    for (const Series& d : run.derivative) out.derivative.push_back(row_of(d));
+    return out;
+  }
+  const FreeState from = free_state(model, r, i);
+  Model varied = model;
+  StateSensitivities sens = sensitivity_setup(varied, run.parameters, options);
+  Workspace ws(varied);
+  Motion m = motion(varied, ws, Route::kReduced, options);
+  m.varied = sens.model;
+  m.parameters = sens.parameters.data();
+  m.applied = sens.parameters;
+  // the angles and positions continue from the sample's, on its side of the limit determinant
+  ws.instant.angle = from.angle;
+  ws.instant.x = from.x;
+  m.cache = from.x;
+  ++m.evaluations;
+  if (!reduced_state(m, from.t, from.y.data())) return std::nullopt;
+  m.root_sign = normalised_determinant(ws) > 0 ? 1.0 : -1.0;
+  integrators::Problem problem = free_problem(options, from.y, t, m, reduced_rhs);
+  problem.t0 = from.t;
+  problem.root = reduced_root;
+  problem.sensitivities = {sens.parameters.data(), sens.which, sens.scales, sens.tolerance, {}};
+  for (std::size_t j = 0; j < count; ++j) {
+    const auto first = run.state.begin() + static_cast<std::ptrdiff_t>((i * count + j) * size);
+    problem.sensitivities.initial.emplace_back(first, first + static_cast<std::ptrdiff_t>(size));
+  }
+  integrators::Integration integration(problem);
+  if (integration.advance(t, true) != integrators::Integration::Outcome::kReached) {
+    return std::nullopt;
+  }
+  // the derivatives, then the instant at t as the run evaluates a sample (the angles continue
+  // the last evaluation's, within a step before t)
+  const std::vector<double> last = ws.instant.angle;
+  Series scratch{r.table.columns, {}};
+  sens.derivative.assign(count, Series{r.table.columns, {}});
+  if (!sample_derivatives(varied, m, sens, t, integration.y(), &integration, last, scratch) ||
+      !reduced_sample(m, t, integration.y(), last)) {
+    return std::nullopt;
+  }
+  Series row{r.table.columns, {}};
+  append_row(varied, ws.instant, row);
+  out.row = std::move(row.values);
+  for (Series& d : sens.derivative) out.derivative.push_back(std::move(d.values));
   return out;
 }
 

@@ -141,6 +141,16 @@ struct FreeSensitivities {
   /// parameters[j], in the table's layout (its columns, the t column 0), in their units per the
   /// parameter's unit. Empty where the run failed.
   std::vector<Series> derivative;
+  /// The integrator's sensitivities at each sample (what a continuation from it starts from):
+  /// for sample i and parameter j the trajectory.state_size numbers d(z, ż)/dπ_j from entry
+  /// (i · parameters.size() + j) · state_size on. Empty where the run failed.
+  std::vector<double> state;
+};
+
+/// A free run's row at one instant and its derivatives (free_derivatives_at()).
+struct InstantDerivatives {
+  std::vector<double> row;                      // the row at the instant (columns(model))
+  std::vector<std::vector<double>> derivative;  // per parameter, the row differentiated
 };
 
 /// simulate_free() on the reduced route with forward sensitivities of the samples with respect
@@ -165,5 +175,16 @@ struct FreeSensitivities {
 FreeSensitivities simulate_free_sensitivities(const Model& model, const FreeScene& scene,
                                               const std::vector<int>& parameters,
                                               const SimulateOptions& options = {});
+
+/// The derivatives with respect to run.parameters of the run's row at any instant t of its span,
+/// not only at its samples (the run = simulate_free_sensitivities(model, …, options)): at a
+/// sample's time that sample's; between samples the run continued with its sensitivities from
+/// the latest sample before t by its own route, integrator and tolerances, in one integration
+/// whose last step ends at t (as free_state_from() continues a plain run), the row and its
+/// derivatives there computed as the run computes its samples'. None outside the run's span,
+/// for a run without derivatives, or where the continuation or a difference fails.
+std::optional<InstantDerivatives> free_derivatives_at(const Model& model,
+                                                      const SimulateOptions& options,
+                                                      const FreeSensitivities& run, double t);
 
 }  // namespace bd::core::planar

@@ -33,9 +33,8 @@ struct OptimizeRequest {
   std::vector<optimize::Term> objective;                         // in the order of the file
   std::vector<optimize::Limit> limits;                           // in the order of the file
   bool force_balance = false;  // eq. 57 as equalities (full shaking-force balance)
-  /// optimize.peaks: resolved (true, the default in a driven scene) bounds the motion's peaks
-  /// (exchange steps: optimize::DesignProblem::resolve_peaks), sampled (false, and always in a
-  /// free scene) the samples'
+  /// optimize.peaks: resolved (true, the default) bounds the motion's peaks
+  /// (optimize::DesignProblem::resolve_peaks), sampled (false) the samples'
   bool resolve_peaks = true;
   optimize::OptimizeOptions options;
   std::optional<ParetoRequest> pareto;
@@ -59,9 +58,8 @@ struct PlanarOptimizeRequest {
   std::vector<optimize::planar::Term> objective;                         // in the file's order
   std::vector<optimize::planar::Limit> limits;                           // in the file's order
   bool force_balance = false;  // the momentum conditions as equalities (full force balance)
-  /// optimize.peaks: resolved (true, the default in a driven scene) bounds the motion's peaks
-  /// (optimize::planar::DesignProblem::resolve_peaks), sampled (false, and always in a free
-  /// scene) the samples'
+  /// optimize.peaks: resolved (true, the default) bounds the motion's peaks
+  /// (optimize::planar::DesignProblem::resolve_peaks), sampled (false) the samples'
   bool resolve_peaks = true;
   optimize::OptimizeOptions options;
   std::optional<PlanarParetoRequest> pareto;

@@ -37,7 +37,7 @@ class OptimizeReader {
     o.check_keys({"algorithm", "objective", "constraints", "variables", "max_evaluations",
                   "starts", "tolerance", "peaks", "pareto"});
     const SolverMarks marks = read_solver(o, e.key_mark, is_free(study.scene), req.options);
-    req.resolve_peaks = read_peaks(o, study);
+    req.resolve_peaks = read_peaks(o);
     read_objective(o.require("objective", "the metrics to minimise, each with a weight"), study,
                    req);
     if (const MapReader::Entry* c = o.find("constraints")) read_constraints(*c, study, req);
@@ -70,7 +70,7 @@ class OptimizeReader {
     o.check_keys({"algorithm", "objective", "constraints", "variables", "max_evaluations",
                   "starts", "tolerance", "peaks", "pareto"});
     const SolverMarks marks = read_solver(o, e.key_mark, is_free(study.scene), req.options);
-    req.resolve_peaks = read_peaks(o, study);
+    req.resolve_peaks = read_peaks(o);
     table_ = core::planar::metric_table(core::planar::Model(linkage));
 
     // objective: {metric: weight}
@@ -288,23 +288,16 @@ class OptimizeReader {
   };
 
   // algorithm, max_evaluations, starts, tolerance; each mark defaults to the section's
-  // optimize.peaks: resolved (true, the default in a driven scene) or sampled (false; always
-  // in a free scene)
-  bool read_peaks(const MapReader& o, const Study& study) {
+  // optimize.peaks: resolved (true, the default) or sampled (false)
+  bool read_peaks(const MapReader& o) {
     const MapReader::Entry* k = o.find("peaks");
-    if (!k) return !is_free(study.scene);
+    if (!k) return true;
     const std::string how = read_text(r_, *k, "optimize.peaks");
-    const YAML::Mark at = mark_of(k->value, k->key_mark);
     if (how != "resolved" && how != "sampled") {
-      r_.fail(at, "optimize.peaks must be resolved or sampled, got '" + how + "'");
+      r_.fail(mark_of(k->value, k->key_mark),
+              "optimize.peaks must be resolved or sampled, got '" + how + "'");
     }
-    if (how == "sampled") return false;
-    if (is_free(study.scene)) {
-      r_.fail(at,
-              "optimize.peaks: resolved is for driven scenes (a free scene's peaks are its "
-              "samples' in the optimiser)");
-    }
-    return true;
+    return how == "resolved";
   }
 
   SolverMarks read_solver(const MapReader& o, const YAML::Mark& section, bool free_scene,

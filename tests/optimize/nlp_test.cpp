@@ -641,15 +641,31 @@ TEST(Nlp, FreeSceneSimulatesEveryDesign) {
   EXPECT_TRUE(nlp.has_gradients());
   EXPECT_EQ(nlp.n(), design_variables(p));  // no bound variables in free scenes
   EXPECT_EQ(nlp.n_ineq(), 2 + 3);
-  const core::Metrics o = core::metrics(core::simulate_free(p.original, scene, options_of(p)));
+  // the peaks the problem reads (Msh_max, RA0_max) resolved between the samples by core; the
+  // original's every peak (the normalisers)
+  const core::MetricMask read = resolved_peak_rows(p);
+  for (std::size_t k = 0; k < core::kMetricCount; ++k) {
+    EXPECT_EQ(read[k], k == static_cast<std::size_t>(Metric::kMshMax) ||
+                           k == static_cast<std::size_t>(Metric::kRA0Max))
+        << core::kMetricTable[k].name;
+  }
+  const core::Metrics o = core::metrics(
+      p.original, core::simulate_free(p.original, scene, options_of(p)), options_of(p));
   EXPECT_EQ(nlp.original(Metric::kMshMax), o.Msh_max);
 
+  int between = 0;  // designs whose RA0 peaks between two samples
   for (int trial = 0; trial < 3; ++trial) {
     const Eigen::VectorXd x = random_x(nlp, p, rng);
     const core::Trajectory t = core::simulate_free(nlp.design(x), scene, options_of(p));
     ASSERT_TRUE(t.ok()) << t.message;
-    const core::Metrics want = core::metrics(t);
+    const core::Metrics want = core::metrics(nlp.design(x), t, options_of(p), &read);
     const core::Metrics got = nlp.metrics(x);
+    // a peak read lies between the samples or at an end of the run (0.4 s), never below the
+    // largest sample; the peaks not read are the largest samples
+    const core::Metrics samples = core::metrics(t);
+    EXPECT_GE(want.RA0_max, samples.RA0_max);
+    between += want.RA0_max > samples.RA0_max;
+    EXPECT_EQ(want.Fsh_max, samples.Fsh_max);
     EXPECT_EQ(got.Fsh_rms, want.Fsh_rms);
     EXPECT_EQ(got.Fsh_max, want.Fsh_max);
     EXPECT_EQ(got.Msh_rms, want.Msh_rms);
@@ -675,6 +691,7 @@ TEST(Nlp, FreeSceneSimulatesEveryDesign) {
     nlp.equalities(x, c, nullptr);
     EXPECT_EQ(c.size(), 4);
   }
+  EXPECT_GE(between, 1);  // measured: 1 of the 3
   // on the opened loop's DAE no gradients: asking is a programming error
   p.formulation = core::Formulation::kOpenedLoop;
   const Nlp opened(p);

@@ -742,13 +742,6 @@ TEST(LoadStudy, OptimizeMetricsAFreeSceneCannotHave) {
                    "optimize:\n  algorithm: cobyla\n  objective: {Msh_rms: 1}\n"
                    "  constraints: {tau_max: 2}\n  variables: {counterweights: {crank: }}\n",
                21, 17, "optimize.constraints.tau_max: a free scene has no drive torque");
-  // the motion's peaks are bounded in driven scenes only
-  expect_error(kBase +
-                   "optimize:\n  algorithm: cobyla\n  peaks: resolved\n  objective: {Msh_max: 1}\n"
-                   "  variables: {counterweights: {crank: }}\n",
-               20, 10,
-               "optimize.peaks: resolved is for driven scenes (a free scene's peaks are its "
-               "samples' in the optimiser)");
 }
 
 TEST(LoadStudy, GradientAlgorithmInAFreeSceneOnTheOpenedLoopIsAnErrorAtAlgorithm) {
@@ -772,12 +765,18 @@ TEST(LoadStudy, GradientAlgorithmInAFreeSceneOnTheOpenedLoopIsAnErrorAtAlgorithm
   EXPECT_EQ(d.optimize->options.algorithm, optimize::Algorithm::kCobyla);
   // a derivative-free method is fine
   EXPECT_NO_THROW(parse_study(moving + "optimize:\n  algorithm: cobyla\n" + section, "study.yaml"));
-  // without the peaks key, a free scene's peaks are its samples' (resolved is the driven default)
-  const Study peak = parse_study(
-      moving + "optimize:\n  objective: {Msh_max: 1}\n  variables: {counterweights: {crank: }}\n",
-      "study.yaml");
-  EXPECT_FALSE(peak.optimize->resolve_peaks);
-  EXPECT_FALSE(design_problem(peak).resolve_peaks);
+  // without the peaks key, a free scene's peaks are resolved between the samples, as a driven
+  // scene's; `peaks: sampled` takes the samples'
+  const std::string peak_section =
+      "optimize:\n  objective: {Msh_max: 1}\n  variables: {counterweights: {crank: }}\n";
+  const Study peak = parse_study(moving + peak_section, "study.yaml");
+  EXPECT_TRUE(peak.optimize->resolve_peaks);
+  EXPECT_TRUE(design_problem(peak).resolve_peaks);
+  EXPECT_TRUE(parse_study(moving + peak_section + "  peaks: resolved\n", "study.yaml")
+                  .optimize->resolve_peaks);
+  const Study sampled = parse_study(moving + peak_section + "  peaks: sampled\n", "study.yaml");
+  EXPECT_FALSE(sampled.optimize->resolve_peaks);
+  EXPECT_FALSE(design_problem(sampled).resolve_peaks);
 }
 
 TEST(LoadStudy, OptimizeNeedsOriginalMetricsToNormaliseBy) {

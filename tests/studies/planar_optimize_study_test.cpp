@@ -128,11 +128,13 @@ TEST(PlanarOptimizeStudy, MistakesAreOneLineAtTheirPlace) {
   free.replace(free.find("  type: driven\n"), 15, "  type: free\n  duration: 0.1\n");
   free.erase(free.find("  speeds:"), free.find("  samples:") - free.find("  speeds:"));
   free.insert(free.find("  samples:"), "  rates: [20.0]\n");  // set in motion: Msh_rms > 0
-  EXPECT_FALSE(
+  // its peaks resolved between the samples, as a driven scene's, unless the study says sampled
+  EXPECT_TRUE(
       parse_study(free + "optimize:\n  algorithm: slsqp\n" + kObjective + kVariables, "e.yaml")
-          .planar_optimize->resolve_peaks);  // its samples' peaks, without a word
-  expect_error(free + "optimize:\n" + kObjective + kVariables + "  peaks: resolved\n", 26, 10,
-               "optimize.peaks: resolved is for driven scenes");
+          .planar_optimize->resolve_peaks);
+  EXPECT_FALSE(
+      parse_study(free + "optimize:\n" + kObjective + kVariables + "  peaks: sampled\n", "e.yaml")
+          .planar_optimize->resolve_peaks);
   // a balance section beside it
   expect_error(kEngine + "balance: {}\noptimize:\n" + kObjective + kVariables, 21, 1,
                "a study has a balance section or an optimize section, not both");

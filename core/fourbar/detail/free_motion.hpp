@@ -57,6 +57,9 @@ struct StateSensitivities {
   std::vector<int> which;       // the entries of LinkParameters differentiated
   std::vector<double> scales;   // their typical magnitudes, > 0 (CVODES' pbar)
   double tolerance{};           // relative, of the sensitivities' error test
+  /// d(theta1, omega1)/dp at the start, per entry of `which`; empty: 0 (a run from the scene's
+  /// start), else those of the instant a run is continued from
+  std::vector<Vec2> initial;
   LinkParameters parameters{};  // set by the run: the model's
   /// set by the run: per sample, per entry of `which`, d(theta1, omega1)/dp [rad/unit],
   /// [rad/s/unit]
