@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -57,23 +58,47 @@ std::vector<int> vanishing_counterweight_variables(const Eigen::VectorXd& x,
   return out;
 }
 
+/// The subgradients the first-order check adds at a cone's apex besides the one facing -g: the
+/// unit vectors u_k = (cos 2πk/K, sin 2πk/K). Nonnegative combinations of the rows
+/// (-1 / mass_max, u_k / (mass_max d)) are the multiples of the cone's subgradients there whose u
+/// lies in the regular K-gon inscribed in the unit disc (every u with |u| <= 1 is one), so the
+/// multipliers can face whatever the other active rows leave in p: where the objective reads p
+/// only through them (a peak's bound variable), -g has no p part to face. The K-gon reaches
+/// cos(π/K) = 0.995 of the disc's radius in every direction.
+inline constexpr int kApexSubgradients = 32;
+
 /// Row `row` of the inequalities as the first-order check reads a counterweight's cone whose
 /// variables are x(j) = m, x(j + 1), x(j + 2) = p: (|p| - m d) / (mass_max d), its gradient
-/// (-1 / mass_max, u / (mass_max d)) with u = p / |p|, or at the apex the unit vector facing -g
-/// (Program::first_order_inequalities()).
+/// (-1 / mass_max, u / (mass_max d)) with u = p / |p|; at the apex the unit vector facing -g,
+/// and kApexSubgradients more rows appended to c and jac, each 0 there with one of the apex's
+/// subgradients (Program::first_order_inequalities()).
 inline void cone_first_order_row(const Eigen::VectorXd& x, const Eigen::VectorXd& g, int j,
                                  double mass_max, double distance_max, Eigen::Index row,
                                  Eigen::VectorXd& c, Eigen::MatrixXd& jac) {
   const double pmax = mass_max * distance_max;
   const Vec2 p(x(j + 1), x(j + 2));
   Vec2 u = p;
-  if (!(u.norm() > 1e-12 * pmax)) u = -Vec2(g(j + 1), g(j + 2));
+  const bool apex = !(u.norm() > 1e-12 * pmax);
+  if (apex) u = -Vec2(g(j + 1), g(j + 2));
   if (u.norm() > 0) u.normalize();
   c(row) = (p.norm() - x(j) * distance_max) / pmax;
   jac.row(row).setZero();
   jac(row, j) = -1 / mass_max;
   jac(row, j + 1) = u.x() / pmax;
   jac(row, j + 2) = u.y() / pmax;
+  if (!apex) return;
+  const Eigen::Index first = c.size();
+  c.conservativeResize(first + kApexSubgradients);
+  jac.conservativeResize(first + kApexSubgradients, Eigen::NoChange);
+  for (int k = 0; k < kApexSubgradients; ++k) {
+    const double angle = 2 * std::numbers::pi * k / kApexSubgradients;
+    const Eigen::Index r = first + k;
+    c(r) = c(row);
+    jac.row(r).setZero();
+    jac(r, j) = -1 / mass_max;
+    jac(r, j + 1) = std::cos(angle) / pmax;
+    jac(r, j + 2) = std::sin(angle) / pmax;
+  }
 }
 
 /// A lower bound of the objective over every feasible design, and how it was found.

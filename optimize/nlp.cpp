@@ -46,6 +46,9 @@ Eigen::VectorXd Nlp::from_positions(const Eigen::VectorXd& x) const {
 Eigen::VectorXd Nlp::to_positions(const Eigen::VectorXd& x) const {
   return at(x).to_positions(x);
 }
+Eigen::VectorXd Nlp::within_envelopes(const Eigen::VectorXd& x) const {
+  return from_positions(to_positions(x));
+}
 Eigen::VectorXd Nlp::without_vanishing_counterweights(const Eigen::VectorXd& x,
                                                       double fraction) const {
   return at(x).without_vanishing_counterweights(x, fraction);

@@ -171,6 +171,9 @@ class PlanarNlp final : public Program {
   std::vector<int> vanishing_counterweight_variables(const Eigen::VectorXd& x,
                                                      double fraction) const override;
   std::vector<int> counterweight_mass_variables() const override;
+  Eigen::VectorXd within_envelopes(const Eigen::VectorXd& x) const override {
+    return from_positions(to_positions(x));
+  }
   /// start() with each counterweight's mass (and mass moment) scaled by `fraction`.
   Eigen::VectorXd start_scaled(double fraction) const;
 

@@ -65,7 +65,9 @@ class Program {
   /// objective's gradient g at x: by default inequalities(x, c, jac). A program whose
   /// constraint function loses its gradient where the set it bounds has a corner (a cone
   /// |p|² <= m² d² at its apex) gives there the rows of an equivalent convex function
-  /// (|p| - m d), with the subgradient that faces -g, so that the check sees the constraint.
+  /// (|p| - m d), with the subgradient that faces -g, so that the check sees the constraint;
+  /// at the apex, where the subgradients form a disc, it may append rows after the n_ineq()
+  /// ones, each 0 with another subgradient (cone_first_order_row(), convex_solve.hpp).
   virtual void first_order_inequalities(const Eigen::VectorXd& x, const Eigen::VectorXd& /*g*/,
                                         Eigen::VectorXd& c, Eigen::MatrixXd& jac) const {
     inequalities(x, c, &jac);
@@ -99,6 +101,12 @@ class Program {
                                                            double /*fraction*/) const {
     return x;
   }
+  /// x with each counterweight brought within its envelope (in mass-moment variables
+  /// |p| <= m distance_max: a solver's end may hold a little more, within the constraint
+  /// tolerance, which a vanishing mass makes a distance far beyond distance_max) and the
+  /// variables that only bound others set for it (each a hair above what it bounds). Default,
+  /// and in position variables: x.
+  virtual Eigen::VectorXd within_envelopes(const Eigen::VectorXd& x) const { return x; }
 };
 
 }  // namespace bd::optimize
