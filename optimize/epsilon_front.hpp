@@ -19,9 +19,10 @@ namespace bd::optimize::detail {
 /// Returns (ε, result) per point: minimise `first` subject to the base constraints and
 /// second <= ε, ε spaced from the loosest useful bound down to the tightest reachable one. Each
 /// point starts from its neighbour's design (the first point: the loose end's design, which
-/// meets its bound and minimises `first` there), brought within its bound by feasible_towards()
-/// the design that minimises `second` alone (which meets every bound of the front) in
-/// Front::solve(), else as a lone solve.
+/// meets its bound and minimises `first` there), brought within its bound towards the design
+/// that minimises `second` alone (which meets every bound of the front) by optimize(), given
+/// both as starts in Front::solve() (detail::exchange_rounds(): a first start of several is
+/// moved towards the first later one that is feasible), else as a lone solve.
 template <class Front>
 std::vector<std::pair<double, typename Front::Result>> epsilon_front(const Front& f,
                                                                      typename Front::Metric first,

@@ -34,13 +34,8 @@ struct FourBarFront {
     std::vector<Eigen::VectorXd> designs;
     for (const Result* r : warm)
       if (r->ok()) designs.push_back(r->x);
-    // the neighbour's design, first, brought within this point's bound towards the last (the
-    // second metric's minimiser): the solve then goes on along the front from the neighbour
-    if (designs.size() >= 2) {
-      const Nlp program(p);
-      designs.front() =
-          detail::feasible_towards(program, designs.front(), designs.back(), options.constraint_tolerance);
-    }
+    // the neighbour's design first: optimize() brings it within this point's bound towards the
+    // last (the second metric's minimiser), and the solve goes on along the front from there
     return optimize(p, options, designs);
   }
   // the value of `m` at a result, in the units of a Limit on it: the fraction of the original's

@@ -1561,7 +1561,7 @@ std::vector<double> short_peak_times(const DesignProblem& problem, const PlanarN
   const std::vector<double> bounded = nlp.metrics(solved.x);
   std::vector<double> instants = run.table.column_values("t");
   // a periodic run's end (its first sample's next turn) closes the last interval
-  if (const double period = cp::DrivenRows(model, *scene, run).period();
+  if (const double period = cp::driven_period(model, *scene, run);
       period > 0 && !instants.empty()) {
     instants.push_back(instants.front() + period);
   }
@@ -1689,13 +1689,8 @@ struct PlanarFront {
     std::vector<VectorXd> designs;
     for (const Result* r : warm)
       if (r->ok()) designs.push_back(r->x);
-    // the neighbour's design, first, brought within this point's bound towards the last (the
-    // second metric's minimiser): the solve then goes on along the front from the neighbour
-    if (designs.size() >= 2) {
-      const PlanarNlp program(p);
-      designs.front() =
-          detail::feasible_towards(program, designs.front(), designs.back(), options.constraint_tolerance);
-    }
+    // the neighbour's design first: optimize() brings it within this point's bound towards the
+    // last (the second metric's minimiser), and the solve goes on along the front from there
     return optimize(p, options, designs);
   }
   // the value of `m` at a result, in the units of a Limit on it: the fraction of the original's

@@ -224,21 +224,26 @@ std::vector<double> resolved_values(const std::vector<ColumnMetric>& metrics, co
 
 }  // namespace
 
+double driven_period(const Model& model, const DrivenScene& scene, const Trajectory& run) {
+  // periodic: whole revolutions of the one input that moves, run to the end
+  const Linkage& l = model.linkage();
+  int moving = 0;
+  double period = 0;
+  for (std::size_t k = 0; k < l.inputs.size() && k < scene.speeds.size(); ++k) {
+    if (scene.speeds[k] == 0) continue;
+    ++moving;
+    if (l.inputs[k].kind == Input::Kind::kAngle)
+      period = 2 * std::numbers::pi / std::abs(scene.speeds[k]) * scene.revolutions;
+  }
+  return moving != 1 || scene.duration > 0 || !run.ok() ? 0.0 : period;
+}
+
 struct DrivenRows::State {
   State(const Model& m, const DrivenScene& sc, const Trajectory& r)
       : model(m), scene(sc), table(r.table), positions(m, r.table), ws(m) {
-    const Linkage& l = model.linkage();
     t = table.column_values("t");
     start = scene.start.empty() ? drawn_inputs(model) : scene.start;
-    // periodic: whole revolutions of the one input that moves, run to the end
-    int moving = 0;
-    for (std::size_t k = 0; k < l.inputs.size() && k < scene.speeds.size(); ++k) {
-      if (scene.speeds[k] == 0) continue;
-      ++moving;
-      if (l.inputs[k].kind == Input::Kind::kAngle)
-        period = 2 * std::numbers::pi / std::abs(scene.speeds[k]) * scene.revolutions;
-    }
-    if (moving != 1 || scene.duration > 0 || !r.ok()) period = 0;
+    period = driven_period(model, scene, r);
     row.columns = table.columns;
     z.resize(start.size());
     zero.assign(start.size(), 0.0);

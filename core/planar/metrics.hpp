@@ -45,6 +45,10 @@ std::vector<double> metric_values(const Model& model, const DrivenScene& scene,
                                   const std::vector<ColumnMetric>& metrics, const Trajectory& run,
                                   std::vector<Peak>* peaks = nullptr);
 
+/// The period of a driven run of `model` in `scene` when it is whole revolutions of one moving
+/// input run to the end (the last sample's neighbour is then the first), else 0.
+double driven_period(const Model& model, const DrivenScene& scene, const Trajectory& run);
+
 /// The whole row of a driven run's table at any time s, not only at its samples: the nodes solved
 /// from the nearest sample's (periodic runs: modulo the period, as metric_values() reads them),
 /// then the inverse dynamics at the inputs' values and speeds at s. The model, scene and run are
@@ -59,7 +63,7 @@ class DrivenRows {
   /// cannot be solved or lands away from the samples' branch (a node further than a quarter of
   /// the linkage's size from the nearest sample's), or the dynamics cannot be evaluated.
   const double* at(double s);
-  /// The run's period when it is whole revolutions of one moving input run to the end, else 0.
+  /// driven_period() of the run.
   double period() const;
 
  private:

@@ -143,9 +143,10 @@ auto exchange_rounds(const Problem& problem, std::vector<Eigen::VectorXd> starts
   for (int round = 0;; ++round) {
     const Nlp nlp(exchanged);
     if (round == 0) on_first(nlp);
-    if (round > 0) {
+    if (round > 0 || starts.size() >= 2) {
       // the last optimum may miss the rows of the instants just added (a peak limit's, its peak
-      // rising above the bound between the samples): without a feasible start nearby a local
+      // rising above the bound between the samples), and a first start of several (a Pareto
+      // front's neighbour) its own problem's bound: without a feasible start nearby a local
       // method starts at the first feasible one and may stay there (a Pareto front's inner
       // points ended at the second metric's minimiser); so it moves towards the first later
       // start, or the original design, that meets them, just far enough to meet them too
