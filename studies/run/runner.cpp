@@ -448,7 +448,7 @@ std::string optimized_yaml(const Study& study, const OptimizedRun& run) {
   }
   std::vector<CounterweightPart> added;
   for (const optimize::PlacedCounterweight& p : r.counterweights)
-    added.push_back({p.link, -1, p.counterweight});
+    if (p.counterweight.mass > 0) added.push_back({p.link, -1, p.counterweight});
   const Study written =
       with_parts(optimized_study(study, r.design), design_parts(study, base, added, r.design));  std::string header = "The optimised design of study '" + study.name + "', found by\n";
   header += "balance-design from its optimize section";

@@ -594,6 +594,36 @@ TEST_F(RunnerTest, OptimizedYamlLoadsBackToTheOptimumAndReproducesItsRun) {
   }
 }
 
+// An optimum without counterweights (weighing the added mass three times against the peak
+// shaking force, none pays: the original design is the optimum) writes none as data, only the
+// header's words; before, optimized.yaml listed both with mass 0 at a position.
+TEST_F(RunnerTest, AnOptimumWithoutCounterweightsWritesNone) {
+  std::ifstream in(std::string(BD_SOURCE_DIR "/studies/examples/weighted-counterweights.yaml"));
+  std::stringstream file;
+  file << in.rdbuf();
+  std::string yaml = file.str();
+  for (const auto& [from, to] :
+       {std::pair<std::string, std::string>{"  samples: 360", "  samples: 36"},
+        {"    Fsh_rms: 1.0\n    Msh_rms: 1.0\n    tau_rms: 1.0\n",
+         "    Fsh_max: 1.0\n    added_mass: 3.0\n"}}) {
+    const auto at = yaml.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    yaml.replace(at, from.size(), to);
+  }
+  const Study study = parse_study(yaml, "apex.yaml");
+  const RunResult r = run_study(study, dir_ / "apex");
+  ASSERT_TRUE(r.ok());
+  const OptimizedRun& o = *r.optimized;
+  ASSERT_EQ(o.result.termination, optimize::Termination::kConverged) << o.result.message;
+  EXPECT_TRUE(o.result.global) << o.result.optimality;
+  const std::string text = read(o.study_file);
+  EXPECT_NE(text.find("The crank carries no counterweight"), std::string::npos) << text;
+  EXPECT_NE(text.find("The rocker carries no counterweight"), std::string::npos) << text;
+  EXPECT_EQ(text.find("counterweights:"), std::string::npos) << text;
+  const Study back = load_study(o.study_file.string());
+  bd::testing::expect_same_model(study.fourbar(), back.fourbar());
+}
+
 TEST_F(RunnerTest, ParetoFrontIsWrittenPointByPoint) {
   const Study study = driven_with(
       "optimize:\n"
