@@ -591,9 +591,11 @@ TEST(Optimize, PeakUnderABudgetIsGlobalAndNoNearbyDesignBeatsIt) {
 
   // The motion's peak (resolved, the default): Ipopt's optimum is certified global, the peak it
   // bounds is its design's resolved peak, no lower than the samples' optimum (more constraints),
-  // and no nearby design in the budget does better over the instants it bounded. SLSQP stops
-  // short on this minimax optimum (its quasi-Newton steps stall among the nearly equal rows of
-  // its peaks: first-order conditions to 0.06 after 1455 evaluations, measured), and says so.
+  // and no nearby design in the budget does better over the instants it bounded. SLSQP ends
+  // there too, certified: its quasi-Newton steps stall among the nearly equal rows of its peaks
+  // (first-order conditions to 0.06), where the rocker's counterweight vanishes; put on the apex,
+  // whose subgradients the check reads, the rest solves to 2.4e-5 (measured: 749 evaluations;
+  // before the apex's subgradients, stopped short after 1455).
   DesignProblem resolved = p;
   resolved.resolve_peaks = true;
   OptimizeOptions by_ipopt;
@@ -621,11 +623,11 @@ TEST(Optimize, PeakUnderABudgetIsGlobalAndNoNearbyDesignBeatsIt) {
   }
   OptimizeOptions by_slsqp;
   const OptimizeResult s = optimize(resolved, by_slsqp);
-  ASSERT_TRUE(s.ok()) << s.message;
-  if (!s.global) {
-    EXPECT_EQ(s.optimality.rfind("not proven global", 0), 0u) << s.optimality;
-  }
+  SCOPED_TRACE("slsqp: " + s.brief_report() + " | " + s.message + " | " + s.optimality);
+  EXPECT_EQ(s.termination, Termination::kConverged);
+  EXPECT_TRUE(s.global);
   EXPECT_GE(s.metrics.Fsh_max, r.metrics.Fsh_max * (1 - 1e-9));
+  EXPECT_NEAR(s.metrics.Fsh_max, r.metrics.Fsh_max, 1e-8 * original);
 }
 
 // The exchange step (resolve_peaks): with 24 samples a revolution, the optimum of the samples'
