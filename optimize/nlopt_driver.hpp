@@ -163,8 +163,12 @@ Eigen::VectorXd snapped_to_bounds(const Program& program, const OptimizeOptions&
 /// within max(`violation`, the tolerance). A solver leaves such a counterweight where its start
 /// put it (a counterweight on a crank turning at constant speed about the origin moves no drive
 /// torque and no shaking moment about the origin: half its mass_max at half its distance_max), a
-/// mass the designer would pay for and gain nothing by. `said`, when not null, gets what to
-/// append to the message ("; the crank counterweight changed nothing ... and is left out").
+/// mass the designer would pay for and gain nothing by. A counterweight the problem reads only
+/// by its mass moment (a shaking force, not an inertia: its mass and distance trade off freely)
+/// is moved out to its distance_max with the mass that keeps its moment, where that reads the
+/// same (position variables, Program::counterweight_reach()): the least mass for what it does.
+/// `said`, when not null, gets what to append to the message ("; the crank counterweight
+/// changed nothing ... and is left out", "; the rocker counterweight is moved out to ...").
 Eigen::VectorXd without_needless_counterweights(const Program& program,
                                                 const OptimizeOptions& options,
                                                 const Eigen::VectorXd& x, double objective,

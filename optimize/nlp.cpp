@@ -104,6 +104,7 @@ double Nlp::metric(const Eigen::VectorXd& x, Metric m) const { return at(x).metr
 
 double Nlp::original(Metric m) const { return program_->original(m); }
 std::vector<int> Nlp::counterweight_mass_variables() const { return program_->cw_var(); }
+std::vector<double> Nlp::counterweight_reach() const { return program_->counterweight_reach(); }
 
 std::vector<double> Nlp::peak_instants(const Eigen::VectorXd& x, double within) const {
   return at(x).peak_instants(x, within);

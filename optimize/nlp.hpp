@@ -158,6 +158,7 @@ class Nlp final : public Program {
   std::vector<int> vanishing_counterweight_variables(const Eigen::VectorXd& x,
                                                      double fraction) const override;
   std::vector<int> counterweight_mass_variables() const override;
+  std::vector<double> counterweight_reach() const override;
   Eigen::VectorXd within_envelopes(const Eigen::VectorXd& x) const override;
 
   /// The objective and, when `grad` is not null, its gradient.

@@ -104,6 +104,13 @@ class NlpProgram {
   virtual core::Metrics metrics(const Eigen::VectorXd& x) const = 0;
   /// The first variable (the mass) of each counterweight.
   const std::vector<int>& cw_var() const { return cw_var_; }
+  /// Program::counterweight_reach(): each counterweight's distance_max in position variables.
+  std::vector<double> counterweight_reach() const {
+    std::vector<double> out;
+    if (moments_) return out;
+    for (const CounterweightVariables& c : problem_.counterweights) out.push_back(c.distance_max);
+    return out;
+  }
   /// Nlp::peak_instants(); the default: none (a free scene has no added instants).
   virtual std::vector<double> peak_instants(const Eigen::VectorXd& /*x*/, double /*within*/) const {
     return {};

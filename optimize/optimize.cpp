@@ -563,25 +563,49 @@ VectorXd detail::without_needless_counterweights(const Program& program,
                                                  double objective, double violation,
                                                  std::string* said) {
   VectorXd out = x;
-  std::vector<std::string> left_out;
+  std::vector<std::string> left_out, lighter;
   const double allowed_violation = std::max(violation, options.constraint_tolerance);
-  for (const int j : program.counterweight_mass_variables()) {
-    if (!(out(j) > 0)) continue;
-    VectorXd trial = out;
-    trial.segment(j, 3).setZero();
-    // a peak's bound variable tight at the design without it (else a peak it lowers would leave
-    // the objective overstated, and one it raises show only as a violated row)
+  // trial in place of out where it reads the same: the objective within 1e-12 of out's (or
+  // lower), the constraints no more violated than allowed
+  const auto same = [&](VectorXd& trial) {
+    // a peak's bound variable tight at the trial design (else a peak it lowers would leave the
+    // objective overstated, and one it raises show only as a violated row)
     program.polish(trial);
     const double f = program.objective(trial, nullptr);
     if (!(f <= objective + 1e-12 * std::max(std::abs(objective), 1.0)) ||
         !(constraint_violation(program, trial) <= allowed_violation)) {
-      continue;
+      return false;
     }
     out = trial;
     objective = std::min(objective, f);
+    return true;
+  };
+  const std::vector<int> first = program.counterweight_mass_variables();
+  const std::vector<double> reach = program.counterweight_reach();
+  for (std::size_t c = 0; c < first.size(); ++c) {
+    const int j = first[c];
+    if (!(out(j) > 0)) continue;
     std::string name = program.variable_names()[static_cast<std::size_t>(j)];
     if (const auto at = name.rfind(" mass"); at != std::string::npos) name.resize(at);
-    left_out.push_back(name);
+    VectorXd trial = out;
+    trial.segment(j, 3).setZero();
+    if (same(trial)) {
+      left_out.push_back(name);
+      continue;
+    }
+    // where the problem reads only its mass moment (its force, not its inertia: a shaking
+    // force alone), the same moment with the least mass: at distance_max (position variables)
+    if (reach.size() != first.size()) continue;
+    const double mass = out(j), at = std::hypot(out(j + 1), out(j + 2)), d = reach[c];
+    if (!(at > 0) || !(at < d * (1 - 1e-6))) continue;
+    trial = out;
+    trial(j) = mass * at / d;
+    trial.segment(j + 1, 2) *= d / at;
+    if (same(trial)) {
+      lighter.push_back("the " + name + " is moved out to its distance_max, " +
+                        text::digits(trial(j), 6) + " kg instead of " + text::digits(mass, 6) +
+                        " kg at the same mass moment");
+    }
   }
   if (said && !left_out.empty()) {
     std::string names;
@@ -592,6 +616,10 @@ VectorXd detail::without_needless_counterweights(const Program& program,
             " nothing the problem reads (objective and constraints the same without " +
             (left_out.size() == 1 ? "it" : "them") + ") and " +
             (left_out.size() == 1 ? "is" : "are") + " left out";
+  }
+  if (said && !lighter.empty()) {
+    *said += "; only the mass moment counts in the problem (objective and constraints the same)";
+    for (const std::string& l : lighter) *said += "; " + l;
   }
   return out;
 }

@@ -73,10 +73,11 @@ struct OptimizeOptions {
   double constraint_tolerance = 1e-9;  // feasibility of the reported optimum (scaled)
   bool check_gradients = false;        // compare analytic gradients with central differences first
   unsigned seed = 1;                   // global methods
-  /// Leave out of the optimum each counterweight that changes nothing the problem reads
-  /// (detail::without_needless_counterweights()). A Pareto front's points keep them: each point
-  /// starts from its neighbour's design, and from a counterweight without mass (on its pivot) a
-  /// local method has no gradient to grow it again where a tighter bound needs it.
+  /// Leave out of the optimum each counterweight that changes nothing the problem reads, and
+  /// move one the problem reads only by its mass moment out to its distance_max with the least
+  /// mass (detail::without_needless_counterweights()). A Pareto front's points keep them: each
+  /// point starts from its neighbour's design, and from a counterweight without mass (on its pivot)
+  /// a local method has no gradient to grow it again where a tighter bound needs it.
   bool leave_out_needless_counterweights = true;
   /// Empty when valid, else the first problem, its field one of "algorithm",
   /// "max_evaluations", "starts", "relative_tolerance", "constraint_tolerance"; e.g. text()

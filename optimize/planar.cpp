@@ -1399,6 +1399,12 @@ std::vector<double> PlanarNlp::metrics(const VectorXd& x) const {
 }
 
 std::vector<int> PlanarNlp::counterweight_mass_variables() const { return impl_->cw_var; }
+std::vector<double> PlanarNlp::counterweight_reach() const {
+  std::vector<double> out;
+  if (impl_->moments) return out;
+  for (const CounterweightVariables& c : impl_->p.counterweights) out.push_back(c.distance_max);
+  return out;
+}
 
 std::vector<double> PlanarNlp::peak_instants(const VectorXd& x, double within) const {
   const Impl& m = *impl_;

@@ -171,6 +171,7 @@ class PlanarNlp final : public Program {
   std::vector<int> vanishing_counterweight_variables(const Eigen::VectorXd& x,
                                                      double fraction) const override;
   std::vector<int> counterweight_mass_variables() const override;
+  std::vector<double> counterweight_reach() const override;
   Eigen::VectorXd within_envelopes(const Eigen::VectorXd& x) const override {
     return from_positions(to_positions(x));
   }

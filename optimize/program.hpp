@@ -95,6 +95,9 @@ class Program {
   /// The first variable of each counterweight, its mass (the next two are its position or its
   /// mass moment), in the problem's order. Default: none.
   virtual std::vector<int> counterweight_mass_variables() const { return {}; }
+  /// In position variables, each counterweight's distance_max [m], in the order of
+  /// counterweight_mass_variables(); empty in mass-moment variables. Default: empty.
+  virtual std::vector<double> counterweight_reach() const { return {}; }
   /// x with those counterweights taken away (their variables 0, the variables that only bound
   /// them set for it): put on the cone's apex itself. Default, and in position variables: x.
   virtual Eigen::VectorXd without_vanishing_counterweights(const Eigen::VectorXd& x,
