@@ -117,18 +117,18 @@ FreeNlp::Evaluation FreeNlp::evaluate(const VectorXd& x, bool with_gradient) con
   e.x = x;
   const core::SimulateOptions options = simulate_options();
   const core::FourBar model = design(x);
+  // the peaks the problem reads resolved (none without resolve_peaks: read_peaks_ is then all
+  // false, and these are the samples' metrics and gradients)
   if (!with_gradient) {
     const core::Trajectory t = simulate(model);
-    e.metrics = !t.ok()                  ? infinite_metrics()
-                : problem_.resolve_peaks ? core::metrics(model, t, options, &read_peaks_)
-                                         : core::metrics(t);
+    e.metrics = t.ok() ? core::metrics(model, t, options, &read_peaks_) : infinite_metrics();
   } else {
     const core::FreeSensitivities run = core::simulate_free_sensitivities(
         model, std::get<core::FreeScene>(problem_.scene), parameters_, options);
     e.gradient = MatrixXd::Zero(static_cast<Eigen::Index>(core::kMetricCount), n_);
     if (!run.trajectory.ok()) {
       e.metrics = infinite_metrics();
-    } else if (problem_.resolve_peaks) {
+    } else {
       core::PeakList peaks;
       e.metrics = core::metrics(model, run.trajectory, options, &read_peaks_, &peaks);
       // the others' peaks as metric_gradients(run) takes them: at their largest samples
@@ -136,9 +136,6 @@ FreeNlp::Evaluation FreeNlp::evaluate(const VectorXd& x, bool with_gradient) con
         if (!read_peaks_[k]) peaks.table[k] = core::Peak{};
       }
       e.gradient = core::metric_gradients(model, run, options, peaks) * parameter_jacobian(x);
-    } else {
-      e.metrics = core::metrics(run.trajectory);
-      e.gradient = core::metric_gradients(run) * parameter_jacobian(x);
     }
   }
   cached_ = e;

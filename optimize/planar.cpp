@@ -850,10 +850,8 @@ PlanarNlp::Evaluation PlanarNlp::simulated(const VectorXd& x, bool gradient) con
       MatrixXd dq(static_cast<Eigen::Index>(m.sensitivity_parameters.size()), m.n);
       for (std::size_t j = 0; j < m.sensitivity_parameters.size(); ++j)
         dq.row(static_cast<Eigen::Index>(j)) = J.row(m.sensitivity_parameters[j]);
-      e.gradient =
-          (m.read_peaks.empty() ? cp::metric_gradients(m.table, run)
-                                : cp::metric_gradients(model, m.p.simulate, m.table, run, peaks)) *
-          dq;
+      // the peaks not read (every one without resolve_peaks) at their largest samples
+      e.gradient = cp::metric_gradients(model, m.p.simulate, m.table, run, peaks) * dq;
     }
   }
   m.cached = e;

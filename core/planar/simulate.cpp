@@ -928,6 +928,32 @@ FreeState free_state(const Model& model, const Trajectory& run, std::size_t i) {
   return out;
 }
 
+namespace {
+
+// A continuation of a free run from `from` to t: the workspace at the state's angles and positions
+// (every evaluation continues the last), on the reduced route the side of the limit determinant
+// the run keeps (as the run takes it at its start), and the integration's problem from from.t
+// (m's route). None where the state cannot be evaluated.
+std::optional<integrators::Problem> continuation(Motion& m, const FreeState& from, double t,
+                                                 const SimulateOptions& options) {
+  Workspace& ws = *m.ws;
+  ws.instant.angle = from.angle;
+  ws.instant.x = from.x;
+  m.cache = from.x;
+  const bool dae = m.route == Route::kDae;
+  if (!dae) {
+    ++m.evaluations;
+    if (!reduced_state(m, from.t, from.y.data())) return std::nullopt;
+    m.root_sign = normalised_determinant(ws) > 0 ? 1.0 : -1.0;
+  }
+  integrators::Problem problem = free_problem(options, from.y, t, m, dae ? dae_rhs : reduced_rhs);
+  problem.t0 = from.t;
+  if (!dae) problem.root = reduced_root;
+  return problem;
+}
+
+}  // namespace
+
 std::optional<FreeState> free_state_from(const Model& model, const SimulateOptions& options,
                                          const FreeState& from, double t, Series& row) {
   const bool dae = options.route == Route::kDae;
@@ -939,23 +965,15 @@ std::optional<FreeState> free_state_from(const Model& model, const SimulateOptio
   }
   Workspace ws(model);
   Motion m = motion(model, ws, options.route, options);
+  FreeState out{t, from.y, {}, {}};
   // the angles and positions continue from the state's (every evaluation continues the last)
   ws.instant.angle = from.angle;
   ws.instant.x = from.x;
   m.cache = from.x;
-  FreeState out{t, from.y, {}, {}};
   if (t > from.t) {
-    if (!dae) {
-      // the side of the limit determinant the run keeps, as the run takes it at its start
-      ++m.evaluations;
-      if (!reduced_state(m, from.t, from.y.data())) return std::nullopt;
-      m.root_sign = normalised_determinant(ws) > 0 ? 1.0 : -1.0;
-    }
-    integrators::Problem problem =
-        free_problem(options, from.y, t, m, dae ? dae_rhs : reduced_rhs);
-    problem.t0 = from.t;
-    if (!dae) problem.root = reduced_root;
-    integrators::Integration integration(problem);
+    const std::optional<integrators::Problem> problem = continuation(m, from, t, options);
+    if (!problem) return std::nullopt;
+    integrators::Integration integration(*problem);
     if (integration.advance(t, true) != integrators::Integration::Outcome::kReached) {
       return std::nullopt;
     }
@@ -1050,16 +1068,9 @@ std::optional<InstantDerivatives> free_derivatives_at(const Model& model,
   m.varied = sens.model;
   m.parameters = sens.parameters.data();
   m.applied = sens.parameters;
-  // the angles and positions continue from the sample's, on its side of the limit determinant
-  ws.instant.angle = from.angle;
-  ws.instant.x = from.x;
-  m.cache = from.x;
-  ++m.evaluations;
-  if (!reduced_state(m, from.t, from.y.data())) return std::nullopt;
-  m.root_sign = normalised_determinant(ws) > 0 ? 1.0 : -1.0;
-  integrators::Problem problem = free_problem(options, from.y, t, m, reduced_rhs);
-  problem.t0 = from.t;
-  problem.root = reduced_root;
+  std::optional<integrators::Problem> continued = continuation(m, from, t, options);
+  if (!continued) return std::nullopt;
+  integrators::Problem& problem = *continued;
   problem.sensitivities = {sens.parameters.data(), sens.which, sens.scales, sens.tolerance, {}};
   for (std::size_t j = 0; j < count; ++j) {
     const auto first = run.state.begin() + static_cast<std::ptrdiff_t>((i * count + j) * size);

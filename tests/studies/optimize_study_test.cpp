@@ -4,9 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 
 #include "balance/counterweight.hpp"
@@ -123,19 +121,13 @@ TEST(OptimizeStudy, DesignProblemAndOptimizedStudyComeFromTheStudy) {
 // from the same design (their neighbour missed their tighter bound), until each started from its
 // neighbour brought within its bound (detail::feasible_towards()).
 TEST(OptimizeStudy, AParetoFrontsPointsAreEachBoundsOptimum) {
-  std::ifstream in(bd::testing::example_path("weighted-counterweights.yaml"));
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string yaml = text.str();
-  auto replace = [&yaml](const std::string& from, const std::string& to) {
-    const auto at = yaml.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    yaml.replace(at, from.size(), to);
-  };
-  replace("  samples: 360", "  samples: 36");
-  replace("  max_evaluations: 2000", "  max_evaluations: 2000\n  pareto: {first: Msh_rms, "
-                                     "second: tau_max, points: 4}");
-  const Study study = parse_study(yaml, "weighted.yaml");
+  const Study study = parse_study(
+      bd::testing::edited_example("weighted-counterweights.yaml",
+                                  {{"  samples: 360", "  samples: 36"},
+                                   {"  max_evaluations: 2000",
+                                    "  max_evaluations: 2000\n  pareto: {first: Msh_rms, "
+                                    "second: tau_max, points: 4}"}}),
+      "weighted.yaml");
   const optimize::DesignProblem problem = design_problem(study);
   optimize::DesignProblem alone = problem;
   alone.objective = {optimize::Term{optimize::Metric::kMshRms, 1.0}};
@@ -172,17 +164,12 @@ TEST(OptimizeStudy, AParetoFrontsPointsAreEachBoundsOptimum) {
 // weighted example under RA0_max <= 0.6 x original, where SLSQP ends with the rocker's disc at
 // its mass's lower bound, and the console printed "9.66396e-36 kg ... radius 1.4e-19 m".
 TEST(OptimizeStudy, ACounterweightLeftAtNothingIsExactlyNone) {
-  std::ifstream in(bd::testing::example_path("weighted-counterweights.yaml"));
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string yaml = text.str();
-  for (const auto& [from, to] : {std::pair<std::string, std::string>{"  samples: 360", "  samples: 36"},
-                                 {"    tau_rms: 1.0\n", "    tau_rms: 1.0\n  constraints: {RA0_max: 0.6}\n"}}) {
-    const auto at = yaml.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    yaml.replace(at, from.size(), to);
-  }
-  const Study study = parse_study(yaml, "weighted.yaml");
+  const Study study = parse_study(
+      bd::testing::edited_example(
+          "weighted-counterweights.yaml",
+          {{"  samples: 360", "  samples: 36"},
+           {"    tau_rms: 1.0\n", "    tau_rms: 1.0\n  constraints: {RA0_max: 0.6}\n"}}),
+      "weighted.yaml");
   const optimize::OptimizeResult r =
       optimize::optimize(design_problem(study), study.optimize->options);
   ASSERT_TRUE(r.ok()) << r.message;
@@ -200,19 +187,13 @@ TEST(OptimizeStudy, ACounterweightLeftAtNothingIsExactlyNone) {
 // too small for force balance) is the ratio the tables show, both resolved between the samples, and
 // summary.json says how the peaks were bounded and at which added crank angles.
 TEST(OptimizeStudy, ResolvedPeaksAreWhatTheTablesShow) {
-  std::ifstream in(bd::testing::example_path("weighted-counterweights.yaml"));
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string yaml = text.str();
-  for (const auto& [from, to] :
-       {std::pair<std::string, std::string>{"  samples: 360", "  samples: 24"},
-        {"    Fsh_rms: 1.0\n    Msh_rms: 1.0\n    tau_rms: 1.0\n",
-         "    Fsh_max: 1.0\n  constraints: {added_mass: 2.0}\n  peaks: resolved\n"}}) {
-    const auto at = yaml.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    yaml.replace(at, from.size(), to);
-  }
-  const Study study = parse_study(yaml, "weighted.yaml");
+  const Study study = parse_study(
+      bd::testing::edited_example(
+          "weighted-counterweights.yaml",
+          {{"  samples: 360", "  samples: 24"},
+           {"    Fsh_rms: 1.0\n    Msh_rms: 1.0\n    tau_rms: 1.0\n",
+            "    Fsh_max: 1.0\n  constraints: {added_mass: 2.0}\n  peaks: resolved\n"}}),
+      "weighted.yaml");
   ASSERT_TRUE(study.optimize->resolve_peaks);
   namespace fs = std::filesystem;
   const fs::path out = fs::path(BD_BINARY_DIR) / "test-output" / "optimize-study" / "resolved";

@@ -25,6 +25,7 @@
 #include "tests/support/csv.hpp"
 #include "tests/support/json_view.hpp"
 #include "tests/support/models.hpp"
+#include "tests/support/studies.hpp"
 #include "tests/support/text.hpp"
 
 namespace bd::studies {
@@ -598,19 +599,12 @@ TEST_F(RunnerTest, OptimizedYamlLoadsBackToTheOptimumAndReproducesItsRun) {
 // shaking force, none pays: the original design is the optimum) writes none as data, only the
 // header's words; before, optimized.yaml listed both with mass 0 at a position.
 TEST_F(RunnerTest, AnOptimumWithoutCounterweightsWritesNone) {
-  std::ifstream in(std::string(BD_SOURCE_DIR "/studies/examples/weighted-counterweights.yaml"));
-  std::stringstream file;
-  file << in.rdbuf();
-  std::string yaml = file.str();
-  for (const auto& [from, to] :
-       {std::pair<std::string, std::string>{"  samples: 360", "  samples: 36"},
-        {"    Fsh_rms: 1.0\n    Msh_rms: 1.0\n    tau_rms: 1.0\n",
-         "    Fsh_max: 1.0\n    added_mass: 3.0\n"}}) {
-    const auto at = yaml.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    yaml.replace(at, from.size(), to);
-  }
-  const Study study = parse_study(yaml, "apex.yaml");
+  const Study study = parse_study(
+      bd::testing::edited_example("weighted-counterweights.yaml",
+                                  {{"  samples: 360", "  samples: 36"},
+                                   {"    Fsh_rms: 1.0\n    Msh_rms: 1.0\n    tau_rms: 1.0\n",
+                                    "    Fsh_max: 1.0\n    added_mass: 3.0\n"}}),
+      "apex.yaml");
   const RunResult r = run_study(study, dir_ / "apex");
   ASSERT_TRUE(r.ok());
   const OptimizedRun& o = *r.optimized;

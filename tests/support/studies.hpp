@@ -1,7 +1,11 @@
 #pragma once
 // Test support: study-file texts the tests share.
 #include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace bd::testing {
@@ -9,6 +13,22 @@ namespace bd::testing {
 /// The path of an example study in the source tree, e.g. "watt-sixbar.yaml".
 inline std::string example_path(const std::string& file) {
   return std::string(BD_SOURCE_DIR) + "/studies/examples/" + file;
+}
+
+/// The text of the example study `file` with each edit's first text replaced, once, by its
+/// second. Throws std::runtime_error where a text to replace is not found (the example changed).
+inline std::string edited_example(const std::string& file,
+                                  const std::vector<std::pair<std::string, std::string>>& edits) {
+  std::ifstream in(example_path(file));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  for (const auto& [from, to] : edits) {
+    const auto at = yaml.find(from);
+    if (at == std::string::npos) throw std::runtime_error(file + " has no '" + from + "' to edit");
+    yaml.replace(at, from.size(), to);
+  }
+  return yaml;
 }
 
 /// The RMS over samples of the magnitude of (x, y).
