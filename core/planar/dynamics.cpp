@@ -5,8 +5,9 @@
 #include <limits>
 
 #include "core/number_text.hpp"
-#include "core/polar_angle.hpp"
+#include "core/planar/blocks.hpp"
 #include "core/planar/system.hpp"
+#include "core/polar_angle.hpp"
 
 namespace bd::core::planar {
 
@@ -330,6 +331,7 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
                                            const std::vector<double>& inputs) {
   const System& s = model.system();
   Instant& in = ws.instant;
+  ws.by_blocks = false;
   if (s.rows != s.n) {
     return Unexpected<PlanarError>(
         PlanarError{PlanarError::Kind::kMobility, std::to_string(s.inputs.size()) + " inputs for " +
@@ -491,6 +493,16 @@ void multiply(const MatrixXd& M, const VectorXd& x, VectorXd& y) {
   }
 }
 
+// x = G⁻¹ b with the factorisation of the last position: the whole system's (ws.lu) or the
+// blocks' (core/planar/blocks.hpp)
+void solve_constraints(const Model& model, Workspace& ws, const VectorXd& b, VectorXd& x) {
+  if (ws.by_blocks) {
+    detail::block_solve(model, ws, b, x);
+  } else {
+    ws.lu.solve(b, x);
+  }
+}
+
 // the node velocities for the inputs' rates, with the factorisation at the current position
 void velocities(const Model& model, Workspace& ws, const std::vector<double>& rates) {
   const System& s = model.system();
@@ -499,7 +511,7 @@ void velocities(const Model& model, Workspace& ws, const std::vector<double>& ra
     const double r = rates[static_cast<std::size_t>(in.input)];
     ws.rhs[in.row] = in.angle ? in.length * r : r;
   }
-  ws.lu.solve(ws.rhs, ws.qd);
+  solve_constraints(model, ws, ws.rhs, ws.qd);
   detail::node_rates_from(s, ws.qd, ws.instant.v);
   copy_values(rates, ws.instant.input_rate);
 }
@@ -734,7 +746,11 @@ Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t) 
   ws.rhs -= ws.F;
   // Gᵀ λ = rhs, in place
   ws.lambda = ws.rhs;
-  ws.lu.solve_transpose(ws.lambda);
+  if (ws.by_blocks) {
+    detail::block_solve_transpose(model, ws, ws.lambda);
+  } else {
+    ws.lu.solve_transpose(ws.lambda);
+  }
   for (const System::InputRow& ir : s.inputs) {
     in.effort[static_cast<std::size_t>(ir.input)] =
         ir.angle ? ws.lambda[ir.row] * ir.length : ws.lambda[ir.row];
@@ -765,7 +781,7 @@ Expected<bool, PlanarError> inverse_dynamics(const Model& model, Workspace& ws, 
     const double z = accelerations[static_cast<std::size_t>(in.input)];
     ws.rhs[in.row] += in.angle ? in.length * z : z;
   }
-  ws.lu.solve(ws.rhs, ws.qdd);
+  solve_constraints(model, ws, ws.rhs, ws.qdd);
   copy_values(accelerations, ws.instant.input_acceleration);
   return finish(model, ws, t);
 }
@@ -779,10 +795,19 @@ Expected<bool, PlanarError> forward_dynamics(const Model& model, Workspace& ws, 
   // q̇ = T ż: T's columns solve G T = E (E the input rows, scaled as the rows are)
   ws.MT.setZero(s.n, dof);  // the input rows' unit columns, scaled as the rows are
   for (const System::InputRow& in : s.inputs) ws.MT(in.row, in.input) = in.angle ? in.length : 1.0;
-  ws.lu.solve(ws.MT, ws.T);
+  if (ws.by_blocks) {
+    ws.T.resize(s.n, dof);
+    for (int k = 0; k < dof; ++k) {
+      ws.rhs = ws.MT.col(k);  // (ws.rhs is written whole below)
+      detail::block_solve(model, ws, ws.rhs, ws.step);
+      ws.T.col(k) = ws.step;
+    }
+  } else {
+    ws.lu.solve(ws.MT, ws.T);
+  }
   // q̈ = T z̈ + c with G c = -γ
   detail::constraint_bias(s, ws.instant.x, ws.instant.v, s.rows, ws.gamma);
-  ws.lu.solve(ws.gamma, ws.c);  // c = -G⁻¹ γ, the sign applied below
+  solve_constraints(model, ws, ws.gamma, ws.c);  // c = -G⁻¹ γ, the sign applied below
   detail::applied_forces(s, ws.instant.x, ws.instant.v, nullptr, ws.F);
   ws.MT.noalias() = s.M * ws.T;
   ws.reduced.noalias() = ws.T.transpose() * ws.MT;

@@ -135,6 +135,14 @@ class Workspace {
   Eigen::LDLT<Eigen::MatrixXd> ldlt;
   std::vector<Vec2> target;  // the inputs of the last position solve (detail::input_targets)
   std::vector<Vec2> on_link;  // force recovery: per link and node, the force from the joint
+  // the block-triangular route (core/planar/blocks.hpp): whether the last position was placed
+  // by it (then G is the Jacobian there and the blocks are factorised, lu is not), per block
+  // its branch, its determinant (two rows) or factorisation, and scratch
+  bool by_blocks = false;
+  std::vector<double> block_sign, block_det;
+  std::vector<detail::SmallLu> block_lu;
+  Eigen::MatrixXd block_matrix;
+  Eigen::VectorXd block_rhs, block_x, block_lambda;
 };
 
 /// Solves the positions with the inputs at `inputs` by Newton's method from `guess` (node

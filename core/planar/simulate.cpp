@@ -10,6 +10,7 @@
 #include "core/input_error.hpp"
 #include "core/integrators.hpp"
 #include "core/number_text.hpp"
+#include "core/planar/blocks.hpp"
 #include "core/planar/system.hpp"
 
 namespace bd::core::planar {
@@ -260,25 +261,30 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
   // only through a singular position, where the branches meet
   auto branch = [&ws]() { return ws.lu.determinant() < 0 ? -1 : 1; };
   const int drawn_branch = branch();
+  // the positions block by block where the linkage allows (core/planar/blocks.hpp): closed forms
+  // for its dyads, cranks, guides and further nodes need no guess; the general route below takes
+  // any sample they cannot answer to round-off (a dead centre near)
+  detail::prime_blocks(model, ws);
+  const bool closed = system.blocks.usable && system.blocks.closed;
   double t_prev = 0;
   for (long long i = 0; i < rows; ++i) {
     const double t = times.at(i);
     for (std::size_t k = 0; k < z.size(); ++k) z[k] = start[k] + scene.speeds[k] * t;
+    const double h = t - t_prev;
     // The guess: from the second sample on, the quintic through the last two samples' positions,
     // velocities and accelerations (Hermite), extrapolated one step (the samples are evenly
     // spaced): its error is h⁶ x⁽⁶⁾ / 90, so that at 360 samples per turn the chord method
     // closes in two or three steps (2.3 on average over the paper four-bar's revolution, against
     // 6 from the third-order Taylor guess). The second sample continues the first to second
-    // order.
+    // order. A plan of closed forms reads no guess.
     if (i > 0) {
-      const double h = t - t_prev;
       const Instant& at = ws.instant;
-      if (i == 1) {
+      if (i == 1 && !closed) {
         for (int n : system.moving) {
           const std::size_t k = static_cast<std::size_t>(n);
           guess[k] = at.x[k] + h * (at.v[k] + h / 2 * at.a[k]);
         }
-      } else {
+      } else if (!closed) {
         // p(1) = 32 p0 - 31 p1 - 16 p0' - 14 p1' + 4 p0'' - 2 p1'' in the step s = (t - t0)/h,
         // p' = h v, p'' = h² a (index 0 the last sample, 1 the one before), written as
         // p0 + 31 (p0 - p1) so that the large coefficients act on a difference
@@ -296,18 +302,29 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
       std::swap(v_previous, ws.instant.v);
       std::swap(a_previous, ws.instant.a);
     }
-    auto ok = solve_position(model, ws, guess, z);
-    if (ok && i > 0 && branch() != drawn_branch) {
-      // near a singular position the prediction can overshoot onto another branch (the rates
-      // grow without bound there): continue from the previous sample's positions in small steps
-      constexpr int kSubsteps = 16;
-      guess = previous;
-      for (int j = 1; j <= kSubsteps && ok; ++j) {
-        for (std::size_t k = 0; k < z.size(); ++k)
-          z_step[k] = z_previous[k] + (z[k] - z_previous[k]) * j / kSubsteps;
-        ok = solve_position(model, ws, guess, z_step);
-        guess = ws.instant.x;
+    Expected<bool, PlanarError> ok = true;
+    if (!detail::place_by_blocks(model, ws, guess, z)) {
+      if (closed && i > 0) {  // the general route needs a guess: the last sample's, to second order
+        for (int n : system.moving) {
+          const std::size_t k = static_cast<std::size_t>(n);
+          guess[k] = previous[k] + h * (v_previous[k] + h / 2 * a_previous[k]);
+        }
       }
+      ok = solve_position(model, ws, guess, z);
+      if (ok && i > 0 && branch() != drawn_branch) {
+        // near a singular position the prediction can overshoot onto another branch (the rates
+        // grow without bound there): continue from the previous sample's positions in small
+        // steps
+        constexpr int kSubsteps = 16;
+        guess = previous;
+        for (int j = 1; j <= kSubsteps && ok; ++j) {
+          for (std::size_t k = 0; k < z.size(); ++k)
+            z_step[k] = z_previous[k] + (z[k] - z_previous[k]) * j / kSubsteps;
+          ok = solve_position(model, ws, guess, z_step);
+          guess = ws.instant.x;
+        }
+      }
+      if (ok) detail::prime_blocks(model, ws);
     }
     if (ok) ok = inverse_dynamics(model, ws, t, scene.speeds, zero);
     std::swap(z_previous, z);  // z is written whole at the next sample

@@ -245,6 +245,7 @@ System::System(const Linkage& l) : linkage(l) {
   rows = add_input_rows(*this, structural_rows);
   add_masses_and_loads(*this);
   add_shafts(*this);
+  blocks = plan_blocks(*this);
 }
 
 void set_mass_parameters(System& s, const double* pi) {

@@ -35,6 +35,39 @@ using Eigen::VectorXd;
 /// Positions, velocities or accelerations of every node (ground nodes included, fixed there).
 using NodeVectors = std::vector<Vec2>;
 
+/// One diagonal block of the system in block-triangular form (core/planar/blocks.hpp): its rows
+/// and the coordinates they determine.
+struct Block {
+  enum class Kind {
+    kGeneral,  // Newton's method on the block's rows
+    kCrank,    // an angle input and its link's element from a known end A: P = A ± l u
+    kDyad,     // two elements from known nodes A and B meet at P: two circles
+    kGuide,    // an element from a known node A meets a frame guide at P: a circle and a line
+    kSlide,    // a slide input on a frame guide: P = from + s u
+    kRigid,    // a further node of a link whose element nodes are known: P = Wp p + Wq q
+  };
+  Kind kind = Kind::kGeneral;
+  int first{}, size{};  // into BlockPlan::rows and ::coords
+  int node = -1;        // the closed forms: the node placed
+  int a = -1, b = -1;   // the known nodes it is placed from (dyad: both; crank, guide: a)
+  double ra{}, rb{};    // dyad: |P - A|, |P - B|; crank, guide: |P - A| (crank: signed, ± l)
+  int index = -1;       // crank, slide: the input; guide: the slider; rigid: the rigid entry
+};
+
+struct BlockPlan {
+  /// The rows matched one to one with the coordinates (false for a linkage whose inputs do not
+  /// match its mobility structurally, or without moving nodes): then there are no blocks.
+  bool usable = false;
+  bool closed = false;            // every block has a closed form (no Newton's method, no guess)
+  std::vector<int> rows, coords;  // the blocks' rows and coordinates, block after block
+  std::vector<Block> blocks;      // in the order of solution
+  /// Per entry of `rows`: the coordinates of earlier blocks the row involves, in
+  /// row_deps[row_first[i]] up to row_deps[row_first[i + 1]] (the forward substitution's terms);
+  /// per entry of `coords`: the rows of later blocks that involve the coordinate (the backward
+  /// substitution's), in coord_deps[coord_first[j]] up to coord_deps[coord_first[j + 1]].
+  std::vector<int> row_first, row_deps, coord_first, coord_deps;
+};
+
 /// The compiled equations of one linkage.
 struct System {
   Linkage linkage;
@@ -98,10 +131,15 @@ struct System {
   };
   std::vector<ShaftRef> shafts;
   MatrixXd M;                     // n x n, constant
+  BlockPlan blocks;               // the rows and coordinates in block-triangular form
   std::vector<double> node_mass;  // per node: point masses there [kg]
 
   explicit System(const Linkage& linkage);
 };
+
+/// The block-triangular form of a compiled system (System's constructor sets System::blocks), from
+/// the rows' structure.
+BlockPlan plan_blocks(const System& s);
 
 /// Replaces the links' and point masses' mass parameters by `pi` (core/planar/model.hpp,
 /// mass_parameters()' layout) in place: the element masses, the mass matrix and the weights.

@@ -310,6 +310,32 @@ inline core::Series reference_table(const cp::Model& model, const Glue& g,
 }
 
 // ---------------------------------------------------------------------------------------------
+// The engine's general route along a driven scene: each instant evaluated by the public
+// per-instant API exactly as the scene is defined (inputs at start + speed t, constant speeds),
+// its position by Newton's method continued from the previous instant (cp::solve_position), then
+// its inverse dynamics; each instant is handed to `use`. Stops at the first failure (a test
+// failure).
+
+template <class Use>
+void general_route(const cp::Model& model, const std::vector<double>& speeds,
+                   const std::vector<double>& times, Use use) {
+  cp::Workspace ws(model);
+  const std::vector<double> start = cp::drawn_inputs(model);
+  EXPECT_TRUE(cp::assemble(model, ws, start));
+  std::vector<double> z(start.size()), zero(start.size(), 0.0);
+  for (double t : times) {
+    for (std::size_t k = 0; k < z.size(); ++k) z[k] = start[k] + speeds[k] * t;
+    const std::vector<Vec2> guess = ws.instant.x;
+    auto ok = cp::solve_position(model, ws, guess, z);
+    if (ok) ok = cp::inverse_dynamics(model, ws, t, speeds, zero);
+    EXPECT_TRUE(ok) << (ok ? "" : ok.error().detail);
+    if (!ok) break;
+    EXPECT_FALSE(ws.by_blocks);
+    use(ws.instant);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
 // What an Instant has beyond the table: node velocities and accelerations, the inputs' values,
 // rates and accelerations (as columns named so that compare_tables knows their families:
 // theta_in_/omega_in_/alpha_in_ for an angle input, s_in_/v_in_/a_in_ for a slide input).

@@ -36,19 +36,8 @@ core::Series engine_instants(const cp::Model& model, const std::vector<double>& 
                              const std::vector<double>& times) {
   core::Series out;
   out.columns = instant_columns(model);
-  cp::Workspace ws(model);
-  const std::vector<double> start = cp::drawn_inputs(model);
-  EXPECT_TRUE(cp::assemble(model, ws, start));
-  std::vector<double> z(start.size()), zero(start.size(), 0.0);
-  for (double t : times) {
-    for (std::size_t k = 0; k < z.size(); ++k) z[k] = start[k] + speeds[k] * t;
-    const std::vector<Vec2> guess = ws.instant.x;
-    auto ok = cp::solve_position(model, ws, guess, z);
-    if (ok) ok = cp::inverse_dynamics(model, ws, t, speeds, zero);
-    EXPECT_TRUE(ok) << (ok ? "" : ok.error().detail);
-    if (!ok) break;
-    append_instant(model, ws.instant, out);
-  }
+  general_route(model, speeds, times,
+                [&](const cp::Instant& in) { append_instant(model, in, out); });
   return out;
 }
 

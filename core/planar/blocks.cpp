@@ -1,0 +1,467 @@
+#include "core/planar/blocks.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/planar/dynamics.hpp"
+
+namespace bd::core::planar::detail {
+
+namespace {
+
+// a block whose rows meet at a sine below this (its determinant over its rows' norms), or whose
+// pivots are further apart, is left to the general route, which decides whether the position is
+// singular (dynamics.cpp: the same figure decides when the condition estimate is needed there)
+constexpr double kWellConditioned = 1e-2;
+// Newton's method on a general block: as the general route's (dynamics.cpp)
+constexpr double kNewtonStep = 1e-14;
+constexpr int kBlockIterations = 8;
+
+const Vec2& at(const NodeVectors& x, int node) { return x[static_cast<std::size_t>(node)]; }
+
+// the moving nodes' coordinates a row involves
+std::vector<int> row_coordinates(const System& s, const NodeVectors& x, int row) {
+  GradientEntry entries[3];
+  const int count = row_gradient(s, x, row, entries);
+  std::vector<int> out;
+  for (int j = 0; j < count; ++j) {
+    const int c = s.coord[static_cast<std::size_t>(entries[j].node)];
+    if (c < 0 || std::find(out.begin(), out.end(), c) != out.end()) continue;
+    out.push_back(c);
+    out.push_back(c + 1);
+  }
+  return out;
+}
+
+// Kuhn's augmenting path from row r
+bool augment(int r, const std::vector<std::vector<int>>& adjacent, std::vector<int>& row_of,
+             std::vector<char>& seen) {
+  for (int c : adjacent[static_cast<std::size_t>(r)]) {
+    if (seen[static_cast<std::size_t>(c)]) continue;
+    seen[static_cast<std::size_t>(c)] = 1;
+    const int other = row_of[static_cast<std::size_t>(c)];
+    if (other < 0 || augment(other, adjacent, row_of, seen)) {
+      row_of[static_cast<std::size_t>(c)] = r;
+      return true;
+    }
+  }
+  return false;
+}
+
+// Tarjan's strongly connected components of the rows, row r depending on the row matched to
+// each coordinate it involves; a component is emitted after every component it depends on
+struct Components {
+  const std::vector<std::vector<int>>& adjacent;
+  const std::vector<int>& row_of;
+  std::vector<int> index, low, stack;
+  std::vector<char> on_stack;
+  std::vector<std::vector<int>> out;
+  int counter = 0;
+
+  void visit(int r) {
+    const std::size_t u = static_cast<std::size_t>(r);
+    index[u] = low[u] = counter++;
+    stack.push_back(r);
+    on_stack[u] = 1;
+    for (int c : adjacent[u]) {
+      const int w = row_of[static_cast<std::size_t>(c)];
+      const std::size_t v = static_cast<std::size_t>(w);
+      if (index[v] < 0) {
+        visit(w);
+        low[u] = std::min(low[u], low[v]);
+      } else if (on_stack[v]) {
+        low[u] = std::min(low[u], index[v]);
+      }
+    }
+    if (low[u] != index[u]) return;
+    std::vector<int> component;
+    int w = -1;
+    do {
+      w = stack.back();
+      stack.pop_back();
+      on_stack[static_cast<std::size_t>(w)] = 0;
+      component.push_back(w);
+    } while (w != r);
+    std::sort(component.begin(), component.end());
+    out.push_back(std::move(component));
+  }
+};
+
+// the closed form of a block of two rows that place one node, if it has one
+void classify(const System& s, const std::vector<int>& node_of, Block& b,
+              const std::vector<int>& rows, const std::vector<int>& coords) {
+  if (b.size != 2) return;
+  const int c0 = coords[static_cast<std::size_t>(b.first)];
+  const int c1 = coords[static_cast<std::size_t>(b.first) + 1];
+  if (c1 != c0 + 1 || c0 % 2 != 0) return;
+  const int P = node_of[static_cast<std::size_t>(c0)];
+  using K = System::RowRef::Kind;
+  const System::RowRef r0 =
+      s.row_ref[static_cast<std::size_t>(rows[static_cast<std::size_t>(b.first)])];
+  const System::RowRef r1 =
+      s.row_ref[static_cast<std::size_t>(rows[static_cast<std::size_t>(b.first) + 1])];
+  // the other end of element k from P, or -1
+  auto other_end = [&](int k) {
+    const System::ElementRow& e = s.elements[static_cast<std::size_t>(k)];
+    return e.p == P ? e.q : e.q == P ? e.p : -1;
+  };
+  auto set = [&](Block::Kind kind, int a, int bb, double ra, double rb, int index) {
+    b.kind = kind;
+    b.node = P;
+    b.a = a;
+    b.b = bb;
+    b.ra = ra;
+    b.rb = rb;
+    b.index = index;
+  };
+  if (r0.kind == K::kElement && r1.kind == K::kElement) {
+    const int A = other_end(r0.index), B = other_end(r1.index);
+    if (A < 0 || B < 0 || A == B) return;
+    set(Block::Kind::kDyad, A, B, s.elements[static_cast<std::size_t>(r0.index)].length,
+        s.elements[static_cast<std::size_t>(r1.index)].length, -1);
+    return;
+  }
+  const System::RowRef* element = r0.kind == K::kElement   ? &r0
+                                  : r1.kind == K::kElement ? &r1
+                                                           : nullptr;
+  const System::RowRef& other = element == &r0 ? r1 : r0;
+  if (element != nullptr && other.kind == K::kInput) {
+    const System::InputRow& in = s.inputs[static_cast<std::size_t>(other.index)];
+    const System::ElementRow& e = s.elements[static_cast<std::size_t>(element->index)];
+    if (!in.angle || in.p != e.p || in.q != e.q || other_end(element->index) < 0) return;
+    // the input's angle is the direction p -> q
+    set(Block::Kind::kCrank, other_end(element->index), -1, P == e.q ? e.length : -e.length, 0,
+        in.input);
+    return;
+  }
+  if (element != nullptr && other.kind == K::kSlider) {
+    const System::SliderRow& sl = s.sliders[static_cast<std::size_t>(other.index)];
+    const int A = other_end(element->index);
+    if (sl.on_link || sl.node != P || A < 0) return;
+    set(Block::Kind::kGuide, A, -1, s.elements[static_cast<std::size_t>(element->index)].length, 0,
+        other.index);
+    return;
+  }
+  if (r0.kind == K::kSlider && r1.kind == K::kInput) {
+    const System::SliderRow& sl = s.sliders[static_cast<std::size_t>(r0.index)];
+    const System::InputRow& in = s.inputs[static_cast<std::size_t>(r1.index)];
+    if (sl.on_link || sl.node != P || in.angle || in.slider != r0.index) return;
+    set(Block::Kind::kSlide, -1, -1, 0, 0, in.input);
+    return;
+  }
+  if (r0.kind == K::kRigid && r1.kind == K::kRigid && r0.index == r1.index &&
+      s.rigid[static_cast<std::size_t>(r0.index)].node == P) {
+    set(Block::Kind::kRigid, -1, -1, 0, 0, r0.index);
+  }
+}
+
+// the side of the line A -> B on which P lies (dyad), or of the foot of A on the guide (guide)
+double side(const System& s, const Block& b, const NodeVectors& x) {
+  const Vec2& P = at(x, b.node);
+  const Vec2& A = at(x, b.a);
+  if (b.kind == Block::Kind::kDyad) return cross(at(x, b.b) - A, P - A) < 0 ? -1.0 : 1.0;
+  const System::SliderRow& sl = s.sliders[static_cast<std::size_t>(b.index)];
+  return sl.unit.dot(P - A) < 0 ? -1.0 : 1.0;
+}
+
+// the block's matrix, rows x coordinates, from the whole Jacobian
+void block_matrix(const BlockPlan& plan, const Block& b, const Eigen::MatrixXd& G,
+                  Eigen::MatrixXd& out) {
+  out.resize(b.size, b.size);
+  for (int i = 0; i < b.size; ++i) {
+    for (int j = 0; j < b.size; ++j) {
+      out(i, j) = G(plan.rows[static_cast<std::size_t>(b.first + i)],
+                    plan.coords[static_cast<std::size_t>(b.first + j)]);
+    }
+  }
+}
+
+// a two-row block's determinant over its rows' norms: the sine at which they meet
+double two_row_sine(double a, double b, double c, double d) {
+  const double n = std::sqrt((a * a + b * b) * (c * c + d * d));
+  return n > 0 ? (a * d - b * c) / n : 0.0;
+}
+
+}  // namespace
+
+BlockPlan plan_blocks(const System& s) {
+  BlockPlan plan;
+  if (s.rows != s.n || s.n == 0) return plan;
+  NodeVectors x;
+  for (const Node& n : s.linkage.nodes) x.push_back(n.position);
+  std::vector<std::vector<int>> adjacent(static_cast<std::size_t>(s.rows));
+  for (int r = 0; r < s.rows; ++r) adjacent[static_cast<std::size_t>(r)] = row_coordinates(s, x, r);
+  std::vector<int> row_of(static_cast<std::size_t>(s.n), -1);
+  for (int r = 0; r < s.rows; ++r) {
+    std::vector<char> seen(static_cast<std::size_t>(s.n), 0);
+    if (!augment(r, adjacent, row_of, seen)) return plan;
+  }
+  std::vector<int> coord_of(static_cast<std::size_t>(s.rows), -1);
+  for (int c = 0; c < s.n; ++c)
+    coord_of[static_cast<std::size_t>(row_of[static_cast<std::size_t>(c)])] = c;
+  Components tarjan{adjacent, row_of, {}, {}, {}, {}, {}, 0};
+  tarjan.index.assign(static_cast<std::size_t>(s.rows), -1);
+  tarjan.low.assign(static_cast<std::size_t>(s.rows), -1);
+  tarjan.on_stack.assign(static_cast<std::size_t>(s.rows), 0);
+  for (int r = 0; r < s.rows; ++r) {
+    if (tarjan.index[static_cast<std::size_t>(r)] < 0) tarjan.visit(r);
+  }
+  std::vector<int> node_of(static_cast<std::size_t>(s.n), -1);
+  for (int i : s.moving) {
+    node_of[static_cast<std::size_t>(s.coord[static_cast<std::size_t>(i)])] = i;
+    node_of[static_cast<std::size_t>(s.coord[static_cast<std::size_t>(i)]) + 1] = i;
+  }
+  plan.closed = true;
+  for (const std::vector<int>& component : tarjan.out) {
+    Block b;
+    b.first = static_cast<int>(plan.rows.size());
+    b.size = static_cast<int>(component.size());
+    std::vector<int> coords;
+    for (int r : component) coords.push_back(coord_of[static_cast<std::size_t>(r)]);
+    std::sort(coords.begin(), coords.end());
+    plan.rows.insert(plan.rows.end(), component.begin(), component.end());
+    plan.coords.insert(plan.coords.end(), coords.begin(), coords.end());
+    classify(s, node_of, b, plan.rows, plan.coords);
+    plan.closed = plan.closed && b.kind != Block::Kind::kGeneral;
+    plan.blocks.push_back(b);
+  }
+  // the substitutions' terms: the entries of the rows outside the diagonal blocks
+  std::vector<int> block_of_row(static_cast<std::size_t>(s.rows)), block_of_coord(block_of_row);
+  for (std::size_t k = 0; k < plan.blocks.size(); ++k) {
+    const Block& b = plan.blocks[k];
+    for (int i = b.first; i < b.first + b.size; ++i) {
+      block_of_row[static_cast<std::size_t>(plan.rows[static_cast<std::size_t>(i)])] =
+          static_cast<int>(k);
+      block_of_coord[static_cast<std::size_t>(plan.coords[static_cast<std::size_t>(i)])] =
+          static_cast<int>(k);
+    }
+  }
+  for (int r : plan.rows) {
+    plan.row_first.push_back(static_cast<int>(plan.row_deps.size()));
+    for (int c : adjacent[static_cast<std::size_t>(r)]) {
+      if (block_of_coord[static_cast<std::size_t>(c)] < block_of_row[static_cast<std::size_t>(r)])
+        plan.row_deps.push_back(c);
+    }
+  }
+  plan.row_first.push_back(static_cast<int>(plan.row_deps.size()));
+  for (int c : plan.coords) {
+    plan.coord_first.push_back(static_cast<int>(plan.coord_deps.size()));
+    for (int r = 0; r < s.rows; ++r) {
+      const std::vector<int>& a = adjacent[static_cast<std::size_t>(r)];
+      if (block_of_row[static_cast<std::size_t>(r)] > block_of_coord[static_cast<std::size_t>(c)] &&
+          std::find(a.begin(), a.end(), c) != a.end())
+        plan.coord_deps.push_back(r);
+    }
+  }
+  plan.coord_first.push_back(static_cast<int>(plan.coord_deps.size()));
+  plan.usable = true;
+  return plan;
+}
+
+void prime_blocks(const Model& model, Workspace& ws) {
+  const System& s = model.system();
+  const BlockPlan& plan = s.blocks;
+  ws.block_sign.assign(plan.blocks.size(), 1.0);
+  ws.block_lu.resize(plan.blocks.size());
+  ws.block_det.assign(plan.blocks.size(), 0.0);
+  if (!plan.usable) return;
+  bool general = false;
+  for (std::size_t k = 0; k < plan.blocks.size(); ++k) {
+    const Block& b = plan.blocks[k];
+    if (b.kind == Block::Kind::kDyad || b.kind == Block::Kind::kGuide) {
+      ws.block_sign[k] = side(s, b, ws.instant.x);
+    } else if (b.kind == Block::Kind::kGeneral) {
+      general = true;
+    }
+  }
+  if (!general) return;
+  constraint_jacobian(s, ws.instant.x, s.rows, ws.G);
+  for (std::size_t k = 0; k < plan.blocks.size(); ++k) {
+    const Block& b = plan.blocks[k];
+    if (b.kind != Block::Kind::kGeneral) continue;
+    block_matrix(plan, b, ws.G, ws.block_matrix);
+    ws.block_lu[k].compute(ws.block_matrix);
+    ws.block_sign[k] = ws.block_lu[k].determinant() < 0 ? -1.0 : 1.0;
+  }
+}
+
+bool place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess,
+                     const std::vector<double>& inputs) {
+  const System& s = model.system();
+  const BlockPlan& plan = s.blocks;
+  if (!plan.usable || ws.block_sign.size() != plan.blocks.size()) return false;
+  Instant& in = ws.instant;
+  input_targets(s, inputs, ws.target);
+  NodeVectors& x = in.x;
+  if (!plan.closed) x = guess;
+  const double step_limit = kNewtonStep * model.length_scale();
+  for (std::size_t k = 0; k < plan.blocks.size(); ++k) {
+    const Block& b = plan.blocks[k];
+    const std::size_t P = static_cast<std::size_t>(b.node);
+    switch (b.kind) {
+      case Block::Kind::kCrank:
+        x[P] = at(x, b.a) + b.ra * ws.target[static_cast<std::size_t>(b.index)];
+        break;
+      case Block::Kind::kDyad: {
+        // P on the circles |P - A| = ra and |P - B| = rb: a along A -> B, h across it
+        const Vec2& A = at(x, b.a);
+        const Vec2 d = at(x, b.b) - A;
+        const double D = d.norm();
+        const double along = (b.ra * b.ra - b.rb * b.rb + D * D) / (2 * D);
+        const double h2 = (b.ra - along) * (b.ra + along);
+        if (!(h2 >= 0) || !(D > 0)) return false;
+        x[P] = A + (along / D) * d + (ws.block_sign[k] * std::sqrt(h2) / D) * perp(d);
+        break;
+      }
+      case Block::Kind::kGuide: {
+        // P on the guide from + s u at |P - A| = ra: s from the foot of A on the guide
+        const System::SliderRow& sl = s.sliders[static_cast<std::size_t>(b.index)];
+        const Vec2 w = at(x, b.a) - sl.from;
+        const double off = sl.normal.dot(w);
+        const double h2 = (b.ra - off) * (b.ra + off);
+        if (!(h2 >= 0)) return false;
+        x[P] = sl.from + (sl.unit.dot(w) + ws.block_sign[k] * std::sqrt(h2)) * sl.unit;
+        break;
+      }
+      case Block::Kind::kSlide: {
+        const System::InputRow& ir = s.inputs[static_cast<std::size_t>(b.index)];
+        const System::SliderRow& sl = s.sliders[static_cast<std::size_t>(ir.slider)];
+        x[P] = sl.from + inputs[static_cast<std::size_t>(b.index)] * sl.unit;
+        break;
+      }
+      case Block::Kind::kRigid: {
+        const System::RigidRows& r = s.rigid[static_cast<std::size_t>(b.index)];
+        x[P] = r.weights.at_p * at(x, r.p) + r.weights.at_q * at(x, r.q);
+        break;
+      }
+      case Block::Kind::kGeneral: {
+        // Newton's method on the block's rows, the blocks before it fixed
+        bool converged = false;
+        for (int it = 0; it < kBlockIterations && !converged; ++it) {
+          constraint_values(s, x, ws.target, ws.g);
+          constraint_jacobian(s, x, s.rows, ws.G);
+          block_matrix(plan, b, ws.G, ws.block_matrix);
+          SmallLu& lu = ws.block_lu[k];
+          lu.compute(ws.block_matrix);
+          if (!(lu.pivot_ratio() >= kWellConditioned)) return false;
+          ws.block_rhs.resize(b.size);
+          for (int i = 0; i < b.size; ++i)
+            ws.block_rhs[i] = ws.g[plan.rows[static_cast<std::size_t>(b.first + i)]];
+          lu.solve(ws.block_rhs, ws.block_x);
+          if (!ws.block_x.allFinite()) return false;
+          for (int j = 0; j < b.size; ++j) {
+            const int c = plan.coords[static_cast<std::size_t>(b.first + j)];
+            Vec2& node = x[static_cast<std::size_t>(s.moving[static_cast<std::size_t>(c / 2)])];
+            node[c % 2] -= ws.block_x[j];
+          }
+          converged = ws.block_x.cwiseAbs().maxCoeff() <= step_limit;
+        }
+        if (!converged) return false;
+        break;
+      }
+    }
+  }
+  // the Jacobian at the solution and the blocks' factorisations
+  constraint_jacobian(s, x, s.rows, ws.G);
+  if (!ws.G.allFinite()) return false;
+  for (std::size_t k = 0; k < plan.blocks.size(); ++k) {
+    const Block& b = plan.blocks[k];
+    const int* r = &plan.rows[static_cast<std::size_t>(b.first)];
+    const int* c = &plan.coords[static_cast<std::size_t>(b.first)];
+    if (b.size == 2) {
+      const double sine =
+          two_row_sine(ws.G(r[0], c[0]), ws.G(r[0], c[1]), ws.G(r[1], c[0]), ws.G(r[1], c[1]));
+      if (!(std::abs(sine) >= kWellConditioned)) return false;
+      ws.block_det[k] = ws.G(r[0], c[0]) * ws.G(r[1], c[1]) - ws.G(r[0], c[1]) * ws.G(r[1], c[0]);
+      if (b.kind == Block::Kind::kGeneral && (ws.block_det[k] < 0 ? -1.0 : 1.0) != ws.block_sign[k])
+        return false;
+    } else {
+      block_matrix(plan, b, ws.G, ws.block_matrix);
+      SmallLu& lu = ws.block_lu[k];
+      lu.compute(ws.block_matrix);
+      if (!(lu.pivot_ratio() >= kWellConditioned) ||
+          (lu.determinant() < 0 ? -1.0 : 1.0) != ws.block_sign[k])
+        return false;
+    }
+  }
+  if (in.input.size() == inputs.size()) {
+    std::copy(inputs.begin(), inputs.end(), in.input.begin());
+  } else {
+    in.input = inputs;
+  }
+  ws.factorised = false;  // ws.lu is not at this position
+  ws.by_blocks = true;
+  return true;
+}
+
+void block_solve(const Model& model, Workspace& ws, const Eigen::VectorXd& rhs,
+                 Eigen::VectorXd& x) {
+  const BlockPlan& plan = model.system().blocks;
+  const double* G = ws.G.data();
+  const Eigen::Index ld = ws.G.rows();
+  auto g = [&](int r, int c) { return G[r + c * ld]; };
+  x.resize(ws.G.cols());
+  const int* first = plan.row_first.data();
+  const int* deps = plan.row_deps.data();
+  // the right-hand side of row entry i less its terms in the coordinates already solved
+  auto reduced = [&](int i) {
+    const int r = plan.rows[static_cast<std::size_t>(i)];
+    double y = rhs[r];
+    for (int j = first[i]; j < first[i + 1]; ++j) y -= g(r, deps[j]) * x[deps[j]];
+    return y;
+  };
+  for (std::size_t k = 0; k < plan.blocks.size(); ++k) {
+    const Block& b = plan.blocks[k];
+    const int* r = &plan.rows[static_cast<std::size_t>(b.first)];
+    const int* c = &plan.coords[static_cast<std::size_t>(b.first)];
+    if (b.size == 2) {
+      const double y0 = reduced(b.first), y1 = reduced(b.first + 1);
+      const double det = ws.block_det[k];
+      x[c[0]] = (g(r[1], c[1]) * y0 - g(r[0], c[1]) * y1) / det;
+      x[c[1]] = (g(r[0], c[0]) * y1 - g(r[1], c[0]) * y0) / det;
+    } else {
+      ws.block_rhs.resize(b.size);
+      for (int i = 0; i < b.size; ++i) ws.block_rhs[i] = reduced(b.first + i);
+      ws.block_lu[k].solve(ws.block_rhs, ws.block_x);
+      for (int j = 0; j < b.size; ++j) x[c[j]] = ws.block_x[j];
+    }
+  }
+}
+
+void block_solve_transpose(const Model& model, Workspace& ws, Eigen::VectorXd& b) {
+  const BlockPlan& plan = model.system().blocks;
+  const double* G = ws.G.data();
+  const Eigen::Index ld = ws.G.rows();
+  auto g = [&](int r, int c) { return G[r + c * ld]; };
+  Eigen::VectorXd& lambda = ws.block_lambda;
+  lambda.resize(ws.G.rows());
+  const int* first = plan.coord_first.data();
+  const int* deps = plan.coord_deps.data();
+  // the right-hand side of coordinate entry j less its terms in the rows already solved
+  auto reduced = [&](int j) {
+    const int c = plan.coords[static_cast<std::size_t>(j)];
+    double y = b[c];
+    for (int i = first[j]; i < first[j + 1]; ++i) y -= g(deps[i], c) * lambda[deps[i]];
+    return y;
+  };
+  for (std::size_t k = plan.blocks.size(); k-- > 0;) {
+    const Block& bl = plan.blocks[k];
+    const int* r = &plan.rows[static_cast<std::size_t>(bl.first)];
+    const int* c = &plan.coords[static_cast<std::size_t>(bl.first)];
+    if (bl.size == 2) {
+      const double y0 = reduced(bl.first), y1 = reduced(bl.first + 1);
+      const double det = ws.block_det[k];
+      lambda[r[0]] = (g(r[1], c[1]) * y0 - g(r[1], c[0]) * y1) / det;
+      lambda[r[1]] = (g(r[0], c[0]) * y1 - g(r[0], c[1]) * y0) / det;
+    } else {
+      ws.block_rhs.resize(bl.size);
+      for (int j = 0; j < bl.size; ++j) ws.block_rhs[j] = reduced(bl.first + j);
+      ws.block_lu[k].solve_transpose(ws.block_rhs);
+      for (int i = 0; i < bl.size; ++i) lambda[r[i]] = ws.block_rhs[i];
+    }
+  }
+  b.swap(lambda);
+}
+
+}  // namespace bd::core::planar::detail

@@ -1,0 +1,57 @@
+#pragma once
+/// The constraints and inputs of a linkage (core/planar/system.hpp) in block-triangular form, and
+/// the evaluations that use it.
+///
+/// The square system of the constraint rows and the inputs, G q̇ = b, is sparse: a row involves
+/// at most three nodes. Permuted to block-triangular form (Dulmage–Mendelsohn: a perfect matching
+/// of rows to coordinates, then the strongly connected components of the rows' dependencies in
+/// the order that puts every block after the blocks it depends on) it is solved block by block,
+/// each block with the coordinates of the blocks before it known. For the linkages people build
+/// the blocks are Assur's: a crank's tip placed from its pivot and the input's angle, a dyad's
+/// middle node from its two outer nodes (two circles), a slider's node on a frame guide (a circle
+/// and a line), a further node of a link from its element's nodes; each of those has a closed
+/// form, exact to round-off without iterations. Any other block (a triad, a ternary link's
+/// element node held through a further node) is solved by Newton's method on its own rows.
+///
+/// The positions, the rates, the accelerations (forward substitution over the blocks) and the
+/// multipliers (backward substitution with Gᵀ) then need no factorisation of the whole system.
+/// This is the driven sweep's route (core/planar/simulate.cpp); where a block is poorly
+/// conditioned (a dead centre near), a circle pair no longer meets, or Newton's method on a
+/// block does not converge, place_by_blocks() declines and the caller takes the general route
+/// (core/planar/dynamics.hpp, solve_position()), which decides whether the position is singular
+/// and says so. docs/performance.md ("The general planar engine") has the measurements.
+///
+/// Internal to core/planar.
+#include <Eigen/Core>
+#include <vector>
+
+#include "core/planar/system.hpp"
+
+namespace bd::core::planar {
+class Model;
+class Workspace;
+}  // namespace bd::core::planar
+
+namespace bd::core::planar::detail {
+
+/// Records the assembly branch of the positions in ws.instant.x: per block, the side of the line
+/// through the known nodes on which a dyad's node lies, the side of the foot of the perpendicular
+/// on which a guide's node lies, a general block's determinant sign. place_by_blocks() keeps
+/// those; call after every position the general route solved.
+void prime_blocks(const Model& model, Workspace& ws);
+
+/// The positions at `inputs` block by block (the general blocks by Newton's method from `guess`,
+/// which closed-form plans do not read), on the branch prime_blocks() recorded, and the blocks'
+/// factorisations there. Sets ws.instant.x and .input and ws.by_blocks. Returns false, changing
+/// nothing the general route reads, where it cannot answer to round-off: no plan, two circles
+/// that do not meet, a block whose conditioning is poor (its rows' sine below 1e-2) or whose
+/// determinant changed sign, a general block where Newton's method does not converge.
+bool place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess,
+                     const std::vector<double>& inputs);
+
+/// After place_by_blocks(): x = G⁻¹ b by forward substitution over the blocks (x may not be b).
+void block_solve(const Model& model, Workspace& ws, const Eigen::VectorXd& b, Eigen::VectorXd& x);
+/// After place_by_blocks(): b = G⁻ᵀ b by backward substitution, in place.
+void block_solve_transpose(const Model& model, Workspace& ws, Eigen::VectorXd& b);
+
+}  // namespace bd::core::planar::detail
