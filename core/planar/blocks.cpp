@@ -237,24 +237,34 @@ BlockPlan plan_blocks(const System& s) {
           static_cast<int>(k);
     }
   }
+  auto offset = [&s](int r, int c) { return r + c * s.rows; };
   for (int r : plan.rows) {
-    plan.row_first.push_back(static_cast<int>(plan.row_deps.size()));
+    plan.row_first.push_back(static_cast<int>(plan.row_terms.size()));
     for (int c : adjacent[static_cast<std::size_t>(r)]) {
       if (block_of_coord[static_cast<std::size_t>(c)] < block_of_row[static_cast<std::size_t>(r)])
-        plan.row_deps.push_back(c);
+        plan.row_terms.push_back({offset(r, c), c});
     }
   }
-  plan.row_first.push_back(static_cast<int>(plan.row_deps.size()));
+  plan.row_first.push_back(static_cast<int>(plan.row_terms.size()));
   for (int c : plan.coords) {
-    plan.coord_first.push_back(static_cast<int>(plan.coord_deps.size()));
+    plan.coord_first.push_back(static_cast<int>(plan.coord_terms.size()));
     for (int r = 0; r < s.rows; ++r) {
       const std::vector<int>& a = adjacent[static_cast<std::size_t>(r)];
       if (block_of_row[static_cast<std::size_t>(r)] > block_of_coord[static_cast<std::size_t>(c)] &&
           std::find(a.begin(), a.end(), c) != a.end())
-        plan.coord_deps.push_back(r);
+        plan.coord_terms.push_back({offset(r, c), r});
     }
   }
-  plan.coord_first.push_back(static_cast<int>(plan.coord_deps.size()));
+  plan.coord_first.push_back(static_cast<int>(plan.coord_terms.size()));
+  for (Block& b : plan.blocks) {
+    if (b.size != 2) continue;
+    const int* r = &plan.rows[static_cast<std::size_t>(b.first)];
+    const int* c = &plan.coords[static_cast<std::size_t>(b.first)];
+    b.entry[0] = offset(r[0], c[0]);
+    b.entry[1] = offset(r[0], c[1]);
+    b.entry[2] = offset(r[1], c[0]);
+    b.entry[3] = offset(r[1], c[1]);
+  }
   plan.usable = true;
   return plan;
 }
@@ -363,17 +373,17 @@ bool place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess
     }
   }
   // the Jacobian at the solution and the blocks' factorisations
+  // (a value that is not finite fails the blocks' conditioning tests, or the finish's check of
+  // the multipliers)
   constraint_jacobian(s, x, s.rows, ws.G);
-  if (!ws.G.allFinite()) return false;
+  const double* G = ws.G.data();
   for (std::size_t k = 0; k < plan.blocks.size(); ++k) {
     const Block& b = plan.blocks[k];
-    const int* r = &plan.rows[static_cast<std::size_t>(b.first)];
-    const int* c = &plan.coords[static_cast<std::size_t>(b.first)];
     if (b.size == 2) {
-      const double sine =
-          two_row_sine(ws.G(r[0], c[0]), ws.G(r[0], c[1]), ws.G(r[1], c[0]), ws.G(r[1], c[1]));
-      if (!(std::abs(sine) >= kWellConditioned)) return false;
-      ws.block_det[k] = ws.G(r[0], c[0]) * ws.G(r[1], c[1]) - ws.G(r[0], c[1]) * ws.G(r[1], c[0]);
+      const double g00 = G[b.entry[0]], g01 = G[b.entry[1]], g10 = G[b.entry[2]],
+                   g11 = G[b.entry[3]];
+      if (!(std::abs(two_row_sine(g00, g01, g10, g11)) >= kWellConditioned)) return false;
+      ws.block_det[k] = g00 * g11 - g01 * g10;
       if (b.kind == Block::Kind::kGeneral && (ws.block_det[k] < 0 ? -1.0 : 1.0) != ws.block_sign[k])
         return false;
     } else {
@@ -399,32 +409,30 @@ void block_solve(const Model& model, Workspace& ws, const Eigen::VectorXd& rhs,
                  Eigen::VectorXd& x) {
   const BlockPlan& plan = model.system().blocks;
   const double* G = ws.G.data();
-  const Eigen::Index ld = ws.G.rows();
-  auto g = [&](int r, int c) { return G[r + c * ld]; };
+  const double* b = rhs.data();
   x.resize(ws.G.cols());
+  double* out = x.data();
   const int* first = plan.row_first.data();
-  const int* deps = plan.row_deps.data();
+  const BlockPlan::Term* terms = plan.row_terms.data();
   // the right-hand side of row entry i less its terms in the coordinates already solved
   auto reduced = [&](int i) {
-    const int r = plan.rows[static_cast<std::size_t>(i)];
-    double y = rhs[r];
-    for (int j = first[i]; j < first[i + 1]; ++j) y -= g(r, deps[j]) * x[deps[j]];
+    double y = b[plan.rows[static_cast<std::size_t>(i)]];
+    for (int j = first[i]; j < first[i + 1]; ++j) y -= G[terms[j].entry] * out[terms[j].other];
     return y;
   };
   for (std::size_t k = 0; k < plan.blocks.size(); ++k) {
-    const Block& b = plan.blocks[k];
-    const int* r = &plan.rows[static_cast<std::size_t>(b.first)];
-    const int* c = &plan.coords[static_cast<std::size_t>(b.first)];
-    if (b.size == 2) {
-      const double y0 = reduced(b.first), y1 = reduced(b.first + 1);
+    const Block& bl = plan.blocks[k];
+    const int* c = &plan.coords[static_cast<std::size_t>(bl.first)];
+    if (bl.size == 2) {
+      const double y0 = reduced(bl.first), y1 = reduced(bl.first + 1);
       const double det = ws.block_det[k];
-      x[c[0]] = (g(r[1], c[1]) * y0 - g(r[0], c[1]) * y1) / det;
-      x[c[1]] = (g(r[0], c[0]) * y1 - g(r[1], c[0]) * y0) / det;
+      out[c[0]] = (G[bl.entry[3]] * y0 - G[bl.entry[1]] * y1) / det;
+      out[c[1]] = (G[bl.entry[0]] * y1 - G[bl.entry[2]] * y0) / det;
     } else {
-      ws.block_rhs.resize(b.size);
-      for (int i = 0; i < b.size; ++i) ws.block_rhs[i] = reduced(b.first + i);
+      ws.block_rhs.resize(bl.size);
+      for (int i = 0; i < bl.size; ++i) ws.block_rhs[i] = reduced(bl.first + i);
       ws.block_lu[k].solve(ws.block_rhs, ws.block_x);
-      for (int j = 0; j < b.size; ++j) x[c[j]] = ws.block_x[j];
+      for (int j = 0; j < bl.size; ++j) out[c[j]] = ws.block_x[j];
     }
   }
 }
@@ -432,36 +440,33 @@ void block_solve(const Model& model, Workspace& ws, const Eigen::VectorXd& rhs,
 void block_solve_transpose(const Model& model, Workspace& ws, Eigen::VectorXd& b) {
   const BlockPlan& plan = model.system().blocks;
   const double* G = ws.G.data();
-  const Eigen::Index ld = ws.G.rows();
-  auto g = [&](int r, int c) { return G[r + c * ld]; };
-  Eigen::VectorXd& lambda = ws.block_lambda;
-  lambda.resize(ws.G.rows());
+  const double* in = b.data();
+  ws.block_lambda.resize(ws.G.rows());
+  double* out = ws.block_lambda.data();
   const int* first = plan.coord_first.data();
-  const int* deps = plan.coord_deps.data();
+  const BlockPlan::Term* terms = plan.coord_terms.data();
   // the right-hand side of coordinate entry j less its terms in the rows already solved
   auto reduced = [&](int j) {
-    const int c = plan.coords[static_cast<std::size_t>(j)];
-    double y = b[c];
-    for (int i = first[j]; i < first[j + 1]; ++i) y -= g(deps[i], c) * lambda[deps[i]];
+    double y = in[plan.coords[static_cast<std::size_t>(j)]];
+    for (int i = first[j]; i < first[j + 1]; ++i) y -= G[terms[i].entry] * out[terms[i].other];
     return y;
   };
   for (std::size_t k = plan.blocks.size(); k-- > 0;) {
     const Block& bl = plan.blocks[k];
     const int* r = &plan.rows[static_cast<std::size_t>(bl.first)];
-    const int* c = &plan.coords[static_cast<std::size_t>(bl.first)];
     if (bl.size == 2) {
       const double y0 = reduced(bl.first), y1 = reduced(bl.first + 1);
       const double det = ws.block_det[k];
-      lambda[r[0]] = (g(r[1], c[1]) * y0 - g(r[1], c[0]) * y1) / det;
-      lambda[r[1]] = (g(r[0], c[0]) * y1 - g(r[0], c[1]) * y0) / det;
+      out[r[0]] = (G[bl.entry[3]] * y0 - G[bl.entry[2]] * y1) / det;
+      out[r[1]] = (G[bl.entry[0]] * y1 - G[bl.entry[1]] * y0) / det;
     } else {
       ws.block_rhs.resize(bl.size);
       for (int j = 0; j < bl.size; ++j) ws.block_rhs[j] = reduced(bl.first + j);
       ws.block_lu[k].solve_transpose(ws.block_rhs);
-      for (int i = 0; i < bl.size; ++i) lambda[r[i]] = ws.block_rhs[i];
+      for (int i = 0; i < bl.size; ++i) out[r[i]] = ws.block_rhs[i];
     }
   }
-  b.swap(lambda);
+  b.swap(ws.block_lambda);
 }
 
 }  // namespace bd::core::planar::detail

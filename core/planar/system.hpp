@@ -52,6 +52,7 @@ struct Block {
   int a = -1, b = -1;   // the known nodes it is placed from (dyad: both; crank, guide: a)
   double ra{}, rb{};    // dyad: |P - A|, |P - B|; crank, guide: |P - A| (crank: signed, ± l)
   int index = -1;       // crank, slide: the input; guide: the slider; rigid: the rigid entry
+  int entry[4]{};       // two rows: the offsets in G of its entries (0,0), (0,1), (1,0), (1,1)
 };
 
 struct BlockPlan {
@@ -61,11 +62,16 @@ struct BlockPlan {
   bool closed = false;            // every block has a closed form (no Newton's method, no guess)
   std::vector<int> rows, coords;  // the blocks' rows and coordinates, block after block
   std::vector<Block> blocks;      // in the order of solution
-  /// Per entry of `rows`: the coordinates of earlier blocks the row involves, in
-  /// row_deps[row_first[i]] up to row_deps[row_first[i + 1]] (the forward substitution's terms);
-  /// per entry of `coords`: the rows of later blocks that involve the coordinate (the backward
-  /// substitution's), in coord_deps[coord_first[j]] up to coord_deps[coord_first[j + 1]].
-  std::vector<int> row_first, row_deps, coord_first, coord_deps;
+  /// A term of the substitutions: an entry of the Jacobian G outside the diagonal blocks (its
+  /// offset in G, column-major, rows x n) and the unknown it multiplies (forward: a coordinate
+  /// of an earlier block; backward: a row of a later block).
+  struct Term {
+    int entry{}, other{};
+  };
+  /// Per entry i of `rows`, its forward terms row_terms[row_first[i]] up to
+  /// row_terms[row_first[i + 1]]; per entry j of `coords`, its backward terms likewise.
+  std::vector<int> row_first, coord_first;
+  std::vector<Term> row_terms, coord_terms;
 };
 
 /// The compiled equations of one linkage.
