@@ -447,8 +447,8 @@ void print_optimize(const st::Study& study, const st::RunResult& r) {
     print_counterweight(bd::core::link_name(p.link), 7, p.counterweight,
                         p.link == 1 ? "A0" : "A3");
   }
-  std::printf("  verified with %s: largest relative difference %.3g\n",
-              bd::core::to_string(o.verified_with), o.verification_error);
+  std::printf("  verified with %s: largest relative difference %.3g\n", o.verified_by().c_str(),
+              o.verification_error);
   std::printf("  optimum: method %s, %zu samples, status %s\n", st::to_string(run.method.method),
               run.trajectory.samples.size(), bd::core::to_string(run.trajectory.status));
   if (!run.pareto.empty()) {

@@ -13,6 +13,8 @@
 
 #include "core/input_error.hpp"
 #include "core/number_text.hpp"
+#include "core/planar/from_fourbar.hpp"
+#include "core/planar/simulate.hpp"
 #include "optimize/check_inputs.hpp"
 #include "optimize/convex_solve.hpp"
 #include "optimize/detail/peak_exchange.hpp"
@@ -274,6 +276,10 @@ const char* to_string(Termination t) {
   return "unknown";
 }
 
+std::string OptimizeResult::verified_by() const {
+  return verified_on_general_engine ? "truss-dae" : core::to_string(verified_with);
+}
+
 std::string OptimizeResult::brief_report() const {
   std::string s = solver_report(*this);
   if (!peak_angles.empty()) {
@@ -283,8 +289,7 @@ std::string OptimizeResult::brief_report() const {
   if (termination == Termination::kNotRun || std::isnan(verification_error)) {
     s += ", not verified";
   } else {
-    s += ", verified by " + std::string(core::to_string(verified_with)) + " to " +
-         text::digits(verification_error, 2);
+    s += ", verified by " + verified_by() + " to " + text::digits(verification_error, 2);
   }
   return s;
 }
@@ -315,20 +320,44 @@ void detail::check_feasibility(const Program& nlp, const OptimizeOptions& option
 
 namespace {
 
-// The optimum re-simulated with another formulation, compared metric by metric.
+// A free scene on the general planar engine's DAE route, which passes limit positions, as a
+// four-bar trajectory.
+core::Trajectory general_engine_run(const core::FourBar& design, const core::FreeScene& scene,
+                                    double tolerance) {
+  const core::planar::Model model(core::planar::linkage_of(design, scene.theta1));
+  core::planar::SimulateOptions options;
+  options.route = core::planar::Route::kDae;
+  options.tolerance = tolerance;
+  return core::planar::fourbar_trajectory(core::planar::simulate_free(
+      model, core::planar::FreeScene{{scene.theta1}, {scene.omega1}, scene.duration, scene.samples},
+      options));
+}
+
+// The optimum re-simulated with another formulation, compared metric by metric. A free scene
+// that passes limit positions, which of the closed forms only the opened loop follows, is
+// re-simulated on the general planar engine instead (its DAE route passes them too).
 void verify(const DesignProblem& problem, OptimizeResult& r) {
   core::SimulateOptions simulate;
   simulate.formulation = other_than(problem.formulation);
   simulate.tolerance = problem.tolerance;
   r.verified_with = simulate.formulation;
-  const core::Trajectory trajectory =
-      std::holds_alternative<core::DrivenScene>(problem.scene)
-          ? core::simulate_driven(r.design, std::get<core::DrivenScene>(problem.scene), simulate)
-          : core::simulate_free(r.design, std::get<core::FreeScene>(problem.scene), simulate);
+  r.verified_on_general_engine = false;
+  const auto* free_scene = std::get_if<core::FreeScene>(&problem.scene);
+  core::Trajectory trajectory =
+      free_scene
+          ? core::simulate_free(r.design, *free_scene, simulate)
+          : core::simulate_driven(r.design, std::get<core::DrivenScene>(problem.scene), simulate);
+  if (free_scene && trajectory.status == core::SimulationStatus::kSingular &&
+      problem.formulation == core::Formulation::kOpenedLoop) {
+    // the peaks are still resolved by the optimiser's formulation, between the samples of the
+    // general engine's run
+    simulate.formulation = problem.formulation;
+    r.verified_on_general_engine = true;
+    trajectory = general_engine_run(r.design, *free_scene, problem.tolerance);
+  }
   if (!trajectory.ok()) {
     r.verification_error = std::numeric_limits<double>::infinity();
-    r.message += "; verification by " + std::string(core::to_string(simulate.formulation)) +
-                 " failed: " + trajectory.message;
+    r.message += "; verification by " + r.verified_by() + " failed: " + trajectory.message;
     return;
   }
   // the peaks as the optimiser's: a free scene's program resolves those it reads, a driven

@@ -150,6 +150,13 @@ struct OptimizeResult {
   core::Metrics metrics;   // of the optimum, as the optimiser evaluated them
   core::Metrics verified;  // re-simulated with another formulation
   core::Formulation verified_with = core::Formulation::kMassMatrix;
+  /// True where no closed form other than the optimiser's could follow the motion (a free scene
+  /// that passes limit positions, which only the opened loop passes among them): the optimum
+  /// was then verified on the general planar engine's DAE route (truss-dae).
+  bool verified_on_general_engine = false;
+  /// How the optimum was verified, in the study file's method names: "truss-dae" or
+  /// verified_with's.
+  std::string verified_by() const;
   double verification_error{};  // largest relative difference metrics vs verified
   /// True when the optimum is proven global: the problem is convex in the counterweights' masses
   /// and mass moments (Nlp::why_not_convex()) and the design meets the first-order conditions

@@ -456,12 +456,14 @@ std::string optimized_yaml(const Study& study, const OptimizedRun& run) {
   header += "Objective: minimise " + objective_text(req) + ".\n";
   header += "Constraints: " + constraints_text(req) + ".\n";
   char line[512];
-  std::snprintf(line, sizeof line,
-                "Solver: %s, %s after %d evaluations; objective %.6g; verified with %s (largest "
-                "relative difference %.3g).\n",
+  std::snprintf(line, sizeof line, "Solver: %s, %s after %d evaluations; objective %.6g; ",
                 optimize::to_string(req.options.algorithm), optimize::to_string(r.termination),
-                r.evaluations, r.objective, core::to_string(r.verified_with), r.verification_error);
+                r.evaluations, r.objective);
   header += line;
+  header += std::isfinite(r.verification_error)
+                ? "verified with " + r.verified_by() + " (largest relative difference " +
+                      text::digits(r.verification_error, 3) + ").\n"
+                : "its verification with " + r.verified_by() + " failed (see summary.json).\n";
   const char* pivots[] = {"", "A0", "", "A3"};
   for (const optimize::PlacedCounterweight& p : r.counterweights) {
     const balance::Counterweight& c = p.counterweight;

@@ -348,8 +348,9 @@ Json optimize_json(const Study& study, const RunResult& result) {
   if (found) {
     j["added_mass"] = added_mass(study.fourbar(), r.design);
     j["added_inertia"] = added_inertia(study.fourbar(), r.design);
-    j["verified_with"] = core::to_string(r.verified_with);
-    j["verification_error"] = r.verification_error;
+    j["verified_with"] = r.verified_by();
+    // null where the re-simulation failed (the message says why)
+    j["verification_error"] = value_or_null(r.verification_error);
   }
   if (req.pareto) {
     j["pareto"] = {{"first", optimize::to_string(req.pareto->first)},
@@ -398,7 +399,7 @@ Json planar_optimize_json(const Study& study, const RunResult& result) {
     // a driven scene: the optimum simulated against the regressor's values; a free scene: the
     // other route of the engine (dae) against the reduced route's
     j["verified_with"] = is_free(study.scene) ? "dae route" : "the optimum simulated";
-    j["verification_error"] = r.verification_error;
+    j["verification_error"] = value_or_null(r.verification_error);       // null: the run failed
     j["inertial_verification_error"] = value_or_null(r.inertial_error);  // null: not computed
   }
   j["counterweights"] = cws;

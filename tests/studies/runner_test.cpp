@@ -618,6 +618,36 @@ TEST_F(RunnerTest, AnOptimumWithoutCounterweightsWritesNone) {
   bd::testing::expect_same_model(study.fourbar(), back.fourbar());
 }
 
+// A free scene through limit positions runs on the opened loop, the one closed form that passes
+// them; the optimum is then verified on the general planar engine's DAE route, which passes them
+// too (the mass matrix, the optimiser's usual second formulation, stops at the first one).
+TEST_F(RunnerTest, AFreeOptimumThroughLimitPositionsIsVerifiedOnTheGeneralEngine) {
+  const Study study = parse_study(
+      bd::testing::edited_example(
+          "triple-rocker-free.yaml",
+          {{"  duration: 20.0", "  duration: 10.0"},
+           {"  samples: 2001", "  samples: 101"},
+           {"\nmethod: auto",
+            "\nmethod: auto\n"
+            "optimize:\n"
+            "  objective: {Fsh_rms: 1.0}\n"
+            "  variables: {counterweights: {crank: {mass_max: 3.0, distance_max: 1.0}}}\n"
+            "  algorithm: cobyla\n"
+            "  max_evaluations: 10\n"}}),
+      "limits.yaml");
+  const RunResult r = run_study(study, dir_ / "limits");
+  ASSERT_TRUE(r.ok()) << r.trajectory.message;
+  ASSERT_TRUE(r.optimized.has_value());
+  const optimize::OptimizeResult& o = r.optimized->result;
+  EXPECT_EQ(r.method.formulation, core::Formulation::kOpenedLoop);
+  EXPECT_TRUE(o.verified_on_general_engine) << o.message;
+  EXPECT_EQ(o.verified_by(), "truss-dae");
+  // the two routes agree to their integration tolerance (the study's 1e-10 relative)
+  EXPECT_LE(o.verification_error, 1e-7) << o.message;
+  const std::string summary = read(dir_ / "limits" / "summary.json");
+  EXPECT_NE(summary.find("\"verified_with\": \"truss-dae\""), std::string::npos);
+}
+
 TEST_F(RunnerTest, ParetoFrontIsWrittenPointByPoint) {
   const Study study = driven_with(
       "optimize:\n"
