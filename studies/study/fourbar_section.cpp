@@ -282,7 +282,9 @@ class FourBarSection::Impl {
   // a driven scene turns the crank through whole revolutions: refused at scene.type when the
   // loop cannot close at every crank angle (the run would stop at the first limit position)
   void check_turns(const core::FourBar& model, const Scene& scene, const MapReader::Entry& e) {
-    if (!std::holds_alternative<core::DrivenScene>(scene) || core::crank_turns_fully(model)) return;
+    if (!std::holds_alternative<core::DrivenScene>(scene)) return;
+    const bool change_point = core::classify_grashof(model) == core::GrashofClass::kChangePoint;
+    if (core::crank_turns_fully(model) && !change_point) return;
     const YAML::Node type = e.value["type"];
     const YAML::Mark where = type ? mark_of(type, e.key_mark) : e.key_mark;
     // the crank angles where the loop just closes: |A1 - A3| = l2 + l3 or |l2 - l3|
@@ -291,9 +293,22 @@ class FourBarSection::Impl {
     for (double d : {model.coupler.length + model.rocker.length,
                      std::abs(model.coupler.length - model.rocker.length)}) {
       const double c = (l1 * l1 + l4 * l4 - d * d) / (2 * l1 * l4);
-      if (std::abs(c) <= 1) {
-        limits += (limits.empty() ? "" : ", ") + std::string("±") + text::digits(std::acos(c), 6);
+      if (std::abs(c) <= 1 + 1e-12) {
+        const double a = std::acos(std::clamp(c, -1.0, 1.0));
+        limits += std::string(limits.empty() ? "" : ", ") +
+                  (a < 1e-9 || a > std::acos(-1.0) - 1e-9 ? "" : "±") + text::digits(a, 6);
       }
+    }
+    if (change_point) {
+      // the crank turns, but where the links fold into one line the loop closes two ways
+      r_.fail(where,
+              "scene.type: driven turns the crank through whole revolutions, but this linkage is "
+              "change-point (shortest + longest link = the other two): at theta1 = " +
+                  limits +
+                  " rad its links fold into one line, where it can go on as the linkage drawn "
+                  "or as its crossed twin (a parallelogram as an antiparallelogram), and the "
+                  "run cannot tell which; change a link length so that the sums differ");
+      return;
     }
     r_.fail(where, std::string("scene.type: driven turns the crank through whole revolutions, but "
                                "this linkage is ") +

@@ -583,16 +583,16 @@ class PlanarSection::Impl {
     if (!ok) r_.fail(e.key_mark, "scene: " + ok.error().detail + " (the start of the scene)");
   }
 
-  // a driven scene over whole revolutions: refused at scene.type when the linkage cannot be
-  // assembled somewhere in the first revolution, as the four-bar's crank that cannot turn fully
-  // is (the run would stop at the first limit position). The revolution is stepped as the run
-  // steps it (at its samples, at most 3600), positions and dynamics; a singular position on an
-  // assembly that goes on (a dead centre) stops the run there instead, with the samples before.
+  // a driven scene over whole revolutions, or over its duration: refused at scene.type when the
+  // linkage cannot be assembled somewhere in the first revolution (or the duration), as the
+  // four-bar's crank that cannot turn fully is (the run would stop at the first limit position).
+  // The motion is stepped as the run steps it (at its samples, at most 3600), positions and
+  // dynamics; a singular position on an assembly that goes on (a dead centre) stops the run
+  // there instead, with the samples before.
   void check_turns(const MapReader::Entry& e, const MapReader::Entry& type,
                    const core::planar::Model& model, const core::planar::DrivenScene& d) {
-    if (d.duration > 0) return;
     core::planar::DrivenScene one = d;
-    one.revolutions = 1;
+    one.revolutions = 1;  // (a scene by duration: its whole duration)
     one.samples = std::min(d.samples, kTurnCheckSamples);
     core::planar::Trajectory run;
     try {
@@ -602,9 +602,14 @@ class PlanarSection::Impl {
     }
     if (run.status != core::SimulationStatus::kAssemblyFailed) return;
     r_.fail(mark_of(type.value, type.key_mark),
-            "scene.type: driven turns the inputs through whole revolutions, but " + run.message +
+            std::string(d.duration > 0 ? "scene.type: driven moves the inputs at their speeds "
+                                         "for the whole duration, but "
+                                       : "scene.type: driven turns the inputs through whole "
+                                         "revolutions, but ") +
+                run.message +
                 ", so the run would stop there; simulate it with type: free, which passes the "
-                "limit positions where the linkage does, or change the link lengths");
+                "limit positions where the linkage does, " +
+                (d.duration > 0 ? "shorten the duration, " : "") + "or change the link lengths");
   }
   static constexpr int kTurnCheckSamples = 3600;
 

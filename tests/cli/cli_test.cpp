@@ -139,10 +139,10 @@ TEST_F(CliTest, SimulationStoppedEarlyExitsThreeAndKeepsResults) {
                        0),
             0u)
       << err_;
-  // a parallelogram (a change-point linkage): its crank turns fully, but at theta1 = pi the
-  // links fold flat, a dead centre where the driven run stops
-  write("stops.yaml",
-        "name: stops\n"
+  // a parallelogram (a change-point linkage): its crank turns fully, but at theta1 = 0 and pi
+  // its links fold into one line, where the loop closes two ways: refused before it runs too
+  write("folds.yaml",
+        "name: folds\n"
         "linkage:\n"
         "  type: fourbar\n"
         "  frame: 3.0\n"
@@ -151,10 +151,26 @@ TEST_F(CliTest, SimulationStoppedEarlyExitsThreeAndKeepsResults) {
         "  coupler: {length: 3.0, mass: 3.0, s: 1.45, sigma: 0.4, inertia: 3.1}\n"
         "  rocker:  {length: 1.0, mass: 2.2, s: 0.66, sigma: -0.4, inertia: 2.1}\n"
         "scene: {type: driven, theta1: 1.5707963267948966, omega1: 6.283185307179586}\n");
+  EXPECT_EQ(run("folds.yaml --out res"), 2) << err_;
+  EXPECT_EQ(err_.rfind("folds.yaml:9:15: scene.type: driven turns the crank through whole "
+                       "revolutions, but this linkage is change-point",
+                       0),
+            0u)
+      << err_;
+  EXPECT_FALSE(fs::exists(dir_ / "res" / "timeseries.csv"));
+  // a free triple rocker on the mass matrix, whose reduced equation in theta1 cannot pass a limit
+  // position: the run stops at the first one (exit 3), keeping the samples before
+  std::string stops = bd::testing::read(fs::path(kExamples) / "triple-rocker-free.yaml");
+  stops.replace(stops.find("\nmethod: auto"), 13, "\nmethod: mass-matrix");
+  write("stops.yaml", stops);
   EXPECT_EQ(run("stops.yaml --out res"), 3) << err_;
   // its metrics say they cover part of the run only
-  EXPECT_NE(out_.find("  partial  the metrics below cover only the 90 samples before the run "
-                      "stopped"),
+  const std::string csv = bd::testing::read(dir_ / "res" / "timeseries.csv");
+  const auto rows = static_cast<std::size_t>(std::count(csv.begin(), csv.end(), '\n') - 1);
+  EXPECT_GT(rows, 1u);
+  EXPECT_LT(rows, 2001u);
+  EXPECT_NE(out_.find("  partial  the metrics below cover only the " + std::to_string(rows) +
+                      " samples before the run stopped"),
             std::string::npos)
       << out_;
   EXPECT_NE(read(dir_ / "res" / "summary.json").find("\"metrics_partial\": true"),
@@ -162,32 +178,37 @@ TEST_F(CliTest, SimulationStoppedEarlyExitsThreeAndKeepsResults) {
   EXPECT_EQ(err_.rfind("stops.yaml: simulation stopped early: ", 0), 0u) << err_;
   EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
   EXPECT_NE(err_.find("theta1"), std::string::npos) << err_;
-  EXPECT_TRUE(fs::exists(dir_ / "res" / "timeseries.csv"));
   EXPECT_NE(read(dir_ / "res" / "summary.json").find("\"ok\": false"), std::string::npos);
 }
 
 TEST_F(CliTest, PlanarSimulationStoppedEarlyNamesWhereItStopped) {
-  write("piston.yaml", bd::testing::piston_driven_slider_crank(1.5, 151));
-  EXPECT_EQ(run("piston.yaml --out res"), 3) << err_;
-  // the planar run's own message (not the empty four-bar trajectory's)
-  EXPECT_EQ(err_.rfind("piston.yaml: simulation stopped early: the linkage cannot be assembled "
-                       "at piston = 0.18",
-                       0),
-            0u)
-      << err_;
+  // a free non-Grashof four-bar on the general engine's reduced route (method: truss), which
+  // cannot pass a limit position: the run stops at the first one (exit 3), keeping the samples
+  // before (its crank, turning from pi/2, reaches it near 2.02 rad; the driven scene of this
+  // linkage is refused below)
+  write("limit.yaml",
+        "name: limit\n"
+        "linkage:\n"
+        "  type: planar\n"
+        "  nodes:\n"
+        "    A0: {at: [0, 0], ground: true}\n"
+        "    A3: {at: [0.3, 0], ground: true}\n"
+        "    A1: [0, 0.5]\n"
+        "    A2: [0.3, 0.35]\n"
+        "  links:\n"
+        "    crank: {nodes: [A0, A1], mass: 1.0, e: 0.1, f: 0, inertia: 0.002}\n"
+        "    coupler: {nodes: [A1, A2], mass: 1.0, e: 0.1, f: 0, inertia: 0.002}\n"
+        "    rocker: {nodes: [A3, A2], mass: 1.0, e: 0.1, f: 0, inertia: 0.002}\n"
+        "  inputs:\n"
+        "    crank: {link: crank}\n"
+        "scene: {type: free, duration: 0.5, rates: [6.283185307179586]}\n"
+        "method: truss\n");
+  EXPECT_EQ(run("limit.yaml --out res"), 3) << err_;
+  // the planar run's own message (not the empty four-bar trajectory's), naming where
+  EXPECT_EQ(err_.rfind("limit.yaml: simulation stopped early: ", 0), 0u) << err_;
+  EXPECT_NE(err_.find("crank = 2.0"), std::string::npos) << err_;
   EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
   EXPECT_TRUE(fs::exists(dir_ / "res" / "timeseries.csv"));
-
-  // its bench keeps every row and says how many runs stopped; the exit code is the run's
-  EXPECT_EQ(run("bench piston.yaml --quick --out bench"), 3) << err_;
-  EXPECT_NE(out_.find("  bench    14 rows (quick, 1 repeat): "), std::string::npos) << out_;
-  EXPECT_NE(out_.find("  bench    14 of 14 runs stopped before the end of the scene"),
-            std::string::npos)
-      << out_;
-  EXPECT_NE(err_.find("piston.yaml: simulation stopped early: the linkage cannot be assembled"),
-            std::string::npos)
-      << err_;
-  EXPECT_EQ(bd::testing::read(dir_ / "bench" / "driven-convergence.csv").substr(0, 7), "method,");
 }
 
 TEST_F(CliTest, PlanarDrivenInputThatCannotTurnFullyIsRefusedAtSceneType) {

@@ -113,6 +113,29 @@ TEST(PlanarStudy, MistakesAreOneLineAtTheirPlace) {
   beyond.replace(beyond.find("  speeds: [314.1592653589793]\n"), 30,
                  "  speeds: [0.1]\n  duration: 1\n  start: [0.3]\n");
   expect_error(beyond, 16, 1, "scene: the linkage cannot be assembled at stroke = 0.18");
+  // a scene by duration that drives the piston past its inner dead centre (rod - crank =
+  // 0.10 m from O) is refused at scene.type, at the first sample beyond it, as a scene over
+  // whole revolutions is where the linkage cannot turn (the run would stop there)
+  std::string past = from_piston;  // drawn with the crank upright, away from the dead centres
+  auto replace = [](std::string& text, const std::string& from, const std::string& to) {
+    text.replace(text.find(from), from.size(), to);
+  };
+  replace(past, "    A: [0.04, 0]\n", "    A: [0, 0.04]\n");
+  replace(past, "    B: [0.18, 0]\n", "    B: [0.13416407864998739, 0]\n");
+  replace(past, "  speeds: [314.1592653589793]\n",
+          "  speeds: [-0.1]\n  duration: 1\n  start: [0.13]\n");
+  expect_error(past, 17, 9,
+               "scene.type: driven moves the inputs at their speeds for the whole duration, but "
+               "the linkage cannot be assembled at stroke = ");
+  const std::string message = bd::testing::study_error_of(past, "e.yaml").message();
+  const double stroke = std::stod(message.substr(message.find("stroke = ") + 9));
+  const double step = 0.1 / 35;  // 36 samples over 1 s at 0.1 m/s
+  EXPECT_LT(stroke, 0.10) << message;
+  EXPECT_GE(stroke, 0.10 - step) << message;
+  // within its reach it runs
+  std::string within = past;  // (the stroke ends at 0.105 m)
+  replace(within, "duration: 1\n", "duration: 0.25\n");
+  EXPECT_NO_THROW(parse_study(within, "e.yaml"));
 }
 
 TEST(PlanarStudy, ExamplesWriteBackAsThemselves) {

@@ -54,6 +54,40 @@ TEST(ValidationMotion, DrivenSceneOfACrankThatCannotTurnIsAnErrorAtSceneType) {
   EXPECT_NO_THROW(studies::parse_study(free, "t.yaml"));
 }
 
+// A change-point linkage (shortest + longest = the other two: a parallelogram) turns fully, but at
+// the crank angles where its links fold into one line the loop closes two ways (on as drawn, or
+// crossed): driven through them, the run followed the crossed twin without a word. An input
+// error at scene.type, naming the fold angles, which this test finds from the poses: there the
+// transmission sine sin(theta3 - theta2) vanishes.
+TEST(ValidationMotion, DrivenChangePointLinkageIsAnErrorAtSceneType) {
+  std::string parallelogram = kTripleRocker;
+  parallelogram.replace(parallelogram.find("frame: 3.5"), 10, "frame: 3.0");
+  parallelogram.replace(parallelogram.find("crank:   {length: 2.0"), 21, "crank:   {length: 1.0");
+  parallelogram.replace(parallelogram.find("coupler: {length: 2.0"), 21, "coupler: {length: 3.0");
+  parallelogram.replace(parallelogram.find("rocker:  {length: 2.0"), 21, "rocker:  {length: 1.0");
+  testing::expect_study_error(parallelogram, "p.yaml", 10, 9,
+                              "scene.type: driven turns the crank through whole revolutions, but "
+                              "this linkage is change-point");
+  const std::string message = testing::study_error_of(parallelogram, "p.yaml").message();
+  EXPECT_NE(message.find("theta1 = 3.14159, 0 rad"), std::string::npos) << message;
+  core::FourBar fb;
+  fb.frame_length = 3.0;
+  fb.crank = {1.0, 1.0, 0.8, 0.1, 0.4};
+  fb.coupler = {3.0, 1.5, 1.0, 0.0, 0.6};
+  fb.rocker = {1.0, 1.2, 0.9, -0.1, 0.5};
+  for (double fold : {0.0, M_PI}) {
+    const auto near = core::solve_position(fb, fold + 1e-10);
+    const auto away = core::solve_position(fb, fold + 0.5);
+    ASSERT_TRUE(near && away);
+    EXPECT_LT(std::abs(std::sin(near->theta3 - near->theta2)), 1e-3) << fold;
+    EXPECT_GT(std::abs(std::sin(away->theta3 - away->theta2)), 0.1) << fold;
+  }
+  // the crank three per mille shorter: a crank-rocker, which runs
+  std::string crank_rocker = parallelogram;
+  crank_rocker.replace(crank_rocker.find("crank:   {length: 1.0"), 21, "crank:   {length: 0.997");
+  EXPECT_NO_THROW(studies::parse_study(crank_rocker, "p.yaml"));
+}
+
 // a tab in the indentation: named as such at its line and column, not yaml-cpp's "illegal map
 // value"
 TEST(ValidationMotion, TabInIndentationIsNamedAtItsPlace) {
