@@ -469,4 +469,74 @@ void block_solve_transpose(const Model& model, Workspace& ws, Eigen::VectorXd& b
   b.swap(ws.block_lambda);
 }
 
+void closed_form_kinematics(const Model& model, Workspace& ws, const std::vector<double>& rates,
+                            const std::vector<double>& accelerations) {
+  const System& s = model.system();
+  const BlockPlan& plan = s.blocks;
+  Instant& in = ws.instant;
+  const NodeVectors& x = in.x;
+  NodeVectors& v = in.v;
+  NodeVectors& a = in.a;
+  for (int i : s.fixed) {
+    v[static_cast<std::size_t>(i)] = Vec2(0, 0);
+    a[static_cast<std::size_t>(i)] = Vec2(0, 0);
+  }
+  for (const Block& b : plan.blocks) {
+    const std::size_t P = static_cast<std::size_t>(b.node);
+    switch (b.kind) {
+      case Block::Kind::kCrank: {
+        // P = A + L u(θ): v = v_A + L θ̇ perp(u), a = a_A + L (θ̈ perp(u) - θ̇² u)
+        const std::size_t k = static_cast<std::size_t>(b.index);
+        const Vec2& u = ws.target[k];
+        const double w = rates[k], dw = accelerations[k];
+        v[P] = at(v, b.a) + (b.ra * w) * perp(u);
+        a[P] = at(a, b.a) + b.ra * (dw * perp(u) - (w * w) * u);
+        break;
+      }
+      case Block::Kind::kDyad: {
+        // (P - A)·(v_P - v_A) = 0, (P - B)·(v_P - v_B) = 0; differentiated once more,
+        // (P - A)·(a_P - a_A) = -|v_P - v_A|², likewise for B
+        const Vec2 ea = x[P] - at(x, b.a), eb = x[P] - at(x, b.b);
+        const double det = cross(ea, eb);
+        auto solve = [&](double y0, double y1) {
+          return Vec2((y0 * eb.y() - y1 * ea.y()) / det, (ea.x() * y1 - eb.x() * y0) / det);
+        };
+        v[P] = solve(ea.dot(at(v, b.a)), eb.dot(at(v, b.b)));
+        const Vec2 wa = v[P] - at(v, b.a), wb = v[P] - at(v, b.b);
+        a[P] = solve(ea.dot(at(a, b.a)) - wa.squaredNorm(), eb.dot(at(a, b.b)) - wb.squaredNorm());
+        break;
+      }
+      case Block::Kind::kGuide: {
+        // P moves along the guide: (P - A)·(ṡ u - v_A) = 0, (P - A)·(s̈ u - a_A) = -|v_P - v_A|²
+        const System::SliderRow& sl = s.sliders[static_cast<std::size_t>(b.index)];
+        const Vec2 ea = x[P] - at(x, b.a);
+        const double along = ea.dot(sl.unit);
+        v[P] = (ea.dot(at(v, b.a)) / along) * sl.unit;
+        const Vec2 wa = v[P] - at(v, b.a);
+        a[P] = ((ea.dot(at(a, b.a)) - wa.squaredNorm()) / along) * sl.unit;
+        break;
+      }
+      case Block::Kind::kSlide: {
+        const System::InputRow& ir = s.inputs[static_cast<std::size_t>(b.index)];
+        const Vec2& unit = s.sliders[static_cast<std::size_t>(ir.slider)].unit;
+        v[P] = rates[static_cast<std::size_t>(b.index)] * unit;
+        a[P] = accelerations[static_cast<std::size_t>(b.index)] * unit;
+        break;
+      }
+      case Block::Kind::kRigid: {
+        const System::RigidRows& r = s.rigid[static_cast<std::size_t>(b.index)];
+        v[P] = r.weights.at_p * at(v, r.p) + r.weights.at_q * at(v, r.q);
+        a[P] = r.weights.at_p * at(a, r.p) + r.weights.at_q * at(a, r.q);
+        break;
+      }
+      case Block::Kind::kGeneral:
+        break;  // (not a closed plan)
+    }
+  }
+  q_from_nodes(s, v, ws.qd);
+  q_from_nodes(s, a, ws.qdd);
+  std::copy(rates.begin(), rates.end(), in.input_rate.begin());
+  std::copy(accelerations.begin(), accelerations.end(), in.input_acceleration.begin());
+}
+
 }  // namespace bd::core::planar::detail

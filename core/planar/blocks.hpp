@@ -54,4 +54,13 @@ void block_solve(const Model& model, Workspace& ws, const Eigen::VectorXd& b, Ei
 /// After place_by_blocks(): b = G⁻ᵀ b by backward substitution, in place.
 void block_solve_transpose(const Model& model, Workspace& ws, Eigen::VectorXd& b);
 
+/// After place_by_blocks() on a plan of closed forms (BlockPlan::closed): the nodes' velocities
+/// and accelerations for the inputs' rates and accelerations, block by block from each block's
+/// own geometry (a crank's tip turning about its pivot; a dyad's node from its two rows
+/// (P - A)·(v_P - v_A) = 0, (P - B)·(v_P - v_B) = 0 and their derivatives; a guide's node along
+/// its guide; a further node as its element's nodes weigh it), without the Jacobian. Sets
+/// ws.instant.v, .a, .input_rate, .input_acceleration and ws.qd, ws.qdd.
+void closed_form_kinematics(const Model& model, Workspace& ws, const std::vector<double>& rates,
+                            const std::vector<double>& accelerations);
+
 }  // namespace bd::core::planar::detail

@@ -735,12 +735,14 @@ void forces(const Model& model, Workspace& ws) {
 }
 
 // after the accelerations q̈: the multipliers from Gᵀ λ = M q̈ - F (efforts of the inputs
-// excluded from F: they are the input rows' multipliers) and every output
-Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t) {
+// excluded from F: they are the input rows' multipliers) and every output; the nodes'
+// accelerations from q̈ unless `accelerations_set` (the closed forms set both)
+Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t,
+                                   bool accelerations_set = false) {
   const System& s = model.system();
   Instant& in = ws.instant;
   in.t = t;
-  detail::node_rates_from(s, ws.qdd, in.a);
+  if (!accelerations_set) detail::node_rates_from(s, ws.qdd, in.a);
   detail::applied_forces(s, in.x, in.v, nullptr, ws.F);
   multiply(s.M, ws.qdd, ws.rhs);
   ws.rhs -= ws.F;
@@ -774,6 +776,10 @@ Expected<bool, PlanarError> inverse_dynamics(const Model& model, Workspace& ws, 
                                              const std::vector<double>& rates,
                                              const std::vector<double>& accelerations) {
   const System& s = model.system();
+  if (ws.by_blocks && s.blocks.closed) {
+    detail::closed_form_kinematics(model, ws, rates, accelerations);
+    return finish(model, ws, t, true);
+  }
   velocities(model, ws, rates);
   detail::constraint_bias(s, ws.instant.x, ws.instant.v, s.rows, ws.gamma);
   ws.rhs = -ws.gamma;

@@ -4,7 +4,7 @@
 // method and an LU of the whole system, cp::solve_position and cp::inverse_dynamics at each
 // instant): every column of a driven revolution's table, on random linkages of every family the
 // engine's referee tests draw. Both routes are exact; they differ by round-off amplified by the
-// conditioning of the positions: ~1e-14 of each quantity's scale measured, and up to 1.3e-12 in
+// conditioning of the positions: ~1e-14 of each quantity's scale measured, and up to 2e-12 in
 // the angular accelerations, where the general route's LU of the whole system mixes the rows of
 // the fastest links into the crank's (its condition number reaches ~1e4 at the transmission
 // angles the generators allow, kTransmission in tests/support/planar_mechanisms.hpp); 1e-11
