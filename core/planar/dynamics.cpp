@@ -228,6 +228,7 @@ Workspace::Workspace(const Model& model) {
   zdd.setZero(model.inputs());
   target.assign(static_cast<std::size_t>(model.inputs()), Vec2(0, 0));
   on_link.assign(model.linkage().links.size() * model.linkage().nodes.size(), Vec2(0, 0));
+  element_force.assign(model.linkage().links.size(), Vec4::Zero());
 }
 
 std::vector<double> drawn_inputs(const Model& model) {
@@ -547,9 +548,61 @@ void link_kinematics(const Model& model, Instant& in) {
   }
 }
 
+// per link: its element's nodal forces, inertia less applied load (eq. 46), at its first and
+// second node, into ws.element_force: what M q̈ - F assembles (multiplier_rhs()) and what the
+// joint forces start from (link_node_forces())
+void element_forces(const Model& model, Workspace& ws) {
+  const System& s = model.system();
+  const Instant& in = ws.instant;
+  const std::size_t links = s.elements.size();
+  for (std::size_t k = 0; k < links; ++k) {
+    const System::ElementRow& e = s.elements[k];
+    const std::size_t p = static_cast<std::size_t>(e.p), q = static_cast<std::size_t>(e.q);
+    Vec4 acc;
+    acc << in.a[p], in.a[q];
+    Vec4& f = ws.element_force[k];
+    f.noalias() = s.element_M[k] * acc;
+    const double moment =
+        s.shafts.empty() ? s.link_moment[k] : detail::link_moment_at(s, static_cast<int>(k), in.x);
+    if (s.link_force[k].isZero(0.0) && moment == 0.0) continue;  // an unloaded link
+    f -= element_nodal_forces(s.com_weights[k], s.link_force[k], moment, in.x[p], in.x[q]);
+  }
+}
+
+// M q̈ - F (the efforts excluded) from the element forces, the point masses, the node forces and
+// the springs, into ws.rhs: the right-hand side of the multipliers' Gᵀ λ = M q̈ - F
+void multiplier_rhs(const Model& model, Workspace& ws) {
+  const System& s = model.system();
+  const Linkage& l = s.linkage;
+  const Instant& in = ws.instant;
+  ws.rhs.setZero(s.n);
+  double* rhs = ws.rhs.data();
+  const int* coord = s.coord.data();
+  auto add = [&](int node, const Vec2& f) {
+    const int c = coord[node];
+    if (c < 0) return;
+    rhs[c] += f.x();
+    rhs[c + 1] += f.y();
+  };
+  const std::size_t links = s.elements.size();
+  for (std::size_t k = 0; k < links; ++k) {
+    add(s.elements[k].p, ws.element_force[k].segment<2>(0));
+    add(s.elements[k].q, ws.element_force[k].segment<2>(2));
+  }
+  const Vec2& g = l.loads.gravity;
+  for (const PointMass& pm : l.point_masses)
+    add(pm.node, pm.mass * (in.a[static_cast<std::size_t>(pm.node)] - g));
+  for (const NodeForce& nf : l.loads.node_forces) add(nf.node, -nf.force);
+  for (std::size_t k = 0; k < l.springs.size(); ++k) {
+    const detail::SpringState st = detail::spring_state(s, static_cast<int>(k), in.x, in.v);
+    add(l.springs[k].a, -st.tension * st.unit);
+    add(l.springs[k].b, st.tension * st.unit);
+  }
+}
+
 // per link and node: the force on the link from the joint there (f = inertia - load - the
-// link's own constraint forces), from the multipliers of the structural rows (ws.lambda);
-// stored densely in ws.on_link, links x nodes
+// link's own constraint forces), from the element forces and the multipliers of the structural
+// rows (ws.lambda); stored densely in ws.on_link, links x nodes
 void link_node_forces(const Model& model, Workspace& ws) {
   const System& s = model.system();
   const Linkage& l = s.linkage;
@@ -560,26 +613,17 @@ void link_node_forces(const Model& model, Workspace& ws) {
   auto f = [&](int link, int node) -> Vec2& {
     return on_link[static_cast<std::size_t>(link) * nodes + static_cast<std::size_t>(node)];
   };
-  for (std::size_t k = 0; k < l.links.size(); ++k) {
+  const std::size_t links = s.elements.size();
+  for (std::size_t k = 0; k < links; ++k) {
     const System::ElementRow& e = s.elements[k];
     const Vec2& xp = in.x[static_cast<std::size_t>(e.p)];
     const Vec2& xq = in.x[static_cast<std::size_t>(e.q)];
-    Vec4 acc;
-    acc << in.a[static_cast<std::size_t>(e.p)], in.a[static_cast<std::size_t>(e.q)];
-    const Vec4 inertia = s.element_M[k] * acc;
     // the element's own row (row k): its axial force λ_k along the unit vector p -> q,
     // row_gradient()'s element case without its dispatch
     const Vec2 axial = ws.lambda[static_cast<Eigen::Index>(k)] * ((xq - xp) / e.length);
-    const double moment =
-        s.shafts.empty() ? s.link_moment[k] : detail::link_moment_at(s, static_cast<int>(k), in.x);
-    if (s.link_force[k].isZero(0.0) && moment == 0.0) {  // an unloaded link (as applied_forces)
-      f(static_cast<int>(k), e.p) += inertia.segment<2>(0) + axial;
-      f(static_cast<int>(k), e.q) += inertia.segment<2>(2) - axial;
-      continue;
-    }
-    const Vec4 applied = element_nodal_forces(s.com_weights[k], s.link_force[k], moment, xp, xq);
-    f(static_cast<int>(k), e.p) += inertia.segment<2>(0) - applied.segment<2>(0) + axial;
-    f(static_cast<int>(k), e.q) += inertia.segment<2>(2) - applied.segment<2>(2) - axial;
+    const Vec4& ef = ws.element_force[k];
+    f(static_cast<int>(k), e.p) += ef.segment<2>(0) + axial;
+    f(static_cast<int>(k), e.q) += ef.segment<2>(2) - axial;
   }
   GradientEntry entries[3];
   for (int row = static_cast<int>(l.links.size()); row < s.rows; ++row) {
@@ -727,11 +771,18 @@ void shaking_parts(const Model& model, Instant& in) {
   }
 }
 
-// every force output from the multipliers of the structural rows (ws.lambda) and the efforts
+// every force output from the element forces, the multipliers of the structural rows
+// (ws.lambda) and the efforts
 void forces(const Model& model, Workspace& ws) {
   link_node_forces(model, ws);
   frame_forces(model, ws);
   shaking_parts(model, ws.instant);
+}
+
+// with the element forces current: the link kinematics and every force output
+void outputs(const Model& model, Workspace& ws) {
+  link_kinematics(model, ws.instant);
+  forces(model, ws);
 }
 
 // after the accelerations q̈: the multipliers from Gᵀ λ = M q̈ - F (efforts of the inputs
@@ -743,9 +794,8 @@ Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t,
   Instant& in = ws.instant;
   in.t = t;
   if (!accelerations_set) detail::node_rates_from(s, ws.qdd, in.a);
-  detail::applied_forces(s, in.x, in.v, nullptr, ws.F);
-  multiply(s.M, ws.qdd, ws.rhs);
-  ws.rhs -= ws.F;
+  element_forces(model, ws);
+  multiplier_rhs(model, ws);
   // Gᵀ λ = rhs, in place
   ws.lambda = ws.rhs;
   if (ws.by_blocks) {
@@ -757,7 +807,7 @@ Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t,
     in.effort[static_cast<std::size_t>(ir.input)] =
         ir.angle ? ws.lambda[ir.row] * ir.length : ws.lambda[ir.row];
   }
-  detail::finish_outputs(model, ws);
+  outputs(model, ws);
   if (!finite(ws.lambda) || !finite(ws.qdd)) {
     return Unexpected<PlanarError>(PlanarError{
         PlanarError::Kind::kNonFinite, "non-finite result at " + inputs_text(model, in.input)});
@@ -768,8 +818,8 @@ Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t,
 }  // namespace
 
 void detail::finish_outputs(const Model& model, Workspace& ws) {
-  link_kinematics(model, ws.instant);
-  forces(model, ws);
+  element_forces(model, ws);
+  outputs(model, ws);
 }
 
 Expected<bool, PlanarError> inverse_dynamics(const Model& model, Workspace& ws, double t,

@@ -135,6 +135,7 @@ class Workspace {
   Eigen::LDLT<Eigen::MatrixXd> ldlt;
   std::vector<Vec2> target;  // the inputs of the last position solve (detail::input_targets)
   std::vector<Vec2> on_link;  // force recovery: per link and node, the force from the joint
+  std::vector<Vec4> element_force;  // per link: its element's nodal inertia less load (p, q)
   // the block-triangular route (core/planar/blocks.hpp): whether the last position was placed
   // by it (then G is the Jacobian there and the blocks are factorised, lu is not), per block
   // its branch, its determinant (two rows) or factorisation, and scratch
