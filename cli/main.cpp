@@ -5,7 +5,6 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <thread>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -13,8 +12,10 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <iterator>
 #include <optional>
 #include <string>
+#include <thread>
 #include <variant>
 #include <vector>
 
@@ -835,21 +836,35 @@ int bench(const BenchArgs& args) {
   return kExitOk;
 }
 
-// `balance-design STUDY.yaml ...` is short for `balance-design run STUDY.yaml ...`
-std::vector<std::string> with_default_command(int argc, char** argv) {
+// the program's commands, which `help COMMAND` explains
+constexpr const char* kCommands[] = {"run", "validate", "report", "bench"};
+
+bool is_command(const std::string& word) {
+  return std::find(std::begin(kCommands), std::end(kCommands), word) != std::end(kCommands);
+}
+
+// `balance-design STUDY.yaml ...` is short for `balance-design run STUDY.yaml ...`; nothing
+// after the one-line error on stderr for `help TOPIC` of a topic that is no command
+std::optional<std::vector<std::string>> with_default_command(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
-  // `balance-design help` is --help; `balance-design help COMMAND` is COMMAND --help
+  // `balance-design help` (and `help help`) is --help; `balance-design help COMMAND` is
+  // COMMAND --help
   if (!args.empty() && args.front() == "help") {
     args.erase(args.begin());
-    if (args.size() > 1) args.resize(1);
+    if (args.empty() || args.front() == "help") return std::vector<std::string>{"--help"};
+    if (!is_command(args.front())) {
+      say_error("balance-design: no help on \"" + args.front() +
+                "\": the commands are run, validate, report and bench (balance-design help)");
+      return std::nullopt;
+    }
+    args.resize(1);
     args.push_back("--help");
-    if (args.front() == "--help") return args;
+    return args;
   }
   if (!args.empty()) {
     const std::string& first = args.front();
-    const bool top_level = first == "run" || first == "validate" || first == "report" ||
-                           first == "bench" || first == "-h" || first == "--help" ||
-                           first == "--version";
+    const bool top_level =
+        is_command(first) || first == "-h" || first == "--help" || first == "--version";
     if (!top_level) args.insert(args.begin(), "run");
   }
   return args;
@@ -951,7 +966,9 @@ int main(int argc, char** argv) {
     report_cmd->footer("\nDIR may be given from anywhere. Exit codes: 0 the page was written, "
                        "1 it could not be, 2 DIR holds no run or a data file of it is cut short.\n");
 
-    std::vector<std::string> argv_rest = with_default_command(argc, argv);
+    std::optional<std::vector<std::string>> parsed_words = with_default_command(argc, argv);
+    if (!parsed_words) return kExitBadInput;
+    std::vector<std::string>& argv_rest = *parsed_words;
     if (argv_rest.empty()) {
       std::fputs(app.help().c_str(), stderr);
       return kExitBadInput;

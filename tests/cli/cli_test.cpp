@@ -463,6 +463,22 @@ TEST_F(CliTest, HelpPerCommand) {
   }
 }
 
+// `help TOPIC` of a topic that is no command is a mistake: one line naming the commands, the
+// usage exit code, and neither run's help nor the overview; `help help` is the overview
+TEST_F(CliTest, HelpOnAnUnknownTopicIsAnError) {
+  EXPECT_EQ(run("help"), 0) << err_;
+  const std::string top = out_;
+  for (const char* topic : {"bogus", "study.yaml", "--out"}) {
+    EXPECT_EQ(run(std::string("help ") + topic), 2) << topic;
+    EXPECT_TRUE(out_.empty()) << topic << "\n" << out_;
+    EXPECT_EQ(err_.find('\n'), err_.size() - 1) << topic << "\n" << err_;
+    EXPECT_NE(err_.find(std::string("no help on \"") + topic + "\""), std::string::npos) << err_;
+    EXPECT_NE(err_.find("run, validate, report and bench"), std::string::npos) << err_;
+  }
+  EXPECT_EQ(run("help help"), 0) << err_;
+  EXPECT_EQ(out_, top);
+}
+
 // the output folder holds its study: `report DIR` from another directory gives the same page,
 // even when the study was given by a relative path that does not lead there
 TEST_F(CliTest, ReportFromAnotherDirectoryGivesTheSamePage) {
