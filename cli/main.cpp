@@ -5,7 +5,6 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <thread>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -13,8 +12,10 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <iterator>
 #include <optional>
 #include <string>
+#include <thread>
 #include <variant>
 #include <vector>
 
@@ -270,8 +271,40 @@ bool is_total(const std::string& metric) {
   return metric.rfind("Fsh_total", 0) == 0 || metric.rfind("Msh_total", 0) == 0;
 }
 
+// the natural scales of the run's values for the display rule of round-off: the linkage's size,
+// the largest force and moment of every design of the run (st::DisplayScales)
+st::DisplayScales display_scales(const st::Study& study, const st::RunResult& r) {
+  st::DisplayScales s;
+  s.length = st::linkage_size(study);
+  s.add(r.metric_list);
+  if (r.balanced) s.add(r.balanced->metric_list);
+  if (r.optimized) s.add(r.optimized->metric_list);
+  return s;
+}
+
+// a number as the terminal shows it: 6 digits, or 0 where it is round-off of `scale`
+std::string shown(double v, double scale) { return bd::text::scaled(v, scale); }
+
+// a point "[x, y]" in m, a coordinate that is round-off of the linkage's `size` as 0
+std::string point_text(const bd::Vec2& p, double size) {
+  return "[" + shown(p.x(), size) + ", " + shown(p.y(), size) + "]";
+}
+
+// the unit of metric `name` of the run (any of its designs), "" when it is none
+std::string unit_of_metric(const st::RunResult& r, const std::string& name) {
+  for (const st::MetricList* list :
+       {&r.metric_list, r.balanced ? &r.balanced->metric_list : nullptr,
+        r.optimized ? &r.optimized->metric_list : nullptr}) {
+    if (!list) continue;
+    for (const st::MetricValue& m : *list)
+      if (m.name == name) return m.unit;
+  }
+  return "";
+}
+
 void print_comparison(const st::Study& study, const st::RunResult& r) {
   const std::vector<st::ComparisonRow> rows = st::comparison(study, r);
+  const st::DisplayScales scales = display_scales(study, r);
   int width = 14;  // the metric column, as wide as the longest name (a shaft's bearing force)
   for (const st::ComparisonRow& row : rows)
     width = std::max(width, static_cast<int>(row.metric.size()));
@@ -279,13 +312,16 @@ void print_comparison(const st::Study& study, const st::RunResult& r) {
   const bool totals = has_static_part(study);
   for (const st::ComparisonRow& row : rows) {
     if (!totals && is_total(row.metric)) continue;
+    // round-off of the larger of the two, or of the run's scale of the unit, as 0, and the
+    // ratio of such an after as 0 too
+    const double scale = std::max(
+        {std::abs(row.before), std::abs(row.after), scales.of(unit_of_metric(r, row.metric))});
+    std::string ratio = "-";
     if (row.ratio) {
-      std::printf("  %-*s %14.6g %14.6g %12.4g\n", width, row.metric.c_str(), row.before, row.after,
-                  *row.ratio);
-    } else {
-      std::printf("  %-*s %14.6g %14.6g %12s\n", width, row.metric.c_str(), row.before, row.after,
-                  "-");
+      ratio = bd::text::is_round_off(row.after, scale) ? "0" : bd::text::scaled(*row.ratio, 1, 4);
     }
+    std::printf("  %-*s %14s %14s %12s\n", width, row.metric.c_str(),
+                shown(row.before, scale).c_str(), shown(row.after, scale).c_str(), ratio.c_str());
   }
 }
 
@@ -298,15 +334,14 @@ void print_warnings(const std::vector<std::string>& warnings) {
 // one counterweight's line: "  NAME  counterweight[ (SHAPE)] M kg at [x, y] m from PIVOT (d m)[,
 // radius r m]", or "  NAME  no counterweight (0 kg)" for none; NAME in a column `width` wide
 void print_counterweight(const std::string& name, int width, const bd::balance::Counterweight& c,
-                         const std::string& pivot, const char* shape = nullptr) {
+                         const std::string& pivot, double size, const char* shape = nullptr) {
   if (!(c.mass > 0)) {
     std::printf("  %-*s  no counterweight (0 kg)\n", width, name.c_str());
     return;
   }
-  std::printf("  %-*s  counterweight%s%s%s %.6g kg at [%.6g, %.6g] m from %s (%.6g m)", width,
-              name.c_str(), shape ? " (" : "", shape ? shape : "", shape ? ")" : "", c.mass + 0.0,
-              c.position.x() + 0.0, c.position.y() + 0.0,  // + 0.0: no "-0"
-              pivot.c_str(), c.distance);
+  std::printf("  %-*s  counterweight%s%s%s %.6g kg at %s m from %s (%.6g m)", width, name.c_str(),
+              shape ? " (" : "", shape ? shape : "", shape ? ")" : "", c.mass + 0.0,
+              point_text(c.position, size).c_str(), pivot.c_str(), c.distance);
   if (c.radius > 0) std::printf(", radius %.6g m", c.radius);
   std::printf("\n");
 }
@@ -328,15 +363,15 @@ void print_balance(const st::Study& study, const st::RunResult& r) {
   const char* pivots[] = {"A0", "A3"};
   for (int i = 0; i < 2; ++i) {
     if (!cws[i]->has_value()) continue;
-    print_counterweight(sides[i], 7, **cws[i], pivots[i],
+    print_counterweight(sides[i], 7, **cws[i], pivots[i], st::linkage_size(study),
                         bd::balance::to_string(specs[i]->shape));
   }
   const bd::core::CounterRotation* discs[] = {&b.model.counter_rotations.crank,
                                               &b.model.counter_rotations.rocker};
   for (int i = 0; i < 2; ++i) {
     if (discs[i]->inertia <= 0) continue;
-    std::printf("  %-7s  counter-rotation J = %.6g kg m^2 on a shaft at [%.6g, %.6g] m\n", sides[i],
-                discs[i]->inertia, discs[i]->at.x(), discs[i]->at.y());
+    std::printf("  %-7s  counter-rotation J = %.6g kg m^2 on a shaft at %s m\n", sides[i],
+                discs[i]->inertia, point_text(discs[i]->at, st::linkage_size(study)).c_str());
   }
   if (run.method.method == r.method.method && run.method.reason == r.method.reason) {
     std::printf("  balanced design: method %s as above", st::to_string(run.method.method));
@@ -355,7 +390,7 @@ void print_planar_counterweights(const bd::core::planar::Linkage& l,
                                  int width) {
   for (const bd::balance::planar::LinkCounterweight& c : cws) {
     print_counterweight(l.links[static_cast<std::size_t>(c.link)].name, width, c.counterweight,
-                        l.nodes[static_cast<std::size_t>(c.pivot)].name);
+                        l.nodes[static_cast<std::size_t>(c.pivot)].name, st::linkage_size(l));
   }
 }
 
@@ -388,9 +423,9 @@ void print_planar_balance(const st::Study& study, const st::RunResult& r) {
       const bd::core::planar::BalanceShaft& s =
           run.shafts->linkage.shafts[static_cast<std::size_t>(i)];
       std::printf(
-          "  %-*s  balance shaft at [%.6g, %.6g] m turning %d times the %s: %.6g kg at "
+          "  %-*s  balance shaft at %s m turning %d times the %s: %.6g kg at "
           "%.6g m\n",
-          width, s.name.c_str(), s.at.x(), s.at.y(), s.ratio,
+          width, s.name.c_str(), point_text(s.at, st::linkage_size(l)).c_str(), s.ratio,
           l.links[static_cast<std::size_t>(s.link)].name.c_str(), s.mass, s.eccentricity.norm());
     }
   }
@@ -398,10 +433,9 @@ void print_planar_balance(const st::Study& study, const st::RunResult& r) {
     for (int i : run.moment->added) {
       const bd::core::planar::BalanceShaft& s =
           run.moment->linkage.shafts[static_cast<std::size_t>(i)];
-      std::printf(
-          "  %-*s  counter-rotation J = %.6g kg m^2 on a shaft at [%.6g, %.6g] m, ratio %d\n",
-          width, l.links[static_cast<std::size_t>(s.link)].name.c_str(), s.inertia, s.at.x(),
-          s.at.y(), s.ratio);
+      std::printf("  %-*s  counter-rotation J = %.6g kg m^2 on a shaft at %s m, ratio %d\n", width,
+                  l.links[static_cast<std::size_t>(s.link)].name.c_str(), s.inertia,
+                  point_text(s.at, st::linkage_size(l)).c_str(), s.ratio);
     }
     std::printf("  balance  moment full: the balanced design is %s\n",
                 run.moment->full ? "moment balanced" : "not moment balanced");
@@ -444,8 +478,8 @@ void print_optimize(const st::Study& study, const st::RunResult& r) {
   if (!run.found()) return;
   print_optimality(o);
   for (const bd::optimize::PlacedCounterweight& p : o.counterweights) {
-    print_counterweight(bd::core::link_name(p.link), 7, p.counterweight,
-                        p.link == 1 ? "A0" : "A3");
+    print_counterweight(bd::core::link_name(p.link), 7, p.counterweight, p.link == 1 ? "A0" : "A3",
+                        st::linkage_size(study));
   }
   std::printf("  verified with %s: largest relative difference %.3g\n", o.verified_by().c_str(),
               o.verification_error);
@@ -527,25 +561,30 @@ void print_scene(const st::Study& study) {
 }
 
 // the metrics in pairs (RMS, then peak, per quantity); a peak alone on its own line
-void print_metrics(const st::MetricList& metrics, bool driven, bool totals) {
+void print_metrics(const st::MetricList& metrics, bool driven, bool totals,
+                   const st::DisplayScales& scales) {
   for (std::size_t k = 0; k < metrics.size(); ++k) {
     const st::MetricValue& m = metrics[k];
     if (!totals && is_total(m.name)) continue;
     std::string symbol = m.name.substr(0, m.name.rfind('_'));
     if (symbol.rfind("tau", 0) == 0 && !driven) continue;  // 0 in free motion without a drive
-    // Fsh, Msh: the inertial part; Fsh_total, Msh_total: weights and loads included
+    // Fsh, Msh: the inertial part (what balancing acts on, and what the metrics take);
+    // Fsh_total, Msh_total: weights and loads included
     const bool total = symbol.ends_with("_total");
     if (total) symbol.resize(symbol.size() - 6);
-    const char* what = total ? "total " : "";
+    const char* what = total ? "total " : symbol == "Fsh" || symbol == "Msh" ? "inertial " : "";
     const bool pair = k + 1 < metrics.size() && m.name.size() > 4 &&
                       m.name.compare(m.name.size() - 4, 4, "_rms") == 0;
+    // round-off of the run's largest force (moment) shows as 0
+    const std::string value = shown(m.value, scales.of(m.unit));
     if (pair) {
       const st::MetricValue& peak = metrics[k + 1];
-      std::printf("  %-8s %srms %.6g %s, max %.6g %s\n", ("|" + symbol + "|").c_str(), what,
-                  m.value, m.unit.c_str(), peak.value, peak.unit.c_str());
+      std::printf("  %-8s %srms %s %s, max %s %s\n", ("|" + symbol + "|").c_str(), what,
+                  value.c_str(), m.unit.c_str(), shown(peak.value, scales.of(peak.unit)).c_str(),
+                  peak.unit.c_str());
       ++k;
     } else {
-      std::printf("  %-8s %smax %.6g %s\n", ("|" + symbol + "|").c_str(), what, m.value,
+      std::printf("  %-8s %smax %s %s\n", ("|" + symbol + "|").c_str(), what, value.c_str(),
                   m.unit.c_str());
     }
   }
@@ -566,7 +605,8 @@ void print_summary(const st::Study& study, const st::RunResult& r) {
     std::printf("  partial  the metrics below cover only the %zu samples before the run stopped\n",
                 status.samples);
   }
-  print_metrics(r.metric_list, !st::is_free(study.scene), has_static_part(study));
+  print_metrics(r.metric_list, !st::is_free(study.scene), has_static_part(study),
+                display_scales(study, r));
   if (study.balance && r.balanced) print_balance(study, r);
   if (study.planar_balance && r.balanced) print_planar_balance(study, r);
   if (study.optimize && r.optimized) print_optimize(study, r);
@@ -835,21 +875,35 @@ int bench(const BenchArgs& args) {
   return kExitOk;
 }
 
-// `balance-design STUDY.yaml ...` is short for `balance-design run STUDY.yaml ...`
-std::vector<std::string> with_default_command(int argc, char** argv) {
+// the program's commands, which `help COMMAND` explains
+constexpr const char* kCommands[] = {"run", "validate", "report", "bench"};
+
+bool is_command(const std::string& word) {
+  return std::find(std::begin(kCommands), std::end(kCommands), word) != std::end(kCommands);
+}
+
+// `balance-design STUDY.yaml ...` is short for `balance-design run STUDY.yaml ...`; nothing
+// after the one-line error on stderr for `help TOPIC` of a topic that is no command
+std::optional<std::vector<std::string>> with_default_command(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
-  // `balance-design help` is --help; `balance-design help COMMAND` is COMMAND --help
+  // `balance-design help` (and `help help`) is --help; `balance-design help COMMAND` is
+  // COMMAND --help
   if (!args.empty() && args.front() == "help") {
     args.erase(args.begin());
-    if (args.size() > 1) args.resize(1);
+    if (args.empty() || args.front() == "help") return std::vector<std::string>{"--help"};
+    if (!is_command(args.front())) {
+      say_error("balance-design: no help on \"" + args.front() +
+                "\": the commands are run, validate, report and bench (balance-design help)");
+      return std::nullopt;
+    }
+    args.resize(1);
     args.push_back("--help");
-    if (args.front() == "--help") return args;
+    return args;
   }
   if (!args.empty()) {
     const std::string& first = args.front();
-    const bool top_level = first == "run" || first == "validate" || first == "report" ||
-                           first == "bench" || first == "-h" || first == "--help" ||
-                           first == "--version";
+    const bool top_level =
+        is_command(first) || first == "-h" || first == "--help" || first == "--version";
     if (!top_level) args.insert(args.begin(), "run");
   }
   return args;
@@ -951,7 +1005,9 @@ int main(int argc, char** argv) {
     report_cmd->footer("\nDIR may be given from anywhere. Exit codes: 0 the page was written, "
                        "1 it could not be, 2 DIR holds no run or a data file of it is cut short.\n");
 
-    std::vector<std::string> argv_rest = with_default_command(argc, argv);
+    std::optional<std::vector<std::string>> parsed_words = with_default_command(argc, argv);
+    if (!parsed_words) return kExitBadInput;
+    std::vector<std::string>& argv_rest = *parsed_words;
     if (argv_rest.empty()) {
       std::fputs(app.help().c_str(), stderr);
       return kExitBadInput;

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <charconv>
+#include <cmath>
 #include <string>
 #include <string_view>
 
@@ -30,6 +31,21 @@ inline std::string shortest(double v) { return fmt::format("{}", v); }
 
 /// `n` significant digits ("%.<n>g"): for a person reading a message or a table.
 inline std::string digits(double v, int n) { return fmt::format("{:.{}g}", v, n); }
+
+/// The display rule of round-off, one for every table, chart and console line: a value within
+/// this fraction of its quantity's natural scale (a position: the linkage's size; a force: the
+/// largest force of the run) is round-off of it and shown as 0. Data files keep every digit.
+inline constexpr double kRoundOff = 1e-12;
+
+/// True when `v` is round-off of `scale` (|v| <= kRoundOff scale, with a finite scale > 0).
+inline bool is_round_off(double v, double scale) {
+  return std::isfinite(v) && std::isfinite(scale) && scale > 0 && std::abs(v) <= kRoundOff * scale;
+}
+
+/// digits(v, n), or "0" where v is round-off of `scale` (is_round_off()); never "-0".
+inline std::string scaled(double v, double scale, int n = 6) {
+  return is_round_off(v, scale) ? std::string("0") : digits(v + 0.0, n);
+}
 
 /// Appends exact(v) to `out` without building a string (per-row file writers).
 inline void append_exact(fmt::memory_buffer& out, double v) {

@@ -197,7 +197,8 @@ Problem OptimizeOptions::validate() const {
     return FieldError{"max_evaluations", -1,
                       "must be >= 1, got " + std::to_string(max_evaluations)};
   }
-  if (starts < 1 || starts > max_evaluations) {
+  // only mlsl makes starts: another algorithm runs once, whatever starts holds (its default)
+  if (algorithm == Algorithm::kMlsl && (starts < 1 || starts > max_evaluations)) {
     return FieldError{"starts", -1,
                       "must be >= 1 and <= max_evaluations (" + std::to_string(max_evaluations) +
                           ": each start needs an evaluation), got " + std::to_string(starts)};

@@ -92,17 +92,19 @@ Drawing drawing(const core::FourBar& model, const Csv& timeseries) {
 }
 
 // the drawn samples of a design as a table
-std::string poses_table(const Drawing& d) {
+std::string poses_table(const Drawing& d, double size) {
   std::string h =
       "<table><tr><th>t [s]</th><th>&theta;1 [rad]</th><th>A1 [m]</th>"
       "<th>A2 [m]</th><th>G1 [m]</th><th>G2 [m]</th><th>G3 [m]</th><th>P1 [m]</th><th>P2 [m]</th>"
       "<th>P3 [m]</th><th>S [m]</th></tr>";
   for (const PoseSample& p : d.poses) {
     h += "<tr><td class=\"n\">" + fmt(p.t) + "</td><td class=\"n\">" + fmt(p.pose.theta1) +
-         "</td><td>" + vec_text(p.joints.A1) + "</td><td>" + vec_text(p.joints.A2) + "</td>";
-    for (const Vec2& g : p.G) h += "<td>" + vec_text(g) + "</td>";
-    h += "<td>" + vec_text(p.principal.P1) + "</td><td>" + vec_text(p.principal.P2) + "</td><td>" +
-         vec_text(p.principal.P3) + "</td><td>" + vec_text(p.S) + "</td></tr>";
+         "</td><td>" + vec_text(p.joints.A1, size) + "</td><td>" + vec_text(p.joints.A2, size) +
+         "</td>";
+    for (const Vec2& g : p.G) h += "<td>" + vec_text(g, size) + "</td>";
+    h += "<td>" + vec_text(p.principal.P1, size) + "</td><td>" + vec_text(p.principal.P2, size) +
+         "</td><td>" + vec_text(p.principal.P3, size) + "</td><td>" + vec_text(p.S, size) +
+         "</td></tr>";
   }
   return h + "</table>\n";
 }
@@ -288,7 +290,7 @@ AnimationFigure fourbar_animation(const core::FourBar& model,
 }
 
 FourBarCharts fourbar_charts(const Study& study, const fs::path& dir, const SecondDesign& sd,
-                             const Csv& ts, const Json& summary) {
+                             const Csv& ts, const Json& summary, const Scales& scales) {
   FourBarCharts out;
   const std::string second = sd.key, second_label = sd.label, second_file = sd.file;
   std::vector<Chart>& charts = out.charts;
@@ -316,9 +318,16 @@ FourBarCharts fourbar_charts(const Study& study, const fs::path& dir, const Seco
     // the samples as data blocks (at most kChartRows rows each: the page stays small)
     datablocks += datablock("ts", ts);
     if (second_study) datablocks += datablock("ts2", ts2);
+    // the shaking force and moment: the inertial part, as the metrics (round-off of the run's
+    // forces: 0)
     const bool closed = periodic_run(study.scene, summary);
-    datablocks += xy_block("hodo", ts, 15, 16, closed);
-    if (second_study) datablocks += xy_block("hodo2", ts2, 15, 16, closed);
+    const ShakingColumns shaking = shaking_columns(ts);
+    datablocks += xy_block("hodo", ts, shaking.x, shaking.y, closed, scales.force);
+    if (second_study) {
+      const ShakingColumns shaking2 = shaking_columns(ts2);
+      datablocks += xy_block("hodo2", ts2, shaking2.x, shaking2.y, closed, scales.force);
+    }
+    const std::string msh_column = std::to_string(shaking.moment);
     const RunAxis axis = run_axis(study.scene, 2);
     const std::string u = " skip 1 using " + axis.x + ":";
     const std::string xl = "\nset xlabel " + gp_string(axis.label) + "\n";
@@ -338,11 +347,12 @@ FourBarCharts fourbar_charts(const Study& study, const fs::path& dir, const Seco
                           "13 with lines lw 2 title 'RA3x', ''" + u +
                           "14 with lines lw 2 title 'RA3y'"});
     std::string hodo =
-        "set title 'Shaking-force hodograph'\nset size ratio -1\n"
-        "set xlabel 'Fshx [N]'\nset ylabel 'Fshy [N]'\n"
+        "set title 'Shaking-force hodograph (inertial part)'\nset size ratio -1\n"
+        "set xlabel 'Fshx inertial [N]'\nset ylabel 'Fshy inertial [N]'\n"
         "plot $hodo skip 1 using 1:2 with lines lw 2 title 'original'";
-    std::string msh = "set title 'Shaking moment about A0'" + xl + "set ylabel 'Msh [N m]'\nplot $ts" +
-                      u + "17 with lines lw 2 title 'original'";
+    std::string msh = "set title 'Shaking moment about A0 (inertial part)'" + xl +
+                      "set ylabel 'Msh inertial [N m]'\nplot $ts" + u + msh_column +
+                      " with lines lw 2 title 'original'";
     // a free scene has no drive: its chart is the bearing loads alone (a torque of 0 on a right
     // axis of its own would read as a constant load)
     const bool driven = !is_free(study.scene);
@@ -359,7 +369,7 @@ FourBarCharts fourbar_charts(const Study& study, const fs::path& dir, const Seco
     if (second_study) {
       hodo += ", $hodo2 skip 1 using 1:2 with linespoints lw 2 dt 2 pt 6 pi 25 title " +
               gp_string(second_label);
-      msh += ", $ts2" + u + "17 with lines lw 2 dt 2 title " + gp_string(second_label);
+      msh += ", $ts2" + u + msh_column + " with lines lw 2 dt 2 title " + gp_string(second_label);
       drive += ", $ts2" + u + "(sqrt($11**2+$12**2)) with lines lw 2 lt 1 dt 2 title '|RA0| " +
                second_label + "', ''" + u +
                "(sqrt($13**2+$14**2)) with lines lw 2 lt 2 dt 2 title '|RA3| " + second_label +
@@ -370,15 +380,17 @@ FourBarCharts fourbar_charts(const Study& study, const fs::path& dir, const Seco
     }
     const std::string overlay =
         second_study ? " The " + second_label + " design is dashed (" + second_file + ")." : "";
-    charts.push_back({"hodograph", "Shaking-force hodograph",
-                      "The tip of the shaking force F̄sh = R̄A0 + R̄A3 over the run, equal axes" +
+    charts.push_back({"hodograph", "Shaking-force hodograph, inertial part",
+                      "The tip of the shaking force over the run, equal axes" +
                           std::string(closed ? ", closed by the periodic end (the first sample "
                                                "again)."
                                              : ".") +
-                          overlay,
+                          shaking.force_note + overlay,
                       hodo, true});
-    charts.push_back({"shaking-moment", "Shaking moment",
-                      "Shaking moment on the frame about A0 over the run." + overlay, msh});
+    charts.push_back(
+        {"shaking-moment", "Shaking moment, inertial part",
+         "Shaking moment on the frame about A0 over the run." + shaking.moment_note + overlay,
+         msh});
     charts.push_back(
         {"drive", driven ? "Drive torque and bearing loads" : "Bearing loads",
          driven ? "Magnitudes of the bearing forces at A0 and A3 (left axis) and the drive "
@@ -408,27 +420,30 @@ std::string fourbar_report_html(const Study& study, const fs::path& dir, const s
   const SecondDesign second = second_design(summary, dir);
   std::string h = page_start(study, summary) + simulation_section(summary);
   h += "<h2>Linkage</h2>\n" + fourbar_linkage_tables(study.fourbar());
-  h +=
-      metrics_section(summary, second,
-                      "Fsh, Msh: shaking force and moment about A0 on the frame; tau: drive "
-                      "torque; RA0, RA3: forces on the ground at the bearings. RMS over the "
-                      "samples, max of magnitudes.");
-  h += comparison_section(dir, summary, second);
-  h += harmonics_section(dir);
-  FourBarCharts c = fourbar_charts(study, dir, second, ts, summary);
+  const double size = linkage_size(study);
+  const Scales scales = run_scales(summary, size);
+  h += metrics_section(summary, second,
+                       shaking_metrics_note("A0") +
+                           " tau: drive torque; RA0, RA3: forces on the ground at the bearings. "
+                           "RMS over the samples, max of magnitudes.",
+                       scales);
+  h += comparison_section(dir, summary, second, scales);
+  h += harmonics_section(dir, scales);
+  FourBarCharts c = fourbar_charts(study, dir, second, ts, summary, scales);
   h += animations_section(c.animations);
-  for (Chart& chart : harmonic_charts(dir, c.datablocks)) c.charts.push_back(std::move(chart));
+  for (Chart& chart : harmonic_charts(dir, c.datablocks, scales))
+    c.charts.push_back(std::move(chart));
   for (Chart& chart : pareto_charts(dir, c.datablocks)) c.charts.push_back(std::move(chart));
   h += charts_section(gnuplot, c.datablocks, c.charts, samples, ts.rows.size());
   if (!c.original.poses.empty()) {
-    h += "<h3>The linkage at four samples</h3>" + poses_table(c.original);
+    h += "<h3>The linkage at four samples</h3>" + poses_table(c.original, size);
   }
   if (!c.second.poses.empty()) {
     h += "<h3>The " + std::string(second.key == "balanced" ? "balanced" : "optimised") +
-         " linkage at four samples</h3>" + poses_table(c.second);
+         " linkage at four samples</h3>" + poses_table(c.second, size);
   }
-  h += second_design_section(summary, second);
-  h += pareto_section(dir);
+  h += second_design_section(summary, second, scales);
+  h += pareto_section(dir, scales);
   // the measurements of `balance-design bench` when the folder has them (work_precision.hpp)
   h += work_precision_section(study, dir, gnuplot);
   return h + data_files_html(dir, data_files());

@@ -40,12 +40,6 @@ std::string effort_text(const core::planar::TimeFunction& f, const char* unit) {
          fmt(f.phase) + ") " + unit;
 }
 
-// the gnuplot column (1-based) of `name` in the timeseries header; 0 when absent
-int gp_column(const Csv& ts, const std::string& name) {
-  const auto it = std::find(ts.header.begin(), ts.header.end(), name);
-  return it == ts.header.end() ? 0 : static_cast<int>(it - ts.header.begin()) + 1;
-}
-
 // one line per column over the run's axis `x` (a gnuplot using expression), `expr` the gnuplot
 // expression of a column index (magnitude or value)
 std::string lines_over(const std::string& file, const std::string& x,
@@ -279,7 +273,8 @@ bool drives_act(const Linkage& l, const Scene& scene) {
 }
 
 std::vector<Chart> planar_charts(const Study& study, const Csv& ts, const Second& second,
-                                 const Json& summary, std::string& datablocks) {
+                                 const Scales& scales, const Json& summary,
+                                 std::string& datablocks) {
   const Linkage& l = study.planar();
   std::vector<Chart> charts;
   if (ts.rows.empty()) return charts;
@@ -311,13 +306,15 @@ std::vector<Chart> planar_charts(const Study& study, const Csv& ts, const Second
   }
   // the hodograph, closed by the periodic end when the run is whole revolutions; the second
   // design has the original's columns (the same links, nodes and joints)
+  // the inertial part, as the metrics (round-off of the run's forces: 0)
   const bool closed = periodic_run(study.scene, summary);
-  datablocks += xy_block("hodo", ts, gp_column(ts, "Fshx"), gp_column(ts, "Fshy"), closed);
+  const ShakingColumns shaking = shaking_columns(ts);
+  datablocks += xy_block("hodo", ts, shaking.x, shaking.y, closed, scales.force);
   std::string hodograph = "$hodo skip 1 using 1:2 with lines lw 2 title " +
                           gp_string(second.file.empty() ? "shaking force" : "original");
   if (!second.file.empty()) {
-    datablocks += xy_block("hodo2", second.ts, gp_column(second.ts, "Fshx"),
-                           gp_column(second.ts, "Fshy"), closed);
+    const ShakingColumns shaking2 = shaking_columns(second.ts);
+    datablocks += xy_block("hodo2", second.ts, shaking2.x, shaking2.y, closed, scales.force);
     hodograph += ", $hodo2 skip 1 using 1:2 with linespoints lw 2 pt 7 ps 0.5 pi 10 title " +
                  gp_string(second.design.label);
   }
@@ -331,17 +328,19 @@ std::vector<Chart> planar_charts(const Study& study, const Csv& ts, const Second
                     "set title 'Support reactions'" + taxis +
                         "set ylabel 'force on the frame [N]'\nplot " +
                         lines_over(file, x, supports)});
-  charts.push_back({"hodograph", "Shaking-force hodograph",
+  charts.push_back({"hodograph", "Shaking-force hodograph, inertial part",
                     std::string("The tip of the shaking force over the run, equal axes") +
-                        (closed ? ", closed by the periodic end (the first sample again)." : "."),
-                    "set title 'Shaking-force hodograph'\nset size ratio -1\nset xlabel 'Fshx "
-                    "[N]'\nset ylabel 'Fshy [N]'\nplot " +
+                        (closed ? ", closed by the periodic end (the first sample again)." : ".") +
+                        shaking.force_note,
+                    "set title 'Shaking-force hodograph (inertial part)'\nset size ratio -1\n"
+                    "set xlabel 'Fshx inertial [N]'\nset ylabel 'Fshy inertial [N]'\nplot " +
                         hodograph,
                     true});
-  charts.push_back(
-      {"shaking-moment", "Shaking moment", "Shaking moment on the frame about the origin.",
-       "set title 'Shaking moment about the origin'" + taxis + "set ylabel 'Msh [N m]'\nplot " +
-           with_second(file, x, second, "Msh", std::to_string(gp_column(ts, "Msh")))});
+  charts.push_back({"shaking-moment", "Shaking moment, inertial part",
+                    "Shaking moment on the frame about the origin." + shaking.moment_note,
+                    "set title 'Shaking moment about the origin (inertial part)'" + taxis +
+                        "set ylabel 'Msh inertial [N m]'\nplot " +
+                        with_second(file, x, second, "Msh", std::to_string(shaking.moment))});
   if (!drives.empty() && drives_act(l, study.scene)) {
     charts.push_back({"drive", "Drive efforts",
                       "The drives' torques [N m] or forces [N] on their inputs, from the frame.",
@@ -360,8 +359,9 @@ std::vector<Chart> planar_charts(const Study& study, const Csv& ts, const Second
 
 std::string planar_linkage_tables(const Linkage& l) {
   std::string h = "<table><tr><th>node</th><th>drawn at [m]</th><th></th></tr>";
+  const double size = linkage_size(l);  // a coordinate that is round-off of it: 0
   for (const core::planar::Node& n : l.nodes) {
-    h += "<tr><th>" + esc(n.name) + "</th><td>" + vec_text(n.position) + "</td><td>" +
+    h += "<tr><th>" + esc(n.name) + "</th><td>" + vec_text(n.position, size) + "</td><td>" +
          (n.ground ? "ground" : "") + "</td></tr>";
   }
   h += "</table><table><tr><th>link</th><th>nodes</th><th>mass m [kg]</th><th>e [m]</th>"
@@ -453,14 +453,15 @@ std::string planar_report_html(const Study& study, const fs::path& dir, const st
   }
   std::string h = page_start(study, summary) + simulation_section(summary);
   h += "<h2>Linkage</h2>\n" + planar_linkage_tables(study.planar());
-  h +=
-      metrics_section(summary, second.design,
-                      "Fsh, Msh: shaking force and moment about the origin on the frame; tau: "
-                      "drive torques (a slide input's: a force in N); R&lt;name&gt;: forces on the "
-                      "frame at a ground node or guide; F&lt;joint&gt;: joint forces on their "
-                      "links. RMS over the samples, max of magnitudes.");
-  h += comparison_section(dir, summary, second.design);
-  h += harmonics_section(dir);
+  const Scales scales = run_scales(summary, linkage_size(study));
+  h += metrics_section(summary, second.design,
+                       shaking_metrics_note("the origin") +
+                           " tau: drive torques (a slide input's: a force in N); R&lt;name&gt;: "
+                           "forces on the frame at a ground node or guide; F&lt;joint&gt;: joint "
+                           "forces on their links. RMS over the samples, max of magnitudes.",
+                       scales);
+  h += comparison_section(dir, summary, second.design, scales);
+  h += harmonics_section(dir, scales);
   std::vector<AnimationFigure> animations;
   const std::vector<CounterweightPart> own =
       study.parts ? study.parts->counterweights : std::vector<CounterweightPart>{};
@@ -472,12 +473,12 @@ std::string planar_report_html(const Study& study, const fs::path& dir, const st
   }
   h += animations_section(animations);
   std::string datablocks;
-  std::vector<Chart> charts = planar_charts(study, ts, second, summary, datablocks);
-  for (Chart& chart : harmonic_charts(dir, datablocks)) charts.push_back(std::move(chart));
+  std::vector<Chart> charts = planar_charts(study, ts, second, scales, summary, datablocks);
+  for (Chart& chart : harmonic_charts(dir, datablocks, scales)) charts.push_back(std::move(chart));
   for (Chart& chart : pareto_charts(dir, datablocks)) charts.push_back(std::move(chart));
   h += charts_section(gnuplot, datablocks, charts, samples, ts.rows.size());
-  h += second_design_section(summary, second.design);
-  h += pareto_section(dir);
+  h += second_design_section(summary, second.design, scales);
+  h += pareto_section(dir, scales);
   // the measurements of `balance-design bench` when the folder has them (work_precision.hpp)
   h += work_precision_section(study, dir, gnuplot);
   return h + data_files_html(dir, data_files());

@@ -16,6 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/number_text.hpp"
 #include "studies/run/files.hpp"
 
 namespace bd::studies::report_support {
@@ -145,16 +146,13 @@ std::string fmt(double v, const char* f) {
 std::string xy(const Vec2& v) { return fmt(v.x(), "%.10g") + "," + fmt(v.y(), "%.10g"); }
 
 std::string fmt_scaled(double v, double scale) {
-  if (std::isfinite(v) && std::isfinite(scale) && scale > 0 && std::abs(v) <= 1e-12 * scale) {
-    return "0";
-  }
-  return fmt(v);
+  return text::is_round_off(v, scale) ? std::string("0") : fmt(v);
 }
 
-std::string vec_text(const Vec2& v) {
-  const double scale = std::max(std::abs(v.x()), std::abs(v.y()));
+std::string vec_text(const Vec2& v, double scale) {
+  const double larger = std::max({std::abs(v.x()), std::abs(v.y()), scale});
   auto part = [&](double x) {
-    return std::abs(x) <= 1e-12 * scale && x != 0 ? std::string("0") : fmt(x, "%.4g");
+    return text::is_round_off(x, larger) && x != 0 ? std::string("0") : fmt(x, "%.4g");
   };
   return "(" + part(v.x()) + ", " + part(v.y()) + ")";
 }
@@ -188,6 +186,10 @@ std::string unit_of(const std::string& name) {
                                                               {"J", "kg m²"},
                                                               {"Fsh_rms_before", "N"},
                                                               {"Fsh_rms_after", "N"},
+                                                              {"forward_before", "N"},
+                                                              {"backward_before", "N"},
+                                                              {"forward_after", "N"},
+                                                              {"backward_after", "N"},
                                                               {"t", "s"},
                                                               {"tau", "N m"}};
   for (const auto& [n, u] : exact)
@@ -201,6 +203,34 @@ std::string unit_of(const std::string& name) {
        std::isdigit(static_cast<unsigned char>(name[1]))))
     return "N";
   return "";
+}
+
+std::string unit_in(const std::string& name) {
+  if (name.size() > 2 && name.back() == ']') {
+    const std::size_t open = name.rfind('[');
+    if (open != std::string::npos) return name.substr(open + 1, name.size() - open - 2);
+  }
+  return unit_of(name);
+}
+
+std::string metric_unit(const Json& summary, const std::string& name) {
+  if (const Json* units = member(summary, "metric_units")) {
+    if (const Json* u = member(*units, name); u && u->is_string()) return u->get<std::string>();
+  }
+  return unit_of(name);
+}
+
+Scales run_scales(const Json& summary, double size) {
+  Scales s;
+  s.length = size;
+  for (const char* key : {"metrics", "balanced_metrics", "optimized_metrics"}) {
+    const Json* metrics = member(summary, key);
+    if (!metrics || !metrics->is_object()) continue;
+    for (const auto& [name, v] : metrics->items()) {
+      if (v.is_number()) s.add(metric_unit(summary, name), v.get<double>());
+    }
+  }
+  return s;
 }
 
 std::string with_unit(const std::string& name) {
@@ -218,7 +248,7 @@ std::string num_cell(const std::string& written, double scale) {
 }
 
 // an object as a two-column table, an array of objects as a table with a column per key
-std::string json_table(const Json& v) {
+std::string json_table(const Json& v, const Scales& scales) {
   std::string h = "<table>";
   // a point mass has no radius or thickness: 0 there means "not a disc"
   auto left_out = [](const std::string& k, const Json& x) {
@@ -228,8 +258,9 @@ std::string json_table(const Json& v) {
     for (const auto& [k, x] : v.items()) {
       if (left_out(k, x)) continue;
       // the momentum left relative to the original's: round-off of 1 shows as 0
-      const std::string cell =
-          k == "momentum_left" && x.is_number() ? num_cell(text(x), 1.0) : json_cell(x);
+      const std::string cell = k == "momentum_left" && x.is_number()
+                                   ? num_cell(text(x), 1.0)
+                                   : json_cell(x, scales, scales.of(unit_in(k)));
       h += "<tr><th>" + esc(with_unit(k)) + "</th>" + cell + "</tr>";
     }
   } else {
@@ -259,12 +290,16 @@ std::string json_table(const Json& v) {
       h += "<tr>";
       // a residual beside its scale (a balance condition): round-off of the scale shows as 0
       const Json* scale = member(item, "scale");
+      // a {name, value} entry: the value's unit is the name's ("... y from O2 [m]")
+      const Json* name = member(item, "name");
       for (const std::string& k : keys) {
         const Json* x = member(item, k);
         if (x && k == "residual" && x->is_number() && scale && scale->is_number()) {
           h += num_cell(text(*x), std::abs(scale->get<double>()));
         } else {
-          h += x ? json_cell(*x) : "<td></td>";
+          const bool named = k == "value" && name && name->is_string();
+          const std::string unit = unit_in(named ? name->get<std::string>() : k);
+          h += x ? json_cell(*x, scales, scales.of(unit)) : "<td></td>";
         }
       }
       h += "</tr>";
@@ -273,17 +308,17 @@ std::string json_table(const Json& v) {
   return h + "</table>";
 }
 
-std::string json_cell(const Json& v) {
+std::string json_cell(const Json& v, const Scales& scales, double quantity_scale) {
   if (v.is_null()) return "<td>&ndash;</td>";
-  if (v.is_number()) return num_cell(text(v));
+  if (v.is_number()) return num_cell(text(v), quantity_scale);
   if (v.is_boolean() || v.is_string()) return "<td>" + esc(text(v)) + "</td>";
-  if (v.is_object()) return "<td>" + json_table(v) + "</td>";
+  if (v.is_object()) return "<td>" + json_table(v, scales) + "</td>";
   if (v.empty()) return "<td>none</td>";
   bool objects = true;
   for (const Json& x : v) objects = objects && x.is_object();
-  if (objects) return "<td>" + json_table(v) + "</td>";
-  // a list of numbers: round-off of its largest shows as 0
-  double scale = 0, least = std::numeric_limits<double>::infinity(), largest = -least;
+  if (objects) return "<td>" + json_table(v, scales) + "</td>";
+  // a list of numbers: round-off of its largest (or of its quantity's scale) shows as 0
+  double scale = quantity_scale, least = std::numeric_limits<double>::infinity(), largest = -least;
   std::size_t numbers = 0;
   for (const Json& x : v) {
     if (!x.is_number()) continue;
@@ -320,13 +355,18 @@ std::string data_files_html(const fs::path& dir, const std::vector<std::string>&
   return h + "</ul>\n</body>\n</html>\n";
 }
 
-std::string csv_table(const Csv& csv) {
+std::string csv_table(const Csv& csv, const Scales& scales) {
   std::string h = "<table><tr>";
-  for (const std::string& k : csv.header) h += "<th>" + esc(k) + "</th>";
+  std::vector<double> scale;
+  for (const std::string& k : csv.header) {
+    h += "<th>" + esc(k) + "</th>";
+    scale.push_back(scales.of(unit_in(k)));
+  }
   h += "</tr>";
   for (const auto& row : csv.rows) {
     h += "<tr>";
-    for (const std::string& f : row) h += num_cell(f);
+    for (std::size_t c = 0; c < row.size(); ++c)
+      h += num_cell(row[c], c < scale.size() ? scale[c] : 0.0);
     h += "</tr>";
   }
   return h + "</table>";

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/types.hpp"
+#include "studies/run/simulation.hpp"
 
 namespace bd::studies::report_support {
 
@@ -46,16 +47,29 @@ std::vector<double> numbers(const std::vector<std::string>& row);
 
 /// A point as gnuplot data, "x,y" (10 digits).
 std::string xy(const Vec2& v);
-/// A point for a table, "(x, y)" (4 digits; a component below 1e-12 of the larger shown as 0).
-std::string vec_text(const Vec2& v);
+/// A point for a table, "(x, y)" (4 digits; a component that is round-off of the larger one or
+/// of `scale`, a position's the linkage's size, shown as 0).
+std::string vec_text(const Vec2& v, double scale = 0);
 /// A number for a page: 6 significant digits, or "0" where it is round-off of the quantity's
-/// `scale` (|v| <= 1e-12 scale: 6.123e-17 for a centre of mass on a link of 0.5 m). A display
-/// rule only: data files keep every digit.
+/// `scale` (text::is_round_off(), |v| <= 1e-12 scale: 6.123e-17 for a centre of mass on a link
+/// of 0.5 m). A display rule only: data files keep every digit.
 std::string fmt_scaled(double v, double scale);
 /// The unit a value of this name has on the page ("N", "N m", "kg", ...), "" when none is known:
 /// metric names (Fsh_rms, Msh_total_max, RA0_max, tau_rms, added_mass), summary.json keys (mass,
 /// position, theta1, omega1, ...).
 std::string unit_of(const std::string& name);
+/// The unit of a column or entry `name`: the one in brackets at its end ("crank counterweight y
+/// from O2 in link axes [m]"), else unit_of(name).
+std::string unit_in(const std::string& name);
+/// The unit of metric `name` of a run: as summary.json's metric_units gives it (the linkage's
+/// own table), else unit_of(name).
+std::string metric_unit(const Json& summary, const std::string& name);
+
+/// The natural scales of a run's quantities, for the display rule of round-off (fmt_scaled()).
+using Scales = DisplayScales;
+/// The scales of a run: the metrics of every design summary.json holds (`metrics`,
+/// `balanced_metrics`, `optimized_metrics`, with their units) and the linkage's `size` [m].
+Scales run_scales(const Json& summary, double size);
 /// `name` with its unit in brackets when it has one ("mass [kg]").
 std::string with_unit(const std::string& name);
 
@@ -68,16 +82,19 @@ std::string fmt(double v, const char* f = "%.6g");
 /// it shows as 0 (fmt_scaled()).
 std::string num_cell(const std::string& written, double scale = 0);
 /// An object as a two-column table, an array of objects as a table with a column per key; keys
-/// with their units (with_unit()), a point mass's radius and thickness of 0 left out.
-std::string json_table(const Json& v);
-/// A JSON value as a table cell.
-std::string json_cell(const Json& v);
+/// with their units (with_unit()), a point mass's radius and thickness of 0 left out. A number
+/// whose key (or, in a list of {name, value}, whose name) has a unit with a scale in `scales`
+/// shows round-off of that scale as 0.
+std::string json_table(const Json& v, const Scales& scales = {});
+/// A JSON value as a table cell; a number (or a list of them) that is round-off of `scale` as 0.
+std::string json_cell(const Json& v, const Scales& scales = {}, double scale = 0);
 /// The "Data files" section: a link and the size of each of `names` that exists in `dir`, in
 /// order, and the end of the page.
 std::string data_files_html(const std::filesystem::path& dir,
                             const std::vector<std::string>& names);
-/// A CSV file as an HTML table (numbers through num_cell()).
-std::string csv_table(const Csv& csv);
+/// A CSV file as an HTML table (numbers through num_cell(); a column whose name has a unit
+/// with a scale in `scales` shows round-off of that scale as 0).
+std::string csv_table(const Csv& csv, const Scales& scales = {});
 /// The pages' style sheet (inline CSS).
 extern const char* const kStyle;
 

@@ -86,19 +86,20 @@ std::string simulation_section(const Json& summary) {
 
 namespace {
 
-// a metric's unit as summary.json's metric_units gives it (the linkage's own table), else by its
-// name (unit_of(): an older summary.json, or a row of comparison.csv that is no metric)
-std::string metric_unit(const Json& summary, const std::string& name) {
-  if (const Json* units = member(summary, "metric_units")) {
-    if (const Json* u = member(*units, name); u && u->is_string()) return u->get<std::string>();
+// the ratio after/before as written: round-off of 1 shows as 0, and so does the ratio of an
+// `after` that is round-off of its scale (0 on the page, so its ratio is 0 too)
+std::string ratio_cell(const std::string& written, const std::string& after, double scale) {
+  const double a = std::strtod(after.c_str(), nullptr);
+  if (!after.empty() && text::is_round_off(a, scale) && !written.empty()) {
+    return "<td class=\"n\" title=\"" + esc(written) + "\">0</td>";
   }
-  return unit_of(name);
+  return num_cell(written, 1.0);
 }
 
 }  // namespace
 
 std::string metrics_section(const Json& summary, const SecondDesign& second,
-                            const std::string& notes) {
+                            const std::string& notes, const Scales& scales) {
   std::string h = "<h2>Metrics</h2>\n<table><tr><th>metric</th><th>original</th>";
   const Json* metrics = member(summary, "metrics");
   const Json* second_metrics =
@@ -110,13 +111,14 @@ std::string metrics_section(const Json& summary, const SecondDesign& second,
   if (metrics) {
     for (const auto& [k, v] : metrics->items()) {
       const Json* s = second_metrics ? member(*second_metrics, k) : nullptr;
-      // round-off of the larger of the two designs' values shows as 0
-      const double scale = std::max(value(&v), value(s));
+      // round-off of the larger of the two designs' values, or of the run's scale of the
+      // metric's unit (the largest force of the run), shows as 0
+      const double scale = std::max({value(&v), value(s), scales.of(metric_unit(summary, k))});
       h += "<tr><th>" + esc(k) + "</th>" + num_cell(text(v), scale);
       if (second_metrics) {
         const Json* r = reduction ? member(*reduction, k) : nullptr;
         h += (s ? num_cell(text(*s), scale) : "<td></td>") +
-             (r ? num_cell(text(*r), 1.0) : "<td></td>");
+             (r ? ratio_cell(text(*r), s ? text(*s) : "", scale) : "<td></td>");
       }
       h += "<td>" + esc(metric_unit(summary, k)) + "</td></tr>";
     }
@@ -124,8 +126,8 @@ std::string metrics_section(const Json& summary, const SecondDesign& second,
   return h + "</table>\n<p>" + notes + "</p>\n";
 }
 
-std::string comparison_section(const fs::path& dir, const Json& summary,
-                               const SecondDesign& second) {
+std::string comparison_section(const fs::path& dir, const Json& summary, const SecondDesign& second,
+                               const Scales& scales) {
   if (!second.present() || !fs::exists(dir / "comparison.csv")) return "";
   const Csv csv = read_csv(dir / "comparison.csv");
   std::string h =
@@ -136,16 +138,43 @@ std::string comparison_section(const fs::path& dir, const Json& summary,
       "<th>before</th><th>after</th><th>ratio after/before</th><th>unit</th></tr>";
   for (const auto& row : csv.rows) {
     if (row.size() < 4) continue;
-    // before and after: round-off of the larger shows as 0
-    const double scale = std::max(std::abs(std::strtod(row[1].c_str(), nullptr)),
-                                  std::abs(std::strtod(row[2].c_str(), nullptr)));
+    // before and after: round-off of the larger, or of the run's scale of the unit, shows as 0
+    const double scale = std::max({std::abs(std::strtod(row[1].c_str(), nullptr)),
+                                   std::abs(std::strtod(row[2].c_str(), nullptr)),
+                                   scales.of(metric_unit(summary, row[0]))});
     h += "<tr><th>" + esc(row[0]) + "</th>" + num_cell(row[1], scale) + num_cell(row[2], scale) +
-         num_cell(row[3], 1.0) + "<td>" + esc(metric_unit(summary, row[0])) + "</td></tr>";
+         ratio_cell(row[3], row[2], scale) + "<td>" + esc(metric_unit(summary, row[0])) +
+         "</td></tr>";
   }
   return h + "</table>\n";
 }
 
-std::string harmonics_section(const fs::path& dir) {
+namespace {
+
+// the scale of each column `at` of harmonics.csv for the display rule of round-off: the
+// force columns' (`forces`) one scale, the largest amplitude of any of them over every design and
+// order or the run's force scale, whichever is larger; the moment columns' (`moments`) the same
+// with the run's moment scale
+std::vector<double> harmonic_scales(const Csv& csv, const std::vector<std::size_t>& at,
+                                    const std::vector<std::size_t>& forces,
+                                    const std::vector<std::size_t>& moments, const Scales& scales) {
+  double force = scales.force, moment = scales.moment;
+  for (const std::vector<std::string>& row : csv.rows) {
+    if (row.size() < csv.header.size()) continue;
+    for (std::size_t k : forces)
+      force = std::max(force, std::abs(std::strtod(row[at[k]].c_str(), nullptr)));
+    for (std::size_t k : moments)
+      moment = std::max(moment, std::abs(std::strtod(row[at[k]].c_str(), nullptr)));
+  }
+  std::vector<double> scale(at.size(), 0.0);
+  for (std::size_t k : forces) scale[k] = force;
+  for (std::size_t k : moments) scale[k] = moment;
+  return scale;
+}
+
+}  // namespace
+
+std::string harmonics_section(const fs::path& dir, const Scales& scales) {
   if (!fs::exists(dir / "harmonics.csv")) return "";
   const Csv csv = read_csv(dir / "harmonics.csv");
   // the amplitudes, one row per design and order; the phases are in the file
@@ -158,20 +187,18 @@ std::string harmonics_section(const fs::path& dir) {
     at.push_back(static_cast<std::size_t>(it - csv.header.begin()));
   }
   std::string h =
-      "<h2>Harmonic orders</h2>\n<p>From <a href=\"harmonics.csv\">harmonics.csv</a>: the shaking "
-      "force and moment over the first revolution of the driven input, by the discrete Fourier "
-      "transform of the exact samples; order k repeats k times per revolution. Amplitudes of Fshx, "
-      "Fshy [N] and Msh [N m]; the force's parts turning with the input (forward: a counterweight "
-      "on the input's link cancels order 1) and against it (backward) [N]. Phases are in the "
+      "<h2>Harmonic orders</h2>\n<p>From <a href=\"harmonics.csv\">harmonics.csv</a>: the total "
+      "shaking force and moment (weights and applied loads included) over the first revolution "
+      "of the driven input, by the discrete Fourier transform of the exact samples; order k "
+      "repeats k times per revolution. A constant load such as a weight is in order 0 only (in "
+      "the file), so orders 1 and up are those of the inertial part as well, unless a load "
+      "changes over the revolution (a spring). Amplitudes of Fshx, Fshy [N] and Msh [N m]; the "
+      "force's parts turning with the input (forward: a counterweight on the input's link "
+      "cancels order 1) and against it (backward) [N]. An amplitude that is round-off of the "
+      "run's forces or moments (at most 1e-12 of the largest) shows as 0. Phases are in the "
       "file.</p><table><tr><th>design</th><th>order</th><th>Fshx [N]</th><th>Fshy [N]</th>"
       "<th>forward [N]</th><th>backward [N]</th><th>Msh [N m]</th></tr>";
-  // each column's largest amplitude over every design and order: round-off of it shows as 0
-  std::vector<double> scale(at.size(), 0.0);
-  for (const std::vector<std::string>& row : csv.rows) {
-    if (row.size() < csv.header.size()) continue;
-    for (std::size_t k = 2; k < at.size(); ++k)
-      scale[k] = std::max(scale[k], std::abs(std::strtod(row[at[k]].c_str(), nullptr)));
-  }
+  const std::vector<double> scale = harmonic_scales(csv, at, {2, 3, 4, 5}, {6}, scales);
   for (const std::vector<std::string>& row : csv.rows) {
     if (row.size() < csv.header.size() || row[at[1]] == "0") continue;  // the mean: in the file
     h += "<tr><td>" + esc(row[at[0]]) + "</td><td class=\"n\">" + esc(row[at[1]]) + "</td>";
@@ -289,7 +316,8 @@ std::vector<Chart> pareto_charts(const fs::path& dir, std::string& datablocks) {
                gp_string(with_unit(second)) + "\nplot " + plot}};
 }
 
-std::vector<Chart> harmonic_charts(const fs::path& dir, std::string& datablocks) {
+std::vector<Chart> harmonic_charts(const fs::path& dir, std::string& datablocks,
+                                   const Scales& scales) {
   if (!fs::exists(dir / "harmonics.csv")) return {};
   const Csv csv = read_csv(dir / "harmonics.csv");
   const char* columns[] = {"design",       "order",         "Fsh_forward",
@@ -306,48 +334,81 @@ std::vector<Chart> harmonic_charts(const fs::path& dir, std::string& datablocks)
     if (std::find(designs.begin(), designs.end(), row[at[0]]) == designs.end())
       designs.push_back(row[at[0]]);
   }
-  // each quantity's largest amplitude over every design and order: a bar of round-off of it
-  // (a balanced design's shaking force) is drawn as 0, not as a chart of noise
-  double scale[6] = {0, 0, 0, 0, 0, 0};
+  // a bar of round-off of the run's forces or moments (a balanced design's shaking force) is
+  // drawn as 0, not as a chart of noise
+  const std::vector<double> scale = harmonic_scales(csv, at, {2, 3}, {4, 5}, scales);
+  // each panel's axis, shared by every design: the largest amplitude of orders 1..N of its kind
+  // (the force's parts; the moment and the torque) on this page, round-off left out
+  auto amplitude = [&](const std::vector<std::string>& row, std::size_t k) {
+    const double v = std::abs(std::strtod(row[at[k]].c_str(), nullptr));
+    return text::is_round_off(v, scale[k]) || !std::isfinite(v) ? 0.0 : v;
+  };
+  auto orders = [&](const std::vector<std::string>& row, const std::string* design) {
+    return row.size() >= csv.header.size() && row[at[1]] != "0" &&
+           (!design || row[at[0]] == *design);
+  };
+  double axis[2] = {0, 0};  // force [N], moment and torque [N m]
   for (const auto& row : csv.rows) {
-    if (row.size() < csv.header.size() || row[at[1]] == "0") continue;
-    for (std::size_t k = 2; k < 6; ++k)
-      scale[k] = std::max(scale[k], std::abs(std::strtod(row[at[k]].c_str(), nullptr)));
+    if (!orders(row, nullptr)) continue;
+    for (std::size_t k = 2; k < 6; ++k) axis[k / 4] = std::max(axis[k / 4], amplitude(row, k));
   }
-  // Fsh forward and backward share one axis, as Msh and tau do
-  scale[2] = scale[3] = std::max(scale[2], scale[3]);
   std::vector<Chart> charts;
   for (const std::string& d : designs) {
     // orders 1..N of this design, the numbers as harmonics.csv has them (round-off: 0)
     const std::string block = "harmonics_" + d;
     datablocks += "$" + block + " << EOD\norder,Fsh_forward,Fsh_backward,Msh,tau\n";
+    double largest[2] = {0, 0};  // this design's largest bar in each panel
     for (const auto& row : csv.rows) {
-      if (row.size() < csv.header.size() || row[at[0]] != d || row[at[1]] == "0") continue;
+      if (!orders(row, &d)) continue;
       datablocks += row[at[1]];
       for (std::size_t k = 2; k < 6; ++k) {
         const double v = std::strtod(row[at[k]].c_str(), nullptr);
-        datablocks += "," + (std::abs(v) <= 1e-12 * scale[k] ? std::string("0") : row[at[k]]);
+        datablocks += "," + (text::is_round_off(v, scale[k]) ? std::string("0") : row[at[k]]);
+        largest[k / 4] = std::max(largest[k / 4], amplitude(row, k));
       }
       datablocks += "\n";
     }
     datablocks += "EOD\n";
+    // a panel on the shared axis whose every bar is under a thousandth of it (under a pixel)
+    // says so, with the size of its largest bar, instead of looking empty
+    auto panel = [&](int kind, const char* unit) {
+      std::string p;
+      if (axis[kind] > 0)
+        p += "set yrange [0:" + text::exact(1.05 * axis[kind]) + "]\n";
+      else
+        p += "set yrange [0:1]\n";
+      std::string note;
+      if (largest[kind] == 0) {
+        note = "every order is 0 (round-off of the run's " +
+               std::string(kind == 0 ? "forces" : "moments") + ")";
+      } else if (largest[kind] < 1e-3 * axis[kind]) {
+        note = "every order below " + text::digits(largest[kind], 2) + " " + unit +
+               ": too small to see at this scale";
+      }
+      p += note.empty() ? "unset label 1\n"
+                        : "set label 1 " + gp_string(note) + " at graph 0.5, graph 0.5 center\n";
+      return p;
+    };
     const std::string b = "$" + block;
     charts.push_back(
         {"harmonics-" + d, "Harmonic orders, " + d + " design",
          "Amplitudes of orders 1..N over a revolution of the driven input (harmonics.csv, " + d +
-             " design): left, the shaking force's parts turning with the input (forward) and "
-             "against it (backward) [N]; right, the shaking moment and the drive torque [N m]. "
-             "An amplitude below 1e-12 of the largest of its kind on this page is round-off and "
-             "drawn as 0.",
+             " design) of the total shaking force and moment (weights and applied loads "
+             "included; a constant weight is in order 0 only): left, the force's parts turning "
+             "with the input (forward) and against it (backward) [N]; right, the shaking moment "
+             "and the drive torque [N m]. Every design's chart has the same axes, the largest "
+             "amplitude of their kind on this page; an amplitude that is round-off of the run's "
+             "forces or moments (at most 1e-12 of the largest) is drawn as 0, and a side whose "
+             "every bar is too small to see at this scale says how small.",
          "set multiplot layout 1,2 title " + gp_string("Harmonic orders, " + d + " design") +
              "\nset style data histogram\nset style histogram clustered gap 1\n"
-             "set style fill solid 0.85 border -1\nset boxwidth 0.9\nset yrange [0:*]\n"
+             "set style fill solid 0.85 border -1\nset boxwidth 0.9\n"
              "set key inside top right\nset xlabel 'order'\n"
-             "set ylabel 'amplitude [N]'\nplot " +
-             b +
+             "set ylabel 'amplitude [N]'\n" +
+             panel(0, "N") + "plot " + b +
              " skip 1 using 2:xtic(1) title 'Fsh forward', '' skip 1 using 3 title "
-             "'Fsh backward'\nset ylabel 'amplitude [N m]'\nplot " +
-             b +
+             "'Fsh backward'\nset ylabel 'amplitude [N m]'\n" +
+             panel(1, "N m") + "plot " + b +
              " skip 1 using 4:xtic(1) title 'Msh', '' skip 1 using 5 title 'τ'\n"
              "unset multiplot"});
   }
@@ -370,18 +431,84 @@ RunAxis run_axis(const Scene& scene, int angle_column) {
   return {"1", time_axis(scene)};
 }
 
-std::string xy_block(const std::string& name, const Csv& csv, int cx, int cy, bool close) {
+std::string xy_block(const std::string& name, const Csv& csv, int cx, int cy, bool close,
+                     double scale) {
   std::string b = "$" + name + " << EOD\nx,y\n";
   const auto x = static_cast<std::size_t>(cx - 1), y = static_cast<std::size_t>(cy - 1);
+  // a value that is round-off of `scale`: 0
+  auto shown = [scale](const std::string& f) {
+    return text::is_round_off(std::strtod(f.c_str(), nullptr), scale) ? std::string("0") : f;
+  };
   std::string first;
   for (const auto& row : csv.rows) {
     if (row.size() <= std::max(x, y)) continue;
-    const std::string line = row[x] + "," + row[y] + "\n";
+    const std::string line = shown(row[x]) + "," + shown(row[y]) + "\n";
     if (first.empty()) first = line;
     b += line;
   }
   if (close) b += first;
   return b + "EOD\n";
+}
+
+int gp_column(const Csv& ts, const std::string& name) {
+  const auto it = std::find(ts.header.begin(), ts.header.end(), name);
+  return it == ts.header.end() ? 0 : static_cast<int>(it - ts.header.begin()) + 1;
+}
+
+std::string shaking_metrics_note(const std::string& about) {
+  return "Fsh, Msh: the inertial part of the shaking force and moment about " + about +
+         " on the frame, &minus;&Sigma; m a and &minus;dH/dt: what balancing acts on, and what "
+         "the ratios, verdicts and objectives take; Fsh_total, Msh_total: the total the frame "
+         "feels, weights and applied loads included (without them the two are equal).";
+}
+
+ShakingColumns shaking_columns(const Csv& ts) {
+  ShakingColumns c;
+  c.x = gp_column(ts, "Fshx_inertial");
+  c.y = gp_column(ts, "Fshy_inertial");
+  c.moment = gp_column(ts, "Msh_inertial");
+  if (c.x == 0 || c.y == 0 || c.moment == 0) {  // a timeseries.csv without the parts: the total
+    c.x = gp_column(ts, "Fshx");
+    c.y = gp_column(ts, "Fshy");
+    c.moment = gp_column(ts, "Msh");
+    c.force_note = " The total shaking force (the file has no inertial part).";
+    c.moment_note = " The total shaking moment (the file has no inertial part).";
+    return c;
+  }
+  c.force_note =
+      " The inertial part, −Σ m a (what balancing acts on, as Fsh_rms and Fsh_max measure it).";
+  c.moment_note =
+      " The inertial part, −dH/dt (what balancing acts on, as Msh_rms and Msh_max measure it).";
+  // the static part (weights, applied loads) of the original's samples: none, a constant, or
+  // one that changes
+  const int sx = gp_column(ts, "Fshx_static"), sy = gp_column(ts, "Fshy_static"),
+            sm = gp_column(ts, "Msh_static");
+  if (sx == 0 || sy == 0 || sm == 0) return c;
+  bool force = false, moment = false, constant = true;
+  std::vector<double> first;
+  for (const auto& row : ts.rows) {
+    const std::vector<double> v = numbers(row);
+    if (v.size() < static_cast<std::size_t>(std::max({sx, sy, sm}))) continue;
+    const double fx = v[static_cast<std::size_t>(sx - 1)], fy = v[static_cast<std::size_t>(sy - 1)];
+    force = force || fx != 0 || fy != 0;
+    moment = moment || v[static_cast<std::size_t>(sm - 1)] != 0;
+    if (first.empty()) first = {fx, fy};
+    constant = constant && fx == first[0] && fy == first[1];
+  }
+  if (force) {
+    c.force_note += " The total the frame feels adds the weights and applied loads";
+    c.force_note += constant ? ": here the original's is the same curve moved by (" +
+                                   text::digits(first[0] + 0.0, 6) + ", " +
+                                   text::digits(first[1] + 0.0, 6) + ") N"
+                             : "";
+    c.force_note += " (timeseries.csv: Fshx, Fshy; Fsh_total_rms, Fsh_total_max).";
+  }
+  if (moment) {
+    c.moment_note +=
+        " The total the frame feels adds the moments of the weights and applied "
+        "loads (timeseries.csv: Msh; Msh_total_rms, Msh_total_max).";
+  }
+  return c;
 }
 
 std::string animations_section(const std::vector<AnimationFigure>& figures) {
@@ -396,7 +523,7 @@ std::string animations_section(const std::vector<AnimationFigure>& figures) {
   return h;
 }
 
-std::string pareto_section(const fs::path& dir) {
+std::string pareto_section(const fs::path& dir, const Scales& scales) {
   if (!fs::exists(dir / "pareto.csv")) return "";
   const Csv pareto = read_csv(dir / "pareto.csv");
   const std::size_t found = designs_on_front(pareto);
@@ -410,7 +537,7 @@ std::string pareto_section(const fs::path& dir) {
                                      "and its termination says why"
                                    : "") +
        ".</p>";
-  return h + csv_table(pareto);
+  return h + csv_table(pareto, scales);
 }
 
 std::string time_axis(const Scene& scene) {
@@ -422,24 +549,25 @@ std::string time_axis(const Scene& scene) {
   return "t [s]";
 }
 
-std::string second_design_section(const Json& summary, const SecondDesign& sd) {
+std::string second_design_section(const Json& summary, const SecondDesign& sd,
+                                  const Scales& scales) {
   std::string h;
   const std::string second = sd.key, second_label = sd.label;
   if (sd.present()) {
     const char* section = second == "balanced" ? "balance" : "optimize";
     h += std::string("<h2>") + (second == "balanced" ? "Balanced design" : "Optimised design") +
          "</h2>\n";
-    if (const Json* s = member(summary, section)) h += json_table(*s);
+    if (const Json* s = member(summary, section)) h += json_table(*s, scales);
     if (const Json* run = member(summary, second + "_run")) {
       h += "<h3>Its simulation (same scene)</h3>" + run_table(*run, second_label + " design's");
     }
   } else if (const Json* s = member(summary, "optimize")) {
-    h +=
-        "<h2>Optimisation</h2>\n<p class=\"notice bad\">No optimum was found.</p>" + json_table(*s);
+    h += "<h2>Optimisation</h2>\n<p class=\"notice bad\">No optimum was found.</p>" +
+         json_table(*s, scales);
   } else if (const Json* b = member(summary, "balance")) {
     h += "<h2>Balanced design</h2>\n<p class=\"notice bad\">The balanced design was not "
          "simulated.</p>" +
-         json_table(*b);
+         json_table(*b, scales);
   }
   return h;
 }

@@ -308,14 +308,14 @@ const char* where_written(const Study& design) {
 }
 
 // a planar design's counterweight in the header comment: 6 digits, a component that is
-// round-off of the position's size (1e-12 of it) written as 0
+// round-off of the linkage's size (text::is_round_off()) written as 0
 std::string counterweight_line(const core::planar::Linkage& l,
                                const balance::planar::LinkCounterweight& c, const Study& written) {
   const balance::Counterweight& w = c.counterweight;
-  const double size = w.position.norm();
-  auto shown = [&](double v) { return std::abs(v) <= 1e-12 * size ? 0.0 : v; };
+  const double size = std::max(w.position.norm(), linkage_size(l));
+  auto shown = [&](double v) { return text::scaled(v, size); };
   return fmt::format(
-      "Link {} carries a counterweight of {:.6g} kg at ({:.6g}, {:.6g}) m from node {} in the "
+      "Link {} carries a counterweight of {:.6g} kg at ({}, {}) m from node {} in the "
       "link's axes ({}).\n",
       l.links[static_cast<std::size_t>(c.link)].name, w.mass, shown(w.position.x()),
       shown(w.position.y()), l.nodes[static_cast<std::size_t>(c.pivot)].name,

@@ -12,6 +12,23 @@
 
 namespace bd::studies {
 
+void DisplayScales::add(const std::string& unit, double value) {
+  if (!std::isfinite(value)) return;
+  if (unit == "N") force = std::max(force, std::abs(value));
+  if (unit == "N m") moment = std::max(moment, std::abs(value));
+}
+
+void DisplayScales::add(const MetricList& metrics) {
+  for (const MetricValue& m : metrics) add(m.unit, m.value);
+}
+
+double DisplayScales::of(const std::string& unit) const {
+  if (unit == "m") return length;
+  if (unit == "N") return force;
+  if (unit == "N m") return std::max(moment, force * length);
+  return 0;
+}
+
 namespace {
 
 core::Trajectory closed_form(const Study& study, const MethodChoice& method,

@@ -23,6 +23,21 @@ struct MetricValue {
 };
 using MetricList = std::vector<MetricValue>;
 
+/// The natural scales of a run's quantities, for the display rule of round-off
+/// (text::is_round_off(): a value within 1e-12 of its scale is shown as 0, on the report page
+/// and the terminal alike): a position's is the linkage's size (linkage_size()), a force's the
+/// largest force of the run (any metric in N of any of its designs), a moment's the largest
+/// moment of the run or that force times the size, whichever is larger.
+struct DisplayScales {
+  double length = 0, force = 0, moment = 0;
+  /// Takes a metric of the run, `value` in `unit`, into the force or moment scale.
+  void add(const std::string& unit, double value);
+  /// Takes every metric of `metrics`.
+  void add(const MetricList& metrics);
+  /// The scale of a quantity in `unit` ("m", "N", "N m"); 0 (none: the values' own) otherwise.
+  double of(const std::string& unit) const;
+};
+
 /// How a run ended, whatever the linkage type.
 struct RunStatus {
   core::SimulationStatus status = core::SimulationStatus::kNotRun;

@@ -285,6 +285,7 @@ class OptimizeReader {
 
   struct SolverMarks {
     YAML::Mark section, algorithm, evaluations, starts, tolerance;
+    bool starts_given = false;  // optimize.starts written (else mlsl's default)
   };
 
   // algorithm, max_evaluations, starts, tolerance; each mark defaults to the section's
@@ -302,7 +303,7 @@ class OptimizeReader {
 
   SolverMarks read_solver(const MapReader& o, const YAML::Mark& section, bool free_scene,
                           optimize::OptimizeOptions& options) {
-    SolverMarks marks{section, section, section, section, section};
+    SolverMarks marks{section, section, section, section, section, false};
     // without the key, the method that suits the scene: a free scene's evaluations are
     // simulations without derivatives
     options.algorithm = optimize::default_algorithm(free_scene);
@@ -325,6 +326,7 @@ class OptimizeReader {
     if (const MapReader::Entry* k = o.find("starts")) {
       options.starts = read_count(r_, *k, "optimize.starts", 1, 1e6);
       marks.starts = mark_of(k->value, k->key_mark);
+      marks.starts_given = true;
       if (options.algorithm != optimize::Algorithm::kMlsl) {
         r_.fail(marks.starts, std::string("optimize.starts is the number of local runs of the "
                                           "multistart mlsl; algorithm ") +
@@ -356,7 +358,10 @@ class OptimizeReader {
       where = marks.tolerance;
     }
     if (p->field == "algorithm") where = marks.algorithm;
-    r_.fail(where, "optimize: " + p->text());
+    // mlsl's default number of starts, not written: say so, and where to change it
+    const bool default_starts = p->field == "starts" && !marks.starts_given;
+    r_.fail(where, "optimize: " + p->text() +
+                       (default_starts ? " (the default; give optimize.starts)" : ""));
   }
 
   // a limit's bound: added_mass in kg (may be 0 or negative: keep the mass as it is, or take

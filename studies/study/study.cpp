@@ -1,5 +1,6 @@
 #include "studies/study/study.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <string>
 #include <utility>
@@ -102,6 +103,23 @@ void set_request(Problem& p, const Request& r) {
 }
 
 }  // namespace
+
+double linkage_size(const core::FourBar& m) {
+  return std::max({m.frame_length, m.crank.length, m.coupler.length, m.rocker.length});
+}
+
+double linkage_size(const core::planar::Linkage& l) {
+  double size = 0;
+  for (std::size_t i = 0; i < l.nodes.size(); ++i) {
+    for (std::size_t j = i + 1; j < l.nodes.size(); ++j)
+      size = std::max(size, (l.nodes[j].position - l.nodes[i].position).norm());
+  }
+  return size;
+}
+
+double linkage_size(const Study& study) {
+  return study.is_fourbar() ? linkage_size(study.fourbar()) : linkage_size(study.planar());
+}
 
 Study balanced_study(const Study& study) {
   assert(study.balance.has_value());

@@ -116,6 +116,12 @@ struct Study {
   std::string method_name() const { return to_string(method); }
 };
 
+/// The linkage's size [m], the natural scale of its positions: a four-bar's longest link or
+/// frame, a planar linkage's largest distance between two of its nodes as drawn.
+double linkage_size(const Study& study);
+double linkage_size(const core::FourBar& fourbar);
+double linkage_size(const core::planar::Linkage& linkage);
+
 /// The study of the balanced design: name `<name>-balanced`, the balanced model, the same scene,
 /// method and tolerance, no balance section, no source. Precondition: study.balance is set.
 Study balanced_study(const Study& study);

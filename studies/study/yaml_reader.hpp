@@ -189,7 +189,7 @@ inline bool read_with_unit(const Reporter& r, const YAML::Node& node, const YAML
   for (const UnitFactor& u : units_for(si)) {
     if (unit == u.name) {
       value = number * u.factor / u.divisor;
-      r.note_unit(path + ": " + text + " = " + text::exact(value) + " " + si);
+      r.note_unit(path + ": " + text + " = " + text::shortest(value) + " " + si);
       return true;
     }
     known += (known.empty() ? "" : ", ") + std::string(u.name);

@@ -1,16 +1,16 @@
 // The balance-design executable: exit codes, the one-line error on stderr, outputs where asked
 // and nothing written for bad input. Needs the executable built (target balance-design).
 #include <gtest/gtest.h>
-
-#include <algorithm>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <regex>
 #include <sstream>
 #include <string>
 
@@ -482,6 +482,53 @@ TEST_F(CliTest, HelpPerCommand) {
     EXPECT_EQ(run(std::string("help ") + command), 0) << command;
     EXPECT_EQ(out_, own) << command;
   }
+}
+
+// `help TOPIC` of a topic that is no command is a mistake: one line naming the commands, the
+// usage exit code, and neither run's help nor the overview; `help help` is the overview
+TEST_F(CliTest, HelpOnAnUnknownTopicIsAnError) {
+  EXPECT_EQ(run("help"), 0) << err_;
+  const std::string top = out_;
+  for (const char* topic : {"bogus", "study.yaml", "--out"}) {
+    EXPECT_EQ(run(std::string("help ") + topic), 2) << topic;
+    EXPECT_TRUE(out_.empty()) << topic << "\n" << out_;
+    EXPECT_EQ(err_.find('\n'), err_.size() - 1) << topic << "\n" << err_;
+    EXPECT_NE(err_.find(std::string("no help on \"") + topic + "\""), std::string::npos) << err_;
+    EXPECT_NE(err_.find("run, validate, report and bench"), std::string::npos) << err_;
+  }
+  EXPECT_EQ(run("help help"), 0) << err_;
+  EXPECT_EQ(out_, top);
+}
+
+// The terminal says which part of the shaking force its lines give, and shows a value that is
+// round-off of its natural scale as 0 (the report page's rule): the optimised Watt six-bar's
+// crank counterweight on its link's axis (y of 1e-17 m in summary.json, a linkage of about 1 m),
+// a balanced linkage's shaking force beside its bearing forces and its ratio to the original's.
+TEST_F(CliTest, TerminalSaysTheInertialPartAndShowsRoundOffAsZero) {
+  EXPECT_EQ(run("run " + quote(kExamples + "/watt-sixbar-optimized.yaml") + " --out w"), 0) << err_;
+  EXPECT_NE(out_.find("\n  |Fsh|    inertial rms 11.8807 N, max 25.0743 N\n"), std::string::npos)
+      << out_;
+  EXPECT_NE(out_.find("\n  |Msh|    inertial rms "), std::string::npos) << out_;
+  const std::string summary = read(dir_ / "w" / "summary.json");
+  const std::regex y(
+      "\"name\": \"crank counterweight y from O2 in link axes \\[m\\]\",\\s*"
+      "\"value\": ([-+0-9.eE]+)");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(summary, m, y)) << summary;
+  ASSERT_GT(std::abs(std::stod(m[1].str())), 0.0);
+  ASSERT_LT(std::abs(std::stod(m[1].str())), 1e-12);
+  EXPECT_NE(out_.find("counterweight 0.46 kg at [-0.25, 0] m from O2"), std::string::npos) << out_;
+
+  EXPECT_EQ(
+      run("run " + quote(kExamples + "/paper-fourbar-driven-force-balanced.yaml") + " --out b"), 0)
+      << err_;
+  const std::regex after("\n  Fsh_rms +169\\.865 +([^ ]+) +([^ \n]+)\n");
+  ASSERT_TRUE(std::regex_search(out_, m, after)) << out_;
+  EXPECT_EQ(m[1].str(), "0") << "round-off of the run's forces";
+  EXPECT_EQ(m[2].str(), "0") << "the ratio of round-off";
+  const std::string comparison = read(dir_ / "b" / "comparison.csv");
+  ASSERT_TRUE(std::regex_search(comparison, m, std::regex("\nFsh_rms,[^,]+,([^,]+),")));
+  EXPECT_GT(std::abs(std::stod(m[1].str())), 0.0) << "the file keeps the exact value";
 }
 
 // the output folder holds its study: `report DIR` from another directory gives the same page,

@@ -257,6 +257,18 @@ TEST(Optimize, OptionsValidate) {
   o = {};
   o.constraint_tolerance = 0;
   EXPECT_EQ(problem(o), "constraint_tolerance must be > 0, got 0 | constraint_tolerance");
+  // starts are mlsl's: another algorithm's evaluations need not cover them (the default 8)
+  for (Algorithm a : {Algorithm::kSlsqp, Algorithm::kMma, Algorithm::kIpopt, Algorithm::kMlsl,
+                      Algorithm::kIsres, Algorithm::kCobyla}) {
+    OptimizeOptions few;
+    few.algorithm = a;
+    few.max_evaluations = 5;
+    EXPECT_EQ(problem(few), a == Algorithm::kMlsl
+                                ? "starts must be >= 1 and <= max_evaluations (5: each start "
+                                  "needs an evaluation), got 8 | starts"
+                                : "")
+        << to_string(a);
+  }
   try {
     (void)optimize(counterweight_problem(), o);
     FAIL() << "invalid options accepted";

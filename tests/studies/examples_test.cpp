@@ -1,12 +1,18 @@
 // Every shipped example study runs as is: users start from them.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
 
 #include "studies/run/runner.hpp"
 #include "studies/studies.hpp"
 #include "studies/study/load_study.hpp"
 #include "studies/sweep/sweep.hpp"
+#include "tests/support/text.hpp"
 
 namespace bd::studies {
 namespace {
@@ -43,6 +49,61 @@ TEST(Examples, EveryExampleRunsToTheEnd) {
                         << (r.optimized ? " / " + r.optimized->message() : "");
   }
   EXPECT_GE(count, 5);
+}
+
+// a number quoted in the docs equals `value` to the digits it shows (half a unit of its last)
+void expect_quoted(const std::string& quoted, double value, const std::string& what) {
+  const std::size_t point = quoted.find('.');
+  const int decimals = point == std::string::npos ? 0 : static_cast<int>(quoted.size() - point - 1);
+  EXPECT_LE(std::abs(std::stod(quoted) - value), 0.5 * std::pow(10.0, -decimals) * (1 + 1e-9))
+      << what << ": the docs quote " << quoted << ", the run gives " << value;
+}
+
+// The numbers docs/study-format.md quotes of the examples are the runs' numbers, to the digits
+// it shows: paper-fourbar's metrics, berkof-lowen-min-shaking-moment's evaluations and its
+// comparison (its rows that are not round-off).
+TEST(Examples, TheFormatDocumentQuotesTheRunsNumbers) {
+  const std::string doc = bd::testing::read(fs::path(BD_SOURCE_DIR) / "docs/study-format.md");
+  const RunResult free = run_example("paper-fourbar.yaml");
+  ASSERT_TRUE(free.ok());
+  int quoted = 0;
+  for (const MetricValue& m : free.metric_list) {
+    const std::regex number("\\b" + m.name + " = ([0-9.]+) N");
+    std::smatch q;
+    if (!std::regex_search(doc, q, number)) continue;
+    expect_quoted(q[1].str(), m.value, "paper-fourbar " + m.name);
+    ++quoted;
+  }
+  EXPECT_GE(quoted, 8);
+
+  const Study study = load_study(std::string(BD_SOURCE_DIR) +
+                                 "/studies/examples/berkof-lowen-min-shaking-moment.yaml");
+  const RunResult r = run_example("berkof-lowen-min-shaking-moment.yaml");
+  ASSERT_TRUE(r.optimized && r.optimized->found());
+  std::smatch q;
+  ASSERT_TRUE(std::regex_search(
+      doc, q,
+      std::regex("For `berkof-lowen-min-shaking-moment.yaml` \\(SLSQP, ([0-9]+) evaluations")));
+  EXPECT_EQ(std::stoi(q[1].str()), r.optimized->result.evaluations);
+  // the comparison block after it
+  const std::size_t from = doc.find("metric,before,after,ratio", q.position());
+  const std::string block = doc.substr(from, doc.find("```", from) - from);
+  std::istringstream lines(block);
+  std::string line;
+  int rows = 0;
+  for (const ComparisonRow& row : comparison(study, r)) {
+    const std::regex quoted_row("\n" + row.metric + ",([^,\n]*),([^,\n]*),");
+    if (!std::regex_search(block, q, quoted_row)) continue;
+    ++rows;
+    for (const auto& [text, value] : {std::pair{q[1].str(), row.before}, {q[2].str(), row.after}}) {
+      if (text.find('e') != std::string::npos) {  // round-off: its size only
+        EXPECT_LT(std::abs(value), 1e-12) << row.metric;
+        continue;
+      }
+      expect_quoted(text, value, "berkof-lowen " + row.metric);
+    }
+  }
+  EXPECT_GE(rows, 7);
 }
 
 TEST(Examples, OptimumsAreVerifiedByASecondFormulation) {

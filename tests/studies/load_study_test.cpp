@@ -628,6 +628,29 @@ TEST(LoadStudy, OptimizeDefaults) {
   EXPECT_EQ(neg.optimize->limits.at(0).value, -0.5);
 }
 
+// starts belong to mlsl: its default of 8 is no bound on another algorithm's evaluations (a
+// cobyla run of 5 evaluations, free or driven, is valid), and mlsl's default that cannot share
+// max_evaluations is said at the section as the default
+TEST(LoadStudy, StartsAreCheckedOnlyWhereMlslMakesThem) {
+  // kBase set in motion (free: it starts at rest without loads), and driven
+  const std::string free_scene = edit("  duration: 5.0\n", "  omega1: 1.0\n  duration: 5.0\n");
+  for (const std::string& scene : {free_scene, driven()}) {
+    for (const char* name : {"cobyla", "slsqp"}) {
+      if (scene == free_scene && std::string(name) == "slsqp") continue;  // free: no gradients
+      const Study s = parse_study(
+          scene + kMinimal + "  algorithm: " + name + "\n  max_evaluations: 5\n", "study.yaml");
+      ASSERT_TRUE(s.optimize.has_value()) << name;
+      EXPECT_EQ(s.optimize->options.max_evaluations, 5) << name;
+    }
+  }
+  expect_error(driven() + kMinimal + "  algorithm: mlsl\n  max_evaluations: 5\n", 18, 1,
+               "optimize: starts must be >= 1 and <= max_evaluations (5: each start needs an "
+               "evaluation), got 8 (the default; give optimize.starts)");
+  EXPECT_NO_THROW(
+      parse_study(driven() + kMinimal + "  algorithm: mlsl\n  max_evaluations: 5\n  starts: 5\n",
+                  "study.yaml"));
+}
+
 TEST(LoadStudy, OptimizeMistakesAreReportedWhereTheyAre) {
   const std::string all =
       "Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max, RA0_rms, RA0_max, RA3_rms, "

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "core/number_text.hpp"
 #include "studies/report/report.hpp"
 #include "studies/report/study_parts.hpp"
 #include "studies/run/files.hpp"
@@ -170,7 +171,11 @@ TEST_F(ReportPageTest, HarmonicBarsAreTheNumbersOfHarmonicsCsv) {
       load_study(bd::testing::example_path("paper-fourbar-driven-force-balanced.yaml"));
   ASSERT_TRUE(run_study(study, dir_).ok());
   std::string blocks;
-  const std::vector<report_support::Chart> charts = report_support::harmonic_charts(dir_, blocks);
+  const report_support::Json summary =
+      report_support::parse_json(read(dir_ / "summary.json"), "summary.json");
+  const report_support::Scales scales = report_support::run_scales(summary, linkage_size(study));
+  const std::vector<report_support::Chart> charts =
+      report_support::harmonic_charts(dir_, blocks, scales);
   ASSERT_EQ(charts.size(), 2u);
   EXPECT_EQ(charts[0].id, "harmonics-original");
   EXPECT_EQ(charts[1].id, "harmonics-balanced");
@@ -183,12 +188,19 @@ TEST_F(ReportPageTest, HarmonicBarsAreTheNumbersOfHarmonicsCsv) {
   const std::size_t design = column("design"), order = column("order");
   const std::size_t cols[] = {column("Fsh_forward"), column("Fsh_backward"),
                               column("Msh_amplitude"), column("tau_amplitude")};
-  // the largest forward/backward amplitude: a bar of round-off of it is drawn as 0
+  // the largest forward/backward amplitude or the largest force of the run (its metrics in N,
+  // read here from summary.json on their own): a bar of round-off of it is drawn as 0
   double fsh_scale = 0;
   for (const auto& row : csv.rows) {
     if (row[order] == "0") continue;
     fsh_scale =
         std::max({fsh_scale, std::abs(std::stod(row[cols[0]])), std::abs(std::stod(row[cols[1]]))});
+  }
+  for (const char* key : {"metrics", "balanced_metrics"}) {
+    for (const auto& [name, v] : summary.at(key).items()) {
+      if (summary.at("metric_units").at(name) == "N")
+        fsh_scale = std::max(fsh_scale, v.get<double>());
+    }
   }
   int bars = 0, zeros = 0;
   for (const auto& row : csv.rows) {
@@ -213,6 +225,129 @@ TEST_F(ReportPageTest, HarmonicBarsAreTheNumbersOfHarmonicsCsv) {
   if (find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
   EXPECT_FALSE(svg_of(html, "chart-harmonics-original").empty());
   EXPECT_FALSE(svg_of(html, "chart-harmonics-balanced").empty());
+}
+
+// the points (SVG pixels) of the curve of plot `plot` of chart `id`, its legend sample left out
+std::vector<std::pair<double, double>> curve_points(const std::string& html, const std::string& id,
+                                                    int plot) {
+  const std::string svg = svg_of(html, "chart-" + id);
+  const std::size_t g = svg.find("<g id=\"" + id + "-gnuplot_plot_" + std::to_string(plot) + "\"");
+  if (g == std::string::npos) return {};
+  const std::size_t d = svg.find("d='", g);
+  const std::string path = svg.substr(d + 3, svg.find('\'', d + 3) - d - 3);
+  const std::regex point("([-0-9.]+),([-0-9.]+)");
+  std::vector<std::pair<double, double>> points;
+  for (auto m = std::sregex_iterator(path.begin(), path.end(), point); m != std::sregex_iterator();
+       ++m) {
+    points.emplace_back(std::stod((*m)[1].str()), std::stod((*m)[2].str()));
+  }
+  if (points.size() >= 2) points.erase(points.begin(), points.begin() + 2);  // the legend's
+  return points;
+}
+
+// A force-balanced four-bar under gravity (the driven paper four-bar's example with g): its
+// metrics (the inertial part) say Fsh_max 0, its total carries the weight. The page says which
+// part each table and chart shows, and the hodograph draws the inertial part: the balanced
+// design's curve sits where the original's is centred, at the origin (over a period of a periodic
+// motion −Σ m a has mean 0), not at its weight, 121.9 N below.
+TEST_F(ReportPageTest, ShakingChartsAndMetricsSayWhichPartTheyShow) {
+  const std::string text = bd::testing::edited(
+      read(bd::testing::example_path("paper-fourbar-driven-force-balanced.yaml")), "\nscene:\n",
+      "\nloads:\n  gravity: [0, -9.81]\nscene:\n");
+  const Study study = parse_study(text, "fbg.yaml");
+  ASSERT_TRUE(run_study(study, dir_).ok());
+  const std::string html = read(dir_ / "report.html");
+  EXPECT_NE(html.find("Fsh, Msh: the inertial part of the shaking force and moment about A0"),
+            std::string::npos);
+  EXPECT_NE(html.find("Fsh_total, Msh_total: the total the frame feels, weights and applied "
+                      "loads included"),
+            std::string::npos);
+  EXPECT_NE(html.find("<h3>Shaking-force hodograph, inertial part</h3>"), std::string::npos);
+  EXPECT_NE(html.find("<h3>Shaking moment, inertial part</h3>"), std::string::npos);
+  EXPECT_NE(html.find("the total shaking force and moment (weights and applied loads included)"),
+            std::string::npos);
+  // the original's total is its inertial hodograph moved by its weight, 7.3 kg x 9.81 m/s² down
+  EXPECT_NE(html.find("the original's is the same curve moved by (0, " +
+                      text::digits(-7.3 * 9.81, 6) + ") N"),
+            std::string::npos);
+  if (find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed: charts not checked";
+  const auto original = curve_points(html, "hodograph", 1);
+  const auto balanced = curve_points(html, "hodograph", 2);
+  ASSERT_GT(original.size(), 300u);
+  ASSERT_FALSE(balanced.empty());
+  double x = 0, y = 0;
+  for (std::size_t i = 0; i + 1 < original.size(); ++i) {  // the last closes the curve
+    x += original[i].first / static_cast<double>(original.size() - 1);
+    y += original[i].second / static_cast<double>(original.size() - 1);
+  }
+  for (const auto& [bx, by] : balanced) {
+    EXPECT_NEAR(bx, x, 1.0) << "the balanced design's inertial shaking force is 0";
+    EXPECT_NEAR(by, y, 1.0) << "the balanced design's inertial shaking force is 0";
+  }
+}
+
+// every number shown as text on a page (a table cell, a chart's tick) that looks like round-off;
+// a relative error (verification_error: its own scale is 1, and it is shown as it is) aside
+std::vector<std::string> tiny_numbers(const std::string& html) {
+  const std::regex tiny(">\\s*([-+]?[0-9.]+e-(1[3-9]|[2-9][0-9]))\\s*<");
+  std::vector<std::string> found;
+  for (auto m = std::sregex_iterator(html.begin(), html.end(), tiny); m != std::sregex_iterator();
+       ++m) {
+    const std::size_t th = html.rfind("<th>", static_cast<std::size_t>(m->position()));
+    const std::string row = th == std::string::npos ? "" : html.substr(th, 60);
+    if (row.find("_error") == std::string::npos) found.push_back((*m)[1].str());
+  }
+  return found;
+}
+
+// Round-off of a quantity's natural scale shows as 0 in every table and chart: the optimised
+// Watt six-bar's crank counterweight on its link's axis (y = 1.5e-17 m beside a linkage of
+// about 1 m), in the variables and the Pareto tables; a balance shaft's order it cancels
+// (engine-lanchester); a balanced linkage's shaking force beside its bearing forces
+// (paper-fourbar-balanced, the only design of its run). The optimised Watt design's force
+// harmonics are constraint-tolerance noise (1e-10 N beside the original's 14 N): its chart,
+// on the original's axes, says they are too small to see.
+TEST_F(ReportPageTest, RoundOffIsZeroInEveryTableAndChart) {
+  for (const char* example :
+       {"watt-sixbar-optimized.yaml", "engine-lanchester.yaml", "paper-fourbar-balanced.yaml"}) {
+    const fs::path out = dir_ / example;
+    const Study study = load_study(bd::testing::example_path(example));
+    ASSERT_TRUE(run_study(study, out).ok()) << example;
+    const std::string html = read(out / "report.html");
+    const std::vector<std::string> tiny = tiny_numbers(html);
+    EXPECT_TRUE(tiny.empty()) << example << ": " << tiny.size() << " numbers of round-off, "
+                              << (tiny.empty() ? "" : tiny[0]);
+    const report_support::Json summary =
+        report_support::parse_json(read(out / "summary.json"), "summary.json");
+    const std::string name = example;
+    if (name == "watt-sixbar-optimized.yaml") {
+      const double size = linkage_size(study);
+      EXPECT_GT(size, 0.5);
+      const report_support::Json& y = summary.at("optimize").at("variables").at(2);
+      ASSERT_EQ(y.at("name"), "crank counterweight y from O2 in link axes [m]");
+      ASSERT_GT(std::abs(y.at("value").get<double>()), 0.0);
+      ASSERT_LT(std::abs(y.at("value").get<double>()), 1e-12 * size);
+      EXPECT_NE(html.find("<td>crank counterweight y from O2 in link axes [m]</td><td class=\"n\" "
+                          "title=\"" +
+                          report_support::text(y.at("value")) + "\">0</td>"),
+                std::string::npos);
+      if (!find_gnuplot().empty()) {
+        const std::string chart = svg_of(html, "chart-harmonics-optimized");
+        EXPECT_NE(chart.find("too small to see at this scale"), std::string::npos);
+        EXPECT_EQ(svg_of(html, "chart-harmonics-original").find("too small to see"),
+                  std::string::npos);
+      }
+    }
+    if (name == "paper-fourbar-balanced.yaml") {
+      const double fsh = summary.at("metrics").at("Fsh_rms").get<double>();
+      const double bearing = summary.at("metrics").at("RA0_max").get<double>();
+      ASSERT_GT(fsh, 0.0);
+      ASSERT_LT(fsh, 1e-12 * bearing);
+      EXPECT_NE(html.find("<tr><th>Fsh_rms</th><td class=\"n\" title=\"" +
+                          report_support::text(summary.at("metrics").at("Fsh_rms")) + "\">0</td>"),
+                std::string::npos);
+    }
+  }
 }
 
 // Data that one chart cannot draw (every value of its curve undefined: gnuplot stops the whole

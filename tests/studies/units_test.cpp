@@ -4,7 +4,11 @@
 // quantity cannot take is an error at the value.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iterator>
 #include <numbers>
 #include <string>
 
@@ -52,6 +56,35 @@ TEST(Units, ValuesWithUnitsEqualTheirSiNumbers) {
   const studies::RunResult r = studies::compute_study(units);
   const std::string json = studies::summary_json(units, r);
   EXPECT_NE(json.find("scene.theta1: 90 deg = 1.5707963267948966 rad"), std::string::npos) << json;
+}
+
+// the SI number of units_read is the shortest text that reads back as the value used: 50 mm is
+// "0.05 m", not 0.050000000000000003 (checked against the fewest printf digits that read back)
+TEST(Units, UnitsReadGivesTheShortestExactNumber) {
+  const studies::Study s =
+      studies::parse_study(fourbar("90 deg", "60 rpm", "50 mm", "2.1 g"), "u.yaml");
+  ASSERT_EQ(s.units_read.size(), 4u);
+  EXPECT_EQ(s.units_read[0], "linkage.crank.length: 50 mm = 0.05 m");
+  const double used[] = {s.fourbar().crank.length, s.fourbar().crank.mass,
+                         std::get<core::DrivenScene>(s.scene).theta1,
+                         std::get<core::DrivenScene>(s.scene).omega1};
+  for (const std::string& line : s.units_read) {
+    const std::size_t eq = line.find(" = ");
+    ASSERT_NE(eq, std::string::npos) << line;
+    const std::string number = line.substr(eq + 3, line.rfind(' ') - eq - 3);
+    const double v = std::stod(number);
+    EXPECT_NE(std::find(std::begin(used), std::end(used), v), std::end(used)) << line;
+    std::string fewest;
+    for (int digits = 1; digits <= 17; ++digits) {
+      char buf[40];
+      std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+      if (std::strtod(buf, nullptr) == v) {
+        fewest = buf;
+        break;
+      }
+    }
+    EXPECT_EQ(number, fewest) << line;
+  }
 }
 
 TEST(Units, AUnitTheQuantityCannotTakeIsAnErrorAtTheValue) {
