@@ -601,12 +601,17 @@ void print_summary(const st::Study& study, const st::RunResult& r) {
                 status.rhs_evaluations);
   }
   std::printf("\n");
-  if (!status.ok()) {
-    std::printf("  partial  the metrics below cover only the %zu samples before the run stopped\n",
-                status.samples);
+  if (status.samples == 0) {
+    std::printf("  metrics  none: the run stopped before its first sample\n");
+  } else {
+    if (!status.ok()) {
+      std::printf(
+          "  partial  the metrics below cover only the %zu samples before the run stopped\n",
+          status.samples);
+    }
+    print_metrics(r.metric_list, !st::is_free(study.scene), has_static_part(study),
+                  display_scales(study, r));
   }
-  print_metrics(r.metric_list, !st::is_free(study.scene), has_static_part(study),
-                display_scales(study, r));
   if (study.balance && r.balanced) print_balance(study, r);
   if (study.planar_balance && r.balanced) print_planar_balance(study, r);
   if (study.optimize && r.optimized) print_optimize(study, r);

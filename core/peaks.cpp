@@ -125,6 +125,34 @@ struct Candidate {
 Peak resolved_peak(std::span<const double> t, std::span<const double> x, double period,
                    const QuantityAt& f) {
   const std::size_t n = std::min(t.size(), x.size());
+  if (f && n >= 2 && n < kMinPeakSamples) {
+    // Too few samples for their local maxima to bracket every peak (a driven revolution at 5
+    // samples can have its largest value between two samples neither of which is a local
+    // maximum): the quantity is evaluated between them too, at least kMinPeakSamples points
+    // over the motion, and the peak is resolved over those.
+    const std::size_t per = (kMinPeakSamples + n - 1) / n;  // points per interval
+    std::vector<double> tt, xx;
+    auto interval = [&](double ta, double xa, double tb) {
+      tt.push_back(ta);
+      xx.push_back(xa);
+      for (std::size_t j = 1; j < per; ++j) {
+        const double tj = ta + (tb - ta) * static_cast<double>(j) / static_cast<double>(per);
+        const double v = f(tj);
+        if (std::isfinite(v)) {
+          tt.push_back(tj);
+          xx.push_back(v);
+        }
+      }
+    };
+    for (std::size_t i = 0; i + 1 < n; ++i) interval(t[i], x[i], t[i + 1]);
+    if (period > 0) {
+      interval(t[n - 1], x[n - 1], t[0] + period);
+    } else {
+      tt.push_back(t[n - 1]);
+      xx.push_back(x[n - 1]);
+    }
+    if (tt.size() >= kMinPeakSamples) return resolved_peak(tt, xx, period, f);
+  }
   Peak best{-std::numeric_limits<double>::infinity(), 0.0};
   if (n < 3 || !f) {
     for (std::size_t i = 0; i < n; ++i) {

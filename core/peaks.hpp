@@ -28,12 +28,17 @@ inline constexpr double kPeakTimeTolerance = 1e-10;
 inline constexpr double kPeakValueTolerance = 1e-14;
 inline constexpr double kPeakSettlingTolerance = 1e-12;
 
-/// The peak of x over the samples x[i] = f(t[i]) (t increasing). Every sampled local maximum whose
+/// Below this many samples over the motion, resolved_peak() evaluates the quantity between them
+/// first (their local maxima alone would not bracket every peak).
+inline constexpr std::size_t kMinPeakSamples = 32;
+
+/// The peak of x over the samples x[i] = f(t[i]) (t increasing); with fewer than kMinPeakSamples
+/// samples, over those and f evaluated evenly between them. Every sampled local maximum whose
 /// parabola through it and its neighbours could reach the largest sample is refined by Brent's
 /// maximisation of f on the interval between its neighbours; the largest value found wins.
 /// `period` > 0: the samples cover one period of a periodic motion, the end excluded, so the
 /// first and last samples are neighbours across it (a driven revolution); 0: an open interval
-/// (the ends are brackets of their own). With fewer than 3 samples: the largest sample.
+/// (the ends are brackets of their own). With one sample, or without f: the largest sample.
 Peak resolved_peak(std::span<const double> t, std::span<const double> x, double period,
                    const QuantityAt& f);
 

@@ -70,6 +70,7 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original,
   core::PeakList peaks;
   o.metrics = fourbar_metrics(best, sim, &peaks);
   o.metric_list = metric_list(o.metrics, &peaks);
+  without_samples_none(o.metric_list, sim);
   if (parts.harmonics) o.harmonics = harmonics(best, o.trajectory, o.planar);
   if (req.pareto) {
     o.pareto = optimize::pareto_front(problem, req.pareto->first, req.pareto->second,
@@ -99,6 +100,7 @@ OptimizedRun planar_optimize_study(const Study& study, const RunResult& original
   Simulation sim = simulate(best);
   o.method = sim.method;
   o.metric_list = metric_list(best, sim);
+  without_samples_none(o.metric_list, sim);
   o.planar = std::move(sim.planar);
   if (parts.harmonics) o.harmonics = harmonics(best, o.trajectory, o.planar);
   if (const std::optional<PlanarParetoRequest>& p = study.planar_optimize->pareto) {
@@ -624,6 +626,7 @@ BalancedRun planar_balanced_run(const Study& study, const RunResult& original,
   Simulation sim = simulate(balanced);
   b.method = sim.method;
   b.metric_list = metric_list(balanced, sim);
+  without_samples_none(b.metric_list, sim);
   b.planar = std::move(sim.planar);
   if (parts.harmonics) b.harmonics = harmonics(balanced, b.trajectory, b.planar);
   return b;
@@ -651,6 +654,7 @@ RunResult compute_study(const Study& study, const ComputeParts& parts) {
   } else {
     result.metric_list = metric_list(study, sim);
   }
+  without_samples_none(result.metric_list, sim);
   result.trajectory = std::move(sim.fourbar);
   result.planar = std::move(sim.planar);
   if (parts.harmonics) result.harmonics = harmonics(study, result.trajectory, result.planar);
@@ -663,6 +667,7 @@ RunResult compute_study(const Study& study, const ComputeParts& parts) {
     core::PeakList peaks;
     b.metrics = fourbar_metrics(design, balanced, &peaks);
     b.metric_list = metric_list(b.metrics, &peaks);
+    without_samples_none(b.metric_list, balanced);
     if (parts.harmonics) b.harmonics = harmonics(design, b.trajectory, b.planar);
     result.balanced = std::move(b);
   }

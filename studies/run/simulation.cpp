@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 #include <variant>
 
 #include "core/number_text.hpp"
-
 #include "core/planar/from_fourbar.hpp"
 #include "core/planar/metrics.hpp"
 
@@ -277,6 +277,17 @@ std::vector<std::string> metric_names(const Study& study) {
     }
   }
   return names;
+}
+
+MetricList& without_samples_none(MetricList& list, const Simulation& simulation) {
+  const std::size_t samples =
+      simulation.is_planar ? simulation.planar.table.rows() : simulation.fourbar.samples.size();
+  if (samples > 0) return list;
+  for (MetricValue& m : list) {
+    m.value = std::numeric_limits<double>::quiet_NaN();
+    m.t.reset();
+  }
+  return list;
 }
 
 MetricList metric_list(const Study& study, const Simulation& simulation) {

@@ -98,6 +98,9 @@ core::Metrics fourbar_metrics(const Study& study, const Simulation& simulation,
                               core::PeakList* peaks = nullptr);
 /// A four-bar's metrics in the table's order (with the peaks' times when given).
 MetricList metric_list(const core::Metrics& metrics, const core::PeakList* peaks = nullptr);
+/// A run that stopped before its first sample has no metrics: each value of `list` becomes NaN
+/// (written as null in summary.json, shown as "none") and has no peak time. Returns `list`.
+MetricList& without_samples_none(MetricList& list, const Simulation& simulation);
 /// The names of the metrics a run of the study has, in its table's order.
 std::vector<std::string> metric_names(const Study& study);
 

@@ -24,7 +24,7 @@ Json value_or_null(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr)
 // the metrics in their table's order
 Json metrics_json(const MetricList& metrics) {
   Json j = Json::object();
-  for (const MetricValue& m : metrics) j[m.name] = m.value;
+  for (const MetricValue& m : metrics) j[m.name] = value_or_null(m.value);  // null: no samples
   return j;
 }
 
@@ -55,7 +55,7 @@ Json reduction_json(const MetricList& before, const MetricList& after) {
   Json j = Json::object();
   for (std::size_t k = 0; k < before.size() && k < after.size(); ++k) {
     const double b = before[k].value;
-    j[before[k].name] = b != 0 ? Json(after[k].value / b) : Json(nullptr);
+    j[before[k].name] = b != 0 ? value_or_null(after[k].value / b) : Json(nullptr);
   }
   return j;
 }

@@ -181,6 +181,30 @@ TEST_F(CliTest, SimulationStoppedEarlyExitsThreeAndKeepsResults) {
   EXPECT_NE(read(dir_ / "res" / "summary.json").find("\"ok\": false"), std::string::npos);
 }
 
+// A run that stops before its first sample has no metrics: "none" on the terminal, null in
+// summary.json, not zeros as if the linkage shook nothing. The triple rocker started free exactly
+// at its limit position (the crank angle where |A1 - A3| = coupler + rocker, by the law of
+// cosines) on the mass matrix, whose reduced equation in theta1 is singular there.
+TEST_F(CliTest, ARunStoppedBeforeItsFirstSampleHasNoMetrics) {
+  std::string text = bd::testing::read(fs::path(kExamples) / "triple-rocker-free.yaml");
+  const double limit = std::acos((2.0 * 2.0 + 3.5 * 3.5 - 4.0 * 4.0) / (2 * 2.0 * 3.5));
+  char theta1[64];
+  std::snprintf(theta1, sizeof theta1, "theta1: %.17g", limit);
+  text.replace(text.find("theta1: 0.0"), 11, theta1);
+  text.replace(text.find("\nmethod: auto"), 13, "\nmethod: mass-matrix");
+  write("limit.yaml", text);
+  EXPECT_EQ(run("limit.yaml --out res"), 3) << err_;
+  EXPECT_NE(out_.find("  samples  0, "), std::string::npos) << out_;
+  EXPECT_NE(out_.find("  metrics  none: the run stopped before its first sample"),
+            std::string::npos)
+      << out_;
+  EXPECT_EQ(out_.find("rms 0 N"), std::string::npos) << out_;
+  const std::string summary = read(dir_ / "res" / "summary.json");
+  EXPECT_NE(summary.find("\"Fsh_rms\": null"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"RA0_max\": null"), std::string::npos) << summary;
+  EXPECT_TRUE(fs::exists(dir_ / "res" / "report.html"));
+}
+
 TEST_F(CliTest, PlanarSimulationStoppedEarlyNamesWhereItStopped) {
   // a free non-Grashof four-bar on the general engine's reduced route (method: truss), which
   // cannot pass a limit position: the run stops at the first one (exit 3), keeping the samples
