@@ -205,28 +205,33 @@ TEST_F(CliTest, ARunStoppedBeforeItsFirstSampleHasNoMetrics) {
   EXPECT_TRUE(fs::exists(dir_ / "res" / "report.html"));
 }
 
+// a non-Grashof four-bar on the general engine (crank 0.5, coupler 0.335, rocker 0.35, frame
+// 0.3: s + l = 0.8 > p + q = 0.685), drawn with its crank at pi/2; its crank reaches a limit
+// position near 2.02 rad, where |A1 - A3| = coupler + rocker. The scene is appended.
+const std::string kNonGrashofPlanar =
+    "name: rocks\n"
+    "linkage:\n"
+    "  type: planar\n"
+    "  nodes:\n"
+    "    A0: {at: [0, 0], ground: true}\n"
+    "    A3: {at: [0.3, 0], ground: true}\n"
+    "    A1: [0, 0.5]\n"
+    "    A2: [0.3, 0.35]\n"
+    "  links:\n"
+    "    crank: {nodes: [A0, A1], mass: 1.0, e: 0.1, f: 0, inertia: 0.002}\n"
+    "    coupler: {nodes: [A1, A2], mass: 1.0, e: 0.1, f: 0, inertia: 0.002}\n"
+    "    rocker: {nodes: [A3, A2], mass: 1.0, e: 0.1, f: 0, inertia: 0.002}\n"
+    "  inputs:\n"
+    "    crank: {link: crank}\n";
+
 TEST_F(CliTest, PlanarSimulationStoppedEarlyNamesWhereItStopped) {
   // a free non-Grashof four-bar on the general engine's reduced route (method: truss), which
   // cannot pass a limit position: the run stops at the first one (exit 3), keeping the samples
   // before (its crank, turning from pi/2, reaches it near 2.02 rad; the driven scene of this
   // linkage is refused below)
-  write("limit.yaml",
-        "name: limit\n"
-        "linkage:\n"
-        "  type: planar\n"
-        "  nodes:\n"
-        "    A0: {at: [0, 0], ground: true}\n"
-        "    A3: {at: [0.3, 0], ground: true}\n"
-        "    A1: [0, 0.5]\n"
-        "    A2: [0.3, 0.35]\n"
-        "  links:\n"
-        "    crank: {nodes: [A0, A1], mass: 1.0, e: 0.1, f: 0, inertia: 0.002}\n"
-        "    coupler: {nodes: [A1, A2], mass: 1.0, e: 0.1, f: 0, inertia: 0.002}\n"
-        "    rocker: {nodes: [A3, A2], mass: 1.0, e: 0.1, f: 0, inertia: 0.002}\n"
-        "  inputs:\n"
-        "    crank: {link: crank}\n"
-        "scene: {type: free, duration: 0.5, rates: [6.283185307179586]}\n"
-        "method: truss\n");
+  write("limit.yaml", kNonGrashofPlanar +
+                          "scene: {type: free, duration: 0.5, rates: [6.283185307179586]}\n"
+                          "method: truss\n");
   EXPECT_EQ(run("limit.yaml --out res"), 3) << err_;
   // the planar run's own message (not the empty four-bar trajectory's), naming where
   EXPECT_EQ(err_.rfind("limit.yaml: simulation stopped early: ", 0), 0u) << err_;
@@ -239,21 +244,7 @@ TEST_F(CliTest, PlanarDrivenInputThatCannotTurnFullyIsRefusedAtSceneType) {
   // a non-Grashof four-bar on the general engine (crank 0.5, coupler 0.335, rocker 0.35, frame
   // 0.3: s + l = 0.8 > p + q = 0.685): its crank reaches a limit position near 2.02 rad, where
   // |A1 - A3| = coupler + rocker; a driven scene is refused before it runs, a free one is not
-  const std::string linkage =
-      "name: rocks\n"
-      "linkage:\n"
-      "  type: planar\n"
-      "  nodes:\n"
-      "    A0: {at: [0, 0], ground: true}\n"
-      "    A3: {at: [0.3, 0], ground: true}\n"
-      "    A1: [0, 0.5]\n"
-      "    A2: [0.3, 0.35]\n"
-      "  links:\n"
-      "    crank: {nodes: [A0, A1], mass: 1.0, e: 0.1, f: 0, inertia: 0.002}\n"
-      "    coupler: {nodes: [A1, A2], mass: 1.0, e: 0.1, f: 0, inertia: 0.002}\n"
-      "    rocker: {nodes: [A3, A2], mass: 1.0, e: 0.1, f: 0, inertia: 0.002}\n"
-      "  inputs:\n"
-      "    crank: {link: crank}\n";
+  const std::string linkage = kNonGrashofPlanar;
   write("rocks.yaml", linkage + "scene:\n  type: driven\n  speeds: [6.283185307179586]\n");
   for (const char* command : {"validate rocks.yaml", "rocks.yaml --out res"}) {
     EXPECT_EQ(run(command), 2) << command << ": " << err_;

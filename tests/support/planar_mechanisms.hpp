@@ -30,6 +30,8 @@ inline double uniform(Rng& rng, double a, double b) {
   return std::uniform_real_distribution<double>(a, b)(rng);
 }
 inline bool coin(Rng& rng, double p = 0.5) { return uniform(rng, 0, 1) < p; }
+/// A driven input's speed: 5 to 40 (rad/s or m/s), either sign.
+inline double random_speed(Rng& rng) { return (coin(rng) ? 1.0 : -1.0) * uniform(rng, 5.0, 40.0); }
 inline Vec2 polar(double r, double angle) { return {r * std::cos(angle), r * std::sin(angle)}; }
 inline Vec2 perp_of(const Vec2& v) { return {-v.y(), v.x()}; }
 inline double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }

@@ -87,8 +87,7 @@ void run_family(const char* family, std::uint64_t seed, int count, Make make) {
   for (int i = 0; i < count; ++i) {
     const cp::Linkage l = make(rng);
     std::vector<double> speeds;
-    for (std::size_t k = 0; k < l.inputs.size(); ++k)
-      speeds.push_back((coin(rng) ? 1.0 : -1.0) * uniform(rng, 5.0, 40.0));
+    for (std::size_t k = 0; k < l.inputs.size(); ++k) speeds.push_back(random_speed(rng));
     all.merge(routes_agree(l, speeds, std::string(family) + " #" + std::to_string(i)));
   }
   std::printf("%s, %d driven revolutions, block route against the general route:\n%s", family,

@@ -70,10 +70,6 @@ Agreement driven_agreement(const cp::Linkage& linkage, const std::vector<double>
   return a;
 }
 
-double random_speed(Rng& rng) {
-  return (coin(rng) ? 1.0 : -1.0) * uniform(rng, 5.0, 40.0);
-}
-
 template <class Make>
 void run_family(const char* family, std::uint64_t seed, int count, Make make) {
   Rng rng(seed);
