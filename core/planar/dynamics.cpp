@@ -569,17 +569,18 @@ void element_forces(const Model& model, Workspace& ws) {
   }
 }
 
-// M q̈ - F (the efforts excluded) from the element forces, the point masses, the node forces and
-// the springs, into ws.rhs: the right-hand side of the multipliers' Gᵀ λ = M q̈ - F
+// M q̈ - F (the efforts excluded) into ws.rhs, the right-hand side of the multipliers'
+// Gᵀ λ = M q̈ - F: the element forces (each link's inertia less its loads, element_forces()),
+// the point masses' inertia, less the rest of the applied forces (node forces, point masses'
+// weights, springs)
 void multiplier_rhs(const Model& model, Workspace& ws) {
   const System& s = model.system();
-  const Linkage& l = s.linkage;
   const Instant& in = ws.instant;
-  ws.rhs.setZero(s.n);
+  detail::applied_forces(s, in.x, in.v, nullptr, ws.F, false);
+  ws.rhs = -ws.F;
   double* rhs = ws.rhs.data();
-  const int* coord = s.coord.data();
   auto add = [&](int node, const Vec2& f) {
-    const int c = coord[node];
+    const int c = s.coord[static_cast<std::size_t>(node)];
     if (c < 0) return;
     rhs[c] += f.x();
     rhs[c + 1] += f.y();
@@ -589,15 +590,8 @@ void multiplier_rhs(const Model& model, Workspace& ws) {
     add(s.elements[k].p, ws.element_force[k].segment<2>(0));
     add(s.elements[k].q, ws.element_force[k].segment<2>(2));
   }
-  const Vec2& g = l.loads.gravity;
-  for (const PointMass& pm : l.point_masses)
-    add(pm.node, pm.mass * (in.a[static_cast<std::size_t>(pm.node)] - g));
-  for (const NodeForce& nf : l.loads.node_forces) add(nf.node, -nf.force);
-  for (std::size_t k = 0; k < l.springs.size(); ++k) {
-    const detail::SpringState st = detail::spring_state(s, static_cast<int>(k), in.x, in.v);
-    add(l.springs[k].a, -st.tension * st.unit);
-    add(l.springs[k].b, st.tension * st.unit);
-  }
+  for (const PointMass& pm : s.linkage.point_masses)
+    add(pm.node, pm.mass * in.a[static_cast<std::size_t>(pm.node)]);
 }
 
 // per link and node: the force on the link from the joint there (f = inertia - load - the

@@ -472,12 +472,12 @@ SpringState spring_state(const System& s, int k, const NodeVectors& x, const Nod
 }
 
 void applied_forces(const System& s, const NodeVectors& x, const NodeVectors& v,
-                    const std::vector<double>* efforts, VectorXd& F) {
+                    const std::vector<double>* efforts, VectorXd& F, bool link_loads) {
   F.setZero(s.n);
   const Linkage& l = s.linkage;
   const Vec2& g = l.loads.gravity;
   // weights at the centres of mass, and the links' loads (eq. 46)
-  for (std::size_t k = 0; k < l.links.size(); ++k) {
+  for (std::size_t k = 0; link_loads && k < l.links.size(); ++k) {
     const double moment =
         s.shafts.empty() ? s.link_moment[k] : link_moment_at(s, static_cast<int>(k), x);
     if (s.link_force[k].isZero(0.0) && moment == 0.0) continue;

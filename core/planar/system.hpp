@@ -205,10 +205,11 @@ void constraint_jacobian(const System& s, const NodeVectors& x, int rows, Matrix
 void constraint_bias(const System& s, const NodeVectors& x, const NodeVectors& v, int rows,
                      VectorXd& gamma);
 
-/// The applied forces on q at time t: the links' loads and weights (eq. 46), the node forces
-/// and point-mass weights, the spring-dampers; with `efforts`, the inputs' drive efforts too.
+/// The applied forces on q at time t: the links' loads and weights (eq. 46; not with
+/// `link_loads` false, for a caller that has them per element), the node forces and point-mass
+/// weights, the spring-dampers; with `efforts`, the inputs' drive efforts too.
 void applied_forces(const System& s, const NodeVectors& x, const NodeVectors& v,
-                    const std::vector<double>* efforts, VectorXd& F);
+                    const std::vector<double>* efforts, VectorXd& F, bool link_loads = true);
 
 /// A balance shaft's motion: its centre of mass from the shaft and that point's acceleration,
 /// its rate and acceleration, and the torque τ its drive applies to it (J α - r × m g) [N m].
