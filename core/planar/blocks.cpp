@@ -183,6 +183,21 @@ double two_row_sine(double a, double b, double c, double d) {
   return n > 0 ? (a * d - b * c) / n : 0.0;
 }
 
+// the sign of a permutation of 0..n-1 (by its cycles)
+double permutation_sign(const std::vector<int>& order) {
+  std::vector<char> seen(order.size(), 0);
+  double sign = 1;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    std::size_t length = 0;
+    for (std::size_t j = i; !seen[j]; j = static_cast<std::size_t>(order[j])) {
+      seen[j] = 1;
+      ++length;
+    }
+    if (length > 0 && length % 2 == 0) sign = -sign;
+  }
+  return sign;
+}
+
 }  // namespace
 
 BlockPlan plan_blocks(const System& s) {
@@ -265,6 +280,7 @@ BlockPlan plan_blocks(const System& s) {
     b.entry[2] = offset(r[1], c[0]);
     b.entry[3] = offset(r[1], c[1]);
   }
+  plan.permutation_sign = permutation_sign(plan.rows) * permutation_sign(plan.coords);
   plan.usable = true;
   return plan;
 }
@@ -294,6 +310,34 @@ void prime_blocks(const Model& model, Workspace& ws) {
     ws.block_lu[k].compute(ws.block_matrix);
     ws.block_sign[k] = ws.block_lu[k].determinant() < 0 ? -1.0 : 1.0;
   }
+}
+
+bool prime_closed_blocks(const Model& model, Workspace& ws, const NodeVectors& x) {
+  const System& s = model.system();
+  const BlockPlan& plan = s.blocks;
+  if (!plan.usable || !plan.closed) return false;
+  ws.block_sign.resize(plan.blocks.size());
+  ws.block_det.resize(plan.blocks.size());
+  ws.block_lu.resize(plan.blocks.size());
+  for (std::size_t k = 0; k < plan.blocks.size(); ++k) {
+    const Block& b = plan.blocks[k];
+    const Vec2 e = at(x, b.node) - at(x, b.a);
+    double measure = 0, scale = 0;  // the branch's sign and its size over the legs'
+    if (b.kind == Block::Kind::kDyad) {
+      const Vec2 d = at(x, b.b) - at(x, b.a);
+      measure = cross(d, e);
+      scale = d.norm() * e.norm();
+    } else if (b.kind == Block::Kind::kGuide) {
+      measure = s.sliders[static_cast<std::size_t>(b.index)].unit.dot(e);
+      scale = e.norm();
+    } else {
+      ws.block_sign[k] = 1.0;
+      continue;
+    }
+    if (!(std::abs(measure) >= kWellConditioned * scale) || !(scale > 0)) return false;
+    ws.block_sign[k] = measure < 0 ? -1.0 : 1.0;
+  }
+  return true;
 }
 
 bool place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess,
@@ -403,6 +447,14 @@ bool place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess
   ws.factorised = false;  // ws.lu is not at this position
   ws.by_blocks = true;
   return true;
+}
+
+double block_determinant(const Model& model, const Workspace& ws) {
+  const BlockPlan& plan = model.system().blocks;
+  double d = plan.permutation_sign;
+  for (std::size_t k = 0; k < plan.blocks.size(); ++k)
+    d *= plan.blocks[k].size == 2 ? ws.block_det[k] : ws.block_lu[k].determinant();
+  return d;
 }
 
 void block_solve(const Model& model, Workspace& ws, const Eigen::VectorXd& rhs,

@@ -40,6 +40,13 @@ namespace bd::core::planar::detail {
 /// those; call after every position the general route solved.
 void prime_blocks(const Model& model, Workspace& ws);
 
+/// For a plan of closed forms (BlockPlan::closed): the branch of each dyad and guide as
+/// prime_blocks() records it, read from positions `x` near the solution (a guess, such as the last
+/// instant's) rather than from a solved position. Returns false, recording nothing, where the plan
+/// is not closed or a block's node in `x` lies within a sine of 1e-2 of the line that divides its
+/// branches (x does not tell the branch clearly; the general route's Newton iterations decide).
+bool prime_closed_blocks(const Model& model, Workspace& ws, const NodeVectors& x);
+
 /// The positions at `inputs` block by block (the general blocks by Newton's method from `guess`,
 /// which closed-form plans do not read), on the branch prime_blocks() recorded, and the blocks'
 /// factorisations there. Sets ws.instant.x and .input and ws.by_blocks. Returns false, changing
@@ -48,6 +55,10 @@ void prime_blocks(const Model& model, Workspace& ws);
 /// determinant changed sign, a general block where Newton's method does not converge.
 bool place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess,
                      const std::vector<double>& inputs);
+
+/// After place_by_blocks(): the determinant of the whole Jacobian G, from the blocks' (as the
+/// general route's factorisation gives it, to round-off).
+double block_determinant(const Model& model, const Workspace& ws);
 
 /// After place_by_blocks(): x = G⁻¹ b by forward substitution over the blocks (x may not be b).
 void block_solve(const Model& model, Workspace& ws, const Eigen::VectorXd& b, Eigen::VectorXd& x);

@@ -329,9 +329,14 @@ bool chord_iterations(const Model& model, Workspace& ws) {
 
 Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
                                            const std::vector<Vec2>& guess,
-                                           const std::vector<double>& inputs) {
+                                           const std::vector<double>& inputs, PositionRoute route) {
   const System& s = model.system();
   Instant& in = ws.instant;
+  // the closed forms block by block where the plan has them and the guess tells each block's
+  // branch; anything they decline (a dead centre near) is decided by the general route below
+  if (route == PositionRoute::kLeanest && detail::prime_closed_blocks(model, ws, guess) &&
+      detail::place_by_blocks(model, ws, guess, inputs))
+    return true;
   ws.by_blocks = false;
   if (s.rows != s.n) {
     return Unexpected<PlanarError>(
@@ -443,10 +448,10 @@ Expected<bool, PlanarError> assemble(const Model& model, Workspace& ws,
     for (std::size_t k = 0; k < inputs.size(); ++k) {
       z[k] = from[k] + (inputs[k] - from[k]) * (i / steps);
     }
-    if (auto ok = solve_position(model, ws, guess, z); !ok) return ok;
+    if (auto ok = solve_position(model, ws, guess, z, PositionRoute::kGeneral); !ok) return ok;
     guess = ws.instant.x;
   }
-  if (steps < 1) return solve_position(model, ws, guess, inputs);
+  if (steps < 1) return solve_position(model, ws, guess, inputs, PositionRoute::kGeneral);
   return true;
 }
 
@@ -865,13 +870,21 @@ Expected<bool, PlanarError> forward_dynamics(const Model& model, Workspace& ws, 
   ws.rhs += ws.F;  // F - M c with c = -G⁻¹ γ
   ws.right.noalias() = ws.T.transpose() * ws.rhs;
   for (int k = 0; k < dof; ++k) ws.right[k] += efforts[static_cast<std::size_t>(k)];
-  ws.ldlt.compute(ws.reduced);
-  if (ws.ldlt.info() != Eigen::Success || !(ws.ldlt.rcond() > 1e-14)) {
+  auto singular = [&]() {
     return Unexpected<PlanarError>(PlanarError{PlanarError::Kind::kSingular,
                                                "the reduced inertia of the inputs is singular at " +
                                                    inputs_text(model, ws.instant.input)});
+  };
+  if (dof == 1) {  // a scalar: what the factorisation below does for one input, without it
+    const double m = ws.reduced(0, 0);
+    if (!(m != 0) || !std::isfinite(m)) return singular();
+    ws.zdd.resize(1);
+    ws.zdd[0] = ws.right[0] / m;
+  } else {
+    ws.ldlt.compute(ws.reduced);
+    if (ws.ldlt.info() != Eigen::Success || !(ws.ldlt.rcond() > 1e-14)) return singular();
+    ws.zdd.noalias() = ws.ldlt.solve(ws.right);
   }
-  ws.zdd.noalias() = ws.ldlt.solve(ws.right);
   ws.qdd.noalias() = ws.T * ws.zdd;
   ws.qdd -= ws.c;
   ws.instant.input_acceleration.assign(ws.zdd.data(), ws.zdd.data() + dof);

@@ -146,15 +146,30 @@ class Workspace {
   Eigen::VectorXd block_rhs, block_x, block_lambda;
 };
 
-/// Solves the positions with the inputs at `inputs` by Newton's method from `guess` (node
-/// positions; the drawn ones, or the last instant's, choose the branch), and factorises the
-/// constraints' Jacobian there. Sets ws.instant.x and .input.
+/// How solve_position() finds the positions.
+enum class PositionRoute {
+  /// The block-triangular closed forms (core/planar/blocks.hpp) where the linkage is built of
+  /// cranks, dyads, guides and further nodes of links and `guess` tells each dyad's and guide's
+  /// branch clearly; the general route otherwise, and wherever the closed forms decline (a dead
+  /// centre near). ws.lu is then not factorised (ws.by_blocks says which route answered).
+  kLeanest,
+  /// Newton's method on every constraint from `guess`, the whole Jacobian factorised in ws.lu
+  /// at the solution (its determinant's sign tells the assembly branch).
+  kGeneral,
+};
+
+/// Solves the positions with the inputs at `inputs` from `guess` (node positions; the drawn
+/// ones, or the last instant's, choose the branch) by the route asked for, and factorises the
+/// constraints' Jacobian there (the whole of it on the general route, block by block on the
+/// leanest). The routes agree to round-off. Sets ws.instant.x and .input.
 Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
                                            const std::vector<Vec2>& guess,
-                                           const std::vector<double>& inputs);
+                                           const std::vector<double>& inputs,
+                                           PositionRoute route = PositionRoute::kLeanest);
 
 /// Assembles the linkage at `inputs`, stepping them from the drawn configuration's values in
-/// small increments so that Newton follows the drawn branch. On success ws.instant.x is set.
+/// small increments so that Newton follows the drawn branch (the general route: ws.lu holds the
+/// Jacobian at the result). On success ws.instant.x is set.
 Expected<bool, PlanarError> assemble(const Model& model, Workspace& ws,
                                      const std::vector<double>& inputs);
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstddef>
 #include <utility>
@@ -146,13 +147,9 @@ void append_row(const Model& model, const Instant& in, Series& table) {
   const Linkage& l = model.linkage();
   const System& s = model.system();
   std::vector<double>& v = table.values;
-  // the row's width, then every value written in place (a vector's insert per value costs more
-  // than the values)
-  const std::size_t width =
-      1 + 3 * (l.links.size() + l.sliders.size()) + static_cast<std::size_t>(s.n) +
-      2 * (in.ground_reaction.size() + in.guide_reaction.size() + in.shaft_reaction.size() +
-           in.spring_reaction.size() + in.drive_reaction.size() + in.joint_force.size()) +
-      3 + in.effort.size() + 6;
+  // the row's width (columns() names every value below), then every value written in place (a
+  // vector's insert per value costs more than the values)
+  const std::size_t width = table.width();
   const std::size_t start = v.size();
   v.resize(start + width);
   double* o = v.data() + start;
@@ -186,6 +183,7 @@ void append_row(const Model& model, const Instant& in, Series& table) {
   put(in.Msh_inertial);
   put2(in.Fsh_static);
   put(in.Msh_static);
+  assert(o == v.data() + start + width);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -310,7 +308,7 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
           guess[k] = previous[k] + h * (v_previous[k] + h / 2 * a_previous[k]);
         }
       }
-      ok = solve_position(model, ws, guess, z);
+      ok = solve_position(model, ws, guess, z, PositionRoute::kGeneral);
       if (ok && i > 0 && branch() != drawn_branch) {
         // near a singular position the prediction can overshoot onto another branch (the rates
         // grow without bound there): continue from the previous sample's positions in small
@@ -320,7 +318,7 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
         for (int j = 1; j <= kSubsteps && ok; ++j) {
           for (std::size_t k = 0; k < z.size(); ++k)
             z_step[k] = z_previous[k] + (z[k] - z_previous[k]) * j / kSubsteps;
-          ok = solve_position(model, ws, guess, z_step);
+          ok = solve_position(model, ws, guess, z_step, PositionRoute::kGeneral);
           guess = ws.instant.x;
         }
       }
@@ -375,8 +373,8 @@ struct Motion {
 };
 
 // the normalised determinant of the factorised constraints and inputs at ws
-double normalised_determinant(Workspace& ws) {
-  double d = ws.lu.determinant();
+double normalised_determinant(const Model& model, Workspace& ws) {
+  double d = ws.by_blocks ? detail::block_determinant(model, ws) : ws.lu.determinant();
   for (Eigen::Index r = 0; r < ws.G.rows(); ++r) d /= ws.G.row(r).norm();
   return d;
 }
@@ -425,7 +423,7 @@ int reduced_root(sunrealtype, N_Vector y, sunrealtype* g, void* data) {
     g[0] = -1;  // beyond a limit: the root lies before
     return 0;
   }
-  g[0] = m.root_sign * normalised_determinant(*m.ws) - kLimitDeterminant;
+  g[0] = m.root_sign * normalised_determinant(*m.model, *m.ws) - kLimitDeterminant;
   return 0;
 }
 
@@ -775,7 +773,7 @@ Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scen
   ++m.evaluations;
   if (first) first = reduced_state(m, 0.0, y0.data());
   if (sens != nullptr) keep_state_derivatives(*sens, y0.size(), nullptr);
-  if (first && std::abs(normalised_determinant(ws)) <= kLimitDeterminant) {
+  if (first && std::abs(normalised_determinant(model, ws)) <= kLimitDeterminant) {
     first = Unexpected<PlanarError>(
         PlanarError{PlanarError::Kind::kSingular, "the start is a limit position of the inputs"});
   }
@@ -784,7 +782,7 @@ Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scen
     out.rhs_evaluations = m.evaluations;
     return out;
   }
-  m.root_sign = normalised_determinant(ws) > 0 ? 1.0 : -1.0;
+  m.root_sign = normalised_determinant(model, ws) > 0 ? 1.0 : -1.0;
   append_row(model, ws.instant, out.table);
   out.states.insert(out.states.end(), y0.begin(), y0.end());
 
@@ -961,7 +959,7 @@ std::optional<integrators::Problem> continuation(Motion& m, const FreeState& fro
   if (!dae) {
     ++m.evaluations;
     if (!reduced_state(m, from.t, from.y.data())) return std::nullopt;
-    m.root_sign = normalised_determinant(ws) > 0 ? 1.0 : -1.0;
+    m.root_sign = normalised_determinant(*m.model, ws) > 0 ? 1.0 : -1.0;
   }
   integrators::Problem problem = free_problem(options, from.y, t, m, dae ? dae_rhs : reduced_rhs);
   problem.t0 = from.t;

@@ -274,9 +274,12 @@ void node_rates_from(const System& s, const VectorXd& qd, NodeVectors& v) {
 
 void q_from_nodes(const System& s, const NodeVectors& x, VectorXd& q) {
   q.resize(s.n);
-  for (std::size_t i = 0; i < s.coord.size(); ++i) {
-    const int c = s.coord[i];
-    if (c >= 0) q.segment<2>(c) = x[i];
+  double* out = q.data();
+  for (int i : s.moving) {
+    const Vec2& node = at(x, i);
+    const int c = s.coord[static_cast<std::size_t>(i)];
+    out[c] = node.x();
+    out[c + 1] = node.y();
   }
 }
 

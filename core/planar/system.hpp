@@ -62,6 +62,9 @@ struct BlockPlan {
   bool closed = false;            // every block has a closed form (no Newton's method, no guess)
   std::vector<int> rows, coords;  // the blocks' rows and coordinates, block after block
   std::vector<Block> blocks;      // in the order of solution
+  /// The sign of the two permutations together (rows, coords): det G = permutation_sign times
+  /// the product of the diagonal blocks' determinants.
+  double permutation_sign = 1;
   /// A term of the substitutions: an entry of the Jacobian G outside the diagonal blocks (its
   /// offset in G, column-major, rows x n) and the unknown it multiplies (forward: a coordinate
   /// of an earlier block; backward: a row of a later block).

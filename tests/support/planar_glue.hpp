@@ -326,7 +326,7 @@ void general_route(const cp::Model& model, const std::vector<double>& speeds,
   for (double t : times) {
     for (std::size_t k = 0; k < z.size(); ++k) z[k] = start[k] + speeds[k] * t;
     const std::vector<Vec2> guess = ws.instant.x;
-    auto ok = cp::solve_position(model, ws, guess, z);
+    auto ok = cp::solve_position(model, ws, guess, z, cp::PositionRoute::kGeneral);
     if (ok) ok = cp::inverse_dynamics(model, ws, t, speeds, zero);
     EXPECT_TRUE(ok) << (ok ? "" : ok.error().detail);
     if (!ok) break;

@@ -154,5 +154,149 @@ TEST(Blocks, FiveBarsBlockRouteEqualsItsGeneralRoute) {
   run_family("two-input five-bars", 7, 10, [](Rng& rng) { return five_bar(rng); });
 }
 
+// The Jacobian's determinant from the blocks' (the free runs' limit-position test reads it) is
+// the whole factorisation's: the permutations' sign and every block's determinant, on linkages
+// whose plans differ in order and kind.
+TEST(Blocks, TheDeterminantFromTheBlocksIsTheWholeJacobians) {
+  Rng rng(31);
+  std::vector<cp::Linkage> linkages;
+  for (int i = 0; i < 4; ++i) {
+    core::FourBar fb = core::samples::random_crank_rocker(rng);
+    if (i % 2 == 1)
+      fb.branch = fb.branch == core::Branch::kPlus ? core::Branch::kMinus : core::Branch::kPlus;
+    linkages.push_back(cp::linkage_of(fb, uniform(rng, -kPi, kPi)));
+    linkages.push_back(slider_crank(rng, coin(rng)));
+    linkages.push_back(quick_return(rng, coin(rng), coin(rng)));
+    linkages.push_back(six_bar_or_retry(rng, i % 2 == 1));
+    linkages.push_back(five_bar(rng));
+  }
+  linkages.push_back(driven_by_piston(slider_crank(rng, true)));
+  for (std::size_t i = 0; i < linkages.size(); ++i) {
+    const cp::Model model(linkages[i]);
+    cp::Workspace ws(model);
+    ASSERT_TRUE(cp::assemble(model, ws, cp::drawn_inputs(model))) << i;
+    const double whole = ws.lu.determinant();
+    cd::prime_blocks(model, ws);
+    ASSERT_TRUE(cd::place_by_blocks(model, ws, ws.instant.x, cp::drawn_inputs(model))) << i;
+    EXPECT_NEAR(cd::block_determinant(model, ws) / whole, 1.0, 1e-12) << i;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// One-instant calls: cp::solve_position takes the block route where the plan is closed and the
+// guess tells each block's branch (PositionRoute::kLeanest, the default), the general route
+// where asked (kGeneral). From the same guesses (a driven revolution's instants by the general
+// route) at inputs half a step on, both routes give the same instant, by inverse and by forward
+// dynamics, to the tolerance above; a plan with a block solved by Newton's method takes the
+// general route.
+
+// each instant at inputs[i] from guesses[i], by `route`, inverse or forward dynamics
+core::Series instants(const cp::Model& model, const std::vector<std::vector<Vec2>>& guesses,
+                      const std::vector<std::vector<double>>& inputs, const std::vector<double>& t,
+                      const std::vector<double>& speeds, bool forward, cp::PositionRoute route,
+                      int& by_blocks) {
+  core::Series out;
+  out.columns = cp::columns(model);
+  cp::Workspace ws(model);
+  const std::vector<double> zero(speeds.size(), 0.0);
+  by_blocks = 0;
+  for (std::size_t i = 0; i < guesses.size(); ++i) {
+    ws.instant.angle = cp::Workspace(model).instant.angle;  // every call on its own
+    auto ok = cp::solve_position(model, ws, guesses[i], inputs[i], route);
+    if (ok) {
+      by_blocks += ws.by_blocks ? 1 : 0;
+      ok = forward ? cp::forward_dynamics(model, ws, t[i], speeds, zero)
+                   : cp::inverse_dynamics(model, ws, t[i], speeds, zero);
+    }
+    EXPECT_TRUE(ok) << (ok ? "" : ok.error().detail);
+    if (!ok) break;
+    cp::append_row(model, ws.instant, out);
+  }
+  return out;
+}
+
+// `share`: the least share of the calls the block route answers
+template <class Make>
+void one_instant_family(const char* family, std::uint64_t seed, int count, double share,
+                        Make make) {
+  Rng rng(seed);
+  Agreement all;
+  int taken = 0, calls = 0;
+  for (int i = 0; i < count; ++i) {
+    const cp::Linkage l = make(rng);
+    const cp::Model model(l);
+    std::vector<double> speeds;
+    for (std::size_t k = 0; k < l.inputs.size(); ++k) speeds.push_back(random_speed(rng));
+    constexpr int kSamples = 48;
+    const double period = 2 * kPi / std::abs(speeds[0]);
+    std::vector<double> times;
+    for (int j = 0; j < kSamples; ++j) times.push_back(period * j / kSamples);
+    std::vector<std::vector<Vec2>> guesses;
+    std::vector<std::vector<double>> inputs;
+    std::vector<double> at;
+    general_route(model, speeds, times, [&](const cp::Instant& in) {
+      guesses.push_back(in.x);
+      at.push_back(in.t + period / (2 * kSamples));
+      std::vector<double> z = in.input;
+      for (std::size_t k = 0; k < z.size(); ++k) z[k] += speeds[k] * period / (2 * kSamples);
+      inputs.push_back(z);
+    });
+    const std::string label = std::string(family) + " #" + std::to_string(i);
+    for (bool forward : {false, true}) {
+      int blocks = 0, general = 0;
+      const core::Series lean = instants(model, guesses, inputs, at, speeds, forward,
+                                         cp::PositionRoute::kLeanest, blocks);
+      const core::Series whole = instants(model, guesses, inputs, at, speeds, forward,
+                                          cp::PositionRoute::kGeneral, general);
+      EXPECT_EQ(general, 0) << label;
+      if (!model.system().blocks.closed) {
+        EXPECT_EQ(blocks, 0) << label;
+      }
+      taken += blocks;
+      calls += static_cast<int>(guesses.size());
+      Agreement a = compare_tables(model, lean, whole, label + (forward ? " forward" : " inverse"));
+      expect_agreement(a, kTol, label);
+      all.merge(a);
+    }
+  }
+  EXPECT_GE(taken, share * calls) << family;
+  std::printf("%s, %d one-instant calls, %d on the block route, against the general route:\n%s",
+              family, calls, taken, all.text().c_str());
+}
+
+TEST(Blocks, OneInstantCallsTakeTheBlockRouteWhereTheGuessTellsTheBranch) {
+  // four-bars on either branch and slider-cranks: closed plans, the block route answers almost
+  // every call (the rest are near a dead centre)
+  for (const bool flip : {false, true}) {
+    Rng rng(21);
+    const core::FourBar fb = core::samples::random_crank_rocker(rng);
+    core::FourBar other = fb;
+    other.branch = fb.branch == core::Branch::kPlus ? core::Branch::kMinus : core::Branch::kPlus;
+    const cp::Model model(cp::linkage_of(flip ? other : fb, 0.4));
+    cp::Workspace lean(model), whole(model);
+    ASSERT_TRUE(cp::assemble(model, whole, {0.7}));
+    // from the assembled branch's positions, the block route keeps that branch
+    ASSERT_TRUE(cp::solve_position(model, lean, whole.instant.x, {0.75}));
+    EXPECT_TRUE(lean.by_blocks);
+    ASSERT_TRUE(
+        cp::solve_position(model, whole, whole.instant.x, {0.75}, cp::PositionRoute::kGeneral));
+    for (std::size_t n = 0; n < lean.instant.x.size(); ++n)
+      EXPECT_LE((lean.instant.x[n] - whole.instant.x[n]).norm(), 1e-14) << n;
+  }
+  one_instant_family("four-bars (both branches)", 22, 10, 0.9, [](Rng& rng) {
+    core::FourBar fb = core::samples::random_crank_rocker(rng);
+    if (coin(rng))
+      fb.branch = fb.branch == core::Branch::kPlus ? core::Branch::kMinus : core::Branch::kPlus;
+    return cp::linkage_of(fb, uniform(rng, -kPi, kPi));
+  });
+  one_instant_family("slider-cranks", 23, 6, 0.9,
+                     [](Rng& rng) { return slider_crank(rng, coin(rng)); });
+  // plans with blocks solved by Newton's method take the general route
+  one_instant_family("quick returns", 24, 4, 0.0,
+                     [](Rng& rng) { return quick_return(rng, coin(rng), coin(rng)); });
+  one_instant_family("Watt six-bars", 25, 4, 0.0,
+                     [](Rng& rng) { return six_bar_or_retry(rng, false); });
+}
+
 }  // namespace
 }  // namespace bd::testing::planar
