@@ -585,8 +585,6 @@ void closed_form_kinematics(const Model& model, Workspace& ws, const std::vector
         break;  // (not a closed plan)
     }
   }
-  q_from_nodes(s, v, ws.qd);
-  q_from_nodes(s, a, ws.qdd);
   std::copy(rates.begin(), rates.end(), in.input_rate.begin());
   std::copy(accelerations.begin(), accelerations.end(), in.input_acceleration.begin());
 }

@@ -70,7 +70,8 @@ void block_solve_transpose(const Model& model, Workspace& ws, Eigen::VectorXd& b
 /// own geometry (a crank's tip turning about its pivot; a dyad's node from its two rows
 /// (P - A)·(v_P - v_A) = 0, (P - B)·(v_P - v_B) = 0 and their derivatives; a guide's node along
 /// its guide; a further node as its element's nodes weigh it), without the Jacobian. Sets
-/// ws.instant.v, .a, .input_rate, .input_acceleration and ws.qd, ws.qdd.
+/// ws.instant.v, .a, .input_rate and .input_acceleration (not ws.qd and ws.qdd: nothing after
+/// reads them).
 void closed_form_kinematics(const Model& model, Workspace& ws, const std::vector<double>& rates,
                             const std::vector<double>& accelerations);
 

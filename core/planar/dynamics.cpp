@@ -227,7 +227,7 @@ Workspace::Workspace(const Model& model) {
   right.setZero(model.inputs());
   zdd.setZero(model.inputs());
   target.assign(static_cast<std::size_t>(model.inputs()), Vec2(0, 0));
-  on_link.assign(model.linkage().links.size() * model.linkage().nodes.size(), Vec2(0, 0));
+  on_link.assign(static_cast<std::size_t>(s.slots), Vec2(0, 0));
   element_force.assign(model.linkage().links.size(), Vec4::Zero());
 }
 
@@ -530,7 +530,11 @@ void link_kinematics(const Model& model, Instant& in) {
     const std::size_t p = static_cast<std::size_t>(e.p), q = static_cast<std::size_t>(e.q);
     const Vec2 d = in.x[q] - in.x[p], dv = in.v[q] - in.v[p], da = in.a[q] - in.a[p];
     const double n2 = d.squaredNorm();
-    const double a = polar_angle(d.y(), d.x());
+    // a link an input turns is at the input's angle (exactly where the blocks placed it; to
+    // round-off of the position solve otherwise)
+    const int input = s.link_input[k];
+    const double a =
+        input >= 0 ? in.input[static_cast<std::size_t>(input)] : polar_angle(d.y(), d.x());
     in.angle[k] = a + 2 * kPi * nearest_whole((in.angle[k] - a) / (2 * kPi));
     in.omega[k] = cross(d, dv) / n2;
     in.alpha[k] = cross(d, da) / n2 - 2 * d.dot(dv) * in.omega[k] / n2;
@@ -599,19 +603,15 @@ void multiplier_rhs(const Model& model, Workspace& ws) {
     add(pm.node, pm.mass * in.a[static_cast<std::size_t>(pm.node)]);
 }
 
-// per link and node: the force on the link from the joint there (f = inertia - load - the
-// link's own constraint forces), from the element forces and the multipliers of the structural
-// rows (ws.lambda); stored densely in ws.on_link, links x nodes
+// per joint slot (System::slots): the force on the link from the joint there (f = inertia -
+// load - the link's own constraint forces), from the element forces and the multipliers of the
+// structural rows (ws.lambda), into ws.on_link
 void link_node_forces(const Model& model, Workspace& ws) {
   const System& s = model.system();
-  const Linkage& l = s.linkage;
   const Instant& in = ws.instant;
-  const std::size_t nodes = l.nodes.size();
-  std::vector<Vec2>& on_link = ws.on_link;
-  std::fill(on_link.begin(), on_link.end(), Vec2(0, 0));
-  auto f = [&](int link, int node) -> Vec2& {
-    return on_link[static_cast<std::size_t>(link) * nodes + static_cast<std::size_t>(node)];
-  };
+  const std::size_t nodes = s.linkage.nodes.size();
+  Vec2* on_link = ws.on_link.data();
+  std::fill(ws.on_link.begin(), ws.on_link.end(), Vec2(0, 0));
   const std::size_t links = s.elements.size();
   for (std::size_t k = 0; k < links; ++k) {
     const System::ElementRow& e = s.elements[k];
@@ -621,15 +621,18 @@ void link_node_forces(const Model& model, Workspace& ws) {
     // row_gradient()'s element case without its dispatch
     const Vec2 axial = ws.lambda[static_cast<Eigen::Index>(k)] * ((xq - xp) / e.length);
     const Vec4& ef = ws.element_force[k];
-    f(static_cast<int>(k), e.p) += ef.segment<2>(0) + axial;
-    f(static_cast<int>(k), e.q) += ef.segment<2>(2) - axial;
+    Vec2* f = on_link + s.first_slot[k];  // the element's first node, then its second
+    f[0] += ef.segment<2>(0) + axial;
+    f[1] += ef.segment<2>(2) - axial;
   }
   GradientEntry entries[3];
-  for (int row = static_cast<int>(l.links.size()); row < s.rows; ++row) {
+  for (int row = static_cast<int>(links); row < s.rows; ++row) {
     const int count = detail::row_gradient(s, in.x, row, entries);
     for (int j = 0; j < count; ++j) {
-      if (entries[j].link >= 0)
-        f(entries[j].link, entries[j].node) -= ws.lambda[row] * entries[j].grad;
+      if (entries[j].link < 0) continue;
+      const std::size_t at = static_cast<std::size_t>(entries[j].link) * nodes +
+                             static_cast<std::size_t>(entries[j].node);
+      on_link[s.slot_of[at]] -= ws.lambda[row] * entries[j].grad;
     }
   }
 }
@@ -670,9 +673,7 @@ void frame_forces(const Model& model, Workspace& ws) {
   const Linkage& l = s.linkage;
   Instant& in = ws.instant;
   const std::size_t nodes = l.nodes.size();
-  auto f = [&](int link, int node) -> const Vec2& {
-    return ws.on_link[static_cast<std::size_t>(link) * nodes + static_cast<std::size_t>(node)];
-  };
+  const Vec2* on_link = ws.on_link.data();
   in.Fsh = Vec2(0, 0);
   in.Msh = 0.0;
   auto on_frame = [&](const Vec2& force, const Vec2& at) {
@@ -682,7 +683,7 @@ void frame_forces(const Model& model, Workspace& ws) {
   for (std::size_t i = 0; i < model.ground_nodes().size(); ++i) {
     const int g = model.ground_nodes()[i];
     Vec2 r(0, 0);
-    for (std::size_t k = 0; k < l.links.size(); ++k) r -= f(static_cast<int>(k), g);
+    for (int j = s.ground_first[i]; j < s.ground_first[i + 1]; ++j) r -= on_link[s.ground_slots[j]];
     in.ground_reaction[i] = r;
     on_frame(r, in.x[static_cast<std::size_t>(g)]);
   }
@@ -713,7 +714,9 @@ void frame_forces(const Model& model, Workspace& ws) {
     on_frame(in.spring_reaction[j], in.x[static_cast<std::size_t>(at_a ? sp.a : sp.b)]);
   }
   for (std::size_t j = 0; j < model.joints().size(); ++j) {
-    in.joint_force[j] = f(model.joints()[j].link, model.joints()[j].node);
+    const JointForce& joint = model.joints()[j];
+    in.joint_force[j] = on_link[s.slot_of[static_cast<std::size_t>(joint.link) * nodes +
+                                          static_cast<std::size_t>(joint.node)]];
   }
   shaft_forces(model, in, on_frame);
 }
@@ -807,7 +810,9 @@ Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t,
         ir.angle ? ws.lambda[ir.row] * ir.length : ws.lambda[ir.row];
   }
   outputs(model, ws);
-  if (!finite(ws.lambda) || !finite(ws.qdd)) {
+  // (accelerations set by the closed forms that are not finite make the multipliers so: the
+  // right-hand side M a - F carries them, 0 * NaN included)
+  if (!finite(ws.lambda) || (!accelerations_set && !finite(ws.qdd))) {
     return Unexpected<PlanarError>(PlanarError{
         PlanarError::Kind::kNonFinite, "non-finite result at " + inputs_text(model, in.input)});
   }

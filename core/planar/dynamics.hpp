@@ -134,7 +134,8 @@ class Workspace {
   bool factorised = false;  // lu holds the Jacobian at the last position solve_position solved
   Eigen::LDLT<Eigen::MatrixXd> ldlt;
   std::vector<Vec2> target;  // the inputs of the last position solve (detail::input_targets)
-  std::vector<Vec2> on_link;  // force recovery: per link and node, the force from the joint
+  std::vector<Vec2> on_link;        // force recovery: per joint slot (System::slots), the force on
+                                    // the link from the joint
   std::vector<Vec4> element_force;  // per link: its element's nodal inertia less load (p, q)
   // the block-triangular route (core/planar/blocks.hpp): whether the last position was placed
   // by it (then G is the Jacobian there and the blocks are factorised, lu is not), per block

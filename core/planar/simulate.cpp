@@ -544,15 +544,20 @@ Expected<bool, PlanarError> dae_instant(Motion& m, double t, const double* y) {
     const std::size_t k = static_cast<std::size_t>(ir.input);
     in.effort[k] = m.efforts[k];
     ws.lambda[ir.row] = ir.angle ? m.efforts[k] / ir.length : m.efforts[k];
+    // the angle inputs as the nodes give them, continuing their links' angles (the outputs take
+    // an input link's angle from its input)
+    if (ir.angle) {
+      const std::size_t link = static_cast<std::size_t>(model.linkage().inputs[k].link);
+      in.input[k] = detail::input_angle(s, ir, in.x, in.angle[link]);
+    }
   }
   detail::finish_outputs(model, ws);
-  // the inputs as the nodes give them
+  // the inputs' rates and accelerations (and the slides) as the nodes give them
   for (const System::InputRow& ir : s.inputs) {
     const std::size_t k = static_cast<std::size_t>(ir.input);
     const Input& input = model.linkage().inputs[k];
     if (ir.angle) {
       const std::size_t link = static_cast<std::size_t>(input.link);
-      in.input[k] = in.angle[link];
       in.input_rate[k] = in.omega[link];
       in.input_acceleration[k] = in.alpha[link];
     } else {
@@ -828,7 +833,8 @@ Trajectory free_dae(const Model& model, Workspace& ws, const FreeScene& scene,
   }
   (void)start;
   std::vector<double> y0(static_cast<std::size_t>(2 * s.n));
-  const VectorXd q0 = detail::q_from_nodes(s, ws.instant.x), qd0 = ws.qd;
+  const VectorXd q0 = detail::q_from_nodes(s, ws.instant.x),
+                 qd0 = detail::q_from_nodes(s, ws.instant.v);
   for (int k = 0; k < s.n; ++k) {
     y0[static_cast<std::size_t>(k)] = q0[k];
     y0[static_cast<std::size_t>(s.n + k)] = qd0[k];

@@ -121,6 +121,7 @@ int add_slider_rows(System& s, int row) {
 // one row per input (a link's angle or a slider's position); returns the next free row
 int add_input_rows(System& s, int row) {
   const Linkage& l = s.linkage;
+  s.link_input.assign(l.links.size(), -1);
   for (std::size_t k = 0; k < l.inputs.size(); ++k) {
     const Input& in = l.inputs[k];
     s.row_ref.push_back({System::RowRef::Kind::kInput, static_cast<int>(k)});
@@ -129,6 +130,7 @@ int add_input_rows(System& s, int row) {
     r.input = static_cast<int>(k);
     r.angle = in.kind == Input::Kind::kAngle;
     if (r.angle) {
+      s.link_input[static_cast<std::size_t>(in.link)] = static_cast<int>(k);
       r.p = l.links[static_cast<std::size_t>(in.link)].nodes[0];
       r.q = l.links[static_cast<std::size_t>(in.link)].nodes[1];
       r.length = s.elements[static_cast<std::size_t>(in.link)].length;
@@ -241,6 +243,20 @@ System::System(const Linkage& l) : linkage(l) {
       fixed.push_back(static_cast<int>(i));
     }
   }
+  const std::size_t nodes = l.nodes.size();
+  slot_of.assign(l.links.size() * nodes, -1);
+  for (std::size_t k = 0; k < l.links.size(); ++k) {
+    first_slot.push_back(slots);
+    for (int node : l.links[k].nodes) slot_of[k * nodes + static_cast<std::size_t>(node)] = slots++;
+  }
+  for (int g : fixed) {
+    ground_first.push_back(static_cast<int>(ground_slots.size()));
+    for (std::size_t k = 0; k < l.links.size(); ++k) {
+      const int slot = slot_of[k * nodes + static_cast<std::size_t>(g)];
+      if (slot >= 0) ground_slots.push_back(slot);
+    }
+  }
+  ground_first.push_back(static_cast<int>(ground_slots.size()));
   structural_rows = add_slider_rows(*this, add_link_rows(*this));
   rows = add_input_rows(*this, structural_rows);
   add_masses_and_loads(*this);

@@ -116,6 +116,15 @@ struct System {
   };
   std::vector<RowRef> row_ref;       // per row
   std::vector<ElementRow> elements;  // per link
+  /// Per link, the angle input that turns it (its angle is the input's value), or -1.
+  std::vector<int> link_input;
+  /// The joint slots: one per link and node of that link (the force on the link from the joint
+  /// there), link after link in the order of each link's nodes, so that an element's first and
+  /// second node are slots first_slot[k] and first_slot[k] + 1. slot_of[link * nodes + node] is
+  /// the slot, or -1 where the link does not hold the node; per ground node (in node order) its
+  /// slots are ground_slots[ground_first[i]] up to ground_slots[ground_first[i + 1]].
+  int slots{};
+  std::vector<int> first_slot, slot_of, ground_first, ground_slots;
   std::vector<RigidRows> rigid;
   std::vector<SliderRow> sliders;  // per linkage slider
   std::vector<InputRow> inputs;    // per input
