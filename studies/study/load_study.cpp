@@ -296,6 +296,31 @@ class DocumentMarks : public YAML::EventHandler {
       r.fail(at, "tabs are not allowed in YAML indentation; indent with spaces");
     }
   }
+  // yaml-cpp's words for the mistakes people make, said as what to look at (its words kept at
+  // the end, for a search)
+  struct Meaning {
+    const char* yaml;
+    const char* what;
+  };
+  static constexpr Meaning kMeanings[] = {
+      {YAML::ErrorMsg::MAP_VALUE,
+       "a 'key: value' where none can be: the keys of one map line up, so check this line's "
+       "indentation against the keys above it; a value holding ': ' needs quotes"},
+      {YAML::ErrorMsg::BLOCK_ENTRY,
+       "a '- ' list item where none can be: the items of one list line up, so check this line's "
+       "indentation against the items or the key above it"},
+      {YAML::ErrorMsg::END_OF_MAP,
+       "a map's keys do not line up: check the indentation of this line and the keys above it"},
+      {YAML::ErrorMsg::END_OF_SEQ,
+       "a list's items do not line up: check the indentation of this line and the items above it"},
+      {YAML::ErrorMsg::END_OF_MAP_FLOW, "a '{' is not closed by a '}'"},
+      {YAML::ErrorMsg::END_OF_SEQ_FLOW, "a '[' is not closed by a ']'"},
+      {YAML::ErrorMsg::FLOW_END, "a '}' or ']' closes nothing that was opened"},
+      {YAML::ErrorMsg::EOF_IN_SCALAR, "a quoted value is not closed by its quote"},
+  };
+  for (const Meaning& m : kMeanings) {
+    if (e.msg == m.yaml) r.fail(e.mark, std::string(m.what) + " (YAML: " + e.msg + ")");
+  }
   r.fail(e.mark, e.msg);
 }
 

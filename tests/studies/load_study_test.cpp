@@ -124,8 +124,15 @@ TEST(LoadStudy, BranchMustBePlusOrMinusOne) {
 }
 
 TEST(LoadStudy, YamlSyntaxErrorsBecomeOneLineErrorsWithTheirPlace) {
-  expect_error(edit("  frame: 3.2\n", "   frame: 3.2\n"), 4, 9, "illegal map value");
-  expect_error(edit("inertia: 3.1}", "inertia: 3.1"), 13, 9, "end of map flow not found");
+  // yaml-cpp's words said as what to look at, its words kept
+  expect_error(edit("  frame: 3.2\n", "   frame: 3.2\n"), 4, 9,
+               "a 'key: value' where none can be: the keys of one map line up, so check this "
+               "line's indentation against the keys above it; a value holding ': ' needs quotes "
+               "(YAML: illegal map value)");
+  expect_error(edit("inertia: 3.1}", "inertia: 3.1"), 13, 9,
+               "a '{' is not closed by a '}' (YAML: end of map flow not found)");
+  expect_error(edit("  coupler: {", "  coupler: [{"), 13, 3,
+               "a '[' is not closed by a ']' (YAML: end of sequence flow not found)");
 }
 
 TEST(LoadStudy, LinkageThatCannotAssembleAtTheInitialAngle) {
