@@ -15,11 +15,12 @@
 ///
 /// The positions, the rates, the accelerations (forward substitution over the blocks) and the
 /// multipliers (backward substitution with Gᵀ) then need no factorisation of the whole system.
-/// This is the driven sweep's route (core/planar/simulate.cpp); where a block is poorly
-/// conditioned (a dead centre near), a circle pair no longer meets, or Newton's method on a
-/// block does not converge, place_by_blocks() declines and the caller takes the general route
-/// (core/planar/dynamics.hpp, solve_position()), which decides whether the position is singular
-/// and says so. docs/performance.md ("The general planar engine") has the measurements.
+/// This is the driven sweep's route (core/planar/simulate.cpp), and solve_position()'s for a plan
+/// of closed forms whose branch the guess tells (one-instant calls, free runs' reduced route;
+/// prime_closed_blocks()). Where a block is poorly conditioned (a dead centre near), a circle
+/// pair no longer meets, or Newton's method on a block does not converge, place_by_blocks()
+/// declines and the caller takes the general route (core/planar/dynamics.hpp, solve_position()),
+/// which decides whether the position is singular and says so. docs/performance.md ("The general planar engine") has the measurements.
 ///
 /// Internal to core/planar.
 #include <Eigen/Core>
