@@ -9,14 +9,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// adds `grad` to row `row` at node `node`'s coordinates (nothing for a ground node)
-void add_gradient(const System& s, MatrixXd& G, int row, int node, const Vec2& grad) {
-  const int c = s.coord[static_cast<std::size_t>(node)];
-  if (c < 0) return;
-  G(row, c) += grad.x();
-  G(row, c + 1) += grad.y();
-}
-
+// adds `force` to F at node `node`'s coordinates (nothing for a ground node)
 void add_force(const System& s, VectorXd& F, int node, const Vec2& force) {
   const int c = s.coord[static_cast<std::size_t>(node)];
   if (c < 0) return;
@@ -433,20 +426,31 @@ int row_gradient(const System& s, const NodeVectors& x, int row, GradientEntry o
 }
 
 void constraint_jacobian(const System& s, const NodeVectors& x, int rows, MatrixXd& G) {
-  G.setZero(rows, s.n);
+  // Every call writes the same entries (a row's nodes are the linkage's, each once per row), and
+  // nothing else writes G: the entries outside them are zero from the zeroing at a change of
+  // shape, and each entry is assigned, not added to.
+  if (G.rows() != rows || G.cols() != s.n) G.setZero(rows, s.n);
+  double* g = G.data();
+  const int* coord = s.coord.data();
+  auto put = [g, coord, rows](int row, int node, const Vec2& d) {
+    const int c = coord[node];
+    if (c < 0) return;
+    g[row + c * rows] = d.x();
+    g[row + (c + 1) * rows] = d.y();
+  };
   // the element rows (the first, one per link) written directly: row_gradient()'s
   // element case without its dispatch
   const int elements = std::min(rows, static_cast<int>(s.elements.size()));
   for (int row = 0; row < elements; ++row) {
     const System::ElementRow& e = s.elements[static_cast<std::size_t>(row)];
     const Vec2 d = (at(x, e.q) - at(x, e.p)) / e.length;
-    add_gradient(s, G, row, e.q, d);
-    add_gradient(s, G, row, e.p, -d);
+    put(row, e.q, d);
+    put(row, e.p, -d);
   }
   GradientEntry entries[3];
   for (int row = elements; row < rows; ++row) {
     const int count = row_gradient(s, x, row, entries);
-    for (int k = 0; k < count; ++k) add_gradient(s, G, row, entries[k].node, entries[k].grad);
+    for (int k = 0; k < count; ++k) put(row, entries[k].node, entries[k].grad);
   }
 }
 
