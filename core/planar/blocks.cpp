@@ -321,16 +321,16 @@ bool prime_closed_blocks(const Model& model, Workspace& ws, const NodeVectors& x
   ws.block_lu.resize(plan.blocks.size());
   for (std::size_t k = 0; k < plan.blocks.size(); ++k) {
     const Block& b = plan.blocks[k];
-    const Vec2 e = at(x, b.node) - at(x, b.a);
     double measure = 0, scale = 0;  // the branch's sign and its size over the legs'
     if (b.kind == Block::Kind::kDyad) {
-      const Vec2 d = at(x, b.b) - at(x, b.a);
+      const Vec2 d = at(x, b.b) - at(x, b.a), e = at(x, b.node) - at(x, b.a);
       measure = cross(d, e);
       scale = d.norm() * e.norm();
     } else if (b.kind == Block::Kind::kGuide) {
+      const Vec2 e = at(x, b.node) - at(x, b.a);
       measure = s.sliders[static_cast<std::size_t>(b.index)].unit.dot(e);
       scale = e.norm();
-    } else {
+    } else {  // (a crank, a slide, a further node: one position, no branch)
       ws.block_sign[k] = 1.0;
       continue;
     }

@@ -20,7 +20,8 @@
 /// prime_closed_blocks()). Where a block is poorly conditioned (a dead centre near), a circle
 /// pair no longer meets, or Newton's method on a block does not converge, place_by_blocks()
 /// declines and the caller takes the general route (core/planar/dynamics.hpp, solve_position()),
-/// which decides whether the position is singular and says so. docs/performance.md ("The general planar engine") has the measurements.
+/// which decides whether the position is singular and says so. docs/performance.md ("The general
+/// planar engine") has the measurements.
 ///
 /// Internal to core/planar.
 #include <Eigen/Core>
@@ -43,9 +44,10 @@ void prime_blocks(const Model& model, Workspace& ws);
 
 /// For a plan of closed forms (BlockPlan::closed): the branch of each dyad and guide as
 /// prime_blocks() records it, read from positions `x` near the solution (a guess, such as the last
-/// instant's) rather than from a solved position. Returns false, recording nothing, where the plan
-/// is not closed or a block's node in `x` lies within a sine of 1e-2 of the line that divides its
-/// branches (x does not tell the branch clearly; the general route's Newton iterations decide).
+/// instant's) rather than from a solved position. Returns false where the plan is not closed or a
+/// block's node in `x` lies within a sine of 1e-2 of the line that divides its branches (x does
+/// not tell the branch clearly; the general route's Newton iterations decide); the branches are
+/// then recorded in part only, so place_by_blocks() needs prime_blocks() or this first again.
 bool prime_closed_blocks(const Model& model, Workspace& ws, const NodeVectors& x);
 
 /// The positions at `inputs` block by block (the general blocks by Newton's method from `guess`,

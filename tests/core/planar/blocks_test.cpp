@@ -283,6 +283,26 @@ TEST(Blocks, OneInstantCallsTakeTheBlockRouteWhereTheGuessTellsTheBranch) {
     for (std::size_t n = 0; n < lean.instant.x.size(); ++n)
       EXPECT_LE((lean.instant.x[n] - whole.instant.x[n]).norm(), 1e-14) << n;
   }
+  // a slider-crank driven by its piston (a slide input, then a dyad), a few steps of its stroke
+  // from the drawn position: the block route, equal to the general route
+  {
+    Rng rng(26);
+    const cp::Model model(driven_by_piston(slider_crank(rng, true)));
+    const double drawn = cp::drawn_inputs(model)[0];
+    const Stroke st = stroke_of(model.linkage());
+    cp::Workspace lean(model), whole(model);
+    ASSERT_TRUE(cp::assemble(model, whole, {drawn}));
+    for (int i = 1; i <= 5; ++i) {
+      const double z =
+          drawn + 0.02 * i * (st.hi - st.lo) * (st.hi - drawn > drawn - st.lo ? 1 : -1);
+      const std::vector<Vec2> guess = whole.instant.x;
+      ASSERT_TRUE(cp::solve_position(model, lean, guess, {z}));
+      EXPECT_TRUE(lean.by_blocks) << i;
+      ASSERT_TRUE(cp::solve_position(model, whole, guess, {z}, cp::PositionRoute::kGeneral));
+      for (std::size_t n = 0; n < lean.instant.x.size(); ++n)
+        EXPECT_LE((lean.instant.x[n] - whole.instant.x[n]).norm(), 1e-14) << i << " " << n;
+    }
+  }
   one_instant_family("four-bars (both branches)", 22, 10, 0.9, [](Rng& rng) {
     core::FourBar fb = core::samples::random_crank_rocker(rng);
     if (coin(rng))
