@@ -187,12 +187,11 @@ std::string harmonics_section(const fs::path& dir, const Scales& scales) {
     at.push_back(static_cast<std::size_t>(it - csv.header.begin()));
   }
   std::string h =
-      "<h2>Harmonic orders</h2>\n<p>From <a href=\"harmonics.csv\">harmonics.csv</a>: the total "
-      "shaking force and moment (weights and applied loads included) over the first revolution "
-      "of the driven input, by the discrete Fourier transform of the exact samples; order k "
-      "repeats k times per revolution. A constant load such as a weight is in order 0 only (in "
-      "the file), so orders 1 and up are those of the inertial part as well, unless a load "
-      "changes over the revolution (a spring). Amplitudes of Fshx, Fshy [N] and Msh [N m]; the "
+      "<h2>Harmonic orders</h2>\n<p>From <a href=\"harmonics.csv\">harmonics.csv</a>: the "
+      "inertial shaking force and moment (what balancing acts on; weights and applied loads are "
+      "not in them) over the first revolution of the driven input, by the discrete Fourier "
+      "transform of the exact samples; order k repeats k times per revolution. Amplitudes of "
+      "Fshx, Fshy [N] and Msh [N m]; the "
       "force's parts turning with the input (forward: a counterweight on the input's link "
       "cancels order 1) and against it (backward) [N]. An amplitude that is round-off of the "
       "run's forces or moments (at most 1e-12 of the largest) shows as 0. Phases are in the "

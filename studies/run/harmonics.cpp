@@ -45,9 +45,9 @@ std::optional<Harmonics> fourbar_harmonics(const core::DrivenScene& scene,
   if (n < 4 || t.samples.size() < n) return std::nullopt;
   std::vector<double> fx, fy, msh, tau;
   for (std::size_t i = 0; i < n; ++i) {
-    fx.push_back(t.samples[i].Fsh.x());
-    fy.push_back(t.samples[i].Fsh.y());
-    msh.push_back(t.samples[i].Msh);
+    fx.push_back(t.samples[i].Fsh_inertial.x());
+    fy.push_back(t.samples[i].Fsh_inertial.y());
+    msh.push_back(t.samples[i].Msh_inertial);
     tau.push_back(t.samples[i].tau);
   }
   return analysed("crank", scene.omega1, scene.theta1, n, fx, fy, msh, tau);
@@ -71,8 +71,8 @@ std::optional<Harmonics> planar_harmonics(const core::planar::Linkage& l,
   const std::string link = l.links[static_cast<std::size_t>(input.link)].name;
   const double theta0 = t.table.column_values("theta_" + link).front();
   return analysed(input.name, scene.speeds[static_cast<std::size_t>(moving)], theta0, n,
-                  t.table.column_values("Fshx"), t.table.column_values("Fshy"),
-                  t.table.column_values("Msh"),
+                  t.table.column_values("Fshx_inertial"), t.table.column_values("Fshy_inertial"),
+                  t.table.column_values("Msh_inertial"),
                   t.table.column_values(l.inputs.size() == 1 ? "tau" : "tau_" + input.name));
 }
 

@@ -1,7 +1,8 @@
 #pragma once
-/// The harmonic orders of a driven run: the shaking force and moment and the drive torque over
-/// the first revolution of the input that turns, by the FFT of the run's exact samples
-/// (core/harmonics.hpp, which the engine balancing's shafts use too).
+/// The harmonic orders of a driven run: the shaking force and moment (their inertial part, what
+/// balancing acts on, as the metrics take them) and the drive torque over the first revolution of
+/// the input that turns, by the FFT of the run's exact samples (core/harmonics.hpp, which the
+/// engine balancing's shafts use too).
 #include <optional>
 #include <string>
 #include <vector>

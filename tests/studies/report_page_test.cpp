@@ -264,8 +264,26 @@ TEST_F(ReportPageTest, ShakingChartsAndMetricsSayWhichPartTheyShow) {
             std::string::npos);
   EXPECT_NE(html.find("<h3>Shaking-force hodograph, inertial part</h3>"), std::string::npos);
   EXPECT_NE(html.find("<h3>Shaking moment, inertial part</h3>"), std::string::npos);
-  EXPECT_NE(html.find("the total shaking force and moment (weights and applied loads included)"),
+  EXPECT_NE(html.find("the inertial shaking force and moment (what balancing acts on; weights "
+                      "and applied loads are not in them)"),
             std::string::npos);
+  // and they are: under gravity the mean (order 0) of the force is zero, not the weight
+  {
+    const report_support::Csv csv = report_support::read_csv(dir_ / "harmonics.csv");
+    const auto column = [&csv](const char* name) {
+      return static_cast<std::size_t>(std::find(csv.header.begin(), csv.header.end(), name) -
+                                      csv.header.begin());
+    };
+    const std::size_t order = column("order"), fy = column("Fshy_amplitude");
+    ASSERT_LT(fy, csv.header.size());
+    int means = 0;
+    for (const std::vector<std::string>& row : csv.rows) {
+      if (row[order] != "0") continue;
+      ++means;
+      EXPECT_LE(std::stod(row[fy]), 1e-9 * 7.3 * 9.81) << row[0];
+    }
+    EXPECT_EQ(means, 2);  // the original and the balanced design
+  }
   // the original's total is its inertial hodograph moved by its weight, 7.3 kg x 9.81 m/s² down
   EXPECT_NE(html.find("the original's is the same curve moved by (0, " +
                       text::digits(-7.3 * 9.81, 6) + ") N"),
