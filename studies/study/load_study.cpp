@@ -266,12 +266,15 @@ namespace {
 class DocumentMarks : public YAML::EventHandler {
  public:
   std::vector<YAML::Mark> starts;
+  std::vector<YAML::Mark> scalars;  // where each scalar starts (a quoted one at its quote)
   void OnDocumentStart(const YAML::Mark& mark) override { starts.push_back(mark); }
   void OnDocumentEnd() override {}
   void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
   void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
-  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t,
-                const std::string&) override {}
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                const std::string&) override {
+    scalars.push_back(mark);
+  }
   void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
                        YAML::EmitterStyle::value) override {}
   void OnSequenceEnd() override {}
@@ -324,6 +327,57 @@ class DocumentMarks : public YAML::EventHandler {
   r.fail(e.mark, e.msg);
 }
 
+// A quote left open: YAML lets a quoted value run on over lines, so a value whose closing quote
+// is forgotten takes the lines below as its text up to the next quote, and the keys there go
+// missing without a YAML error. A quoted value that runs on to a line starting with a 'key:' or
+// a '- ' item no deeper than the line it opened on (which YAML allows as no continuation of a
+// value in a block, though yaml-cpp takes it) is refused at its opening quote.
+void check_quotes_closed(const std::string& text, const std::vector<YAML::Mark>& scalars,
+                         const Reporter& r) {
+  const auto indent_of = [&](std::size_t line_start) {
+    const std::size_t end = text.find_first_not_of(' ', line_start);
+    return (end == std::string::npos ? text.size() : end) - line_start;
+  };
+  for (const YAML::Mark& at : scalars) {
+    if (at.pos < 0 || static_cast<std::size_t>(at.pos) >= text.size()) continue;
+    const auto open = static_cast<std::size_t>(at.pos);
+    const char quote = text[open];
+    if (quote != '"' && quote != '\'') continue;
+    std::size_t close = open + 1;  // the closing quote ('' and \" are quotes within)
+    for (; close < text.size(); ++close) {
+      if (quote == '"' && text[close] == '\\') {
+        ++close;
+      } else if (text[close] == quote) {
+        if (quote == '\'' && close + 1 < text.size() && text[close + 1] == '\'') {
+          ++close;
+        } else {
+          break;
+        }
+      }
+    }
+    const std::size_t first_line = text.rfind('\n', open) + 1;  // npos + 1 == 0
+    const std::size_t depth = indent_of(first_line);
+    int row = at.line;
+    for (std::size_t nl = text.find('\n', open); nl < close; nl = text.find('\n', nl + 1)) {
+      ++row;
+      const std::size_t start = nl + 1;
+      const std::size_t indent = indent_of(start);
+      if (indent > depth || start + indent >= close) continue;
+      const std::size_t eol = std::min(text.find('\n', start), text.size());
+      const std::string_view line(text.data() + start + indent, eol - start - indent);
+      const bool item = line.rfind("- ", 0) == 0 || line == "-";
+      const std::size_t colon = line.find(':');
+      const bool key = colon != std::string_view::npos && colon > 0 &&
+                       (colon + 1 == line.size() || line[colon + 1] == ' ') &&
+                       line.substr(0, colon).find_first_of("\"' ") == std::string_view::npos;
+      if (!item && !key) continue;
+      r.fail(at, "this quoted value is not closed on its line: it runs on to line " +
+                     std::to_string(row + 1) + " ('" + std::string(line.substr(0, 40)) +
+                     "') and takes it as text; close the quote");
+    }
+  }
+}
+
 // The text's one YAML document. Not YAML::LoadAll: yaml-cpp 0.7 never consumes a token that can
 // start no node (a ',' outside brackets, as in a file holding only ","), so LoadAll returns an
 // endless list of empty documents at that token and fills the memory. Here the parser is asked
@@ -338,8 +392,10 @@ YAML::Node one_document(const std::string& text, const Reporter& r) {
     for (int i = 0; i < 2 && parser.HandleNextDocument(marks); ++i) {
     }
   } catch (const YAML::Exception& e) {
+    check_quotes_closed(text, marks.scalars, r);  // the cause, where a quote ran on
     fail_yaml(text, e, r);
   }
+  check_quotes_closed(text, marks.scalars, r);
   if (marks.starts.size() > 1) {
     const YAML::Mark& at = marks.starts[1];
     // a mark past the text (never expected of UTF-8 text) is taken as its end

@@ -133,6 +133,21 @@ TEST(LoadStudy, YamlSyntaxErrorsBecomeOneLineErrorsWithTheirPlace) {
                "a '{' is not closed by a '}' (YAML: end of map flow not found)");
   expect_error(edit("  coupler: {", "  coupler: [{"), 13, 3,
                "a '[' is not closed by a ']' (YAML: end of sequence flow not found)");
+  // a quote left open takes the keys below as text up to the next quote, which YAML allows
+  // (as a valid document missing its keys, or an error where the next quote ends it)
+  expect_error(edit("name: t\n", "name: \"t\n") + "  samples: 9  # \"9\n", 1, 7,
+               "this quoted value is not closed on its line: it runs on to line 2 ('linkage:') "
+               "and takes it as text; close the quote");
+  expect_error(edit("name: t\n", "name: \"t\n") + "  samples: \"9\"\n", 1, 7,
+               "it runs on to line 2 ('linkage:')");
+  expect_error(edit("  type: free\n", "  type: 'free\n") + "  samples: 'x'\n", 15, 9,
+               "it runs on to line 16 ('theta1: 1.0')");
+  // a quoted value may run on over lines deeper than its key, and hold quotes of the other kind
+  // or doubled
+  // or doubled (read whole, then refused as a name for its characters)
+  expect_error(edit("name: t\n", "name: \"a \\\" b\n  c: d 'e'\"\n"), 1, 7,
+               "got 'a \" b c: d 'e''");
+  expect_error(edit("name: t\n", "name: 'it''s\n  - x'\n"), 1, 7, "got 'it's - x'");
 }
 
 TEST(LoadStudy, LinkageThatCannotAssembleAtTheInitialAngle) {
