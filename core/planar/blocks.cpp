@@ -291,6 +291,7 @@ void prime_blocks(const Model& model, Workspace& ws) {
   ws.block_sign.assign(plan.blocks.size(), 1.0);
   ws.block_lu.resize(plan.blocks.size());
   ws.block_det.assign(plan.blocks.size(), 0.0);
+  ws.block_margin.assign(plan.blocks.size(), 0.0);
   if (!plan.usable) return;
   bool general = false;
   for (std::size_t k = 0; k < plan.blocks.size(); ++k) {
@@ -318,6 +319,7 @@ bool prime_closed_blocks(const Model& model, Workspace& ws, const NodeVectors& x
   if (!plan.usable || !plan.closed) return false;
   ws.block_sign.resize(plan.blocks.size());
   ws.block_det.resize(plan.blocks.size());
+  ws.block_margin.resize(plan.blocks.size());
   ws.block_lu.resize(plan.blocks.size());
   for (std::size_t k = 0; k < plan.blocks.size(); ++k) {
     const Block& b = plan.blocks[k];
@@ -340,11 +342,11 @@ bool prime_closed_blocks(const Model& model, Workspace& ws, const NodeVectors& x
   return true;
 }
 
-bool place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess,
-                     const std::vector<double>& inputs) {
+Placement place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess,
+                          const std::vector<double>& inputs) {
   const System& s = model.system();
   const BlockPlan& plan = s.blocks;
-  if (!plan.usable || ws.block_sign.size() != plan.blocks.size()) return false;
+  if (!plan.usable || ws.block_sign.size() != plan.blocks.size()) return Placement::kDeclined;
   Instant& in = ws.instant;
   input_targets(s, inputs, ws.target);
   NodeVectors& x = in.x;
@@ -364,7 +366,8 @@ bool place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess
         const double D = d.norm();
         const double along = (b.ra * b.ra - b.rb * b.rb + D * D) / (2 * D);
         const double h2 = (b.ra - along) * (b.ra + along);
-        if (!(h2 >= 0) || !(D > 0)) return false;
+        ws.block_margin[k] = h2;  // (below 0 too: how far it is from closing)
+        if (!(h2 >= 0) || !(D > 0)) return Placement::kDeclined;
         x[P] = A + (along / D) * d + (ws.block_sign[k] * std::sqrt(h2) / D) * perp(d);
         break;
       }
@@ -374,7 +377,8 @@ bool place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess
         const Vec2 w = at(x, b.a) - sl.from;
         const double off = sl.normal.dot(w);
         const double h2 = (b.ra - off) * (b.ra + off);
-        if (!(h2 >= 0)) return false;
+        ws.block_margin[k] = h2;
+        if (!(h2 >= 0)) return Placement::kDeclined;
         x[P] = sl.from + (sl.unit.dot(w) + ws.block_sign[k] * std::sqrt(h2)) * sl.unit;
         break;
       }
@@ -398,12 +402,12 @@ bool place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess
           block_matrix(plan, b, ws.G, ws.block_matrix);
           SmallLu& lu = ws.block_lu[k];
           lu.compute(ws.block_matrix);
-          if (!(lu.pivot_ratio() >= kWellConditioned)) return false;
+          if (!(lu.pivot_ratio() >= kWellConditioned)) return Placement::kDeclined;
           ws.block_rhs.resize(b.size);
           for (int i = 0; i < b.size; ++i)
             ws.block_rhs[i] = ws.g[plan.rows[static_cast<std::size_t>(b.first + i)]];
           lu.solve(ws.block_rhs, ws.block_x);
-          if (!ws.block_x.allFinite()) return false;
+          if (!ws.block_x.allFinite()) return Placement::kDeclined;
           for (int j = 0; j < b.size; ++j) {
             const int c = plan.coords[static_cast<std::size_t>(b.first + j)];
             Vec2& node = x[static_cast<std::size_t>(s.moving[static_cast<std::size_t>(c / 2)])];
@@ -411,7 +415,7 @@ bool place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess
           }
           converged = ws.block_x.cwiseAbs().maxCoeff() <= step_limit;
         }
-        if (!converged) return false;
+        if (!converged) return Placement::kDeclined;
         break;
       }
     }
@@ -426,17 +430,20 @@ bool place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess
     if (b.size == 2) {
       const double g00 = G[b.entry[0]], g01 = G[b.entry[1]], g10 = G[b.entry[2]],
                    g11 = G[b.entry[3]];
-      if (!(std::abs(two_row_sine(g00, g01, g10, g11)) >= kWellConditioned)) return false;
+      if (!(std::abs(two_row_sine(g00, g01, g10, g11)) >= kWellConditioned)) {
+        // every node is placed, on the recorded branches where the blocks are closed forms
+        return plan.closed ? Placement::kIllConditioned : Placement::kDeclined;
+      }
       ws.block_det[k] = g00 * g11 - g01 * g10;
       if (b.kind == Block::Kind::kGeneral && (ws.block_det[k] < 0 ? -1.0 : 1.0) != ws.block_sign[k])
-        return false;
+        return Placement::kDeclined;
     } else {
       block_matrix(plan, b, ws.G, ws.block_matrix);
       SmallLu& lu = ws.block_lu[k];
       lu.compute(ws.block_matrix);
       if (!(lu.pivot_ratio() >= kWellConditioned) ||
           (lu.determinant() < 0 ? -1.0 : 1.0) != ws.block_sign[k])
-        return false;
+        return Placement::kDeclined;
     }
   }
   if (in.input.size() == inputs.size()) {
@@ -446,7 +453,7 @@ bool place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess
   }
   ws.factorised = false;  // ws.lu is not at this position
   ws.by_blocks = true;
-  return true;
+  return Placement::kPlaced;
 }
 
 double block_determinant(const Model& model, const Workspace& ws) {
@@ -489,12 +496,13 @@ void block_solve(const Model& model, Workspace& ws, const Eigen::VectorXd& rhs,
   }
 }
 
-void block_solve_transpose(const Model& model, Workspace& ws, Eigen::VectorXd& b) {
+void block_solve_transpose(const Model& model, Workspace& ws, const Eigen::VectorXd& b,
+                           Eigen::VectorXd& x) {
   const BlockPlan& plan = model.system().blocks;
   const double* G = ws.G.data();
   const double* in = b.data();
-  ws.block_lambda.resize(ws.G.rows());
-  double* out = ws.block_lambda.data();
+  x.resize(ws.G.rows());
+  double* out = x.data();
   const int* first = plan.coord_first.data();
   const BlockPlan::Term* terms = plan.coord_terms.data();
   // the right-hand side of coordinate entry j less its terms in the rows already solved
@@ -518,7 +526,6 @@ void block_solve_transpose(const Model& model, Workspace& ws, Eigen::VectorXd& b
       for (int i = 0; i < bl.size; ++i) out[r[i]] = ws.block_rhs[i];
     }
   }
-  b.swap(ws.block_lambda);
 }
 
 void closed_form_kinematics(const Model& model, Workspace& ws, const std::vector<double>& rates,

@@ -50,14 +50,26 @@ void prime_blocks(const Model& model, Workspace& ws);
 /// then recorded in part only, so place_by_blocks() needs prime_blocks() or this first again.
 bool prime_closed_blocks(const Model& model, Workspace& ws, const NodeVectors& x);
 
+/// What place_by_blocks() did.
+enum class Placement {
+  kPlaced,  // every node, to round-off, and the blocks' factorisations there
+  /// every node placed by the closed forms on the branches prime_blocks() recorded (in
+  /// ws.instant.x), but a block's rows are too close to singular (their sine below 1e-2) for
+  /// round-off: a guess on the right branch for the general route, not a solution
+  kIllConditioned,
+  /// no plan, two circles that do not meet, a general block whose Newton's method does not
+  /// converge, whose determinant changed sign or whose conditioning is poor
+  kDeclined,
+};
 /// The positions at `inputs` block by block (the general blocks by Newton's method from `guess`,
 /// which closed-form plans do not read), on the branch prime_blocks() recorded, and the blocks'
-/// factorisations there. Sets ws.instant.x and .input and ws.by_blocks. Returns false, changing
-/// nothing the general route reads, where it cannot answer to round-off: no plan, two circles
-/// that do not meet, a block whose conditioning is poor (its rows' sine below 1e-2) or whose
-/// determinant changed sign, a general block where Newton's method does not converge.
-bool place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess,
-                     const std::vector<double>& inputs);
+/// factorisations there. Sets ws.instant.x and .input and ws.by_blocks where it places
+/// (kPlaced); otherwise it changes nothing the general route reads but ws.instant.x. Each dyad
+/// and guide it reaches records its closure margin in ws.block_margin: the square of its node's
+/// distance from the line dividing its branches (h² = r² - a², a along that line), 0 at a limit
+/// position, where the two circles (or the circle and the guide) just touch.
+Placement place_by_blocks(const Model& model, Workspace& ws, const NodeVectors& guess,
+                          const std::vector<double>& inputs);
 
 /// After place_by_blocks(): the determinant of the whole Jacobian G, from the blocks' (as the
 /// general route's factorisation gives it, to round-off).
@@ -65,8 +77,9 @@ double block_determinant(const Model& model, const Workspace& ws);
 
 /// After place_by_blocks(): x = G⁻¹ b by forward substitution over the blocks (x may not be b).
 void block_solve(const Model& model, Workspace& ws, const Eigen::VectorXd& b, Eigen::VectorXd& x);
-/// After place_by_blocks(): b = G⁻ᵀ b by backward substitution, in place.
-void block_solve_transpose(const Model& model, Workspace& ws, Eigen::VectorXd& b);
+/// After place_by_blocks(): x = G⁻ᵀ b by backward substitution (x may not be b).
+void block_solve_transpose(const Model& model, Workspace& ws, const Eigen::VectorXd& b,
+                           Eigen::VectorXd& x);
 
 /// After place_by_blocks() on a plan of closed forms (BlockPlan::closed): the nodes' velocities
 /// and accelerations for the inputs' rates and accelerations, block by block from each block's

@@ -60,7 +60,9 @@ double nearest_whole(double x) {
   return (x + kRound) - kRound;
 }
 
-std::string inputs_text(const Model& model, const std::vector<double>& inputs) {
+}  // namespace
+
+std::string detail::inputs_text(const Model& model, const std::vector<double>& inputs) {
   std::string s;
   for (std::size_t k = 0; k < inputs.size(); ++k) {
     const Input& in = model.linkage().inputs[k];
@@ -69,6 +71,10 @@ std::string inputs_text(const Model& model, const std::vector<double>& inputs) {
   }
   return s;
 }
+
+namespace {
+
+using detail::inputs_text;
 
 // the name of row `row`, for messages
 std::string row_name(const System& s, int row) {
@@ -183,6 +189,10 @@ Model::Model(const Linkage& linkage) : system_(std::make_unique<System>(make_lin
       joints_.push_back({l.nodes[i].name, node, links[0]});
     }
   }
+  for (const JointForce& j : joints_) {
+    joint_slots_.push_back(system_->slot_of[static_cast<std::size_t>(j.link) * l.nodes.size() +
+                                            static_cast<std::size_t>(j.node)]);
+  }
   for (const System::ElementRow& e : system_->elements)
     length_scale_ = std::max(length_scale_, e.length);
 }
@@ -195,6 +205,7 @@ Model::Model(const Model& other)
       frame_springs_(other.frame_springs_),
       frame_drives_(other.frame_drives_),
       joints_(other.joints_),
+      joint_slots_(other.joint_slots_),
       length_scale_(other.length_scale_) {}
 Model& Model::operator=(const Model& other) {
   if (this != &other) *this = Model(other);
@@ -335,7 +346,7 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
   // the closed forms block by block where the plan has them and the guess tells each block's
   // branch; anything they decline (a dead centre near) is decided by the general route below
   if (route == PositionRoute::kLeanest && detail::prime_closed_blocks(model, ws, guess) &&
-      detail::place_by_blocks(model, ws, guess, inputs))
+      detail::place_by_blocks(model, ws, guess, inputs) == detail::Placement::kPlaced)
     return true;
   ws.by_blocks = false;
   if (s.rows != s.n) {
@@ -522,23 +533,64 @@ void velocities(const Model& model, Workspace& ws, const std::vector<double>& ra
   copy_values(rates, ws.instant.input_rate);
 }
 
-// the link angles, rates and accelerations and the sliders' positions and rates, from the nodes
-void link_kinematics(const Model& model, Instant& in) {
+// One pass over the links, each read once (the same nodes serve all three): its angle, rate and
+// acceleration; its element's nodal forces, inertia less applied load (eq. 46), at its first and
+// second node into ws.element_force (what M q̈ - F assembles, multiplier_rhs(), and what the
+// joint forces start from, link_node_forces()); and its mass's part of the shaking force and
+// moment, inertial (-m a and its moment about the origin, -I α) and static (its weight and
+// moment). The parts are started here; shaking_rest() adds the other masses and the loads.
+void link_pass(const Model& model, Workspace& ws) {
   const System& s = model.system();
+  const Linkage& l = s.linkage;
+  Instant& in = ws.instant;
+  const Vec2 g = l.loads.gravity;
+  Vec2 f_inertial(0, 0), f_static(0, 0);
+  double m_inertial = 0.0, m_static = 0.0;
   for (std::size_t k = 0; k < s.elements.size(); ++k) {
     const System::ElementRow& e = s.elements[k];
     const std::size_t p = static_cast<std::size_t>(e.p), q = static_cast<std::size_t>(e.q);
-    const Vec2 d = in.x[q] - in.x[p], dv = in.v[q] - in.v[p], da = in.a[q] - in.a[p];
+    const Vec2 &xp = in.x[p], &xq = in.x[q], &ap = in.a[p], &aq = in.a[q];
+    const Vec2 d = xq - xp, dv = in.v[q] - in.v[p], da = aq - ap;
     const double n2 = d.squaredNorm();
     // a link an input turns is at the input's angle (exactly where the blocks placed it; to
     // round-off of the position solve otherwise)
     const int input = s.link_input[k];
-    const double a =
+    const double angle =
         input >= 0 ? in.input[static_cast<std::size_t>(input)] : polar_angle(d.y(), d.x());
-    in.angle[k] = a + 2 * kPi * nearest_whole((in.angle[k] - a) / (2 * kPi));
-    in.omega[k] = cross(d, dv) / n2;
-    in.alpha[k] = cross(d, da) / n2 - 2 * d.dot(dv) * in.omega[k] / n2;
+    in.angle[k] = angle + 2 * kPi * nearest_whole((in.angle[k] - angle) / (2 * kPi));
+    const double omega = cross(d, dv) / n2;
+    const double alpha = (cross(d, da) - 2 * d.dot(dv) * omega) / n2;
+    in.omega[k] = omega;
+    in.alpha[k] = alpha;
+
+    Vec4 acc;
+    acc << ap, aq;
+    Vec4& f = ws.element_force[k];
+    f.noalias() = s.element_M[k] * acc;
+    const double moment =
+        s.shafts.empty() ? s.link_moment[k] : detail::link_moment_at(s, static_cast<int>(k), in.x);
+    if (!s.link_force[k].isZero(0.0) || moment != 0.0) {  // a loaded link
+      f -= element_nodal_forces(s.com_weights[k], s.link_force[k], moment, xp, xq);
+    }
+
+    const PointWeights& w = s.com_weights[k];
+    const double m = l.links[k].mass;
+    const Vec2 c = w.at_p * xp + w.at_q * xq;
+    const Vec2 ma = m * (w.at_p * ap + w.at_q * aq);
+    f_inertial -= ma;
+    m_inertial -= cross(c, ma) + l.links[k].inertia * alpha;
+    f_static += m * g;
+    m_static += m * cross(c, g);
   }
+  in.Fsh_inertial = f_inertial;
+  in.Msh_inertial = m_inertial;
+  in.Fsh_static = f_static;
+  in.Msh_static = m_static;
+}
+
+// the sliders' positions, rates and accelerations, from the nodes
+void slider_kinematics(const Model& model, Instant& in) {
+  const System& s = model.system();
   for (std::size_t k = 0; k < s.sliders.size(); ++k) {
     const System::SliderRow& sl = s.sliders[k];
     in.slide[k] = detail::slide_position(s, sl, in.x);
@@ -557,36 +609,20 @@ void link_kinematics(const Model& model, Instant& in) {
   }
 }
 
-// per link: its element's nodal forces, inertia less applied load (eq. 46), at its first and
-// second node, into ws.element_force: what M q̈ - F assembles (multiplier_rhs()) and what the
-// joint forces start from (link_node_forces())
-void element_forces(const Model& model, Workspace& ws) {
-  const System& s = model.system();
-  const Instant& in = ws.instant;
-  const std::size_t links = s.elements.size();
-  for (std::size_t k = 0; k < links; ++k) {
-    const System::ElementRow& e = s.elements[k];
-    const std::size_t p = static_cast<std::size_t>(e.p), q = static_cast<std::size_t>(e.q);
-    Vec4 acc;
-    acc << in.a[p], in.a[q];
-    Vec4& f = ws.element_force[k];
-    f.noalias() = s.element_M[k] * acc;
-    const double moment =
-        s.shafts.empty() ? s.link_moment[k] : detail::link_moment_at(s, static_cast<int>(k), in.x);
-    if (s.link_force[k].isZero(0.0) && moment == 0.0) continue;  // an unloaded link
-    f -= element_nodal_forces(s.com_weights[k], s.link_force[k], moment, in.x[p], in.x[q]);
-  }
-}
-
 // M q̈ - F (the efforts excluded) into ws.rhs, the right-hand side of the multipliers'
-// Gᵀ λ = M q̈ - F: the element forces (each link's inertia less its loads, element_forces()),
+// Gᵀ λ = M q̈ - F: the element forces (each link's inertia less its loads, link_pass()),
 // the point masses' inertia, less the rest of the applied forces (node forces, point masses'
 // weights, springs)
 void multiplier_rhs(const Model& model, Workspace& ws) {
   const System& s = model.system();
   const Instant& in = ws.instant;
-  detail::applied_forces(s, in.x, in.v, nullptr, ws.F, false);
-  ws.rhs = -ws.F;
+  const Linkage& l = s.linkage;
+  if (l.loads.node_forces.empty() && l.point_masses.empty() && l.springs.empty()) {
+    ws.rhs.setZero(s.n);  // no applied force beyond the links' (in their element forces)
+  } else {
+    detail::applied_forces(s, in.x, in.v, nullptr, ws.F, false);
+    ws.rhs = -ws.F;
+  }
   double* rhs = ws.rhs.data();
   auto add = [&](int node, const Vec2& f) {
     const int c = s.coord[static_cast<std::size_t>(node)];
@@ -611,7 +647,6 @@ void link_node_forces(const Model& model, Workspace& ws) {
   const Instant& in = ws.instant;
   const std::size_t nodes = s.linkage.nodes.size();
   Vec2* on_link = ws.on_link.data();
-  std::fill(ws.on_link.begin(), ws.on_link.end(), Vec2(0, 0));
   const std::size_t links = s.elements.size();
   for (std::size_t k = 0; k < links; ++k) {
     const System::ElementRow& e = s.elements[k];
@@ -621,12 +656,27 @@ void link_node_forces(const Model& model, Workspace& ws) {
     // row_gradient()'s element case without its dispatch
     const Vec2 axial = ws.lambda[static_cast<Eigen::Index>(k)] * ((xq - xp) / e.length);
     const Vec4& ef = ws.element_force[k];
-    Vec2* f = on_link + s.first_slot[k];  // the element's first node, then its second
-    f[0] += ef.segment<2>(0) + axial;
-    f[1] += ef.segment<2>(2) - axial;
+    // the link's slots: the element's first node, its second, then its other nodes (each slot
+    // is one link's, so the element starts them)
+    Vec2* f = on_link + s.first_slot[k];
+    f[0] = ef.segment<2>(0) + axial;
+    f[1] = ef.segment<2>(2) - axial;
+    for (int j = s.first_slot[k] + 2; j < s.first_slot[k + 1]; ++j) on_link[j] = Vec2(0, 0);
   }
   GradientEntry entries[3];
   for (int row = static_cast<int>(links); row < s.rows; ++row) {
+    const System::RowRef& ref = s.row_ref[static_cast<std::size_t>(row)];
+    if (ref.kind == System::RowRef::Kind::kInput) {  // an angle input's row, without dispatch
+      const System::InputRow& ir = s.inputs[static_cast<std::size_t>(ref.index)];
+      if (ir.angle) {
+        const Vec2 force = ws.lambda[row] * detail::angle_input_gradient(ir, in.x);
+        const std::size_t link =
+            static_cast<std::size_t>(s.linkage.inputs[static_cast<std::size_t>(ir.input)].link);
+        on_link[s.slot_of[link * nodes + static_cast<std::size_t>(ir.q)]] -= force;
+        on_link[s.slot_of[link * nodes + static_cast<std::size_t>(ir.p)]] += force;
+        continue;
+      }
+    }
     const int count = detail::row_gradient(s, in.x, row, entries);
     for (int j = 0; j < count; ++j) {
       if (entries[j].link < 0) continue;
@@ -672,7 +722,6 @@ void frame_forces(const Model& model, Workspace& ws) {
   const System& s = model.system();
   const Linkage& l = s.linkage;
   Instant& in = ws.instant;
-  const std::size_t nodes = l.nodes.size();
   const Vec2* on_link = ws.on_link.data();
   in.Fsh = Vec2(0, 0);
   in.Msh = 0.0;
@@ -713,24 +762,19 @@ void frame_forces(const Model& model, Workspace& ws) {
     in.spring_reaction[j] = (at_a ? st.tension : -st.tension) * st.unit;
     on_frame(in.spring_reaction[j], in.x[static_cast<std::size_t>(at_a ? sp.a : sp.b)]);
   }
-  for (std::size_t j = 0; j < model.joints().size(); ++j) {
-    const JointForce& joint = model.joints()[j];
-    in.joint_force[j] = on_link[s.slot_of[static_cast<std::size_t>(joint.link) * nodes +
-                                          static_cast<std::size_t>(joint.node)]];
-  }
+  const std::vector<int>& joint_slots = model.joint_slots();
+  for (std::size_t j = 0; j < joint_slots.size(); ++j) in.joint_force[j] = on_link[joint_slots[j]];
   shaft_forces(model, in, on_frame);
 }
 
-// the inertial part of the shaking force and moment, -Σ m a and -dH/dt about the origin, and
-// the static part, the weights and the applied loads with their moments about the origin
-void shaking_parts(const Model& model, Instant& in) {
+// the shaking force's and moment's parts from the masses other than the links' (point masses,
+// balance shafts) and the applied loads, added to link_pass()'s: the inertial part -Σ m a and
+// -dH/dt about the origin, the static part the weights and the applied loads with their moments
+// about the origin
+void shaking_rest(const Model& model, Instant& in) {
   const System& s = model.system();
   const Linkage& l = s.linkage;
   const Vec2 g = l.loads.gravity;
-  in.Fsh_inertial = Vec2(0, 0);
-  in.Msh_inertial = 0.0;
-  in.Fsh_static = Vec2(0, 0);
-  in.Msh_static = 0.0;
   // a mass m at c with acceleration a
   auto mass_at = [&](double m, const Vec2& c, const Vec2& a) {
     in.Fsh_inertial -= m * a;
@@ -738,20 +782,11 @@ void shaking_parts(const Model& model, Instant& in) {
     in.Fsh_static += m * g;
     in.Msh_static += cross(c, m * g);
   };
-  std::vector<Vec2>::size_type k = 0;
-  for (; k < l.links.size(); ++k) {
-    const System::ElementRow& e = s.elements[k];
-    const PointWeights& w = s.com_weights[k];
-    const std::size_t p = static_cast<std::size_t>(e.p), q = static_cast<std::size_t>(e.q);
-    mass_at(l.links[k].mass, w.at_p * in.x[p] + w.at_q * in.x[q],
-            w.at_p * in.a[p] + w.at_q * in.a[q]);
-    in.Msh_inertial -= l.links[k].inertia * in.alpha[k];
-  }
   for (const PointMass& pm : l.point_masses) {
     const std::size_t n = static_cast<std::size_t>(pm.node);
     mass_at(pm.mass, in.x[n], in.a[n]);
   }
-  for (k = 0; k < l.shafts.size(); ++k) {
+  for (std::size_t k = 0; k < l.shafts.size(); ++k) {
     const BalanceShaft& b = l.shafts[k];
     const std::size_t link = static_cast<std::size_t>(b.link);
     const detail::ShaftMotion m =
@@ -776,15 +811,10 @@ void shaking_parts(const Model& model, Instant& in) {
 // every force output from the element forces, the multipliers of the structural rows
 // (ws.lambda) and the efforts
 void forces(const Model& model, Workspace& ws) {
+  slider_kinematics(model, ws.instant);
   link_node_forces(model, ws);
   frame_forces(model, ws);
-  shaking_parts(model, ws.instant);
-}
-
-// with the element forces current: the link kinematics and every force output
-void outputs(const Model& model, Workspace& ws) {
-  link_kinematics(model, ws.instant);
-  forces(model, ws);
+  shaking_rest(model, ws.instant);
 }
 
 // after the accelerations q̈: the multipliers from Gᵀ λ = M q̈ - F (efforts of the inputs
@@ -796,23 +826,25 @@ Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t,
   Instant& in = ws.instant;
   in.t = t;
   if (!accelerations_set) detail::node_rates_from(s, ws.qdd, in.a);
-  element_forces(model, ws);
+  link_pass(model, ws);
   multiplier_rhs(model, ws);
-  // Gᵀ λ = rhs, in place
-  ws.lambda = ws.rhs;
+  // Gᵀ λ = rhs
   if (ws.by_blocks) {
-    detail::block_solve_transpose(model, ws, ws.lambda);
+    detail::block_solve_transpose(model, ws, ws.rhs, ws.lambda);
   } else {
+    ws.lambda = ws.rhs;
     ws.lu.solve_transpose(ws.lambda);
   }
   for (const System::InputRow& ir : s.inputs) {
     in.effort[static_cast<std::size_t>(ir.input)] =
         ir.angle ? ws.lambda[ir.row] * ir.length : ws.lambda[ir.row];
   }
-  outputs(model, ws);
+  forces(model, ws);
   // (accelerations set by the closed forms that are not finite make the multipliers so: the
   // right-hand side M a - F carries them, 0 * NaN included)
-  if (!finite(ws.lambda) || (!accelerations_set && !finite(ws.qdd))) {
+  // (a sum is finite where its terms are: NaN and infinities carry through it; only finite
+  // terms near the largest double could overflow it, no result of a linkage)
+  if (!std::isfinite(ws.lambda.sum()) || (!accelerations_set && !finite(ws.qdd))) {
     return Unexpected<PlanarError>(PlanarError{
         PlanarError::Kind::kNonFinite, "non-finite result at " + inputs_text(model, in.input)});
   }
@@ -822,8 +854,8 @@ Expected<bool, PlanarError> finish(const Model& model, Workspace& ws, double t,
 }  // namespace
 
 void detail::finish_outputs(const Model& model, Workspace& ws) {
-  element_forces(model, ws);
-  outputs(model, ws);
+  link_pass(model, ws);
+  forces(model, ws);
 }
 
 Expected<bool, PlanarError> inverse_dynamics(const Model& model, Workspace& ws, double t,

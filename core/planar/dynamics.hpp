@@ -56,6 +56,8 @@ class Model {
   /// each link but the first, from the joint), or in one link and carrying a slider or a point
   /// mass (the force on that link).
   const std::vector<JointForce>& joints() const { return joints_; }
+  /// Per joint, its slot in the system (detail::System::slots: the force on its link there).
+  const std::vector<int>& joint_slots() const { return joint_slots_; }
   /// The springs with an end on the frame, in spring order (their pull on the frame at that
   /// node, R<node>_<spring>, is an output: part of the shaking force, not of the pin's reaction).
   const std::vector<int>& frame_springs() const { return frame_springs_; }
@@ -73,6 +75,7 @@ class Model {
   std::unique_ptr<detail::System> system_;
   std::vector<int> ground_nodes_, frame_guides_, frame_springs_, frame_drives_;
   std::vector<JointForce> joints_;
+  std::vector<int> joint_slots_;
   double length_scale_{};
 };
 
@@ -139,12 +142,14 @@ class Workspace {
   std::vector<Vec4> element_force;  // per link: its element's nodal inertia less load (p, q)
   // the block-triangular route (core/planar/blocks.hpp): whether the last position was placed
   // by it (then G is the Jacobian there and the blocks are factorised, lu is not), per block
-  // its branch, its determinant (two rows) or factorisation, and scratch
+  // its branch, its determinant (two rows) or factorisation, and scratch; per dyad and guide
+  // its closure margin at the last placement (detail::place_by_blocks(): below 0 it does not
+  // close)
   bool by_blocks = false;
-  std::vector<double> block_sign, block_det;
+  std::vector<double> block_sign, block_det, block_margin;
   std::vector<detail::SmallLu> block_lu;
   Eigen::MatrixXd block_matrix;
-  Eigen::VectorXd block_rhs, block_x, block_lambda;
+  Eigen::VectorXd block_rhs, block_x;
 };
 
 /// How solve_position() finds the positions.
@@ -200,6 +205,9 @@ Expected<bool, PlanarError> forward_dynamics(const Model& model, Workspace& ws, 
                                              const std::vector<double>& efforts);
 
 namespace detail {
+/// The inputs' values as messages name them: "crank = 1.5707963268 rad, slider = 0.25 m".
+std::string inputs_text(const Model& model, const std::vector<double>& inputs);
+
 /// With ws.instant's positions, velocities, accelerations and efforts and ws.lambda (the
 /// multipliers of every row, the input rows' matching the efforts) set: the link angles and
 /// rates, the sliders' positions and every force output.

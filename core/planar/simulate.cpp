@@ -2,15 +2,19 @@
 
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 #include <cstddef>
+#include <limits>
+#include <optional>
 #include <utility>
 
 #include "core/detail/sensitivity.hpp"
 #include "core/input_error.hpp"
 #include "core/integrators.hpp"
 #include "core/number_text.hpp"
+#include "core/peaks.hpp"
 #include "core/planar/blocks.hpp"
 #include "core/planar/system.hpp"
 
@@ -236,6 +240,37 @@ DrivenTimes driven_times(const Model& model, const DrivenScene& scene) {
   return d;
 }
 
+// A limit position a driven sweep steps over. A dyad's or guide's closure margin (the square of
+// its node's distance from the line dividing its branches, detail::place_by_blocks()) is 0 where
+// the linkage stops turning; a linkage a hair short of turning fully does not close over an input
+// range narrower than the samples' step, which the blocks' closed forms, holding each branch, step
+// across. With the margins of `block` at three consecutive samples (inputs za, zm, zb at times
+// ta, tm, tb) whose middle one is the least, and the parabola through them dipping well below it
+// (a minimum near 0 between the samples; a minimum of the margin well above 0 lies within the
+// samples' spread, so the parabola stays near them), the least margin over [ta, tb] is found by
+// resolved_peak() on the placed positions. Returns the time where the linkage does not close, if
+// any.
+std::optional<double> limit_between(const Model& model, const Workspace& ws, std::size_t block,
+                                    const std::array<double, 3>& t,
+                                    const std::array<double, 3>& margin,
+                                    const std::vector<double>& za, const std::vector<double>& zb) {
+  const double b = (margin[2] - margin[0]) / 2, c = (margin[0] + margin[2]) / 2 - margin[1];
+  if (!(c > 0) || !(margin[1] - b * b / (4 * c) < 0.5 * margin[1])) return std::nullopt;
+  Workspace probe = ws;
+  std::vector<double> z(za.size());
+  const QuantityAt negative_margin = [&](double at) {
+    const double s = (at - t[0]) / (t[2] - t[0]);
+    for (std::size_t k = 0; k < z.size(); ++k) z[k] = za[k] + s * (zb[k] - za[k]);
+    probe.block_margin[block] = std::numeric_limits<double>::quiet_NaN();
+    detail::place_by_blocks(model, probe, probe.instant.x, z);  // the margin, placed or not
+    return -probe.block_margin[block];
+  };
+  const std::array<double, 3> x = {-margin[0], -margin[1], -margin[2]};
+  const Peak least = resolved_peak(t, x, 0.0, negative_margin);
+  if (!(least.value > 0)) return std::nullopt;
+  return least.t;
+}
+
 }  // namespace
 
 Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
@@ -264,6 +299,22 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
   // any sample they cannot answer to round-off (a dead centre near)
   detail::prime_blocks(model, ws);
   const bool closed = system.blocks.usable && system.blocks.closed;
+  // the dyads' and guides' closure margins at the last two samples the blocks placed (`older`
+  // at t_2, `last` at t_prev), how many samples in a row they placed, for limit_between()
+  std::vector<std::size_t> closing;
+  for (std::size_t k = 0; k < system.blocks.blocks.size(); ++k) {
+    const detail::Block::Kind kind = system.blocks.blocks[k].kind;
+    if (kind == detail::Block::Kind::kDyad || kind == detail::Block::Kind::kGuide)
+      closing.push_back(k);
+  }
+  std::vector<double> older(closing.size()), last(closing.size());
+  int placed_in_a_row = 0;
+  double t_2 = 0;
+  const auto inputs_at = [&](double at) {
+    std::vector<double> z_at(z.size());
+    for (std::size_t j = 0; j < z.size(); ++j) z_at[j] = start[j] + scene.speeds[j] * at;
+    return z_at;
+  };
   double t_prev = 0;
   for (long long i = 0; i < rows; ++i) {
     const double t = times.at(i);
@@ -301,8 +352,46 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
       std::swap(a_previous, ws.instant.a);
     }
     Expected<bool, PlanarError> ok = true;
-    if (!detail::place_by_blocks(model, ws, guess, z)) {
-      if (closed && i > 0) {  // the general route needs a guess: the last sample's, to second order
+    const detail::Placement placed = detail::place_by_blocks(model, ws, guess, z);
+    // every closed form placed (well conditioned or not): the margins are the sample's
+    const bool margins = placed != detail::Placement::kDeclined;
+    if (margins) {
+      ++placed_in_a_row;
+      for (std::size_t j = 0; j < closing.size(); ++j) {
+        const std::array<double, 3> m = {older[j], last[j], ws.block_margin[closing[j]]};
+        older[j] = m[1];
+        last[j] = m[2];
+        if (placed_in_a_row < 3 || m[1] > m[0] || m[1] > m[2]) continue;  // no minimum near
+        const std::vector<double> z_2 = inputs_at(t_2);
+        const std::optional<double> at =
+            limit_between(model, ws, closing[j], {t_2, t_prev, t}, m, z_2, z);
+        if (!at) continue;
+        // the motion ends at the limit: a sample past it goes
+        if (*at < t_prev) out.table.values.resize(out.table.values.size() - out.table.width());
+        const int node = system.blocks.blocks[closing[j]].node;
+        fail(out,
+             PlanarError{PlanarError::Kind::kAssembly,
+                         "the linkage cannot be assembled at " +
+                             detail::inputs_text(model, inputs_at(*at)) + ": node " +
+                             model.linkage().nodes[static_cast<std::size_t>(node)].name +
+                             " is out of its links' reach there (a limit position between the "
+                             "samples at " +
+                             detail::inputs_text(model, z_2) + " and " +
+                             detail::inputs_text(model, z) + ": the input cannot turn through it)"},
+             *at);
+        return out;
+      }
+      t_2 = t_prev;
+    } else {
+      placed_in_a_row = 0;
+    }
+    if (placed != detail::Placement::kPlaced) {
+      if (placed == detail::Placement::kIllConditioned) {
+        // near a dead centre the closed forms still place every node on the linkage's branch,
+        // where a prediction from the last samples, whose rates grow without bound there, may
+        // land on the other one: the general route starts from them
+        guess = ws.instant.x;
+      } else if (closed && i > 0) {  // the general route needs a guess: the last sample's
         for (int n : system.moving) {
           const std::size_t k = static_cast<std::size_t>(n);
           guess[k] = previous[k] + h * (v_previous[k] + h / 2 * a_previous[k]);
@@ -320,6 +409,16 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
             z_step[k] = z_previous[k] + (z[k] - z_previous[k]) * j / kSubsteps;
           ok = solve_position(model, ws, guess, z_step, PositionRoute::kGeneral);
           guess = ws.instant.x;
+        }
+        // a driven input follows its branch: a position found only on the other one lies past
+        // a singular position the steps could not resolve
+        if (ok && branch() != drawn_branch) {
+          ok = Unexpected<PlanarError>(PlanarError{
+              PlanarError::Kind::kSingular,
+              "singular position between " + detail::inputs_text(model, z_previous) + " and " +
+                  detail::inputs_text(model, z) +
+                  " (the assembly cannot be followed on its branch: a dead centre or limit "
+                  "position too near to resolve)"});
         }
       }
       if (ok) detail::prime_blocks(model, ws);

@@ -242,6 +242,7 @@ System::System(const Linkage& l) : linkage(l) {
     first_slot.push_back(slots);
     for (int node : l.links[k].nodes) slot_of[k * nodes + static_cast<std::size_t>(node)] = slots++;
   }
+  first_slot.push_back(slots);
   for (int g : fixed) {
     ground_first.push_back(static_cast<int>(ground_slots.size()));
     for (std::size_t k = 0; k < l.links.size(); ++k) {
@@ -410,8 +411,7 @@ int row_gradient(const System& s, const NodeVectors& x, int row, GradientEntry o
     case System::RowRef::Kind::kInput: {
       const System::InputRow& in = s.inputs[static_cast<std::size_t>(ref.index)];
       if (in.angle) {
-        const Vec2 d = at(x, in.q) - at(x, in.p);
-        const Vec2 grad = in.length * perp(d) / d.squaredNorm();
+        const Vec2 grad = angle_input_gradient(in, x);
         const int link = s.linkage.inputs[static_cast<std::size_t>(in.input)].link;
         out[0] = {in.q, grad, link};
         out[1] = {in.p, -grad, link};
@@ -449,6 +449,16 @@ void constraint_jacobian(const System& s, const NodeVectors& x, int rows, Matrix
   }
   GradientEntry entries[3];
   for (int row = elements; row < rows; ++row) {
+    const System::RowRef& ref = s.row_ref[static_cast<std::size_t>(row)];
+    if (ref.kind == System::RowRef::Kind::kInput) {  // an angle input's row, without dispatch
+      const System::InputRow& in = s.inputs[static_cast<std::size_t>(ref.index)];
+      if (in.angle) {
+        const Vec2 grad = angle_input_gradient(in, x);
+        put(row, in.q, grad);
+        put(row, in.p, -grad);
+        continue;
+      }
+    }
     const int count = row_gradient(s, x, row, entries);
     for (int k = 0; k < count; ++k) put(row, entries[k].node, entries[k].grad);
   }

@@ -120,7 +120,8 @@ struct System {
   std::vector<int> link_input;
   /// The joint slots: one per link and node of that link (the force on the link from the joint
   /// there), link after link in the order of each link's nodes, so that an element's first and
-  /// second node are slots first_slot[k] and first_slot[k] + 1. slot_of[link * nodes + node] is
+  /// second node are slots first_slot[k] and first_slot[k] + 1 (first_slot[links] = slots).
+  /// slot_of[link * nodes + node] is
   /// the slot, or -1 where the link does not hold the node; per ground node (in node order) its
   /// slots are ground_slots[ground_first[i]] up to ground_slots[ground_first[i + 1]].
   int slots{};
@@ -190,6 +191,13 @@ struct GradientEntry {
 /// The (at most three) nonzero entries of row `row`'s gradient at x, ground nodes included;
 /// returns how many.
 int row_gradient(const System& s, const NodeVectors& x, int row, GradientEntry out[3]);
+/// An angle input row's gradient at x with respect to its link's second node (q); the first
+/// node's (p) is its negative. row_gradient()'s case, for the loops that take it without the
+/// dispatch.
+inline Vec2 angle_input_gradient(const System::InputRow& in, const NodeVectors& x) {
+  const Vec2 d = x[static_cast<std::size_t>(in.q)] - x[static_cast<std::size_t>(in.p)];
+  return in.length * perp(d) / d.squaredNorm();
+}
 
 /// The inputs' targets as constraint_values() takes them: per input, the direction (cos θ, sin θ)
 /// of an angle input at θ, (s, 0) for a slide at s. Computed once per position solve, so that

@@ -177,7 +177,9 @@ TEST(Blocks, TheDeterminantFromTheBlocksIsTheWholeJacobians) {
     ASSERT_TRUE(cp::assemble(model, ws, cp::drawn_inputs(model))) << i;
     const double whole = ws.lu.determinant();
     cd::prime_blocks(model, ws);
-    ASSERT_TRUE(cd::place_by_blocks(model, ws, ws.instant.x, cp::drawn_inputs(model))) << i;
+    ASSERT_EQ(cd::place_by_blocks(model, ws, ws.instant.x, cp::drawn_inputs(model)),
+              cd::Placement::kPlaced)
+        << i;
     EXPECT_NEAR(cd::block_determinant(model, ws) / whole, 1.0, 1e-12) << i;
   }
 }

@@ -70,6 +70,121 @@ TEST(Singular, DrivenAwayFromNearADeadCentreStaysOnTheDrawnBranch) {
   }
 }
 
+// A four-bar O-A-B-Q a hair's breadth (`gap` of the frame) from a change point: the coupler and
+// the rocker stretch out (A, B, Q on a line) when the crank points away from Q, where
+// |AQ| = a + d against b + c = a + d + gap. gap > 0: it turns fully, passing within a hair of
+// that dead centre; gap < 0: it cannot, over a range of the crank's angle narrower than a
+// sample's step (about sqrt(gap) wide). Drawn with the crank at `theta0` (from O towards Q at
+// 0), the coupler and rocker on side `side` of the line AQ.
+struct NearChangePoint {
+  cp::Linkage linkage;
+  Vec2 O, Q;
+  double a{}, b{}, c{};
+  double AQ(double theta) const { return (Q - (O + polar(a, theta))).norm(); }
+};
+NearChangePoint near_change_point(Rng& rng, double a, double b, double c, double d, double gap,
+                                  double theta0, double side) {
+  NearChangePoint f;
+  f.O = Vec2(0, 0);
+  f.Q = Vec2(b + c - a - gap * d, 0);
+  f.a = a;
+  f.b = b;
+  f.c = c;
+  const Vec2 A = polar(a, theta0);
+  const Vec2 B = circle_intersection(A, b, f.Q, c, side)->p;
+  cp::Linkage& l = f.linkage;
+  const int o = add_node(l, "O", f.O, true), q = add_node(l, "Q", f.Q, true);
+  const int na = add_node(l, "A", A), nb = add_node(l, "B", B);
+  add_link(l, rng, "crank", {o, na});
+  add_link(l, rng, "coupler", {na, nb});
+  add_link(l, rng, "rocker", {q, nb});
+  l.inputs.push_back(angle_input("crank", 0));
+  return f;
+}
+
+// Passing a hair's breadth (1e-8 of the frame) from a dead centre, with a sample 1e-3 rad from
+// it: the coupler and rocker are then nearly in line and the blocks' closed forms decline for
+// their conditioning; the general route must not take the mirror branch, which lies about
+// 1e-3 of the links away. (Regression: the prediction from the last samples, whose rates grow
+// without bound there, put Newton on the mirror branch, and the rest of the turn ran crossed; the
+// general route now starts from the closed forms' positions on the drawn branch.) The branch is
+// read off the geometry: the side of B from the line AQ.
+TEST(Singular, DrivenPastAHairsBreadthFromADeadCentreKeepsItsBranch) {
+  Rng rng(405);
+  for (int i = 0; i < 8; ++i) {
+    // the first: a sample 5e-4 rad past the dead centre (the case that ran crossed)
+    const double a = i == 0 ? 1.0 : uniform(rng, 0.2, 0.5);
+    const double b = i == 0 ? 1.5 : uniform(rng, 1.0, 1.6),
+                 c = i == 0 ? 3.0 : uniform(rng, 1.8, 2.6);
+    const double theta0 = i == 0 ? 5e-4 : 1e-3, side = i == 0 ? 1.0 : (coin(rng) ? 1.0 : -1.0);
+    const NearChangePoint f = near_change_point(rng, a, b, c, 1.0, 1e-8, theta0, side);
+    const cp::Model model(f.linkage);
+    cp::DrivenScene scene;
+    scene.speeds = {random_speed(rng)};
+    scene.samples = 360;
+    const cp::Trajectory tr = cp::simulate_driven(model, scene);
+    const std::string label = "four-bar #" + std::to_string(i);
+    ASSERT_TRUE(tr.ok()) << label << ": " << tr.message;
+    ASSERT_EQ(tr.table.rows(), 360u) << label;
+    EXPECT_TRUE(all_finite(tr.table)) << label;
+    const auto xa = tr.table.column_values("x_A"), ya = tr.table.column_values("y_A");
+    const auto xb = tr.table.column_values("x_B"), yb = tr.table.column_values("y_B");
+    double closest = INFINITY;  // the samples' least |sin| of the angle at A
+    for (std::size_t k = 0; k < xa.size(); ++k) {
+      const Vec2 A(xa[k], ya[k]), B(xb[k], yb[k]);
+      const double sine = cross2((f.Q - A).normalized(), (B - A).normalized());
+      closest = std::min(closest, std::abs(sine));
+      ASSERT_EQ(sine > 0 ? 1.0 : -1.0, side) << label << ": on the mirror branch at sample " << k;
+    }
+    EXPECT_LT(closest, 2e-3) << label << ": no sample near the dead centre";
+  }
+}
+
+// A hair's breadth (1e-8 of the frame) short of turning fully: the crank cannot pass the angles
+// where |AQ| > b + c, a range about 4e-4 rad wide that the samples (1.7e-2 rad apart, one 1e-3
+// rad either side of it) step over, each of them assemblable. The run must stop at the limit,
+// not go through on the closed forms' branches with forces of 1e11 N beside it. (Regression:
+// it completed.) The place it reports lies where the linkage does not close (by the geometry),
+// and every sample kept before it where it does.
+TEST(Singular, ALimitPositionBetweenTheSamplesStopsTheRun) {
+  Rng rng(406);
+  for (int i = 0; i < 8; ++i) {
+    const double a = uniform(rng, 0.2, 0.5), b = uniform(rng, 1.0, 1.6), c = uniform(rng, 1.8, 2.6);
+    const double side = coin(rng) ? 1.0 : -1.0;
+    const bool forward = coin(rng);
+    // the samples 1e-3 rad either side of the range (its middle at pi)
+    const double theta0 = forward ? 1e-3 : -1e-3;
+    const NearChangePoint f = near_change_point(rng, a, b, c, 1.0, -1e-8, theta0, side);
+    const cp::Model model(f.linkage);
+    cp::DrivenScene scene;
+    scene.speeds = {(forward ? 1.0 : -1.0) * uniform(rng, 5.0, 40.0)};
+    scene.samples = 360;
+    const std::string label = "four-bar #" + std::to_string(i);
+    const cp::Trajectory tr = cp::simulate_driven(model, scene);
+    ASSERT_EQ(tr.status, core::SimulationStatus::kAssemblyFailed) << label << ": " << tr.message;
+    EXPECT_NE(tr.message.find("node B is out of its links' reach there (a limit position between "
+                              "the samples at crank = "),
+              std::string::npos)
+        << label << ": " << tr.message;
+    EXPECT_TRUE(all_finite(tr.table)) << label;
+    // the time of the stop, from the message's "(t = ... s)", and the crank's angle there
+    const std::size_t at = tr.message.rfind("(t = ");
+    ASSERT_NE(at, std::string::npos) << tr.message;
+    const double t_stop = std::stod(tr.message.substr(at + 5));
+    const double theta_stop = theta0 + scene.speeds[0] * t_stop;
+    EXPECT_GT(f.AQ(theta_stop), b + c) << label << ": it closes where the run stopped";
+    EXPECT_NEAR(std::abs(theta_stop), kPi, 1e-3) << label;
+    const auto t = tr.table.column_values("t");
+    const auto theta = tr.table.column_values("theta_crank");
+    ASSERT_GT(t.size(), 100u) << label;
+    EXPECT_LT(t.size(), 182u) << label;
+    for (std::size_t k = 0; k < t.size(); ++k) {
+      EXPECT_LT(t[k], t_stop) << label << ": a sample past the limit kept";
+      EXPECT_LE(f.AQ(theta[k]), b + c) << label << ": a sample kept where it does not close";
+    }
+  }
+}
+
 // Assembly a hair's breadth from a dead centre: the Jacobian's condition number there grows like
 // 1/sqrt of the distance, so Newton's last steps are round-off times it (1e-12 of the length at
 // 1e-9 of the stroke), above the step at which it stops elsewhere (1e-14). It stops where the
