@@ -125,7 +125,7 @@ struct Candidate {
 Peak resolved_peak(std::span<const double> t, std::span<const double> x, double period,
                    const QuantityAt& f) {
   const std::size_t n = std::min(t.size(), x.size());
-  if (f && n >= 2 && n < kMinPeakSamples) {
+  if (f && (n >= 2 || (n == 1 && period > 0)) && n < kMinPeakSamples) {
     // Too few samples for their local maxima to bracket every peak (a driven revolution at 5
     // samples can have its largest value between two samples neither of which is a local
     // maximum): the quantity is evaluated between them too, at least kMinPeakSamples points

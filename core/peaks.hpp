@@ -40,7 +40,8 @@ inline constexpr std::size_t kMinPeakSamples = 16;
 /// maximisation of f on the interval between its neighbours; the largest value found wins.
 /// `period` > 0: the samples cover one period of a periodic motion, the end excluded, so the
 /// first and last samples are neighbours across it (a driven revolution); 0: an open interval
-/// (the ends are brackets of their own). With one sample, or without f: the largest sample.
+/// (the ends are brackets of their own). One sample of a periodic motion is densified like a few;
+/// one sample of an open one, or no f: the largest sample.
 Peak resolved_peak(std::span<const double> t, std::span<const double> x, double period,
                    const QuantityAt& f);
 

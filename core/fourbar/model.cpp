@@ -52,7 +52,7 @@ void require(bool ok, std::string field, int index, const char* expected, const 
   if (!ok) {
     throw InputError(FieldError{std::move(field), index,
                                 std::string("must be ") + expected + (unit[0] ? " " : "") + unit +
-                                    ", got " + text::exact(value)});
+                                    ", got " + text::shortest(value)});
   }
 }
 
@@ -100,7 +100,7 @@ void check_counter_rotation(const CounterRotation& c, const std::string& name, c
       throw InputError(FieldError{name, -1,
                                   ": distance of the shaft from the link's pivot must be > 0 m, "
                                   "got " +
-                                      text::exact(d)});
+                                      text::shortest(d)});
     }
   }
 }

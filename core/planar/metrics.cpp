@@ -279,7 +279,10 @@ const double* DrivenRows::at(double s) {
     const std::vector<Vec2> guess = st.positions.row(st.table, i);
     for (std::size_t k = 0; k < st.z.size(); ++k) st.z[k] = st.start[k] + st.scene.speeds[k] * s;
     if (!solve_position(st.model, st.ws, guess, st.z)) return nullptr;
-    for (std::size_t n = 0; n < guess.size(); ++n) {
+    // Newton's method from the nearest sample may land on another branch where the samples are
+    // far apart; the blocks' closed forms keep the sample's branch however far (1 or 2 samples
+    // per turn)
+    for (std::size_t n = 0; n < guess.size() && !st.ws.by_blocks; ++n) {
       if ((st.ws.instant.x[n] - guess[n]).norm() > 0.25 * st.model.length_scale()) return nullptr;
     }
     if (!inverse_dynamics(st.model, st.ws, s, st.scene.speeds, st.zero)) return nullptr;

@@ -35,7 +35,7 @@ void check_value(const char* list, std::size_t index, const char* key, double v,
   if (!ok || !std::isfinite(v)) {
     fail(list, index,
          std::string(".") + key + " must be " + expected + (unit[0] ? " " : "") + unit + ", got " +
-             text::exact(v));
+             text::shortest(v));
   }
 }
 

@@ -968,15 +968,15 @@ std::vector<double> free_rates(const Model& model, const FreeScene& scene,
   const int dof = model.inputs();
   if (!(scene.duration > 0) || !std::isfinite(scene.duration)) {
     throw InputError(
-        FieldError{"scene.duration", -1, "must be > 0 s, got " + text::exact(scene.duration)});
+        FieldError{"scene.duration", -1, "must be > 0 s, got " + text::shortest(scene.duration)});
   }
   if (scene.samples < 2 || scene.samples > kMaxSamples) {
     throw InputError(FieldError{"scene.samples", -1,
                                 "must be between 2 and 1e8, got " + std::to_string(scene.samples)});
   }
   if (!(options.tolerance > 0 && options.tolerance < 1)) {
-    throw InputError(
-        FieldError{"tolerance", -1, "must be > 0 and < 1, got " + text::exact(options.tolerance)});
+    throw InputError(FieldError{"tolerance", -1,
+                                "must be > 0 and < 1, got " + text::shortest(options.tolerance)});
   }
   if (options.integrator == Integrator::kIda) {
     throw InputError(FieldError{"integrator", -1, ": ida is not available for planar linkages"});

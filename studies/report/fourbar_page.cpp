@@ -197,7 +197,9 @@ AnimationFigure fourbar_animation(const core::FourBar& model,
   AnimationFigure fig;
   fig.animation.id = id;
   if (rows.empty()) return fig;
-  const auto* driven = std::get_if<core::DrivenScene>(&scene);
+  // a driven run's first revolution; a run that stopped before its end is shown as the run it was
+  const core::DrivenScene* driven = std::get_if<core::DrivenScene>(&scene);
+  if (driven && rows.size() < static_cast<std::size_t>(driven->samples)) driven = nullptr;
   std::size_t last = rows.size() - 1;
   if (driven && driven->omega1 != 0) {  // the first revolution
     const double period = 2 * std::numbers::pi / std::abs(driven->omega1);

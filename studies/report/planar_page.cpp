@@ -112,8 +112,10 @@ AnimationFigure planar_animation(const Linkage& l, const Csv& ts, const Scene& s
   };
   // the first revolution of a driven input, or the run
   const auto* driven = std::get_if<core::planar::DrivenScene>(&scene);
+  // (a run that stopped before the revolution's end is shown as the run it was)
   const bool revolution = driven && driven->duration == 0 && driven->revolutions >= 1 &&
-                          driven->speeds.size() == 1 && driven->speeds[0] != 0;
+                          driven->speeds.size() == 1 && driven->speeds[0] != 0 &&
+                          rows.size() >= static_cast<std::size_t>(driven->samples);
   std::size_t last = rows.size() - 1;
   if (revolution) {
     const double period = 2 * std::numbers::pi / std::abs(driven->speeds[0]);

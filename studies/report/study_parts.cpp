@@ -69,7 +69,8 @@ std::string simulation_section(const Json& summary) {
   h += run_table(summary, "original design's");
   if (const Json* scene = member(summary, "scene")) {
     h += "<h3>Scene</h3>" + json_table(*scene);
-    h += "<p>Integrator relative tolerance " + esc(text(summary, "tolerance")) + ".</p>\n";
+    if (text(*scene, "type") == "free")  // a driven scene integrates nothing
+      h += "<p>Integrator relative tolerance " + esc(text(summary, "tolerance")) + ".</p>\n";
   }
   // the units: SI on the page; what the study file gave in units of its own
   h += "<p>Units on this page and in the data files: SI (m, kg, s, rad, N, N m). ";
@@ -392,8 +393,8 @@ std::vector<Chart> harmonic_charts(const fs::path& dir, std::string& datablocks,
     charts.push_back(
         {"harmonics-" + d, "Harmonic orders, " + d + " design",
          "Amplitudes of orders 1..N over a revolution of the driven input (harmonics.csv, " + d +
-             " design) of the total shaking force and moment (weights and applied loads "
-             "included; a constant weight is in order 0 only): left, the force's parts turning "
+             " design) of the inertial shaking force and moment (what balancing acts on; "
+             "weights and applied loads are not in them): left, the force's parts turning "
              "with the input (forward) and against it (backward) [N]; right, the shaking moment "
              "and the drive torque [N m]. Every design's chart has the same axes, the largest "
              "amplitude of their kind on this page; an amplitude that is round-off of the run's "

@@ -35,7 +35,7 @@ std::string metrics_section(const Json& summary, const SecondDesign& second,
 std::string comparison_section(const std::filesystem::path& dir, const Json& summary,
                                const SecondDesign& second, const Scales& scales);
 /// "Harmonic orders" (harmonics.csv), when the folder has it: the amplitudes per design and order
-/// of the total shaking force and moment, round-off of the run's forces (moments) as 0.
+/// of the inertial shaking force and moment, round-off of the run's forces (moments) as 0.
 std::string harmonics_section(const std::filesystem::path& dir, const Scales& scales);
 /// The balanced or optimised design's section: its summary.json section and its run (or the
 /// notice that no optimum was found); round-off of `scales` shows as 0 (json_table()).

@@ -198,6 +198,13 @@ std::vector<ComparisonRow> comparison(const Study& study, const RunResult& resul
     mass = added_mass(study.fourbar(), o.result.design);
     inertia = added_inertia(study.fourbar(), o.result.design);
   }
+  std::vector<ComparisonRow> rows = compare_metrics(a, b);
+  rows.push_back({"added_mass", 0.0, mass, std::nullopt});
+  rows.push_back({"added_inertia", 0.0, inertia, std::nullopt});
+  return rows;
+}
+
+std::vector<ComparisonRow> compare_metrics(const MetricList& a, const MetricList& b) {
   std::vector<ComparisonRow> rows;
   // by name: a balanced design's new parts (a balance shaft's bearing) add metrics, 0 before
   std::vector<bool> matched(b.size(), false);
@@ -212,8 +219,6 @@ std::vector<ComparisonRow> comparison(const Study& study, const RunResult& resul
   for (std::size_t k = 0; k < b.size(); ++k) {
     if (!matched[k]) rows.push_back({b[k].name, 0.0, b[k].value, std::nullopt});
   }
-  rows.push_back({"added_mass", 0.0, mass, std::nullopt});
-  rows.push_back({"added_inertia", 0.0, inertia, std::nullopt});
   for (ComparisonRow& row : rows) {
     if (row.before != 0) row.ratio = row.after / row.before;
   }
@@ -600,12 +605,8 @@ BalancedRun planar_balanced_run(const Study& study, const RunResult& original,
     return b;
   }
   const bp::BalanceRequest& ask = *study.planar_balance;
-  // a driven revolution of the crank passes through every configuration already
-  const auto* driven = std::get_if<core::planar::DrivenScene>(&study.scene);
-  const bool revolution = driven && driven->duration == 0 && driven->revolutions >= 1 &&
-                          !driven->speeds.empty() && driven->speeds[0] != 0;
-  const std::string shown =
-      revolution ? std::string() : with_every_condition(study.planar(), model, *k);
+  // (a driven revolution too: at 1 or 2 samples per turn it shows too few of them)
+  const std::string shown = with_every_condition(study.planar(), model, *k);
   b.design = bp::force_balance(study.planar(), *k, ask.counterweights, ask.balancing_factor);
   if (!shown.empty()) b.design->message += (b.design->message.empty() ? "" : "; ") + shown;
   if (ask.shafts) {

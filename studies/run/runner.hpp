@@ -155,6 +155,10 @@ struct ComparisonRow {
   double before{}, after{};
   std::optional<double> ratio;
 };
+/// The metrics of two designs paired by name, in the first's order, then the second's metrics
+/// the first lacks (a balance shaft's bearing force: 0 before), with after/before: the rows of
+/// comparison.csv and summary.json's `reduction`.
+std::vector<ComparisonRow> compare_metrics(const MetricList& before, const MetricList& after);
 /// The rows of comparison.csv, in order: the metrics in their table's order (a four-bar's
 /// Fsh_rms, Fsh_max, Msh_rms, Msh_max, tau_rms, tau_max, RA0_rms, RA0_max, RA3_rms, RA3_max; a
 /// planar linkage's from core::planar::metric_table()), then the balanced design's metrics the

@@ -50,12 +50,12 @@ Json peaks_json(const Study& study, const MetricList& metrics) {
   return j;
 }
 
-// after / before per metric; null where before is 0
+// after / before per metric, paired by name as in comparison.csv; null where before is 0 (a
+// metric the second design adds, a balance shaft's bearing force)
 Json reduction_json(const MetricList& before, const MetricList& after) {
   Json j = Json::object();
-  for (std::size_t k = 0; k < before.size() && k < after.size(); ++k) {
-    const double b = before[k].value;
-    j[before[k].name] = b != 0 ? value_or_null(after[k].value / b) : Json(nullptr);
+  for (const ComparisonRow& row : compare_metrics(before, after)) {
+    j[row.metric] = row.ratio ? value_or_null(*row.ratio) : Json(nullptr);
   }
   return j;
 }

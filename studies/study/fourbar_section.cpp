@@ -140,7 +140,7 @@ class FourBarSection::Impl {
         r_.fail(mark_of(com.s->value, com.s->key_mark), path +
                                                             ".s must be >= 0 m (sigma gives the "
                                                             "direction), got " +
-                                                            text::exact(sv));
+                                                            text::shortest(sv));
       }
       const double sg = number(*com.sigma, "rad");
       return core::link_from_polar(length, mass, sv, sg, inertia);
@@ -225,7 +225,7 @@ class FourBarSection::Impl {
       free.duration = read_number(r_, d, "scene.duration", "s");
       if (free.duration <= 0) {
         r_.fail(mark_of(d.value, d.key_mark),
-                "scene.duration must be > 0 s, got " + text::exact(free.duration));
+                "scene.duration must be > 0 s, got " + text::shortest(free.duration));
       }
       if (const MapReader::Entry* n = sc.find("samples")) {
         free.samples = read_count(r_, *n, "scene.samples", 2, kMaxRows);
@@ -252,9 +252,9 @@ class FourBarSection::Impl {
       }
       if (static_cast<double>(driven.samples) * driven.revolutions > kMaxRows) {
         r_.fail(e.key_mark,
-                "scene.samples x scene.revolutions must be <= " + text::exact(kMaxRows) +
+                "scene.samples x scene.revolutions must be <= " + text::shortest(kMaxRows) +
                     " rows, got " +
-                    text::exact(static_cast<double>(driven.samples) * driven.revolutions));
+                    text::shortest(static_cast<double>(driven.samples) * driven.revolutions));
       }
       return driven;
     }

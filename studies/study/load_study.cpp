@@ -184,7 +184,8 @@ class StudyParser {
     const double tol = read_number(r_, e, "tolerance", "");
     const YAML::Mark m = mark_of(e.value, e.key_mark);
     if (!(tol > 0 && tol < 1)) {
-      r_.fail(m, "tolerance must be > 0 and < 1 (a relative tolerance), got " + text::exact(tol));
+      r_.fail(m,
+              "tolerance must be > 0 and < 1 (a relative tolerance), got " + text::shortest(tol));
     }
     if (tol < kMinTolerance) {
       // double precision carries about 16 digits: the integrator cannot meet a tighter one

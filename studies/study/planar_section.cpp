@@ -411,8 +411,8 @@ class PlanarSection::Impl {
         const MapReader::Entry row{"", tm, t->value[i]};
         const Vec2 p = read_vec2(r_, row, path + ".table[" + std::to_string(i) + "]", unit, marks);
         if (!f.times.empty() && !(p.x() > f.times.back())) {
-          r_.fail(marks[0], path + ".table: the times must increase, got " + text::exact(p.x()) +
-                                " after " + text::exact(f.times.back()));
+          r_.fail(marks[0], path + ".table: the times must increase, got " + text::shortest(p.x()) +
+                                " after " + text::shortest(f.times.back()));
         }
         f.times.push_back(p.x());
         f.values.push_back(p.y());

@@ -14,12 +14,13 @@ std::string vec(const Vec2& v) {
   return "[" + text::shortest(v.x()) + ", " + text::shortest(v.y()) + "]";
 }
 
-// e, f exactly (they read back bit for bit); the paper's polar form s, sigma as a comment
+// e, f exactly (they read back bit for bit); the paper's polar form s, sigma as a comment for a
+// person (12 digits: sigma = 0.4, not the 0.4000000000000001 its atan2 gives)
 std::string link_line(const char* name, const core::Link& l) {
   return std::string("  ") + name + ": {length: " + text::shortest(l.length) +
          ", mass: " + text::shortest(l.mass) + ", e: " + text::shortest(l.e) +
          ", f: " + text::shortest(l.f) + ", inertia: " + text::shortest(l.inertia) + "}\n" +
-         "    # s = " + text::shortest(l.s()) + " m, sigma = " + text::shortest(l.sigma()) +
+         "    # s = " + text::digits(l.s(), 12) + " m, sigma = " + text::digits(l.sigma(), 12) +
          " rad\n";
 }
 

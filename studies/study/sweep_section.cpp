@@ -124,8 +124,8 @@ class SweepReader {
         product += (product.empty() ? "" : " x ") + std::to_string(p.values.size());
       }
       if (n > kMaxSweepPoints) {
-        r_.fail(list.key_mark, "sweep: the grid has " + product + " = " + text::exact(n) +
-                                   " points, more than the " + text::exact(kMaxSweepPoints) +
+        r_.fail(list.key_mark, "sweep: the grid has " + product + " = " + text::shortest(n) +
+                                   " points, more than the " + text::shortest(kMaxSweepPoints) +
                                    " a sweep may have");
       }
       req.points = static_cast<int>(n);
@@ -208,12 +208,12 @@ class SweepReader {
     p.to = read_number(r_, to, where + ".to", "");
     if (!(p.from < p.to)) {
       r_.fail(mark_of(to.value, to.key_mark),
-              where + ": from must be < to, got from = " + text::exact(p.from) +
-                  ", to = " + text::exact(p.to));
+              where + ": from must be < to, got from = " + text::shortest(p.from) +
+                  ", to = " + text::shortest(p.to));
     }
     if (p.log_scale && !(p.from > 0)) {
       r_.fail(mark_of(from.value, from.key_mark),
-              where + ".from must be > 0 with scale: log, got " + text::exact(p.from));
+              where + ".from must be > 0 with scale: log, got " + text::shortest(p.from));
     }
     if (design == SweepDesign::kGrid) {
       const int n = read_count(r_, *count, where + ".count", 2, kMaxSweepPoints);
@@ -221,8 +221,8 @@ class SweepReader {
       for (std::size_t k = 1; k < p.values.size(); ++k) {
         if (p.values[k] > p.values[k - 1]) continue;
         r_.fail(mark_of(count->value, count->key_mark),
-                where + ".count: " + std::to_string(n) + " values from " + text::exact(p.from) +
-                    " to " + text::exact(p.to) +
+                where + ".count: " + std::to_string(n) + " values from " + text::shortest(p.from) +
+                    " to " + text::shortest(p.to) +
                     " are not distinct in double precision; give fewer");
       }
     }
@@ -244,12 +244,12 @@ class SweepReader {
       const std::string ip = path + "[" + std::to_string(k) + "]";
       const double v = read_number(r_, item, vm, ip, "");
       if (log_scale && !(v > 0)) {
-        r_.fail(mark_of(item, vm), ip + " must be > 0 with scale: log, got " + text::exact(v));
+        r_.fail(mark_of(item, vm), ip + " must be > 0 with scale: log, got " + text::shortest(v));
       }
       for (std::size_t j = 0; j < values.size(); ++j) {
         if (values[j] != v) continue;
         r_.fail(mark_of(item, vm), ip + " repeats values[" + std::to_string(j) + "] (" +
-                                       text::exact(v) + "); a grid's values must be distinct");
+                                       text::shortest(v) + "); a grid's values must be distinct");
       }
       values.push_back(v);
     }

@@ -243,7 +243,7 @@ inline double read_positive(const Reporter& r, const MapReader::Entry& e, const 
   const double v = read_number(r, e, path, unit);
   if (!(v > 0)) {
     r.fail(mark_of(e.value, e.key_mark),
-           path + " must be > 0" + (unit.empty() ? "" : " " + unit) + ", got " + text::exact(v));
+           path + " must be > 0" + (unit.empty() ? "" : " " + unit) + ", got " + text::shortest(v));
   }
   return v;
 }
@@ -254,8 +254,8 @@ inline int read_count(const Reporter& r, const MapReader::Entry& e, const std::s
   const double v = read_number(r, e, path, "");
   const YAML::Mark m = mark_of(e.value, e.key_mark);
   if (v != std::floor(v)) r.fail(m, path + " must be a whole number, got " + describe(e.value));
-  if (v < lo) r.fail(m, path + " must be >= " + text::exact(lo) + ", got " + text::exact(v));
-  if (v > hi) r.fail(m, path + " must be <= " + text::exact(hi) + ", got " + text::exact(v));
+  if (v < lo) r.fail(m, path + " must be >= " + text::shortest(lo) + ", got " + text::shortest(v));
+  if (v > hi) r.fail(m, path + " must be <= " + text::shortest(hi) + ", got " + text::shortest(v));
   return static_cast<int>(v);
 }
 

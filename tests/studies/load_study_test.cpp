@@ -108,6 +108,14 @@ TEST(LoadStudy, NonPhysicalValuesAreReportedWhereTheyAre) {
                "linkage.coupler.mass must be > 0 kg, got -1.2");
   expect_error(edit("  frame: 3.2\n", "  frame: -3.2\n"), 4, 10,
                "linkage.frame must be > 0 m, got -3.2");
+  // the value as a person reads it (the shortest text that reads back as it), not 17 digits
+  for (const char* written : {"-0.1", "-210 g"}) {
+    EXPECT_EQ(bd::testing::study_error_of(
+                  edit("    mass: 2.1\n", std::string("    mass: ") + written + "\n"), "s.yaml")
+                  .message(),
+              std::string("linkage.crank.mass must be > 0 kg, got ") +
+                  (written[1] == '0' ? "-0.1" : "-0.21"));
+  }
   expect_error(edit("    mass: 2.1\n", "    mass: .nan\n"), 8, 11,
                "linkage.crank.mass must be a finite number in kg, got '.nan'");
   expect_error(edit("    s: 0.6\n", "    s: -0.6\n"), 9, 8, "linkage.crank.s must be >= 0 m");

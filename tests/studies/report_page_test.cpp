@@ -267,6 +267,10 @@ TEST_F(ReportPageTest, ShakingChartsAndMetricsSayWhichPartTheyShow) {
   EXPECT_NE(html.find("the inertial shaking force and moment (what balancing acts on; weights "
                       "and applied loads are not in them)"),
             std::string::npos);
+  // the table's caption and the charts' alike
+  EXPECT_NE(html.find("design) of the inertial shaking force and moment (what balancing acts on"),
+            std::string::npos);
+  EXPECT_EQ(html.find("total shaking force and moment"), std::string::npos);
   // and they are: under gravity the mean (order 0) of the force is zero, not the weight
   {
     const report_support::Csv csv = report_support::read_csv(dir_ / "harmonics.csv");
