@@ -9,6 +9,7 @@
 
 #include "core/detail/known_instants.hpp"
 #include "core/detail/sensitivity.hpp"
+#include "core/planar/system.hpp"
 
 namespace bd::core::planar {
 
@@ -31,11 +32,21 @@ std::vector<ColumnMetric> metric_table(const Model& model) {
              (one ? "" : " of " + in.name) + " |" + column + "|",
          {column});
   }
-  for (int g : model.ground_nodes()) {
-    const std::string name = "R" + l.nodes[static_cast<std::size_t>(g)].name;
-    both(name, "N",
-         "the bearing force |" + name + "| at ground node " +
-             l.nodes[static_cast<std::size_t>(g)].name,
+  const detail::System& system = model.system();
+  for (std::size_t i = 0; i < model.ground_nodes().size(); ++i) {
+    // a ground node no link holds (a spring's anchor) has no bearing: its pull is the spring's
+    if (system.ground_first[i + 1] == system.ground_first[i]) continue;
+    const std::string& node = l.nodes[static_cast<std::size_t>(model.ground_nodes()[i])].name;
+    const std::string name = "R" + node;
+    both(name, "N", "the bearing force |" + name + "| at ground node " + node,
+         {name + "x", name + "y"});
+  }
+  for (int k : model.frame_springs()) {
+    const Spring& sp = l.springs[static_cast<std::size_t>(k)];
+    const int anchor = l.nodes[static_cast<std::size_t>(sp.a)].ground ? sp.a : sp.b;
+    const std::string& node = l.nodes[static_cast<std::size_t>(anchor)].name;
+    const std::string name = "R" + node + "_" + sp.name;
+    both(name, "N", "the pull |" + name + "| of spring " + sp.name + " on the frame at " + node,
          {name + "x", name + "y"});
   }
   for (int s : model.frame_guides()) {

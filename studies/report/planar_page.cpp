@@ -291,7 +291,18 @@ std::vector<Chart> planar_charts(const Study& study, const Csv& ts, const Second
   for (const core::planar::Link& link : l.links) {
     angles.push_back({"θ " + link.name, std::to_string(gp_column(ts, "theta_" + link.name))});
   }
+  // a ground node no link holds (a spring's anchor) has no bearing: its R column is 0 (the
+  // spring's pull is its own column)
+  std::vector<std::string> no_bearing;
+  for (const core::planar::Node& n : l.nodes) {
+    const int id = static_cast<int>(&n - l.nodes.data());
+    const bool held = std::any_of(l.links.begin(), l.links.end(), [&](const core::planar::Link& k) {
+      return std::find(k.nodes.begin(), k.nodes.end(), id) != k.nodes.end();
+    });
+    if (n.ground && !held) no_bearing.push_back("R" + n.name + "x");
+  }
   for (const std::string& c : ts.header) {
+    if (std::find(no_bearing.begin(), no_bearing.end(), c) != no_bearing.end()) continue;
     if (c.size() > 2 && c[0] == 'R' && c.back() == 'x') {
       supports.push_back(
           {"|" + c.substr(0, c.size() - 1) + "|", magnitude(ts, c.substr(0, c.size() - 1))});

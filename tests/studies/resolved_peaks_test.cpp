@@ -333,6 +333,39 @@ TEST(ResolvedPeaks, StudyPeaksDoNotDependOnTheSampleCount) {
 // neither of which was a local maximum), the peaks still equal those of 360 samples per turn,
 // which the brute-force tests above hold to the exact maxima. So do 1 and 2 samples per turn
 // (a designer's check found 1 sample's peaks left at that sample: Fsh_max 224 N for 275 N).
+// A spring anchored to the frame at a ground node no link holds (stephenson-sixbar-free.yaml's S):
+// that node has no bearing, so no R<node> metric (it was 0, and drawn as a flat bearing load);
+// the spring's pull on the frame, R<node>_<spring>, has its RMS and peak instead, the RMS that of
+// its columns.
+TEST(ResolvedPeaks, ASpringsAnchorHasTheSpringsPullNotABearing) {
+  const studies::Study study =
+      studies::load_study(BD_SOURCE_DIR "/studies/examples/stephenson-sixbar-free.yaml");
+  const studies::RunResult r = studies::compute_study(study);
+  ASSERT_TRUE(r.ok()) << r.planar.message;
+  auto find = [&](const std::string& name) {
+    return std::find_if(r.metric_list.begin(), r.metric_list.end(),
+                        [&](const studies::MetricValue& m) { return m.name == name; });
+  };
+  EXPECT_EQ(find("RS_rms"), r.metric_list.end());
+  EXPECT_EQ(find("RS_max"), r.metric_list.end());
+  ASSERT_NE(find("RS_return_rms"), r.metric_list.end());
+  ASSERT_NE(find("RS_return_max"), r.metric_list.end());
+  const auto x = r.planar.table.column_values("RS_returnx"),
+             y = r.planar.table.column_values("RS_returny");
+  double sum = 0, largest = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    sum += x[i] * x[i] + y[i] * y[i];
+    largest = std::max(largest, std::hypot(x[i], y[i]));
+  }
+  const double rms = std::sqrt(sum / static_cast<double>(x.size()));
+  EXPECT_GT(rms, 1.0);  // the spring pulls tens of newtons
+  EXPECT_NEAR(find("RS_return_rms")->value, rms, 1e-12 * rms);
+  EXPECT_GE(find("RS_return_max")->value, largest * (1 - 1e-15));
+  EXPECT_LT(find("RS_return_max")->value, largest * 1.01);
+  // the other ground nodes keep theirs
+  EXPECT_NE(find("RO2_max"), r.metric_list.end());
+}
+
 TEST(ResolvedPeaks, PlanarDrivenPeaksAtFiveSamplesPerTurn) {
   auto run = [](int samples) {
     const std::string text = bd::testing::edited_example(
