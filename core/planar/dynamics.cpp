@@ -123,6 +123,7 @@ void resize(Instant& in, const Model& m) {
   in.ground_reaction.assign(m.ground_nodes().size(), Vec2(0, 0));
   in.guide_reaction.assign(m.frame_guides().size(), Vec2(0, 0));
   in.joint_force.assign(m.joints().size(), Vec2(0, 0));
+  in.guide_force.assign(m.link_guides().size(), Vec2(0, 0));
   in.shaft_reaction.assign(l.shafts.size(), Vec2(0, 0));
   in.spring_reaction.assign(m.frame_springs().size(), Vec2(0, 0));
   in.drive_reaction.assign(m.frame_drives().size(), Vec2(0, 0));
@@ -151,7 +152,7 @@ Model::Model(const Linkage& linkage) : system_(std::make_unique<System>(make_lin
     if (l.nodes[i].ground) ground_nodes_.push_back(static_cast<int>(i));
   }
   for (std::size_t k = 0; k < l.sliders.size(); ++k) {
-    if (l.sliders[k].link < 0) frame_guides_.push_back(static_cast<int>(k));
+    (l.sliders[k].link < 0 ? frame_guides_ : link_guides_).push_back(static_cast<int>(k));
   }
   for (std::size_t k = 0; k < l.springs.size(); ++k) {
     const Spring& sp = l.springs[k];
@@ -202,6 +203,7 @@ Model::Model(const Model& other)
     : system_(std::make_unique<System>(*other.system_)),
       ground_nodes_(other.ground_nodes_),
       frame_guides_(other.frame_guides_),
+      link_guides_(other.link_guides_),
       frame_springs_(other.frame_springs_),
       frame_drives_(other.frame_drives_),
       joints_(other.joints_),
@@ -764,6 +766,21 @@ void frame_forces(const Model& model, Workspace& ws) {
   }
   const std::vector<int>& joint_slots = model.joint_slots();
   for (std::size_t j = 0; j < joint_slots.size(); ++j) in.joint_force[j] = on_link[joint_slots[j]];
+  // a slider on a moving guide: the rows' forces on its node, λ ∂g/∂x_node (detail::row_gradient:
+  // the normal row -perp(b)/L, a slide input's b/L, b the guide from its first node to its
+  // second), reacted by the guide's link
+  for (std::size_t j = 0; j < model.link_guides().size(); ++j) {
+    const int k = model.link_guides()[j];
+    const System::SliderRow& sl = s.sliders[static_cast<std::size_t>(k)];
+    const Vec2 b = (in.x[static_cast<std::size_t>(sl.to_node)] -
+                    in.x[static_cast<std::size_t>(sl.from_node)]) /
+                   sl.length;
+    Vec2 on_node = ws.lambda[sl.row] * -perp(b);
+    for (const System::InputRow& ir : s.inputs) {
+      if (!ir.angle && ir.slider == k) on_node += ws.lambda[ir.row] * b;
+    }
+    in.guide_force[j] = -on_node;
+  }
   shaft_forces(model, in, on_frame);
 }
 

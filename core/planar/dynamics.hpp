@@ -52,6 +52,9 @@ class Model {
   const std::vector<int>& ground_nodes() const { return ground_nodes_; }
   /// The sliders on frame guides, in slider order (their reactions R<name> are outputs).
   const std::vector<int>& frame_guides() const { return frame_guides_; }
+  /// The sliders on guides that move with a link, in slider order (the force on the guide's link
+  /// from the slider, F<slider>_guide, is an output).
+  const std::vector<int>& link_guides() const { return link_guides_; }
   /// The joints whose forces are outputs: every moving node in two or more links (the force on
   /// each link but the first, from the joint), or in one link and carrying a slider or a point
   /// mass (the force on that link).
@@ -73,7 +76,7 @@ class Model {
 
  private:
   std::unique_ptr<detail::System> system_;
-  std::vector<int> ground_nodes_, frame_guides_, frame_springs_, frame_drives_;
+  std::vector<int> ground_nodes_, frame_guides_, link_guides_, frame_springs_, frame_drives_;
   std::vector<JointForce> joints_;
   std::vector<int> joint_slots_;
   double length_scale_{};
@@ -93,6 +96,9 @@ struct Instant {
   std::vector<Vec2> ground_reaction;  // per ground node: force of the mechanism ON the frame [N]
   std::vector<Vec2> guide_reaction;   // per frame guide: force ON the frame at the node [N]
   std::vector<Vec2> joint_force;      // per joint: force on the link at the node [N]
+  /// per slider on a moving guide (Model::link_guides()): the force on the guide's link from the
+  /// slider's node, the guide's normal force and a drive's force along it [N]
+  std::vector<Vec2> guide_force;
   /// Per balance shaft: the force ON the frame at its bearing [N] (its weight and inertia, and
   /// the reaction of its tooth force; the tooth force's action on the link reaches the frame
   /// through the link's pivot, in that ground node's reaction).

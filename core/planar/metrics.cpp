@@ -68,6 +68,15 @@ std::vector<ColumnMetric> metric_table(const Model& model) {
                  Statistic::kMax,
                  {name + "x", name + "y"}});
   }
+  for (int k : model.link_guides()) {
+    const std::string& slider = l.sliders[static_cast<std::size_t>(k)].name;
+    const std::string name = "F" + slider + "_guide";
+    t.push_back({name + "_max",
+                 "N",
+                 "peak of the force |" + name + "| between slider " + slider + " and its guide",
+                 Statistic::kMax,
+                 {name + "x", name + "y"}});
+  }
   for (const TotalMetricInfo& m : kTotalMetrics) {
     t.push_back({m.name, m.unit, m.words, m.statistic,
                  m.force ? std::vector<std::string>{"Fshx", "Fshy"}

@@ -136,6 +136,8 @@ std::vector<std::string> columns(const Model& model) {
     pair("R" + l.sliders[static_cast<std::size_t>(in.slider)].name + "_drive");
   }
   for (const JointForce& j : model.joints()) pair("F" + j.name);
+  for (int k : model.link_guides())
+    pair("F" + l.sliders[static_cast<std::size_t>(k)].name + "_guide");
   c.insert(c.end(), {"Fshx", "Fshy", "Msh"});
   if (l.inputs.size() == 1) {
     c.push_back("tau");
@@ -180,6 +182,7 @@ void append_row(const Model& model, const Instant& in, Series& table) {
   for (const Vec2& r : in.spring_reaction) put2(r);
   for (const Vec2& r : in.drive_reaction) put2(r);
   for (const Vec2& f : in.joint_force) put2(f);
+  for (const Vec2& f : in.guide_force) put2(f);
   put2(in.Fsh);
   put(in.Msh);
   for (double e : in.effort) put(e);

@@ -183,5 +183,53 @@ TEST(JointForces, PlanarShakingForceIsTheSumOfItsColumns) {
   }
 }
 
+// A slider on a moving guide (quick returns and shapers: a block on the crank pin A sliding along
+// the rocker): F<slider>_guide, the force on the guide's link from the block, closes the block's
+// free body with the crank pin's joint force FA (the force on the crank from the joint) and the
+// block's weight and inertia, the pin's acceleration taken from the crank's angle, rate and
+// acceleration: F_guide = -FA + m (g - a_A); and it is normal to the guide (no friction, no drive
+// along it).
+TEST(JointForces, AGuideOnALinkCarriesTheBlocksNormalForce) {
+  Rng rng(62);
+  for (int trial = 0; trial < 8; ++trial) {
+    cp::Linkage l = testing::planar::quick_return(rng, trial % 2 == 0, trial >= 4);
+    // the block's node carries only its point mass (no spring or node force there)
+    l.springs.clear();
+    std::erase_if(l.loads.node_forces, [](const cp::NodeForce& f) { return f.node == 1; });
+    l.loads.gravity = Vec2(uniform(rng, -2, 2), -9.81);
+    l = cp::make_linkage(l);
+    const cp::Model model(l);
+    cp::DrivenScene scene;
+    scene.speeds = {uniform(rng, 5, 20)};
+    scene.samples = 60;
+    const cp::Trajectory t = cp::simulate_driven(model, scene);
+    ASSERT_TRUE(t.ok()) << t.message;
+    const core::Series& s = t.table;
+    auto col = [&](const char* name) { return s.column_values(name); };
+    const auto th = col("theta_crank"), w = col("omega_crank"), al = col("alpha_crank");
+    const auto fax = col("FAx"), fay = col("FAy");
+    const auto gx = col("Fblock_guidex"), gy = col("Fblock_guidey");
+    const auto xa = col("x_A"), ya = col("y_A");
+    double m = 0;
+    for (const cp::PointMass& pm : l.point_masses) m += pm.node == 1 ? pm.mass : 0.0;
+    const Vec2 O = l.nodes[0].position, Q = l.nodes[2].position;
+    const double r = (l.nodes[1].position - O).norm();
+    double scale = 0, worst = 0, along = 0;
+    for (std::size_t i = 0; i < th.size(); ++i) {
+      const Vec2 u(std::cos(th[i]), std::sin(th[i]));
+      const Vec2 a = r * (-w[i] * w[i] * u + al[i] * Vec2(-u.y(), u.x()));
+      const Vec2 fa(fax[i], fay[i]), guide(gx[i], gy[i]);
+      const Vec2 expected = -fa + m * (l.loads.gravity - a);
+      scale = std::max({scale, fa.norm(), guide.norm()});
+      worst = std::max(worst, (guide - expected).norm());
+      const Vec2 line = (Vec2(xa[i], ya[i]) - Q).normalized();  // the guide runs through Q and A
+      along = std::max(along, std::abs(guide.dot(line)));
+    }
+    EXPECT_GT(scale, 0.0);
+    EXPECT_LT(worst, 1e-12 * scale) << "trial " << trial;
+    EXPECT_LT(along, 1e-12 * scale) << "trial " << trial;
+  }
+}
+
 }  // namespace
 }  // namespace bd

@@ -34,6 +34,7 @@
 //    link, from the point motions of the node and the guide's two nodes;
 //  * R<ground node> = sum over the node's ground pins of -pin force (force ON the frame);
 //    R<slider> (frame guide) = -slider force (the guide's normal force ON the frame);
+//    F<slider>_guide (moving guide) = -slider force - a slide drive's effort along the guide;
 //  * F<joint> on a link through two or more: the force of pin {host, link}; on the only link
 //    through the node (a slider's or point mass's node): the resultant of everything else on the
 //    node (slider normal forces, slide drives, node forces, springs, weight of the point masses)
@@ -297,6 +298,16 @@ inline core::Series reference_table(const cp::Model& model, const Glue& g,
       const Vec2 f = j.link == g.host[static_cast<std::size_t>(j.node)]
                          ? single_link_joint_force(g, s, j.node)
                          : s.pin_forces[static_cast<std::size_t>(g.pin.at({j.node, j.link}))];
+      v.insert(v.end(), {f.x(), f.y()});
+    }
+    // a slider on a moving guide: the force on the guide's link from the node, the reaction of
+    // the guide's force on the node and of a slide drive's along it
+    for (int k : model.link_guides()) {
+      Vec2 f = -s.slider_forces[static_cast<std::size_t>(k)];
+      for (std::size_t i = 0; i < l.inputs.size(); ++i) {
+        if (l.inputs[i].kind == cp::Input::Kind::kSlide && l.inputs[i].slider == k)
+          f -= s.input_efforts[i] * guide_direction(g, s, k);
+      }
       v.insert(v.end(), {f.x(), f.y()});
     }
     v.insert(v.end(), {s.shaking_force.x(), s.shaking_force.y(), s.shaking_moment});
