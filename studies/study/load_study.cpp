@@ -356,6 +356,9 @@ void check_quotes_closed(const std::string& text, const std::vector<YAML::Mark>&
         }
       }
     }
+    if (close >= text.size()) {  // no closing quote at all: yaml-cpp takes the file's end
+      r.fail(at, "this quoted value is not closed: no closing quote before the end of the file");
+    }
     const std::size_t first_line = text.rfind('\n', open) + 1;  // npos + 1 == 0
     const std::size_t depth = indent_of(first_line);
     int row = at.line;

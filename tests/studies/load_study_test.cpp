@@ -150,6 +150,9 @@ TEST(LoadStudy, YamlSyntaxErrorsBecomeOneLineErrorsWithTheirPlace) {
                "it runs on to line 2 ('linkage:')");
   expect_error(edit("  type: free\n", "  type: 'free\n") + "  samples: 'x'\n", 15, 9,
                "it runs on to line 16 ('theta1: 1.0')");
+  // on the last line, where yaml-cpp ends the value at the file's end without a word
+  expect_error(kBase + "method: \"auto\n", 18, 9,
+               "this quoted value is not closed: no closing quote before the end of the file");
   // a quoted value may run on over lines deeper than its key, and hold quotes of the other kind
   // or doubled
   // or doubled (read whole, then refused as a name for its characters)
