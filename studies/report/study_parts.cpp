@@ -39,7 +39,14 @@ std::string page_start(const Study& study, const Json& summary) {
   return h;
 }
 
-std::string run_table(const Json& run, const std::string& what) {
+namespace {
+bool free_scene(const Json& summary) {
+  const Json* scene = member(summary, "scene");
+  return scene && text(*scene, "type") == "free";
+}
+}  // namespace
+
+std::string run_table(const Json& run, const std::string& what, bool free) {
   std::string h = "<table>";
   if (const Json* method = member(run, "method")) {
     h += "<tr><th>method</th><td><b>" + esc(text(*method, "used")) + "</b> (requested " +
@@ -50,8 +57,9 @@ std::string run_table(const Json& run, const std::string& what) {
        esc(text(run, "status")) + "</td></tr>";
   h += "<tr><th>message</th><td>" + esc(text(run, "message")) + "</td></tr>";
   h += "<tr><th>samples</th><td>" + esc(text(run, "samples")) + "</td></tr>";
-  h += "<tr><th>integrator steps, dynamics evaluations</th><td>" + esc(text(run, "steps")) + ", " +
-       esc(text(run, "rhs_evaluations")) + "</td></tr>";
+  // a driven run integrates nothing: it has no integrator steps to show
+  if (free) h += "<tr><th>integrator steps</th><td>" + esc(text(run, "steps")) + "</td></tr>";
+  h += "<tr><th>dynamics evaluations</th><td>" + esc(text(run, "rhs_evaluations")) + "</td></tr>";
   if (!ok) {
     h += "<tr><td colspan=\"2\" class=\"bad\">The " + what +
          " simulation stopped early: the charts and metrics cover the samples computed.</td></tr>";
@@ -66,10 +74,10 @@ std::string simulation_section(const Json& summary) {
     h += "<p class=\"notice bad\">The simulation stopped early: " + esc(text(summary, "message")) +
          "</p>\n";
   }
-  h += run_table(summary, "original design's");
+  h += run_table(summary, "original design's", free_scene(summary));
   if (const Json* scene = member(summary, "scene")) {
     h += "<h3>Scene</h3>" + json_table(*scene);
-    if (text(*scene, "type") == "free")  // a driven scene integrates nothing
+    if (free_scene(summary))  // a driven scene integrates nothing
       h += "<p>Integrator relative tolerance " + esc(text(summary, "tolerance")) + ".</p>\n";
   }
   // the units: SI on the page; what the study file gave in units of its own
@@ -559,8 +567,20 @@ std::string second_design_section(const Json& summary, const SecondDesign& sd,
          "</h2>\n";
     if (const Json* s = member(summary, section)) h += json_table(*s, scales);
     if (const Json* run = member(summary, second + "_run")) {
-      h += "<h3>Its simulation (same scene)</h3>" + run_table(*run, second_label + " design's");
+      h += "<h3>Its simulation (same scene)</h3>" +
+           run_table(*run, second_label + " design's", free_scene(summary));
     }
+  } else if (member(summary, "balanced_run") || member(summary, "optimized_run")) {
+    // simulated, but its time series is not in this folder (deleted or not copied with it)
+    const bool balanced = member(summary, "balanced_run") != nullptr;
+    h += std::string("<h2>") + (balanced ? "Balanced design" : "Optimised design") +
+         "</h2>\n<p class=\"notice bad\">The " + (balanced ? "balanced" : "optimised") +
+         " design was simulated, but its time series <code>" +
+         (balanced ? "balanced" : "optimized") +
+         "-timeseries.csv</code> is missing from this folder: its charts and metrics are left "
+         "out. Run the study again to write it.</p>";
+    if (const Json* s = member(summary, balanced ? "balance" : "optimize"))
+      h += json_table(*s, scales);
   } else if (const Json* s = member(summary, "optimize")) {
     h += "<h2>Optimisation</h2>\n<p class=\"notice bad\">No optimum was found.</p>" +
          json_table(*s, scales);

@@ -22,8 +22,9 @@ SecondDesign second_design(const Json& summary, const std::filesystem::path& dir
 
 /// The page's head and title, and its first paragraph.
 std::string page_start(const Study& study, const Json& summary);
-/// The run facts of summary.json (or of its balanced_run / optimized_run) as a table.
-std::string run_table(const Json& run, const std::string& what);
+/// The run facts of summary.json (or of its balanced_run / optimized_run) as a table; `free`:
+/// the scene integrates (a driven one has no integrator steps to show).
+std::string run_table(const Json& run, const std::string& what, bool free);
 /// "Simulation": the status first, the run facts and the scene.
 std::string simulation_section(const Json& summary);
 /// "Metrics": the metrics of summary.json, beside the second design's and their ratio; a value

@@ -85,6 +85,7 @@ std::optional<double> number(const std::string& field) {
 
 struct Parameter {
   std::string path;
+  std::string label;  // in an engineer's words with its unit (engineer_name())
   bool log_scale = false;
   std::vector<double> values;  // a grid's values, as sweep.json lists them
 };
@@ -214,6 +215,7 @@ struct Sweep {
 
 void check_header(Sweep& s, const fs::path& csv_file, const fs::path& json_file,
                   const Study& study);
+std::string engineer_name(const std::string& path, const Study& study);
 void choose_sample(Sweep& s, std::size_t points);
 void take_row(Sweep& s, const std::vector<std::string>& row);
 
@@ -235,6 +237,7 @@ Sweep load_sweep(const Study& study, const fs::path& dir) {
     for (const Json& p : (*ps)) {
       Parameter q;
       q.path = text(p, "path");
+      q.label = engineer_name(q.path, study);
       q.log_scale = text(p, "scale") == "log";
       if (const Json* values = member(p, "values")) {
         for (const Json& v : (*values)) {
@@ -295,12 +298,22 @@ void check_header(Sweep& s, const fs::path& csv_file, const fs::path& json_file,
     s.second_label = "optimised";
   }
   // the drive torque is zero in free motion: no chart of it there
-  const bool driven = std::holds_alternative<core::DrivenScene>(study.scene);
+  const bool driven = std::holds_alternative<core::DrivenScene>(study.scene) ||
+                      std::holds_alternative<core::planar::DrivenScene>(study.scene);
   for (const MainMetric& m : kMainMetrics) {
     const std::string base = m.base;
     if (base == "tau" && !driven) continue;
     if (!s.col(base + "_rms")) continue;
-    Metric metric{base, base + "_rms", m.what, {{"original", base + "_rms", base + "_max", false}}};
+    std::string what = m.what;
+    if (!study.is_fourbar()) {
+      // a planar linkage's moment is about the origin; its one input's drive may be a slide's
+      if (base == "Msh") what = "shaking moment |Msh| about the origin [N m]";
+      if (base == "tau" && study.planar().inputs.size() == 1 &&
+          study.planar().inputs[0].kind == core::planar::Input::Kind::kSlide) {
+        what = "drive force |τ| [N]";
+      }
+    }
+    Metric metric{base, base + "_rms", what, {{"original", base + "_rms", base + "_max", false}}};
     if (!s.second.empty() && s.col(s.second + base + "_rms")) {
       metric.series.push_back(
           {s.second_label, s.second + base + "_rms", s.second + base + "_max", true});
@@ -506,7 +519,10 @@ std::string design_section(const Sweep& s) {
 // the parameters' header cells, and one row's parameter cells
 std::string param_headers(const Sweep& s) {
   std::string h;
-  for (const Parameter& p : s.params) h += "<th><code>" + esc(p.path) + "</code></th>";
+  for (const Parameter& p : s.params) {
+    h += "<th>" + esc(p.label) + (p.label == p.path ? "" : "<br><code>" + esc(p.path) + "</code>") +
+         "</th>";
+  }
   return h;
 }
 std::string param_cells(const Sweep& s, const std::vector<std::string>& row) {
@@ -525,30 +541,38 @@ std::string best_section(const Sweep& s) {
       std::string(added_mass ? " and of the added mass" : "") +
       ", among the points whose status is ok";
   if (s.second == "optimized_") h += " (for the original design also those without an optimum)";
-  h += ".</p>\n<table><tr><th>metric</th><th>least value</th><th>at point</th>" + param_headers(s) +
-       "</tr>";
+  h += ".</p>\n<table><tr><th>metric</th><th>least value</th><th>unit</th><th>at point</th>" +
+       param_headers(s) + "</tr>";
   bool any = false, noise = false;
-  std::map<std::string, double> floors;  // by series column
-  for (const Metric& m : s.metrics)
-    for (const Series& se : m.series) floors[se.column] = s.floor(m);
+  std::map<std::string, double> floors;      // by series column
+  std::map<std::string, std::string> units;  // by series column, from its chart's axis label
+  for (const Metric& m : s.metrics) {
+    for (const Series& se : m.series) {
+      floors[se.column] = s.floor(m);
+      units[se.column] = unit_in(m.what);
+    }
+  }
   for (const Series& se : s.all_series()) {
     const auto it = s.best.find(se.column);
     if (it == s.best.end() || !it->second.row) continue;
     any = true;
     const std::vector<std::string>& row = *it->second.row;
-    h += "<tr><th>" + esc(se.column) + "</th>" + num_cell(row[*s.col(se.column)]);
+    const std::string& written = row[*s.col(se.column)];
+    const std::string unit = "<td>" + esc(units[se.column]) + "</td>";
     if (it->second.value <= floors[se.column]) {
-      // round-off: no point is better than another
+      // round-off: no point is better than another, and the value is 0 (exact on hover)
       noise = true;
-      h += "<td colspan=\"" + std::to_string(1 + s.params.size()) +
+      h += "<tr><th>" + esc(se.column) + "</th><td class=\"n\" title=\"" + esc(written) +
+           "\">0</td>" + unit + "<td colspan=\"" + std::to_string(1 + s.params.size()) +
            "\">zero to round-off (every value at or below " + fmt(floors[se.column]) +
            " ranks alike)</td></tr>";
       continue;
     }
-    h += num_cell(row[0]) + param_cells(s, row) + "</tr>";
+    h += "<tr><th>" + esc(se.column) + "</th>" + num_cell(written) + unit + num_cell(row[0]) +
+         param_cells(s, row) + "</tr>";
   }
   if (!any) {
-    h += "<tr><td colspan=\"" + std::to_string(3 + s.params.size()) +
+    h += "<tr><td colspan=\"" + std::to_string(4 + s.params.size()) +
          "\">no point has finished with status ok yet</td></tr>";
   }
   h += "</table>\n";
@@ -659,9 +683,10 @@ const char* const kPalette =
     "set palette defined (0 '#440154', 0.25 '#3b528b', 0.5 '#21918c', 0.75 '#5ec962', "
     "1 '#fde725')\n";
 
-// a swept value in an engineer's words with its unit, e.g. "coupler mass m2 [kg]", from its
-// path in the study file (the path itself when it is not one of these)
-std::string engineer_name(const std::string& path) {
+// a swept value in an engineer's words with its unit, e.g. "coupler mass m2 [kg]" or "speed of
+// input crank [rad/s]", from its path in the study file (the path itself when it is not one of
+// these); `study` names a planar linkage's inputs and their kinds
+std::string engineer_name(const std::string& path, const Study& study) {
   const std::vector<std::string> k = [&] {
     std::vector<std::string> parts;
     std::string part;
@@ -677,10 +702,19 @@ std::string engineer_name(const std::string& path) {
     return parts;
   }();
   if (k.empty()) return path;
+  const auto is = [&](std::initializer_list<const char*> keys) {
+    if (k.size() != keys.size()) return false;
+    std::size_t i = 0;
+    for (const char* key : keys) {
+      if (*key != '*' && k[i] != key) return false;
+      ++i;
+    }
+    return true;
+  };
   const std::map<std::string, std::string> links = {{"crank", "1"}, {"coupler", "2"},
                                                     {"rocker", "3"}};
   const auto axis = [](const std::string& i) { return std::string(i == "0" ? "x" : "y"); };
-  if (k[0] == "linkage" && k.size() == 2 && k[1] == "frame") return "frame length l4 [m]";
+  if (is({"linkage", "frame"})) return "frame length l4 [m]";
   if (k[0] == "linkage" && k.size() >= 3) {
     // a four-bar's links (crank, coupler, rocker) or a planar linkage's (links.NAME.FIELD)
     const bool planar = k[1] == "links" && k.size() == 4;
@@ -700,24 +734,65 @@ std::string engineer_name(const std::string& path) {
       return name + " " + f->second;
     }
   }
-  if (k[0] == "loads" && k.size() == 3 && k[1] == "gravity") return "gravity g" + axis(k[2]) + " [m/s^2]";
-  if (k[0] == "loads" && k.size() == 4 && k[2] == "force") {
-    return k[1] + " force F" + axis(k[3]) + " [N]";
+  // a planar linkage's other parts
+  if (is({"linkage", "nodes", "*", "*"})) return "node " + k[2] + " " + axis(k[3]) + " [m]";
+  if (is({"linkage", "nodes", "*", "at", "*"})) return "node " + k[2] + " " + axis(k[4]) + " [m]";
+  if (is({"linkage", "point_masses", "*"})) return "point mass at " + k[2] + " [kg]";
+  if (is({"linkage", "springs", "*", "*"})) {
+    const std::map<std::string, std::string> fields = {{"stiffness", "stiffness [N/m]"},
+                                                       {"free_length", "free length [m]"},
+                                                       {"damping", "damping [N s/m]"}};
+    if (const auto f = fields.find(k[3]); f != fields.end())
+      return "spring " + k[2] + " " + f->second;
   }
-  if (k[0] == "loads" && k.size() == 3 && k[2] == "moment") return k[1] + " moment [N m]";
-  if (k[0] == "scene" && k.size() == 2) {
+  if (is({"linkage", "balance_shafts", "*", "*"})) {
+    const std::map<std::string, std::string> fields = {
+        {"mass", "mass [kg]"}, {"inertia", "inertia [kg m^2]"}, {"ratio", "speed ratio"}};
+    if (const auto f = fields.find(k[3]); f != fields.end())
+      return "balance shaft " + k[2] + " " + f->second;
+  }
+  if (is({"linkage", "balance_shafts", "*", "*", "*"}) && (k[3] == "at" || k[3] == "eccentricity"))
+    return "balance shaft " + k[2] + " " + (k[3] == "at" ? "position " : "eccentricity ") +
+           axis(k[4]) + " [m]";
+  if (is({"linkage", "counterweights", "*", "mass"}))
+    return "counterweight on " + k[2] + " mass [kg]";
+  if (is({"linkage", "counterweights", "*", "inertia"}))
+    return "counterweight on " + k[2] + " inertia [kg m^2]";
+  if (is({"linkage", "counterweights", "*", "at", "*"}))
+    return "counterweight on " + k[2] + " position " + axis(k[4]) + " [m]";
+  if (is({"linkage", "inputs", "*", "torque"})) return "drive torque on " + k[2] + " [N m]";
+  if (is({"linkage", "inputs", "*", "force"})) return "drive force on " + k[2] + " [N]";
+  if (is({"loads", "gravity", "*"})) return "gravity g" + axis(k[2]) + " [m/s^2]";
+  if (is({"loads", "*", "force", "*"})) return k[1] + " force F" + axis(k[3]) + " [N]";
+  if (is({"loads", "*", "moment"})) return k[1] + " moment [N m]";
+  if (is({"loads", "links", "*", "force", "*"})) return k[2] + " force F" + axis(k[4]) + " [N]";
+  if (is({"loads", "links", "*", "moment"})) return k[2] + " moment [N m]";
+  if (is({"loads", "nodes", "*", "force", "*"}))
+    return "force F" + axis(k[4]) + " at node " + k[2] + " [N]";
+  if (is({"scene", "*"})) {
     const std::map<std::string, std::string> scene = {
         {"omega1", "crank speed ω1 [rad/s]"},
         {"theta1", "initial crank angle θ1 [rad]"},
         {"duration", "duration [s]"}};
     if (const auto f = scene.find(k[1]); f != scene.end()) return f->second;
   }
+  // a planar scene's value per input: named by the input, in its unit (an angle's or a slide's)
+  if (is({"scene", "*", "*"}) && !study.is_fourbar()) {
+    const auto& inputs = study.planar().inputs;
+    const std::size_t i = static_cast<std::size_t>(std::strtoul(k[2].c_str(), nullptr, 10));
+    const std::map<std::string, std::pair<std::string, std::string>> scene = {
+        {"speeds", {"speed", "/s"}}, {"start", {"start", ""}}, {"rates", {"initial rate", "/s"}}};
+    const auto f = scene.find(k[1]);
+    if (f != scene.end() && i < inputs.size()) {
+      const bool angle = inputs[i].kind == core::planar::Input::Kind::kAngle;
+      return f->second.first + " of input " + inputs[i].name + " [" + (angle ? "rad" : "m") +
+             f->second.second + "]";
+    }
+  }
   return path;
 }
 
-std::string axis_label(const Parameter& p) {
-  return engineer_name(p.path) + (p.log_scale ? " (log scale)" : "");
-}
+std::string axis_label(const Parameter& p) { return p.label + (p.log_scale ? " (log scale)" : ""); }
 
 // a value as charted: round-off below the metric's floor drawn as zero
 double charted(double v, double floor) { return std::abs(v) <= floor ? 0.0 : v; }
@@ -852,8 +927,8 @@ void one_parameter(const Sweep& s, Charts& out) {
         peaks ? m.name + " (solid, points) and " + m.id + "_max (dotted) of each point"
               : m.name + " of each point";
     out.charts.push_back(
-        {"sweep-" + m.id, m.name + " against " + engineer_name(s.params[0].path),
-         caption + " against " + engineer_name(s.params[0].path) +
+        {"sweep-" + m.id, m.name + " against " + s.params[0].label,
+         caption + " against " + s.params[0].label +
              (m.series.size() > 1
                   ? ", the " + m.series[1].label + " design dashed over the " + m.series[0].label
                   : std::string()) +
@@ -968,16 +1043,13 @@ void heat_maps(const Sweep& s, Charts& out) {
       panels.push_back("set title " + gp_string(se.label + title_note) + cb + p + items);
     }
     if (panels.empty()) continue;
-    out.charts.push_back(
-        {"sweep-" + m.id,
-         m.name + " over " + engineer_name(px.path) + " and " + engineer_name(py.path),
-         m.name + " (" + m.what +
-             ") at each grid point, one rectangle per point reaching "
-             "halfway to its neighbours" +
-             panels_text(m) +
-             ". Grey: failed points; blank: points not run; " + least_circle_note() +
-             sample_note(s),
-         kPalette + side_by_side(m.name + ": " + m.what, panels), true});
+    out.charts.push_back({"sweep-" + m.id, m.name + " over " + px.label + " and " + py.label,
+                          m.name + " (" + m.what +
+                              ") at each grid point, one rectangle per point reaching "
+                              "halfway to its neighbours" +
+                              panels_text(m) + ". Grey: failed points; blank: points not run; " +
+                              least_circle_note() + sample_note(s),
+                          kPalette + side_by_side(m.name + ": " + m.what, panels), true});
   }
 }
 
@@ -1025,14 +1097,13 @@ void scatter_maps(const Sweep& s, Charts& out) {
       panels.push_back("set title " + gp_string(se.label + title_note) + cb + p + items);
     }
     if (panels.empty()) continue;
-    out.charts.push_back(
-        {"sweep-" + m.id,
-         m.name + " over " + engineer_name(px.path) + " and " + engineer_name(py.path),
-         m.name + " (" + m.what + ") at each point of the " +
-             (s.design == "lhs" ? "Latin-hypercube" : "random") + " design, by colour" +
-             panels_text(m) +
-             ". Grey crosses: failed points; " + least_circle_note() + sample_note(s),
-         kPalette + side_by_side(m.name + ": " + m.what, panels), true});
+    out.charts.push_back({"sweep-" + m.id, m.name + " over " + px.label + " and " + py.label,
+                          m.name + " (" + m.what + ") at each point of the " +
+                              (s.design == "lhs" ? "Latin-hypercube" : "random") +
+                              " design, by colour" + panels_text(m) +
+                              ". Grey crosses: failed points; " + least_circle_note() +
+                              sample_note(s),
+                          kPalette + side_by_side(m.name + ": " + m.what, panels), true});
   }
 }
 

@@ -424,6 +424,9 @@ void add_second_run(Json& j, const Study& study, const std::string& what,
   j[what + "_metrics"] = metrics_json(second);
   j[what + "_peaks"] = peaks_json(study, second);
   j["reduction"] = reduction_json(original, second);
+  // the second design's own metrics (balance shafts, counter-rotations) have their units too
+  for (const MetricValue& m : second)
+    if (!j["metric_units"].contains(m.name)) j["metric_units"][m.name] = m.unit;
 }
 
 }  // namespace

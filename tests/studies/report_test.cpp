@@ -371,6 +371,33 @@ TEST_F(ReportTest, ReportIsRebuiltFromTheDataFiles) {
   EXPECT_EQ(read(dir_ / "report.html"), first);  // the same files give the same page
 }
 
+TEST_F(ReportTest, AMissingTimeSeriesOfTheBalancedDesignIsSaidAsMissing) {
+  const Study study =
+      load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven-force-balanced.yaml");
+  ASSERT_TRUE(run_study(study, dir_).ok());
+  fs::remove(dir_ / "balanced-timeseries.csv");
+  write_report(study, dir_);
+  const std::string html = read(dir_ / "report.html");
+  // it was simulated (summary.json says so): the page does not say otherwise
+  EXPECT_EQ(html.find("was not simulated"), std::string::npos);
+  EXPECT_NE(html.find("<code>balanced-timeseries.csv</code> is missing from this folder"),
+            std::string::npos);
+}
+
+TEST_F(ReportTest, RunFactsSayIntegratorStepsOnlyForAFreeScene) {
+  const auto facts = [&](const char* example) {
+    const Study study = load_study(std::string(BD_SOURCE_DIR "/studies/examples/") + example);
+    run_study(study, dir_);
+    return read(dir_ / "report.html");
+  };
+  const std::string driven = facts("paper-fourbar-driven.yaml");
+  EXPECT_EQ(driven.find("integrator steps"), std::string::npos);
+  EXPECT_NE(driven.find("<tr><th>dynamics evaluations</th>"), std::string::npos);
+  const std::string free = facts("paper-fourbar.yaml");
+  EXPECT_NE(free.find("<tr><th>integrator steps</th>"), std::string::npos);
+  EXPECT_NE(free.find("<tr><th>dynamics evaluations</th>"), std::string::npos);
+}
+
 TEST_F(ReportTest, FolderWithoutSummaryIsAnError) {
   const Study study = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml");
   EXPECT_THROW(report_html(study, dir_, ""), std::runtime_error);

@@ -538,13 +538,13 @@ TEST_F(SweepReportTest, OptimizeSweepKeepsTheOriginalOfAPointWithoutOptimum) {
   EXPECT_EQ(m[1].str(), rows[0][2]);
   // the second design here is force-balanced: its Fsh is round-off, ranked nowhere
   EXPECT_TRUE(std::regex_search(
-      best, std::regex("<tr><th>optimized_Fsh_rms</th><td class=\"n\" title=\"[^\"]*\">[^<]*"
-                       "</td><td colspan=\"2\">zero to round-off")))
+      best, std::regex("<tr><th>optimized_Fsh_rms</th><td class=\"n\" title=\"[^\"]*\">0"
+                       "</td><td>N</td><td colspan=\"2\">zero to round-off")))
       << best;
   ASSERT_TRUE(std::regex_search(
       best, m,
       std::regex("<tr><th>optimized_Msh_rms</th><td class=\"n\" title=\"[^\"]*\">[^<]*</td>"
-                 "<td class=\"n\" title=\"([0-9]+)\">")));
+                 "<td>N m</td><td class=\"n\" title=\"([0-9]+)\">")));
   EXPECT_NE(m[1].str(), "0");  // not at the point without an optimum
   EXPECT_EQ(count(section(html, "Failed points"), ">no-optimum<"), 1u);
 }
@@ -686,15 +686,16 @@ TEST_F(SweepReportTest, LargeGridIsSampledForTheChartsAndRankedWhole) {
   EXPECT_NE(html.find("22500 of 22500 points done"), std::string::npos);
   const std::string best = section(html, "Best points");
   std::smatch m;
-  ASSERT_TRUE(std::regex_search(
-      best, m,
-      std::regex("<tr><th>Fsh_rms</th><td class=\"n\" title=\"[^\"]*\">[^<]*</td>"
-                 "<td class=\"n\" title=\"([0-9]+)\">")));
+  ASSERT_TRUE(
+      std::regex_search(best, m,
+                        std::regex("<tr><th>Fsh_rms</th><td class=\"n\" title=\"[^\"]*\">[^<]*</td>"
+                                   "<td>N</td><td class=\"n\" title=\"([0-9]+)\">")));
   EXPECT_EQ(m[1].str(), "151");
   EXPECT_NE(best.find("<tr><th>balanced_Fsh_rms</th>"), std::string::npos);
-  EXPECT_TRUE(std::regex_search(best, std::regex("<tr><th>balanced_Fsh_rms</th><td class=\"n\" "
-                                                 "title=\"[^\"]*\">[^<]*</td><td colspan=\"3\">"
-                                                 "zero to round-off")))
+  EXPECT_TRUE(
+      std::regex_search(best, std::regex("<tr><th>balanced_Fsh_rms</th><td class=\"n\" "
+                                         "title=\"[^\"]*\">0</td><td>N</td><td colspan=\"3\">"
+                                         "zero to round-off")))
       << best;
   if (gnuplot_.empty()) return;
   // 40 values a side, the last ones included (every 4th value from the first stopped at the

@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "studies/report/report.hpp"
 #include "studies/report/report_support.hpp"
 #include "studies/run/runner.hpp"
 #include "studies/studies.hpp"
@@ -201,6 +202,28 @@ TEST_F(SweepRunner, EachRowIsThePointsStudyRunOnItsOwn) {
   // a values list: from and to are its least and greatest
   EXPECT_EQ((*params)[1]["from"].get<double>(), 0.5);
   EXPECT_EQ((*params)[1]["to"].get<double>(), 2.5);
+}
+
+// A planar sweep's page names each swept value in an engineer's words with its unit (the input
+// by its name, in its unit), gives the best values their units, and the shaking moment's point.
+TEST_F(SweepRunner, APlanarSweepsPageNamesItsParametersAndUnits) {
+  const Study study = parse_study(bd::testing::engine_study(12) +
+                                      "sweep:\n"
+                                      "  parameters:\n"
+                                      "    - {path: linkage.point_masses.B, values: [0.3, 0.5]}\n"
+                                      "    - {path: \"scene.speeds[0]\", values: [100, 200]}\n",
+                                  "e.yaml");
+  ASSERT_EQ(run_sweep(study, dir_, quiet(1)).done, 4);
+  const std::string html = sweep_report_html(study, dir_, "");
+  EXPECT_NE(html.find("<th>point mass at B [kg]<br><code>linkage.point_masses.B</code></th>"),
+            std::string::npos);
+  EXPECT_NE(html.find("<th>speed of input crank [rad/s]<br><code>scene.speeds[0]</code></th>"),
+            std::string::npos);
+  EXPECT_NE(html.find("<tr><th>Msh_rms</th><td class=\"n\" title=\""), std::string::npos);
+  const std::size_t msh = html.find("<tr><th>Msh_rms</th>");
+  EXPECT_NE(html.find("</td><td>N m</td>", msh), std::string::npos);
+  // the four-bar's A0 is no point of this linkage: its moment is about the origin
+  EXPECT_EQ(html.find("about A0"), std::string::npos);
 }
 
 // A planar linkage with a balance section sweeps alike: its own metrics, the balanced design's
