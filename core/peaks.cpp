@@ -122,6 +122,18 @@ struct Candidate {
 
 }  // namespace
 
+std::vector<double> step_instants(std::span<const double> t, std::span<const long> steps_to) {
+  std::vector<double> out;
+  if (steps_to.size() != t.size()) return out;
+  for (std::size_t i = 0; i + 1 < t.size(); ++i) {
+    const long m = std::min(steps_to[i + 1] - steps_to[i], kMaxStepInstants + 1);
+    for (long j = 1; j < m; ++j) {
+      out.push_back(t[i] + (t[i + 1] - t[i]) * static_cast<double>(j) / static_cast<double>(m));
+    }
+  }
+  return out;
+}
+
 Peak resolved_peak(std::span<const double> t, std::span<const double> x, double period,
                    const QuantityAt& f) {
   const std::size_t n = std::min(t.size(), x.size());

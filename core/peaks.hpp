@@ -5,6 +5,7 @@
 /// Shared by every linkage type's metrics (core/fourbar/metrics.hpp, core/planar/metrics.hpp).
 #include <functional>
 #include <span>
+#include <vector>
 
 namespace bd::core {
 
@@ -33,6 +34,19 @@ inline constexpr double kPeakSettlingTolerance = 1e-12;
 /// 7 samples per turn lost a quarter of its peak; from 8 samples on it was found), and 16 gives
 /// that twice over.
 inline constexpr std::size_t kMinPeakSamples = 16;
+
+/// At most this many instants are added between two samples of a free run (step_instants()).
+inline constexpr long kMaxStepInstants = 256;
+
+/// A free run's instants between its samples where its peaks are looked for too: where the
+/// integrator took m > 1 steps from sample i to sample i + 1 (`steps_to[i + 1] - steps_to[i]`),
+/// m - 1 instants evenly between the two (at most kMaxStepInstants), in increasing order. The
+/// quantity evaluated there with the samples is then at least as fine as the integration's own
+/// steps, so a peak the motion resolves has a local maximum near it for resolved_peak() to
+/// refine, however few the samples (a free run's peak may lie wholly between two coarse samples
+/// where neither is a local maximum). `steps_to`: the steps taken up to each sample; none when
+/// its size is not t's.
+std::vector<double> step_instants(std::span<const double> t, std::span<const long> steps_to);
 
 /// The peak of x over the samples x[i] = f(t[i]) (t increasing); with fewer than kMinPeakSamples
 /// samples, over those and f evaluated evenly between them. Every sampled local maximum whose

@@ -108,13 +108,42 @@ Metrics with_peaks(const Trajectory& trajectory, double period,
     }
     return cached;
   };
-  auto refine = [&](std::span<const double> x, bool refined, auto magnitude_of) {
+  // a free run's instants between samples where the integrator stepped more than once, evaluated
+  // once for every refined peak: the samples with them (their magnitudes) are what the refined
+  // peaks search
+  std::vector<double> dense_t;
+  std::vector<DynamicsSample> dense;
+  bool any_refined = resolve == nullptr;
+  for (std::size_t k = 0; resolve && k < kMetricCount; ++k)
+    any_refined = any_refined || (*resolve)[k];
+  if (sample_at && any_refined) {
+    const std::vector<double> extra = step_instants(trajectory.t, trajectory.steps_to);
+    dense_t.reserve(samples.size() + extra.size());
+    dense.reserve(samples.size() + extra.size());
+    std::size_t e = 0;
+    for (std::size_t i = 0; i < samples.size() && !extra.empty(); ++i) {
+      dense_t.push_back(trajectory.t[i]);
+      dense.push_back(samples[i]);
+      for (; e < extra.size() && (i + 1 == samples.size() || extra[e] < trajectory.t[i + 1]); ++e) {
+        if (const std::optional<DynamicsSample>& d = at(extra[e])) {
+          dense_t.push_back(extra[e]);
+          dense.push_back(*d);
+        }
+      }
+    }
+  }
+  const bool densified = dense.size() > samples.size();
+  const std::unique_ptr<const SampleMagnitudes> dense_magnitudes =
+      densified ? std::make_unique<const SampleMagnitudes>(dense) : nullptr;
+  auto refine = [&](std::span<const double> x, std::span<const double> x_dense, bool refined,
+                    auto magnitude_of) {
     QuantityAt f;
     if (sample_at && refined) {
       f = [&](double s) {
         const std::optional<DynamicsSample>& d = at(s);
         return d ? magnitude_of(*d) : std::nan("");
       };
+      if (densified) return resolved_peak(dense_t, x_dense, period, f);
     }
     return resolved_peak(trajectory.t, x, period, f);
   };
@@ -125,8 +154,11 @@ Metrics with_peaks(const Trajectory& trajectory, double period,
       if (peaks) peaks->table[k] = {m.*info.field, 0.0};
       continue;
     }
-    const Peak p = refine(magnitudes.of(info.quantity), !resolve || (*resolve)[k],
-                          [&](const DynamicsSample& d) { return magnitude(d, info.quantity); });
+    const Peak p =
+        refine(magnitudes.of(info.quantity),
+               densified ? dense_magnitudes->of(info.quantity) : std::span<const double>(),
+               !resolve || (*resolve)[k],
+               [&](const DynamicsSample& d) { return magnitude(d, info.quantity); });
     m.*info.field = p.value;
     if (peaks) peaks->table[k] = p;
   }
@@ -137,8 +169,9 @@ Metrics with_peaks(const Trajectory& trajectory, double period,
       if (peaks) peaks->output[k] = {m.*info.field, 0.0};
       continue;
     }
-    const Peak p = refine(magnitudes.output(k), resolve == nullptr,
-                          [&](const DynamicsSample& d) { return magnitude(d, info.quantity); });
+    const Peak p = refine(
+        magnitudes.output(k), densified ? dense_magnitudes->output(k) : std::span<const double>(),
+        resolve == nullptr, [&](const DynamicsSample& d) { return magnitude(d, info.quantity); });
     m.*info.field = p.value;
     if (peaks) peaks->output[k] = p;
   }

@@ -433,6 +433,7 @@ void reserve(OpenedLoopDaeResult& out, std::size_t samples) {
   }
   out.trajectory.t.reserve(samples);
   out.trajectory.samples.reserve(samples);
+  out.trajectory.steps_to.reserve(samples);
   out.branch.reserve(samples);
 }
 
@@ -590,6 +591,7 @@ OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FourBar
     return out;
   }
   record(out, model, 0.0, *first);
+  traj.steps_to.push_back(0);
 
   const bool projection = options.stabilisation == Stabilisation::kProjection;
   integrators::Integration integration(
@@ -617,6 +619,7 @@ OpenedLoopDaeResult simulate_opened_loop_dae(const FourBar& model, const FourBar
       break;
     }
     record(out, model, t_reached, *sample);
+    traj.steps_to.push_back(integration.steps());
   }
 
   traj.steps = integration.steps();

@@ -435,6 +435,7 @@ Trajectory detail::simulate_free_reduced(const FourBar& model, const FreeScene& 
   Trajectory out;
   out.t.reserve(samples);
   out.samples.reserve(samples);
+  out.steps_to.reserve(samples);
 
   FreeMotion motion;
   motion.model = &model;
@@ -451,6 +452,7 @@ Trajectory detail::simulate_free_reduced(const FourBar& model, const FreeScene& 
   }
   out.t.push_back(0.0);
   out.samples.push_back(*first);
+  out.steps_to.push_back(0);
 
   // each output by the integrator's dense output, then the dynamics at that state
   integrators::Problem problem = reduced_problem(model, scene, options, motion);
@@ -488,6 +490,7 @@ Trajectory detail::simulate_free_reduced(const FourBar& model, const FreeScene& 
     continue_angles(model, out.samples.back().state, sample->state);
     out.t.push_back(t_reached);
     out.samples.push_back(*sample);
+    out.steps_to.push_back(integration.steps());
     if (sensitivities != nullptr) {
       std::vector<Vec2>& s = sensitivities->state.emplace_back();
       for (std::size_t i = 0; i < sensitivities->which.size(); ++i) {

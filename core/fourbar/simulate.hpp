@@ -71,6 +71,9 @@ struct Trajectory {
   SimulationStatus status = SimulationStatus::kNotRun;
   std::string message = "simulate was not called";  // one line; names time and crank angle
   long steps{};                                     // integrator steps (free scenes)
+  /// Free scenes: the integrator's steps taken up to each sample (0 at the first), as t; the
+  /// peaks are looked for between samples where it stepped more than once (step_instants()).
+  std::vector<long> steps_to;
   long rhs_evaluations{};                           // dynamics evaluations
   bool ok() const { return status == SimulationStatus::kCompleted; }
 };

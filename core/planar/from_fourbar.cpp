@@ -77,6 +77,7 @@ core::Trajectory fourbar_trajectory(const Trajectory& planar) {
   out.status = planar.status;
   out.message = planar.message;
   out.steps = planar.steps;
+  out.steps_to = planar.steps_to;
   out.rhs_evaluations = planar.rhs_evaluations;
   return out;
 }

@@ -215,24 +215,49 @@ class RowPositions {
 };
 
 // The metrics over the run's table (sample times t), every peak resolved between the samples by
-// `row_at(s)`: the whole row at time s, or null where it cannot be evaluated.
+// `row_at(s)`: the whole row at time s, or null where it cannot be evaluated; `extra`: instants
+// between the samples (increasing) whose rows the peaks' searches start from with the samples'
+// (a free run's step_instants()).
 template <class RowAt>
 std::vector<double> resolved_values(const std::vector<ColumnMetric>& metrics, const Series& table,
                                     const std::vector<double>& t, double period,
-                                    const RowAt& row_at, std::vector<Peak>* peaks) {
+                                    const RowAt& row_at, std::vector<Peak>* peaks,
+                                    std::span<const double> extra = {}) {
   std::vector<double> out = metric_values(metrics, table);
   if (peaks) peaks->assign(metrics.size(), Peak{});
   const std::size_t rows = table.rows();
   if (rows == 0) return out;
   const std::vector<std::vector<int>> columns = metric_columns(metrics, table);
-  std::vector<double> x(rows);
+  // the rows searched: the samples', with the extra instants' rows between them, each evaluated
+  // once for every peak
+  std::vector<double> dense_t;
+  Series dense;
+  dense.columns = table.columns;
+  if (!extra.empty()) {
+    std::size_t e = 0;
+    for (std::size_t i = 0; i < rows; ++i) {
+      dense_t.push_back(t[i]);
+      const std::span<const double> r = table.row(i);
+      dense.values.insert(dense.values.end(), r.begin(), r.end());
+      for (; e < extra.size() && (i + 1 == rows || extra[e] < t[i + 1]); ++e) {
+        if (const double* row = row_at(extra[e])) {
+          dense_t.push_back(extra[e]);
+          dense.values.insert(dense.values.end(), row, row + table.width());
+        }
+      }
+    }
+  }
+  const bool densified = dense_t.size() > rows;
+  const Series& searched = densified ? dense : table;
+  const std::vector<double>& searched_t = densified ? dense_t : t;
+  std::vector<double> x(searched.rows());
   for (std::size_t k = 0; k < metrics.size(); ++k) {
     if (metrics[k].statistic != Statistic::kMax) {
       if (peaks) (*peaks)[k] = {out[k], 0.0};
       continue;
     }
-    for (std::size_t i = 0; i < rows; ++i) x[i] = magnitude(columns[k], table.row(i));
-    const Peak p = resolved_peak(t, x, period, [&](double s) {
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] = magnitude(columns[k], searched.row(i));
+    const Peak p = resolved_peak(searched_t, x, period, [&](double s) {
       const double* row = row_at(s);
       return row ? magnitude(columns[k], {row, table.width()}) : std::nan("");
     });
@@ -367,7 +392,7 @@ std::vector<double> metric_values(const Model& model, const SimulateOptions& opt
     }
     return last ? last->row.data() : nullptr;
   };
-  return resolved_values(metrics, table, t, 0.0, row_at, peaks);
+  return resolved_values(metrics, table, t, 0.0, row_at, peaks, step_instants(t, run.steps_to));
 }
 
 }  // namespace bd::core::planar

@@ -730,6 +730,7 @@ Trajectory empty_table(const Model& model, const FreeScene& scene, std::size_t s
   out.table.values.reserve(static_cast<std::size_t>(scene.samples) * out.table.width());
   out.state_size = state_size;
   out.states.reserve(static_cast<std::size_t>(scene.samples) * state_size);
+  out.steps_to.reserve(static_cast<std::size_t>(scene.samples));
   return out;
 }
 
@@ -759,6 +760,7 @@ void sample_run(const Model& model, Motion& m, integrators::Integration& integra
                 Where where, Evaluate evaluate) {
   out.status = SimulationStatus::kCompleted;
   out.message = "completed";
+  out.steps_to.assign(out.table.rows(), 0);
   for (std::size_t j = 1; j < static_cast<std::size_t>(scene.samples); ++j) {
     m.failed = false;
     const auto outcome = integration.advance(output_time(scene, j));
@@ -771,6 +773,7 @@ void sample_run(const Model& model, Motion& m, integrators::Integration& integra
     }
     append_row(model, m.ws->instant, out.table);
     out.states.insert(out.states.end(), integration.y(), integration.y() + out.state_size);
+    out.steps_to.push_back(integration.steps());
   }
   out.steps = integration.steps();
   out.rhs_evaluations = m.evaluations;

@@ -70,6 +70,9 @@ struct Trajectory {
   SimulationStatus status = SimulationStatus::kNotRun;
   std::string message = "simulate was not called";
   long steps{}, rhs_evaluations{};
+  /// Free runs: the integrator's steps taken up to each row of `table` (0 at the first); the
+  /// peaks are looked for between rows where it stepped more than once (step_instants()).
+  std::vector<long> steps_to;
   /// A free run's integrator state at each sample, `state_size` numbers per row of `table`: the
   /// inputs and their rates (z, ż) on the reduced route, every node coordinate and its rate
   /// (q, q̇) on the dae route, as integrated (before the sample's projection). Empty for a driven
