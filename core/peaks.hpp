@@ -11,8 +11,14 @@ namespace bd::core {
 
 /// Where a quantity is largest, and its value there.
 struct Peak {
+  Peak() = default;
+  Peak(double value_found, double time) : value(value_found), t(time) {}
   double value{};  // the largest value found, never below the largest sample
   double t{};      // its time [s]
+  /// A free scene's inputs there, from the motion at t (a four-bar's crank angle [rad]; a planar
+  /// linkage's inputs in the order of its `inputs`, rad or m); empty in a driven scene, whose
+  /// inputs follow from t, and where the motion at t could not be had.
+  std::vector<double> inputs;
 };
 
 /// The quantity at time t, or NaN where it cannot be evaluated (that instant is then skipped).

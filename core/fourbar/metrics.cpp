@@ -218,16 +218,23 @@ Metrics metrics(const FourBar& model, const Trajectory& trajectory, const Simula
                 const MetricMask* resolve, PeakList* peaks) {
   // each instant integrated from the latest instant known before it
   detail::KnownInstants<DynamicsSample> known(trajectory.t);
-  return with_peaks(
-      trajectory, 0.0,
-      [&](double s) {
-        return known.at(
-            s, [&](std::size_t i) -> const DynamicsSample& { return trajectory.samples[i]; },
-            [&](double t0, const DynamicsSample& from, double t) {
-              return free_sample_from(model, options, t0, from, t);
-            });
-      },
-      peaks, resolve);
+  const auto sample_at = [&](double s) {
+    return known.at(
+        s, [&](std::size_t i) -> const DynamicsSample& { return trajectory.samples[i]; },
+        [&](double t0, const DynamicsSample& from, double t) {
+          return free_sample_from(model, options, t0, from, t);
+        });
+  };
+  const Metrics m = with_peaks(trajectory, 0.0, sample_at, peaks, resolve);
+  // where each peak lies: the crank's angle there
+  const auto locate = [&](Peak& p) {
+    if (const std::optional<DynamicsSample> d = sample_at(p.t)) p.inputs = {d->state.theta1};
+  };
+  for (std::size_t k = 0; peaks && k < kMetricCount; ++k)
+    if (kMetricTable[k].statistic == Statistic::kMax) locate(peaks->table[k]);
+  for (std::size_t k = 0; peaks && k < kOutputCount; ++k)
+    if (kOutputMetrics[k].statistic == Statistic::kMax) locate(peaks->output[k]);
+  return m;
 }
 
 }  // namespace bd::core

@@ -392,7 +392,26 @@ std::vector<double> metric_values(const Model& model, const SimulateOptions& opt
     }
     return last ? last->row.data() : nullptr;
   };
-  return resolved_values(metrics, table, t, 0.0, row_at, peaks, step_instants(t, run.steps_to));
+  std::vector<double> values =
+      resolved_values(metrics, table, t, 0.0, row_at, peaks, step_instants(t, run.steps_to));
+  // where each peak lies: the inputs' values there
+  if (peaks && table.rows() > 0) {
+    std::vector<int> inputs;
+    const Linkage& l = model.linkage();
+    for (const Input& in : l.inputs) {
+      inputs.push_back(
+          in.kind == Input::Kind::kAngle
+              ? table.column("theta_" + l.links[static_cast<std::size_t>(in.link)].name)
+              : table.column("s_" + l.sliders[static_cast<std::size_t>(in.slider)].name));
+    }
+    for (std::size_t k = 0; k < metrics.size(); ++k) {
+      if (metrics[k].statistic != Statistic::kMax) continue;
+      const double* r = row_at((*peaks)[k].t);
+      if (!r) continue;
+      for (const int c : inputs) (*peaks)[k].inputs.push_back(r[c]);
+    }
+  }
+  return values;
 }
 
 }  // namespace bd::core::planar

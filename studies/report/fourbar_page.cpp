@@ -424,7 +424,7 @@ std::string fourbar_report_html(const Study& study, const fs::path& dir, const s
   h += "<h2>Linkage</h2>\n" + fourbar_linkage_tables(study.fourbar());
   const double size = linkage_size(study);
   const Scales scales = run_scales(summary, size);
-  h += metrics_section(summary, second,
+  h += metrics_section(study, summary, second,
                        shaking_metrics_note("A0") +
                            " tau: drive torque; RA0, RA3: forces on the ground at the bearings. "
                            "RMS over the samples, max of magnitudes.",

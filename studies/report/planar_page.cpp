@@ -467,7 +467,7 @@ std::string planar_report_html(const Study& study, const fs::path& dir, const st
   std::string h = page_start(study, summary) + simulation_section(summary);
   h += "<h2>Linkage</h2>\n" + planar_linkage_tables(study.planar());
   const Scales scales = run_scales(summary, linkage_size(study));
-  h += metrics_section(summary, second.design,
+  h += metrics_section(study, summary, second.design,
                        shaking_metrics_note("the origin") +
                            " tau: drive torques (a slide input's: a force in N); R&lt;name&gt;: "
                            "forces on the frame at a ground node or guide; F&lt;joint&gt;: joint "

@@ -107,7 +107,33 @@ std::string ratio_cell(const std::string& written, const std::string& after, dou
 
 }  // namespace
 
-std::string metrics_section(const Json& summary, const SecondDesign& second,
+namespace {
+
+// where the original's peak `name` lies (summary.json's peaks): its time and the inputs there,
+// e.g. "t = 0.0125 s, θ1 = 1.2 rad"; "" for a metric that is no peak
+std::string peak_place(const Study& study, const Json& summary, const std::string& name) {
+  const Json* peaks = member(summary, "peaks");
+  const Json* p = peaks ? member(*peaks, name) : nullptr;
+  const Json* t = p ? member(*p, "t") : nullptr;
+  if (!t || !t->is_number()) return "";
+  std::string s = "t = " + fmt(t->get<double>()) + " s";
+  if (const Json* theta1 = member(*p, "theta1"); theta1 && theta1->is_number()) {
+    s += ", θ1 = " + fmt(theta1->get<double>()) + " rad";
+  } else if (const Json* inputs = member(*p, "inputs");
+             inputs && inputs->is_array() && !study.is_fourbar()) {
+    const auto& in = study.planar().inputs;
+    for (std::size_t k = 0; k < inputs->size() && k < in.size(); ++k) {
+      if (!(*inputs)[k].is_number()) continue;
+      s += ", " + in[k].name + " = " + fmt((*inputs)[k].get<double>()) +
+           (in[k].kind == core::planar::Input::Kind::kAngle ? " rad" : " m");
+    }
+  }
+  return s;
+}
+
+}  // namespace
+
+std::string metrics_section(const Study& study, const Json& summary, const SecondDesign& second,
                             const std::string& notes, const Scales& scales) {
   std::string h = "<h2>Metrics</h2>\n<table><tr><th>metric</th><th>original</th>";
   const Json* metrics = member(summary, "metrics");
@@ -115,7 +141,7 @@ std::string metrics_section(const Json& summary, const SecondDesign& second,
       second.present() ? member(summary, second.key + "_metrics") : nullptr;
   const Json* reduction = member(summary, "reduction");
   if (second_metrics) h += "<th>" + esc(second.label) + "</th><th>ratio after/before</th>";
-  h += "<th>unit</th></tr>";
+  h += "<th>unit</th><th>where the original's peak lies</th></tr>";
   auto value = [](const Json* v) { return v && v->is_number() ? std::abs(v->get<double>()) : 0.0; };
   if (metrics) {
     for (const auto& [k, v] : metrics->items()) {
@@ -129,7 +155,8 @@ std::string metrics_section(const Json& summary, const SecondDesign& second,
         h += (s ? num_cell(text(*s), scale) : "<td></td>") +
              (r ? ratio_cell(text(*r), s ? text(*s) : "", scale) : "<td></td>");
       }
-      h += "<td>" + esc(metric_unit(summary, k)) + "</td></tr>";
+      h += "<td>" + esc(metric_unit(summary, k)) + "</td><td>" +
+           esc(peak_place(study, summary, k)) + "</td></tr>";
     }
   }
   return h + "</table>\n<p>" + notes + "</p>\n";

@@ -29,8 +29,9 @@ std::string run_table(const Json& run, const std::string& what, bool free);
 std::string simulation_section(const Json& summary);
 /// "Metrics": the metrics of summary.json, beside the second design's and their ratio; a value
 /// that is round-off of the run's scale of its unit (`scales`: the largest force of the run, ...)
-/// or of the larger of the two shows as 0, and so does the ratio of such a value.
-std::string metrics_section(const Json& summary, const SecondDesign& second,
+/// or of the larger of the two shows as 0, and so does the ratio of such a value. Each peak
+/// says where the original's lies (its time, and the inputs there; `study` names them).
+std::string metrics_section(const Study& study, const Json& summary, const SecondDesign& second,
                             const std::string& notes, const Scales& scales);
 /// "Comparison" (comparison.csv), when the folder has it; round-off as in metrics_section().
 std::string comparison_section(const std::filesystem::path& dir, const Json& summary,

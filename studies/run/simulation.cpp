@@ -223,19 +223,22 @@ Simulation simulate_unchecked(const Study& study, const MethodChoice& method,
 
 MetricList metric_list(const core::Metrics& metrics, const core::PeakList* peaks) {
   MetricList list;
-  auto peak_t = [](const std::vector<core::Peak>* p, std::size_t k, core::Statistic s) {
-    return p && k < p->size() && s == core::Statistic::kMax ? std::optional<double>((*p)[k].t)
-                                                             : std::nullopt;
+  // a peak's place: its time and, in a free scene, the crank's angle there
+  auto add = [&](const char* name, const char* unit, double value, const std::vector<core::Peak>* p,
+                 std::size_t k, core::Statistic s) {
+    const bool peak = p && k < p->size() && s == core::Statistic::kMax;
+    list.push_back({name, unit, value, peak ? std::optional<double>((*p)[k].t) : std::nullopt,
+                    peak ? (*p)[k].inputs : std::vector<double>{}});
   };
   for (std::size_t k = 0; k < core::kMetricCount; ++k) {
     const core::MetricInfo& info = core::kMetricTable[k];
-    list.push_back({info.name, info.unit, metrics.*info.field,
-                    peak_t(peaks ? &peaks->table : nullptr, k, info.statistic)});
+    add(info.name, info.unit, metrics.*info.field, peaks ? &peaks->table : nullptr, k,
+        info.statistic);
   }
   for (std::size_t k = 0; k < std::size(core::kOutputMetrics); ++k) {
     const core::OutputMetricInfo& info = core::kOutputMetrics[k];
-    list.push_back({info.name, info.unit, metrics.*info.field,
-                    peak_t(peaks ? &peaks->output : nullptr, k, info.statistic)});
+    add(info.name, info.unit, metrics.*info.field, peaks ? &peaks->output : nullptr, k,
+        info.statistic);
   }
   return list;
 }
@@ -286,6 +289,7 @@ MetricList& without_samples_none(MetricList& list, const Simulation& simulation)
   for (MetricValue& m : list) {
     m.value = std::numeric_limits<double>::quiet_NaN();
     m.t.reset();
+    m.inputs.clear();
   }
   return list;
 }
@@ -312,7 +316,8 @@ MetricList metric_list(const Study& study, const Simulation& simulation) {
   for (std::size_t k = 0; k < table.size(); ++k) {
     const bool peak = table[k].statistic == core::Statistic::kMax && k < peaks.size();
     list.push_back({table[k].name, table[k].unit, values[k],
-                    peak ? std::optional<double>(peaks[k].t) : std::nullopt});
+                    peak ? std::optional<double>(peaks[k].t) : std::nullopt,
+                    peak ? peaks[k].inputs : std::vector<double>{}});
   }
   return list;
 }

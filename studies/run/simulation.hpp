@@ -20,6 +20,9 @@ struct MetricValue {
   std::string name, unit;
   double value{};
   std::optional<double> t;  // a peak: the time where it lies [s]
+  /// a peak of a free scene: the inputs' values where it lies (a four-bar's crank angle; a
+  /// planar linkage's inputs), from the motion; empty otherwise
+  std::vector<double> inputs{};
 };
 using MetricList = std::vector<MetricValue>;
 

@@ -44,6 +44,13 @@ Json peaks_json(const Study& study, const MetricList& metrics) {
       for (std::size_t k = 0; k < start.size() && k < pd->speeds.size(); ++k)
         start[k] += pd->speeds[k] * *m.t;
       p["inputs"] = start;
+    } else if (!m.inputs.empty()) {
+      // a free scene: where the motion had the inputs at that time
+      if (study.is_fourbar()) {
+        p["theta1"] = m.inputs[0];
+      } else {
+        p["inputs"] = m.inputs;
+      }
     }
     j[m.name] = p;
   }
