@@ -318,6 +318,46 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
     for (std::size_t j = 0; j < z.size(); ++j) z_at[j] = start[j] + scene.speeds[j] * at;
     return z_at;
   };
+  // A limit position between the last three samples the blocks placed, from their margins
+  // (limit_between()): where, and the run's failure there. `placed`: how the sample at t (inputs
+  // z_now, the one before at t_before) was placed; every closed form placed (well conditioned
+  // or not): the margins are the sample's.
+  struct Limit {
+    double at;
+    std::size_t node;
+    std::vector<double> before, after;  // the inputs at the samples around it
+    // the run's failure there, `shown` the inputs it names
+    PlanarError error(const Model& m, const std::vector<double>& shown) const {
+      return {PlanarError::Kind::kAssembly,
+              "the linkage cannot be assembled at " + detail::inputs_text(m, shown) + ": node " +
+                  m.linkage().nodes[node].name +
+                  " is out of its links' reach there (a limit position between the samples at " +
+                  detail::inputs_text(m, before) + " and " + detail::inputs_text(m, after) +
+                  ": the input cannot turn through it)"};
+    }
+  };
+  const auto limit_at = [&](detail::Placement placed, double t, double t_before,
+                            const std::vector<double>& z_now) -> std::optional<Limit> {
+    if (placed == detail::Placement::kDeclined) {
+      placed_in_a_row = 0;
+      return std::nullopt;
+    }
+    ++placed_in_a_row;
+    for (std::size_t j = 0; j < closing.size(); ++j) {
+      const std::array<double, 3> m = {older[j], last[j], ws.block_margin[closing[j]]};
+      older[j] = m[1];
+      last[j] = m[2];
+      if (placed_in_a_row < 3 || m[1] > m[0] || m[1] > m[2]) continue;  // no minimum near
+      const std::vector<double> z_2 = inputs_at(t_2);
+      const std::optional<double> at =
+          limit_between(model, ws, closing[j], {t_2, t_before, t}, m, z_2, z_now);
+      if (!at) continue;
+      return Limit{*at, static_cast<std::size_t>(system.blocks.blocks[closing[j]].node), z_2,
+                   z_now};
+    }
+    t_2 = t_before;
+    return std::nullopt;
+  };
   double t_prev = 0;
   for (long long i = 0; i < rows; ++i) {
     const double t = times.at(i);
@@ -356,37 +396,11 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
     }
     Expected<bool, PlanarError> ok = true;
     const detail::Placement placed = detail::place_by_blocks(model, ws, guess, z);
-    // every closed form placed (well conditioned or not): the margins are the sample's
-    const bool margins = placed != detail::Placement::kDeclined;
-    if (margins) {
-      ++placed_in_a_row;
-      for (std::size_t j = 0; j < closing.size(); ++j) {
-        const std::array<double, 3> m = {older[j], last[j], ws.block_margin[closing[j]]};
-        older[j] = m[1];
-        last[j] = m[2];
-        if (placed_in_a_row < 3 || m[1] > m[0] || m[1] > m[2]) continue;  // no minimum near
-        const std::vector<double> z_2 = inputs_at(t_2);
-        const std::optional<double> at =
-            limit_between(model, ws, closing[j], {t_2, t_prev, t}, m, z_2, z);
-        if (!at) continue;
-        // the motion ends at the limit: a sample past it goes
-        if (*at < t_prev) out.table.values.resize(out.table.values.size() - out.table.width());
-        const int node = system.blocks.blocks[closing[j]].node;
-        fail(out,
-             PlanarError{PlanarError::Kind::kAssembly,
-                         "the linkage cannot be assembled at " +
-                             detail::inputs_text(model, inputs_at(*at)) + ": node " +
-                             model.linkage().nodes[static_cast<std::size_t>(node)].name +
-                             " is out of its links' reach there (a limit position between the "
-                             "samples at " +
-                             detail::inputs_text(model, z_2) + " and " +
-                             detail::inputs_text(model, z) + ": the input cannot turn through it)"},
-             *at);
-        return out;
-      }
-      t_2 = t_prev;
-    } else {
-      placed_in_a_row = 0;
+    if (const std::optional<Limit> limit = limit_at(placed, t, t_prev, z)) {
+      // the motion ends at the limit: a sample past it goes
+      if (limit->at < t_prev) out.table.values.resize(out.table.values.size() - out.table.width());
+      fail(out, limit->error(model, inputs_at(limit->at)), limit->at);
+      return out;
     }
     if (placed != detail::Placement::kPlaced) {
       if (placed == detail::Placement::kIllConditioned) {
@@ -435,6 +449,36 @@ Trajectory simulate_driven(const Model& model, const DrivenScene& scene) {
     }
     append_row(model, ws.instant, out.table);
     t_prev = t;
+  }
+  // A periodic run (one input turning, whole turns): the samples' windows around its end and its
+  // start (the last sample, the period's end, which is the start, and the second sample) are
+  // searched too, the motion continued past the end at the end's and the second sample's inputs;
+  // a limit there stops the run as one between samples does.
+  int moving = 0;
+  bool turning = false;
+  for (std::size_t k = 0; k < z.size(); ++k) {
+    if (scene.speeds[k] == 0) continue;
+    ++moving;
+    turning = model.linkage().inputs[k].kind == Input::Kind::kAngle;
+  }
+  if (!times.by_duration && moving == 1 && turning && rows >= 2) {
+    const double end = times.at(rows);  // the period's end: the start again
+    for (const double t : {end, times.at(rows + 1)}) {
+      const std::vector<double> z_now = inputs_at(t);
+      const detail::Placement placed = detail::place_by_blocks(model, ws, guess, z_now);
+      const std::optional<Limit> limit = limit_at(placed, t, t_prev, z_now);
+      t_prev = t;
+      if (!limit) continue;
+      // past the end is after the start: the motion stops right after its first sample
+      const double at = limit->at > end ? limit->at - end : limit->at;
+      if (limit->at > end) {
+        out.table.values.resize(out.table.width());
+      } else if (limit->at < times.at(rows - 1)) {
+        out.table.values.resize(out.table.values.size() - out.table.width());
+      }
+      fail(out, limit->error(model, inputs_at(at)), at);
+      return out;
+    }
   }
   out.status = SimulationStatus::kCompleted;
   out.message = "completed";

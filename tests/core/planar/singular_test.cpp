@@ -185,6 +185,58 @@ TEST(Singular, ALimitPositionBetweenTheSamplesStopsTheRun) {
   }
 }
 
+// The same limit range at a single revolution's wrap: between the last sample and the period's
+// end (the start drawn 1e-3 rad past the range), or between the first sample and the second (the
+// start 1e-3 rad before it). No three samples of the revolution bracket it; the run must still
+// stop there: at the end, keeping every sample, or right after its first sample. (Regression: both
+// completed.)
+TEST(Singular, ALimitPositionAtTheRevolutionsWrapStopsTheRun) {
+  Rng rng(407);
+  for (int i = 0; i < 8; ++i) {
+    const double a = uniform(rng, 0.2, 0.5), b = uniform(rng, 1.0, 1.6), c = uniform(rng, 1.8, 2.6);
+    const double side = coin(rng) ? 1.0 : -1.0;
+    const bool forward = coin(rng), at_end = i % 2 == 0;
+    const double direction = forward ? 1.0 : -1.0;
+    // the range's middle at pi (mod 2 pi), the start 1e-3 rad past it or before it
+    const double theta0 = direction * (kPi + (at_end ? 1e-3 : -1e-3));
+    const NearChangePoint f = near_change_point(rng, a, b, c, 1.0, -1e-8, theta0, side);
+    const cp::Model model(f.linkage);
+    cp::DrivenScene scene;
+    scene.speeds = {direction * uniform(rng, 5.0, 40.0)};
+    scene.samples = 360;
+    const std::string label =
+        "four-bar #" + std::to_string(i) + (at_end ? " (at the end)" : " (at the start)");
+    const cp::Trajectory tr = cp::simulate_driven(model, scene);
+    ASSERT_EQ(tr.status, core::SimulationStatus::kAssemblyFailed) << label << ": " << tr.message;
+    EXPECT_NE(tr.message.find("node B is out of its links' reach there (a limit position between "
+                              "the samples at crank = "),
+              std::string::npos)
+        << label << ": " << tr.message;
+    EXPECT_TRUE(all_finite(tr.table)) << label;
+    const std::size_t at = tr.message.rfind("(t = ");
+    ASSERT_NE(at, std::string::npos) << tr.message;
+    const double t_stop = std::stod(tr.message.substr(at + 5));
+    const double theta_stop = theta0 + scene.speeds[0] * t_stop;
+    EXPECT_GT(f.AQ(theta_stop), b + c) << label << ": it closes where the run stopped";
+    const double period = 2 * kPi / std::abs(scene.speeds[0]), h = period / 360;
+    const auto t = tr.table.column_values("t");
+    const auto theta = tr.table.column_values("theta_crank");
+    if (at_end) {
+      EXPECT_GT(t_stop, period - h) << label;
+      EXPECT_LT(t_stop, period) << label;
+      EXPECT_EQ(t.size(), 360u) << label;
+    } else {
+      EXPECT_GT(t_stop, 0.0) << label;
+      EXPECT_LT(t_stop, h) << label;
+      EXPECT_EQ(t.size(), 1u) << label;
+    }
+    for (std::size_t k = 0; k < t.size(); ++k) {
+      EXPECT_LT(t[k], at_end ? period : t_stop) << label;
+      EXPECT_LE(f.AQ(theta[k]), b + c) << label << ": a sample kept where it does not close";
+    }
+  }
+}
+
 // Assembly a hair's breadth from a dead centre: the Jacobian's condition number there grows like
 // 1/sqrt of the distance, so Newton's last steps are round-off times it (1e-12 of the length at
 // 1e-9 of the stroke), above the step at which it stops elsewhere (1e-14). It stops where the
