@@ -13,7 +13,9 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 #include <random>
+#include <string>
 
 #include "core/number_text.hpp"
 #include "core/planar/simulate.hpp"
@@ -140,6 +142,27 @@ TEST(Singular, DrivenPastAHairsBreadthFromADeadCentreKeepsItsBranch) {
   }
 }
 
+// A driven run of f's linkage that must stop at its limit range: the run's stop time (from the
+// message's "(t = ... s)", none where it did not stop so), its status, message and finite table
+// checked, and the crank's angle there (`theta0` the start) checked to lie where the linkage does
+// not close.
+std::optional<double> limit_stop(const NearChangePoint& f, const cp::DrivenScene& scene,
+                                 double theta0, const cp::Trajectory& tr,
+                                 const std::string& label) {
+  EXPECT_EQ(tr.status, core::SimulationStatus::kAssemblyFailed) << label << ": " << tr.message;
+  EXPECT_NE(tr.message.find("node B is out of its links' reach there (a limit position between "
+                            "the samples at crank = "),
+            std::string::npos)
+      << label << ": " << tr.message;
+  EXPECT_TRUE(all_finite(tr.table)) << label;
+  const std::size_t at = tr.message.rfind("(t = ");
+  if (tr.status != core::SimulationStatus::kAssemblyFailed || at == std::string::npos) return {};
+  const double t_stop = std::stod(tr.message.substr(at + 5));
+  EXPECT_GT(f.AQ(theta0 + scene.speeds[0] * t_stop), f.b + f.c)
+      << label << ": it closes where the run stopped";
+  return t_stop;
+}
+
 // A hair's breadth (1e-8 of the frame) short of turning fully: the crank cannot pass the angles
 // where |AQ| > b + c, a range about 4e-4 rad wide that the samples (1.7e-2 rad apart, one 1e-3
 // rad either side of it) step over, each of them assemblable. The run must stop at the limit,
@@ -161,19 +184,10 @@ TEST(Singular, ALimitPositionBetweenTheSamplesStopsTheRun) {
     scene.samples = 360;
     const std::string label = "four-bar #" + std::to_string(i);
     const cp::Trajectory tr = cp::simulate_driven(model, scene);
-    ASSERT_EQ(tr.status, core::SimulationStatus::kAssemblyFailed) << label << ": " << tr.message;
-    EXPECT_NE(tr.message.find("node B is out of its links' reach there (a limit position between "
-                              "the samples at crank = "),
-              std::string::npos)
-        << label << ": " << tr.message;
-    EXPECT_TRUE(all_finite(tr.table)) << label;
-    // the time of the stop, from the message's "(t = ... s)", and the crank's angle there
-    const std::size_t at = tr.message.rfind("(t = ");
-    ASSERT_NE(at, std::string::npos) << tr.message;
-    const double t_stop = std::stod(tr.message.substr(at + 5));
-    const double theta_stop = theta0 + scene.speeds[0] * t_stop;
-    EXPECT_GT(f.AQ(theta_stop), b + c) << label << ": it closes where the run stopped";
-    EXPECT_NEAR(std::abs(theta_stop), kPi, 1e-3) << label;
+    const std::optional<double> stop = limit_stop(f, scene, theta0, tr, label);
+    ASSERT_TRUE(stop) << label;
+    const double t_stop = *stop;
+    EXPECT_NEAR(std::abs(theta0 + scene.speeds[0] * t_stop), kPi, 1e-3) << label;
     const auto t = tr.table.column_values("t");
     const auto theta = tr.table.column_values("theta_crank");
     ASSERT_GT(t.size(), 100u) << label;
@@ -207,17 +221,9 @@ TEST(Singular, ALimitPositionAtTheRevolutionsWrapStopsTheRun) {
     const std::string label =
         "four-bar #" + std::to_string(i) + (at_end ? " (at the end)" : " (at the start)");
     const cp::Trajectory tr = cp::simulate_driven(model, scene);
-    ASSERT_EQ(tr.status, core::SimulationStatus::kAssemblyFailed) << label << ": " << tr.message;
-    EXPECT_NE(tr.message.find("node B is out of its links' reach there (a limit position between "
-                              "the samples at crank = "),
-              std::string::npos)
-        << label << ": " << tr.message;
-    EXPECT_TRUE(all_finite(tr.table)) << label;
-    const std::size_t at = tr.message.rfind("(t = ");
-    ASSERT_NE(at, std::string::npos) << tr.message;
-    const double t_stop = std::stod(tr.message.substr(at + 5));
-    const double theta_stop = theta0 + scene.speeds[0] * t_stop;
-    EXPECT_GT(f.AQ(theta_stop), b + c) << label << ": it closes where the run stopped";
+    const std::optional<double> stop = limit_stop(f, scene, theta0, tr, label);
+    ASSERT_TRUE(stop) << label;
+    const double t_stop = *stop;
     const double period = 2 * kPi / std::abs(scene.speeds[0]), h = period / 360;
     const auto t = tr.table.column_values("t");
     const auto theta = tr.table.column_values("theta_crank");
