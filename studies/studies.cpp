@@ -2,6 +2,7 @@
 
 #include <exception>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <system_error>
 
@@ -12,6 +13,17 @@
 namespace bd::studies {
 
 namespace fs = std::filesystem;
+
+namespace {
+// a file's whole text; none when it cannot be read
+std::optional<std::string> read_text(const fs::path& file) {
+  try {
+    return read_file(file);
+  } catch (const std::runtime_error&) {
+    return std::nullopt;
+  }
+}
+}  // namespace
 
 std::optional<std::string> try_write_report(const Study& study, const fs::path& dir) {
   try {
@@ -40,6 +52,12 @@ RunResult run_study(const Study& study, const fs::path& out_dir) {
   }
   // compute first: an invalid scene throws before anything is created on disk
   RunResult result = compute_study(study);
+  // `bench`'s measurements belong to the study the folder held: kept for the same study file,
+  // removed for another (its report would show another linkage's speed against accuracy)
+  if (read_text(out_dir / "study.yaml") !=
+      (study.source.empty() ? std::nullopt : read_text(study.source))) {
+    remove_bench_files(out_dir);
+  }
   write_run(study, result, out_dir);
   Study page = study;
   page.sweep.reset();  // a study page, also for a sweep's base study

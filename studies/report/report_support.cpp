@@ -186,10 +186,10 @@ std::string unit_of(const std::string& name) {
                                                               {"J", "kg m²"},
                                                               {"Fsh_rms_before", "N"},
                                                               {"Fsh_rms_after", "N"},
-                                                              {"forward_before", "N"},
-                                                              {"backward_before", "N"},
-                                                              {"forward_after", "N"},
-                                                              {"backward_after", "N"},
+                                                              {"forward_before", "kg m"},
+                                                              {"backward_before", "kg m"},
+                                                              {"forward_after", "kg m"},
+                                                              {"backward_after", "kg m"},
                                                               {"t", "s"},
                                                               {"tau", "N m"}};
   for (const auto& [n, u] : exact)
@@ -228,6 +228,18 @@ Scales run_scales(const Json& summary, double size) {
     if (!metrics || !metrics->is_object()) continue;
     for (const auto& [name, v] : metrics->items()) {
       if (v.is_number()) s.add(metric_unit(summary, name), v.get<double>());
+    }
+  }
+  // an engine's balance shafts: the orders' rotating parts before balancing [kg m]
+  const Json* balance = member(summary, "balance");
+  const Json* shafts = balance ? member(*balance, "shafts") : nullptr;
+  const Json* orders = shafts ? member(*shafts, "orders") : nullptr;
+  if (orders && orders->is_array()) {
+    for (const Json& o : *orders) {
+      for (const char* key : {"forward_before", "backward_before"}) {
+        const Json* v = member(o, key);
+        if (v && v->is_number()) s.add("kg m", v->get<double>());
+      }
     }
   }
   return s;

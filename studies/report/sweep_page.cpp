@@ -725,7 +725,7 @@ std::string engineer_name(const std::string& path, const Study& study) {
     const std::map<std::string, std::string> fields = {
         {"length", "length l" + sub + " [m]"},
         {"mass", "mass m" + sub + " [kg]"},
-        {"inertia", "inertia I" + sub + " about its centre of mass [kg m^2]"},
+        {"inertia", "inertia I" + sub + " about its centre of mass [kg m²]"},
         {"s", "centre of mass s" + sub + " [m]"},
         {"sigma", "centre-of-mass angle σ" + sub + " [rad]"},
         {"e", "centre of mass e" + sub + " along the link [m]"},
@@ -747,7 +747,7 @@ std::string engineer_name(const std::string& path, const Study& study) {
   }
   if (is({"linkage", "balance_shafts", "*", "*"})) {
     const std::map<std::string, std::string> fields = {
-        {"mass", "mass [kg]"}, {"inertia", "inertia [kg m^2]"}, {"ratio", "speed ratio"}};
+        {"mass", "mass [kg]"}, {"inertia", "inertia [kg m²]"}, {"ratio", "speed ratio"}};
     if (const auto f = fields.find(k[3]); f != fields.end())
       return "balance shaft " + k[2] + " " + f->second;
   }
@@ -757,7 +757,7 @@ std::string engineer_name(const std::string& path, const Study& study) {
   if (is({"linkage", "counterweights", "*", "mass"}))
     return "counterweight on " + k[2] + " mass [kg]";
   if (is({"linkage", "counterweights", "*", "inertia"}))
-    return "counterweight on " + k[2] + " inertia [kg m^2]";
+    return "counterweight on " + k[2] + " inertia [kg m²]";
   if (is({"linkage", "counterweights", "*", "at", "*"}))
     return "counterweight on " + k[2] + " position " + axis(k[4]) + " [m]";
   if (is({"linkage", "inputs", "*", "torque"})) return "drive torque on " + k[2] + " [N m]";

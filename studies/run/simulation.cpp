@@ -16,6 +16,7 @@ void DisplayScales::add(const std::string& unit, double value) {
   if (!std::isfinite(value)) return;
   if (unit == "N") force = std::max(force, std::abs(value));
   if (unit == "N m") moment = std::max(moment, std::abs(value));
+  if (unit == "kg m") imbalance = std::max(imbalance, std::abs(value));
 }
 
 void DisplayScales::add(const MetricList& metrics) {
@@ -26,6 +27,7 @@ double DisplayScales::of(const std::string& unit) const {
   if (unit == "m") return length;
   if (unit == "N") return force;
   if (unit == "N m") return std::max(moment, force * length);
+  if (unit == "kg m") return imbalance;
   return 0;
 }
 

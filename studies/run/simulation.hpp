@@ -33,11 +33,13 @@ using MetricList = std::vector<MetricValue>;
 /// moment of the run or that force times the size, whichever is larger.
 struct DisplayScales {
   double length = 0, force = 0, moment = 0;
-  /// Takes a metric of the run, `value` in `unit`, into the force or moment scale.
+  double imbalance = 0;  // a shaking force's rotating parts per unit speed squared [kg m]
+  /// Takes a metric of the run, `value` in `unit`, into the force, moment or imbalance scale.
   void add(const std::string& unit, double value);
   /// Takes every metric of `metrics`.
   void add(const MetricList& metrics);
-  /// The scale of a quantity in `unit` ("m", "N", "N m"); 0 (none: the values' own) otherwise.
+  /// The scale of a quantity in `unit` ("m", "N", "N m", "kg m"); 0 (none: the values' own)
+  /// otherwise.
   double of(const std::string& unit) const;
 };
 

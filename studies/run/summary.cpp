@@ -33,7 +33,8 @@ Json metrics_json(const MetricList& metrics) {
 Json peaks_json(const Study& study, const MetricList& metrics) {
   Json j = Json::object();
   for (const MetricValue& m : metrics) {
-    if (!m.t) continue;
+    // a quantity that is 0 throughout (a free scene's drive torque) has no place to name
+    if (!m.t || m.value == 0) continue;
     Json p = {{"value", m.value}, {"t", *m.t}};
     if (const auto* d = std::get_if<core::DrivenScene>(&study.scene)) {
       p["theta1"] = d->theta1 + d->omega1 * *m.t;

@@ -10,16 +10,16 @@ namespace bd::studies {
 
 namespace {
 
-std::string vec(const Vec2& v) {
-  return "[" + text::shortest(v.x()) + ", " + text::shortest(v.y()) + "]";
-}
+// a number as the study file has it: shortest exact, a negative zero (a mirrored 0) as 0
+std::string num(double v) { return text::shortest(v == 0 ? 0.0 : v); }
+
+std::string vec(const Vec2& v) { return "[" + num(v.x()) + ", " + num(v.y()) + "]"; }
 
 // e, f exactly (they read back bit for bit); the paper's polar form s, sigma as a comment for a
 // person (12 digits: sigma = 0.4, not the 0.4000000000000001 its atan2 gives)
 std::string link_line(const char* name, const core::Link& l) {
-  return std::string("  ") + name + ": {length: " + text::shortest(l.length) +
-         ", mass: " + text::shortest(l.mass) + ", e: " + text::shortest(l.e) +
-         ", f: " + text::shortest(l.f) + ", inertia: " + text::shortest(l.inertia) + "}\n" +
+  return std::string("  ") + name + ": {length: " + num(l.length) + ", mass: " + num(l.mass) +
+         ", e: " + num(l.e) + ", f: " + num(l.f) + ", inertia: " + num(l.inertia) + "}\n" +
          "    # s = " + text::digits(l.s(), 12) + " m, sigma = " + text::digits(l.sigma(), 12) +
          " rad\n";
 }
@@ -36,33 +36,33 @@ std::string counterweights_yaml(const std::vector<CounterweightPart>& parts,
         l ? "from: " + l->nodes[static_cast<std::size_t>(p.pivot)].name + ", " : std::string();
     const std::string name =
         l ? l->links[static_cast<std::size_t>(p.link)].name : std::string(p.link == 1 ? "crank" : "rocker");
-    y += "    " + name + ": {" + from + "mass: " + text::shortest(c.mass) + ", at: " + vec(c.position) +
-         ", inertia: " + text::shortest(c.inertia) + "}\n";
+    y += "    " + name + ": {" + from + "mass: " + num(c.mass) + ", at: " + vec(c.position) +
+         ", inertia: " + num(c.inertia) + "}\n";
   }
   return y;
 }
 
 std::string load_line(const char* name, const core::LinkLoad& l) {
-  return std::string("  ") + name + ": {force: " + vec(l.force) +
-         ", moment: " + text::shortest(l.moment) + "}\n";
+  return std::string("  ") + name + ": {force: " + vec(l.force) + ", moment: " + num(l.moment) +
+         "}\n";
 }
 
 std::string list(const std::vector<double>& v) {
   std::string s = "[";
-  for (std::size_t k = 0; k < v.size(); ++k) s += (k ? ", " : "") + text::shortest(v[k]);
+  for (std::size_t k = 0; k < v.size(); ++k) s += (k ? ", " : "") + num(v[k]);
   return s + "]";
 }
 
 std::string effort(const core::planar::TimeFunction& f) {
   using K = core::planar::TimeFunction::Kind;
-  if (f.kind == K::kConstant) return text::shortest(f.value);
+  if (f.kind == K::kConstant) return num(f.value);
   if (f.kind == K::kHarmonic) {
-    return "{mean: " + text::shortest(f.mean) + ", amplitude: " + text::shortest(f.amplitude) +
-           ", frequency: " + text::shortest(f.frequency) + ", phase: " + text::shortest(f.phase) + "}";
+    return "{mean: " + num(f.mean) + ", amplitude: " + num(f.amplitude) +
+           ", frequency: " + num(f.frequency) + ", phase: " + num(f.phase) + "}";
   }
   std::string s = "{table: [";
   for (std::size_t k = 0; k < f.times.size(); ++k) {
-    s += (k ? ", [" : "[") + text::shortest(f.times[k]) + ", " + text::shortest(f.values[k]) + "]";
+    s += (k ? ", [" : "[") + num(f.times[k]) + ", " + num(f.values[k]) + "]";
   }
   return s + "]}";
 }
@@ -79,14 +79,13 @@ std::string planar_linkage_yaml(const core::planar::Linkage& l,
   for (const core::planar::Link& k : l.links) {
     std::string nodes;
     for (int i : k.nodes) nodes += (nodes.empty() ? "" : ", ") + node(i);
-    y += "    " + k.name + ": {nodes: [" + nodes + "], mass: " + text::shortest(k.mass) +
-         ", e: " + text::shortest(k.e) + ", f: " + text::shortest(k.f) +
-         ", inertia: " + text::shortest(k.inertia) + "}\n";
+    y += "    " + k.name + ": {nodes: [" + nodes + "], mass: " + num(k.mass) + ", e: " + num(k.e) +
+         ", f: " + num(k.f) + ", inertia: " + num(k.inertia) + "}\n";
   }
   if (!l.point_masses.empty()) {
     y += "  point_masses:\n";
     for (const core::planar::PointMass& p : l.point_masses) {
-      y += "    " + node(p.node) + ": " + text::shortest(p.mass) + "\n";
+      y += "    " + node(p.node) + ": " + num(p.mass) + "\n";
     }
   }
   if (!l.sliders.empty()) {
@@ -103,18 +102,16 @@ std::string planar_linkage_yaml(const core::planar::Linkage& l,
     y += "  springs:\n";
     for (const core::planar::Spring& sp : l.springs) {
       y += "    " + sp.name + ": {between: [" + node(sp.a) + ", " + node(sp.b) +
-           "], stiffness: " + text::shortest(sp.stiffness) +
-           ", free_length: " + text::shortest(sp.free_length) +
-           ", damping: " + text::shortest(sp.damping) + "}\n";
+           "], stiffness: " + num(sp.stiffness) + ", free_length: " + num(sp.free_length) +
+           ", damping: " + num(sp.damping) + "}\n";
     }
   }
   if (!l.shafts.empty()) {
     y += "  balance_shafts:\n";
     for (const core::planar::BalanceShaft& b : l.shafts) {
       y += "    " + b.name + ": {link: " + l.links[static_cast<std::size_t>(b.link)].name +
-           ", ratio: " + std::to_string(b.ratio) + ", at: " + vec(b.at) +
-           ", mass: " + text::shortest(b.mass) + ", eccentricity: " + vec(b.eccentricity) +
-           ", inertia: " + text::shortest(b.inertia) + "}\n";
+           ", ratio: " + std::to_string(b.ratio) + ", at: " + vec(b.at) + ", mass: " + num(b.mass) +
+           ", eccentricity: " + vec(b.eccentricity) + ", inertia: " + num(b.inertia) + "}\n";
     }
   }
   y += counterweights_yaml(parts, &l);
@@ -133,7 +130,7 @@ std::string planar_linkage_yaml(const core::planar::Linkage& l,
     y += "  links:\n";
     for (const core::planar::LinkLoad& ld : l.loads.link_loads) {
       y += "    " + l.links[static_cast<std::size_t>(ld.link)].name + ": {force: " + vec(ld.force) +
-           ", moment: " + text::shortest(ld.moment) + "}\n";
+           ", moment: " + num(ld.moment) + "}\n";
     }
   }
   if (!l.loads.node_forces.empty()) {
@@ -151,7 +148,7 @@ std::string planar_scene_yaml(const Scene& scene) {
     y += "  type: free\n";
     if (!f->start.empty()) y += "  start: " + list(f->start) + "\n";
     if (!f->rates.empty()) y += "  rates: " + list(f->rates) + "\n";
-    y += "  duration: " + text::shortest(f->duration) + "\n";
+    y += "  duration: " + num(f->duration) + "\n";
     return y + "  samples: " + std::to_string(f->samples) + "\n";
   }
   const auto& d = std::get<core::planar::DrivenScene>(scene);
@@ -159,7 +156,7 @@ std::string planar_scene_yaml(const Scene& scene) {
   if (!d.start.empty()) y += "  start: " + list(d.start) + "\n";
   y += "  speeds: " + list(d.speeds) + "\n";
   if (d.duration > 0) {
-    y += "  duration: " + text::shortest(d.duration) + "\n";
+    y += "  duration: " + num(d.duration) + "\n";
   } else {
     y += "  revolutions: " + std::to_string(d.revolutions) + "\n";
   }
@@ -185,14 +182,14 @@ std::string study_yaml(const Study& study, const std::string& header) {
     y += planar_linkage_yaml(std::get<core::planar::Linkage>(linkage), parts) +
          planar_scene_yaml(study.scene);
     y += "\nmethod: " + study.method_name() + "\n";
-    return y + "tolerance: " + text::shortest(study.tolerance) + "\n";
+    return y + "tolerance: " + num(study.tolerance) + "\n";
   }
 
   // linkage: links with e, f (see link_line)
   const core::FourBar& m = std::get<core::FourBar>(linkage);
   y += "linkage:\n";
   y += "  type: fourbar\n";
-  y += "  frame: " + text::shortest(m.frame_length) + "\n";
+  y += "  frame: " + num(m.frame_length) + "\n";
   y += std::string("  branch: ") + (m.branch == core::Branch::kPlus ? "1" : "-1") + "\n";
   y += link_line("crank", m.crank);
   y += link_line("coupler", m.coupler);
@@ -203,7 +200,7 @@ std::string study_yaml(const Study& study, const std::string& header) {
     y += "  counter_rotations:\n";
     for (int i = 0; i < 2; ++i) {
       if (discs[i]->inertia <= 0) continue;
-      y += std::string("    ") + disc_names[i] + ": {inertia: " + text::shortest(discs[i]->inertia) +
+      y += std::string("    ") + disc_names[i] + ": {inertia: " + num(discs[i]->inertia) +
            ", at: " + vec(discs[i]->at) + "}\n";
     }
   }
@@ -220,20 +217,20 @@ std::string study_yaml(const Study& study, const std::string& header) {
   y += "\nscene:\n";
   if (const auto* free = std::get_if<core::FreeScene>(&study.scene)) {
     y += "  type: free\n";
-    y += "  theta1: " + text::shortest(free->theta1) + "\n";
-    y += "  omega1: " + text::shortest(free->omega1) + "\n";
-    y += "  duration: " + text::shortest(free->duration) + "\n";
+    y += "  theta1: " + num(free->theta1) + "\n";
+    y += "  omega1: " + num(free->omega1) + "\n";
+    y += "  duration: " + num(free->duration) + "\n";
     y += "  samples: " + std::to_string(free->samples) + "\n";
   } else {
     const auto& driven = std::get<core::DrivenScene>(study.scene);
     y += "  type: driven\n";
-    y += "  theta1: " + text::shortest(driven.theta1) + "\n";
-    y += "  omega1: " + text::shortest(driven.omega1) + "\n";
+    y += "  theta1: " + num(driven.theta1) + "\n";
+    y += "  omega1: " + num(driven.omega1) + "\n";
     y += "  revolutions: " + std::to_string(driven.revolutions) + "\n";
     y += "  samples: " + std::to_string(driven.samples) + "\n";
   }
   y += "\nmethod: " + study.method_name() + "\n";
-  y += "tolerance: " + text::shortest(study.tolerance) + "\n";
+  y += "tolerance: " + num(study.tolerance) + "\n";
   return y;
 }
 

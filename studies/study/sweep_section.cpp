@@ -204,6 +204,8 @@ class SweepReader {
 
     const MapReader::Entry& from = m.require("from", "the lower end of the range");
     const MapReader::Entry& to = m.require("to", "the upper end of the range");
+    check_plain(from.value, from.key_mark, where + ".from");
+    check_plain(to.value, to.key_mark, where + ".to");
     p.from = read_number(r_, from, where + ".from", "");
     p.to = read_number(r_, to, where + ".to", "");
     if (!(p.from < p.to)) {
@@ -242,6 +244,7 @@ class SweepReader {
     for (std::size_t k = 0; k < e.value.size(); ++k) {
       const YAML::Node item = e.value[k];
       const std::string ip = path + "[" + std::to_string(k) + "]";
+      check_plain(item, vm, ip);
       const double v = read_number(r_, item, vm, ip, "");
       if (log_scale && !(v > 0)) {
         r_.fail(mark_of(item, vm), ip + " must be > 0 with scale: log, got " + text::shortest(v));
@@ -314,11 +317,13 @@ class SweepReader {
       }
       node.reset(next);
     }
-    // where it leads: a number the study states
+    // where it leads: a number the study states (in SI or with a unit of its own: the sweep's
+    // plain SI values take its place)
     double v = 0.0;
     if (node.IsScalar() && YAML::convert<double>::decode(node, v) && std::isfinite(v)) {
       return node;
     }
+    if (with_unit(node)) return node;
     std::string hint;
     if (node.IsMap() && node.size() > 0) {
       hint = "; name one of its values, e.g. " + path + "." + node.begin()->first.Scalar();
@@ -328,6 +333,26 @@ class SweepReader {
     r_.fail(m, head + path + " is " + what_is(node) + ", not a " +
                    (node.IsScalar() && YAML::convert<double>::decode(node, v) ? "finite " : "") +
                    "number" + hint);
+  }
+
+  // a number with a unit after it ("300 rpm"), as the study's values may be written
+  static bool with_unit(const YAML::Node& n) {
+    if (!n.IsScalar()) return false;
+    const char* begin = n.Scalar().c_str();
+    char* end = nullptr;
+    const double v = std::strtod(begin, &end);
+    return end != begin && std::isfinite(v) && *end == ' ' &&
+           std::string(end).find_first_not_of(' ') != std::string::npos;
+  }
+
+  // a swept value is a plain number in SI units: one written with a unit is refused as such
+  void check_plain(const YAML::Node& n, const YAML::Mark& fallback, const std::string& path) const {
+    if (!with_unit(n)) return;
+    r_.fail(mark_of(n, fallback),
+            path +
+                ": the swept values are plain numbers in SI units (rad, m, kg, s, N, rad/s, ...), "
+                "got " +
+                describe(n) + "; the value the path names may carry a unit of its own");
   }
 
   // what a node is, for "X is ..., not a number"

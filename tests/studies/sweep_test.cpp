@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <span>
 #include <string>
 #include <thread>
@@ -147,6 +148,30 @@ TEST(SweepLoad, CombinesWithBalanceOrOptimize) {
                                     "    - {path: balance.counterweights.crank.mass, "
                                     "from: 1, to: 3, count: 3}\n");
   EXPECT_EQ(r.parameters[0].values, (std::vector<double>{1, 2, 3}));
+}
+
+// A value the study writes with a unit ("300 rpm") may be swept: the sweep's plain SI values take
+// its place, and each point runs at them. The swept values themselves are plain SI numbers: one
+// written with a unit is refused at its place, saying so.
+TEST(SweepLoad, AValueWithAUnitIsSweptInSI) {
+  std::string text = kStudy;
+  text.replace(text.find("omega1: 6.0"), 11, "omega1: 300 rpm");
+  const std::string swept = text + "sweep:\n  parameters:\n    - path: scene.omega1\n";
+  const Study study = parse_study(swept + "      values: [6, 12]\n", "sweep.yaml");
+  ASSERT_TRUE(study.sweep);
+  // each point as the same study written with the value in SI
+  const auto points = sweep_points(*study.sweep);
+  ASSERT_EQ(points.size(), 2u);
+  EXPECT_EQ(std::get<core::DrivenScene>(study.scene).omega1, 10 * std::numbers::pi);
+  EXPECT_EQ(std::get<core::DrivenScene>(point_study(study, points[0]).scene).omega1, 6.0);
+  EXPECT_EQ(std::get<core::DrivenScene>(point_study(study, points[1]).scene).omega1, 12.0);
+  const std::string message =
+      ": the swept values are plain numbers in SI units (rad, m, kg, s, N, rad/s, ...), got "
+      "'100 rpm'; the value the path names may carry a unit of its own";
+  expect_error(swept + "      values: [6, 100 rpm]\n", 18, 19,
+               "sweep.parameters[0].values[1]" + message);
+  expect_error(swept + "      from: 100 rpm\n      to: 200\n      count: 2\n", 18, 13,
+               "sweep.parameters[0].from" + message);
 }
 
 TEST(SweepLoad, BadPathsNameWhatTheFileHas) {

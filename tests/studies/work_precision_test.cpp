@@ -534,6 +534,22 @@ TEST_F(WorkPrecisionTest, ABenchRemovesEarlierMeasurementsOfTheOtherSceneType) {
   EXPECT_EQ(html.find("driven-convergence.csv"), std::string::npos);
 }
 
+TEST_F(WorkPrecisionTest, ARunOfAnotherStudyRemovesTheFoldersMeasurements) {
+  // a bench's measurements stay for a run of the same study file, and go with another study's:
+  // its report would show another linkage's speed against accuracy
+  const Study driven = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml");
+  BenchOptions options = BenchOptions::quick();
+  options.samples = {8, 360};
+  run_bench(driven, dir_, options);
+  ASSERT_TRUE(fs::exists(dir_ / "driven-convergence.csv"));
+  run_study(driven, dir_);
+  EXPECT_TRUE(fs::exists(dir_ / "driven-convergence.csv"));
+  EXPECT_NE(read(dir_ / "report.html").find("driven-convergence.csv"), std::string::npos);
+  run_study(load_study(BD_SOURCE_DIR "/studies/examples/engine-slider-crank.yaml"), dir_);
+  EXPECT_FALSE(fs::exists(dir_ / "driven-convergence.csv"));
+  EXPECT_EQ(read(dir_ / "report.html").find("driven-convergence.csv"), std::string::npos);
+}
+
 TEST(WorkPrecision, SceneTypeAndOptionsAreChecked) {
   const Study free = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar.yaml");
   const Study driven = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml");
