@@ -515,13 +515,19 @@ TEST_F(WorkPrecisionTest, APlanarDrivenBenchKeepsTheRowsOfRunsThatCannotBeAssemb
   EXPECT_NE(html.find("3 of 3 runs stopped before the end of the scene"), std::string::npos);
 }
 
-TEST_F(WorkPrecisionTest, ABenchRemovesEarlierMeasurementsOfTheOtherSceneType) {
-  // a folder measured as driven, then benched with a free study: no stale driven rows in it
-  const Study driven = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml");
+// the paper four-bar's driven study benched into `dir` (quick, at 8 and 360 samples): the
+// options, for a bench after it
+BenchOptions bench_driven(const fs::path& dir) {
   BenchOptions options = BenchOptions::quick();
   options.samples = {8, 360};
-  run_bench(driven, dir_, options);
-  ASSERT_TRUE(fs::exists(dir_ / "driven-convergence.csv"));
+  run_bench(load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml"), dir, options);
+  EXPECT_TRUE(fs::exists(dir / "driven-convergence.csv"));
+  return options;
+}
+
+TEST_F(WorkPrecisionTest, ABenchRemovesEarlierMeasurementsOfTheOtherSceneType) {
+  // a folder measured as driven, then benched with a free study: no stale driven rows in it
+  BenchOptions options = bench_driven(dir_);
   Study free = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar.yaml");
   auto& scene = std::get<core::FreeScene>(free.scene);
   scene.duration = 0.5;
@@ -537,12 +543,8 @@ TEST_F(WorkPrecisionTest, ABenchRemovesEarlierMeasurementsOfTheOtherSceneType) {
 TEST_F(WorkPrecisionTest, ARunOfAnotherStudyRemovesTheFoldersMeasurements) {
   // a bench's measurements stay for a run of the same study file, and go with another study's:
   // its report would show another linkage's speed against accuracy
-  const Study driven = load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml");
-  BenchOptions options = BenchOptions::quick();
-  options.samples = {8, 360};
-  run_bench(driven, dir_, options);
-  ASSERT_TRUE(fs::exists(dir_ / "driven-convergence.csv"));
-  run_study(driven, dir_);
+  bench_driven(dir_);
+  run_study(load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven.yaml"), dir_);
   EXPECT_TRUE(fs::exists(dir_ / "driven-convergence.csv"));
   EXPECT_NE(read(dir_ / "report.html").find("driven-convergence.csv"), std::string::npos);
   run_study(load_study(BD_SOURCE_DIR "/studies/examples/engine-slider-crank.yaml"), dir_);
