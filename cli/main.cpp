@@ -994,9 +994,12 @@ int main(int argc, char** argv) {
         ->required()
         ->type_name("FILE");
     std::string report_dir;
-    CLI::App* report_cmd =
-        app.add_subcommand("report", "rebuild DIR/report.html from the data files of a run in DIR");
-    report_cmd->add_option("DIR", report_dir, "the output folder of a run (has summary.json)")
+    CLI::App* report_cmd = app.add_subcommand(
+        "report", "rebuild DIR/report.html from the data files of a run or a sweep in DIR");
+    report_cmd
+        ->add_option("DIR", report_dir,
+                     "the output folder of a run (has summary.json) or of a sweep (has "
+                     "sweep.json)")
         ->required()
         ->type_name("DIR");
 
@@ -1005,6 +1008,9 @@ int main(int argc, char** argv) {
     app.footer(std::string(kFooter) + kExitCodes +
                "\nbalance-design COMMAND --help (or balance-design help COMMAND) says what one "
                "command does.\n");
+    // the description's list says what each command does: CLI11's own list of them would
+    // repeat it (an empty group keeps a command out of the program's help, not its own)
+    for (CLI::App* command : {run_cmd, validate_cmd, report_cmd, bench_cmd}) command->group("");
     validate_cmd->footer("\nExit codes: 0 the study is valid (one ok line), 2 it is not (one "
                          "line FILE:LINE:COLUMN: message on stderr).\n");
     report_cmd->footer("\nDIR may be given from anywhere. Exit codes: 0 the page was written, "

@@ -26,7 +26,7 @@ namespace {
 // the Quantity values are 0, 1, ..., kQuantityCount - 1, the last kReactionA3 (as for
 // OutputQuantity)
 constexpr std::size_t kQuantityCount = static_cast<std::size_t>(Quantity::kReactionA3) + 1;
-static_assert(static_cast<std::size_t>(OutputQuantity::kJointA2) + 1 == kOutputQuantityCount);
+static_assert(static_cast<std::size_t>(OutputQuantity::kCounterRocker) + 1 == kOutputQuantityCount);
 constexpr std::size_t kOutputCount = std::size(kOutputMetrics);
 
 // Every sample's magnitudes, computed once for the RMS, the peaks and their search: a column

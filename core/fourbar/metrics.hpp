@@ -27,6 +27,8 @@ struct Metrics {
   double Fsh_total_rms{}, Fsh_total_max{};  // |F̄sh| [N]
   double Msh_total_rms{}, Msh_total_max{};  // |Msh| [N m]
   double FA1_max{}, FA2_max{};              // |F̄A1|, |F̄A2| [N]
+  /// The counter-rotation shafts' bearing forces (0 without a disc): |R̄C1|, |R̄C3| [N]
+  double RC1_rms{}, RC1_max{}, RC3_rms{}, RC3_max{};
 };
 
 /// The magnitude a metric summarises, one value per sample.
@@ -101,8 +103,10 @@ enum class OutputQuantity {
   kTotalShakingMoment,  // |Msh|, weights and loads included [N m]
   kJointA1,             // |F̄A1| [N]
   kJointA2,             // |F̄A2| [N]
+  kCounterCrank,        // |R̄C1|, the crank's counter-rotation shaft on the frame [N]
+  kCounterRocker,       // |R̄C3|, the rocker's [N]
 };
-inline constexpr std::size_t kOutputQuantityCount = 4;
+inline constexpr std::size_t kOutputQuantityCount = 6;
 
 /// The magnitude of `quantity` at one sample.
 inline double magnitude(const DynamicsSample& s, OutputQuantity quantity) {
@@ -115,6 +119,10 @@ inline double magnitude(const DynamicsSample& s, OutputQuantity quantity) {
       return core::magnitude(s.FA1.x(), s.FA1.y());
     case OutputQuantity::kJointA2:
       return core::magnitude(s.FA2.x(), s.FA2.y());
+    case OutputQuantity::kCounterCrank:
+      return core::magnitude(s.RC1.x(), s.RC1.y());
+    case OutputQuantity::kCounterRocker:
+      return core::magnitude(s.RC3.x(), s.RC3.y());
   }
   return 0.0;
 }
@@ -143,6 +151,16 @@ inline constexpr OutputMetricInfo kOutputMetrics[] = {
      &Metrics::FA1_max, OutputQuantity::kJointA1},
     {"FA2_max", "N", "peak of the joint force |FA2| (coupler on rocker)", Statistic::kMax,
      &Metrics::FA2_max, OutputQuantity::kJointA2},
+    // the counter-rotation shafts' bearings: a study lists them only where the disc is
+    // (studies::metric_list())
+    {"RC1_rms", "N", "RMS of the crank's counter-rotation shaft force |RC1|", Statistic::kRms,
+     &Metrics::RC1_rms, OutputQuantity::kCounterCrank},
+    {"RC1_max", "N", "peak of the crank's counter-rotation shaft force |RC1|", Statistic::kMax,
+     &Metrics::RC1_max, OutputQuantity::kCounterCrank},
+    {"RC3_rms", "N", "RMS of the rocker's counter-rotation shaft force |RC3|", Statistic::kRms,
+     &Metrics::RC3_rms, OutputQuantity::kCounterRocker},
+    {"RC3_max", "N", "peak of the rocker's counter-rotation shaft force |RC3|", Statistic::kMax,
+     &Metrics::RC3_max, OutputQuantity::kCounterRocker},
 };
 
 /// Where the peaks of a run lie: per row of kMetricTable (RMS rows: their value and t = 0),

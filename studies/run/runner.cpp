@@ -69,7 +69,7 @@ OptimizedRun optimize_study(const Study& study, const RunResult& original,
   o.trajectory = sim.fourbar;
   core::PeakList peaks;
   o.metrics = fourbar_metrics(best, sim, &peaks);
-  o.metric_list = metric_list(o.metrics, &peaks);
+  o.metric_list = metric_list(best.fourbar(), o.metrics, &peaks);
   without_samples_none(o.metric_list, sim);
   if (parts.harmonics) o.harmonics = harmonics(best, o.trajectory, o.planar);
   if (req.pareto) {
@@ -651,7 +651,7 @@ RunResult compute_study(const Study& study, const ComputeParts& parts) {
   if (study.is_fourbar()) {
     core::PeakList peaks;
     result.metrics = fourbar_metrics(study, sim, &peaks);
-    result.metric_list = metric_list(result.metrics, &peaks);
+    result.metric_list = metric_list(study.fourbar(), result.metrics, &peaks);
   } else {
     result.metric_list = metric_list(study, sim);
   }
@@ -667,7 +667,7 @@ RunResult compute_study(const Study& study, const ComputeParts& parts) {
     b.trajectory = balanced.fourbar;
     core::PeakList peaks;
     b.metrics = fourbar_metrics(design, balanced, &peaks);
-    b.metric_list = metric_list(b.metrics, &peaks);
+    b.metric_list = metric_list(design.fourbar(), b.metrics, &peaks);
     without_samples_none(b.metric_list, balanced);
     if (parts.harmonics) b.harmonics = harmonics(design, b.trajectory, b.planar);
     result.balanced = std::move(b);

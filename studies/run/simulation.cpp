@@ -223,7 +223,18 @@ Simulation simulate_unchecked(const Study& study, const MethodChoice& method,
 
 }  // namespace
 
-MetricList metric_list(const core::Metrics& metrics, const core::PeakList* peaks) {
+namespace {
+// whether a four-bar's metric is one of the model's: a counter-rotation shaft's only with its
+// disc
+bool has_metric(const core::FourBar& model, std::string_view name) {
+  if (name.starts_with("RC1_")) return model.counter_rotations.crank.inertia > 0;
+  if (name.starts_with("RC3_")) return model.counter_rotations.rocker.inertia > 0;
+  return true;
+}
+}  // namespace
+
+MetricList metric_list(const core::FourBar& model, const core::Metrics& metrics,
+                       const core::PeakList* peaks) {
   MetricList list;
   // a peak's place: its time and, in a free scene, the crank's angle there
   auto add = [&](const char* name, const char* unit, double value, const std::vector<core::Peak>* p,
@@ -239,6 +250,7 @@ MetricList metric_list(const core::Metrics& metrics, const core::PeakList* peaks
   }
   for (std::size_t k = 0; k < std::size(core::kOutputMetrics); ++k) {
     const core::OutputMetricInfo& info = core::kOutputMetrics[k];
+    if (!has_metric(model, info.name)) continue;
     add(info.name, info.unit, metrics.*info.field, peaks ? &peaks->output : nullptr, k,
         info.statistic);
   }
@@ -275,7 +287,9 @@ std::vector<std::string> metric_names(const Study& study) {
   std::vector<std::string> names;
   if (study.is_fourbar()) {
     for (const core::MetricInfo& info : core::kMetricTable) names.emplace_back(info.name);
-    for (const core::OutputMetricInfo& info : core::kOutputMetrics) names.emplace_back(info.name);
+    for (const core::OutputMetricInfo& info : core::kOutputMetrics) {
+      if (has_metric(study.fourbar(), info.name)) names.emplace_back(info.name);
+    }
   } else {
     for (const auto& m : core::planar::metric_table(core::planar::Model(study.planar()))) {
       names.push_back(m.name);
@@ -300,7 +314,7 @@ MetricList metric_list(const Study& study, const Simulation& simulation) {
   if (!simulation.is_planar) {
     core::PeakList peaks;
     const core::Metrics m = fourbar_metrics(study, simulation, &peaks);
-    return metric_list(m, &peaks);
+    return metric_list(study.fourbar(), m, &peaks);
   }
   const core::planar::Model model(study.planar());
   const std::vector<core::planar::ColumnMetric> table = core::planar::metric_table(model);

@@ -101,8 +101,10 @@ MetricList metric_list(const Study& study, const Simulation& simulation);
 /// A four-bar's run's metrics, as metric_list() computes them, with where their peaks lie.
 core::Metrics fourbar_metrics(const Study& study, const Simulation& simulation,
                               core::PeakList* peaks = nullptr);
-/// A four-bar's metrics in the table's order (with the peaks' times when given).
-MetricList metric_list(const core::Metrics& metrics, const core::PeakList* peaks = nullptr);
+/// A four-bar's metrics in the table's order (with the peaks' times when given); the
+/// counter-rotation shafts' bearing forces (RC1_*, RC3_*) only where `model` has that disc.
+MetricList metric_list(const core::FourBar& model, const core::Metrics& metrics,
+                       const core::PeakList* peaks = nullptr);
 /// A run that stopped before its first sample has no metrics: each value of `list` becomes NaN
 /// (written as null in summary.json, shown as "none") and has no peak time. Returns `list`.
 MetricList& without_samples_none(MetricList& list, const Simulation& simulation);

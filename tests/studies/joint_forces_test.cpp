@@ -133,6 +133,36 @@ TEST(JointForces, FourBarTimeseriesHasEveryForceOnTheFrame) {
         EXPECT_NEAR(row[col("Fsh" + a)], sum, 1e-13 * largest) << file;
       }
     }
+    // the counter-rotation shafts' bearing forces are metrics where the disc is: the balanced
+    // design's (the original has none), their RMS that of the columns, their peak at least the
+    // largest sample's (resolved between the samples)
+    const studies::MetricList& list =
+        std::string(file) == "timeseries.csv" ? r.metric_list : r.balanced->metric_list;
+    for (const char* side : {"RC1", "RC3"}) {
+      const std::string s = side;
+      const auto of = [&](const std::string& name) -> const studies::MetricValue* {
+        for (const studies::MetricValue& m : list)
+          if (m.name == name) return &m;
+        return nullptr;
+      };
+      if (std::string(file) == "timeseries.csv") {
+        EXPECT_FALSE(of(s + "_rms")) << side;
+        continue;
+      }
+      ASSERT_TRUE(of(s + "_rms") && of(s + "_max")) << side;
+      double squares = 0, most = 0;
+      for (const auto& row : rows) {
+        const double f = std::hypot(row[col(s + "x")], row[col(s + "y")]);
+        squares += f * f;
+        most = std::max(most, f);
+      }
+      EXPECT_NEAR(of(s + "_rms")->value, std::sqrt(squares / static_cast<double>(rows.size())),
+                  1e-12 * largest)
+          << side;
+      EXPECT_GE(of(s + "_max")->value, most) << side;
+      EXPECT_LE(of(s + "_max")->value, most * 1.01) << side;
+      EXPECT_EQ(of(s + "_max")->unit, "N");
+    }
   }
 }
 
