@@ -111,8 +111,9 @@ namespace {
 
 // where the original's peak `name` lies (summary.json's peaks): its time and the inputs there,
 // e.g. "t = 0.0125 s, θ1 = 1.2 rad"; "" for a metric that is no peak
-std::string peak_place(const Study& study, const Json& summary, const std::string& name) {
-  const Json* peaks = member(summary, "peaks");
+std::string peak_place(const Study& study, const Json& summary, const std::string& name,
+                       const std::string& key = "peaks") {
+  const Json* peaks = member(summary, key);
   const Json* p = peaks ? member(*peaks, name) : nullptr;
   const Json* t = p ? member(*p, "t") : nullptr;
   if (!t || !t->is_number()) return "";
@@ -135,13 +136,25 @@ std::string peak_place(const Study& study, const Json& summary, const std::strin
 
 std::string metrics_section(const Study& study, const Json& summary, const SecondDesign& second,
                             const std::string& notes, const Scales& scales) {
-  std::string h = "<h2>Metrics</h2>\n<table><tr><th>metric</th><th>original</th>";
+  // a run that stopped early: its metrics cover the samples before the stop only
+  const auto partial = [&](const std::string& key) {
+    return text(summary, key) == "true"
+               ? std::string("<br><span class=\"bad\">partial: the samples before the stop</span>")
+               : std::string();
+  };
+  std::string h = "<h2>Metrics</h2>\n<table><tr><th>metric</th><th>original" +
+                  partial("metrics_partial") + "</th>";
   const Json* metrics = member(summary, "metrics");
   const Json* second_metrics =
       second.present() ? member(summary, second.key + "_metrics") : nullptr;
   const Json* reduction = member(summary, "reduction");
-  if (second_metrics) h += "<th>" + esc(second.label) + "</th><th>ratio after/before</th>";
-  h += "<th>unit</th><th>where the original's peak lies</th></tr>";
+  if (second_metrics) {
+    h += "<th>" + esc(second.label) + partial(second.key + "_metrics_partial") +
+         "</th><th>ratio after/before</th>";
+  }
+  h += "<th>unit</th><th>where the original's peak lies</th>";
+  if (second_metrics) h += "<th>where the " + esc(second.label) + " design's lies</th>";
+  h += "</tr>";
   auto value = [](const Json* v) { return v && v->is_number() ? std::abs(v->get<double>()) : 0.0; };
   if (metrics) {
     for (const auto& [k, v] : metrics->items()) {
@@ -155,8 +168,14 @@ std::string metrics_section(const Study& study, const Json& summary, const Secon
         h += (s ? num_cell(text(*s), scale) : "<td></td>") +
              (r ? ratio_cell(text(*r), s ? text(*s) : "", scale) : "<td></td>");
       }
-      h += "<td>" + esc(metric_unit(summary, k)) + "</td><td>" +
-           esc(peak_place(study, summary, k)) + "</td></tr>";
+      // a value shown as 0 (round-off) has no place to name
+      const auto place = [&](const Json* x, const std::string& key) {
+        const bool zero = !x || !x->is_number() || text::is_round_off(x->get<double>(), scale);
+        return "<td>" + (zero ? std::string() : esc(peak_place(study, summary, k, key))) + "</td>";
+      };
+      h += "<td>" + esc(metric_unit(summary, k)) + "</td>" + place(&v, "peaks");
+      if (second_metrics) h += place(s, second.key + "_peaks");
+      h += "</tr>";
     }
   }
   return h + "</table>\n<p>" + notes + "</p>\n";

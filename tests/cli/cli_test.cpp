@@ -175,6 +175,11 @@ TEST_F(CliTest, SimulationStoppedEarlyExitsThreeAndKeepsResults) {
       << out_;
   EXPECT_NE(read(dir_ / "res" / "summary.json").find("\"metrics_partial\": true"),
             std::string::npos);
+  // and so does the report's metrics table, at its column
+  EXPECT_NE(read(dir_ / "res" / "report.html")
+                .find("<th>original<br><span class=\"bad\">partial: the samples before the "
+                      "stop</span></th>"),
+            std::string::npos);
   EXPECT_EQ(err_.rfind("stops.yaml: simulation stopped early: ", 0), 0u) << err_;
   EXPECT_EQ(err_.find('\n'), err_.size() - 1) << err_;
   EXPECT_NE(err_.find("theta1"), std::string::npos) << err_;
