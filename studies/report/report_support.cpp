@@ -371,8 +371,10 @@ std::string csv_table(const Csv& csv, const Scales& scales) {
   std::string h = "<table><tr>";
   std::vector<double> scale;
   for (const std::string& k : csv.header) {
-    h += "<th>" + esc(k) + "</th>";
-    scale.push_back(scales.of(unit_in(k)));
+    // each column with its unit, as the data file names it or as the page knows it
+    const std::string u = unit_in(k);
+    h += "<th>" + esc(k.ends_with("]") || u.empty() ? k : k + " [" + u + "]") + "</th>";
+    scale.push_back(scales.of(u));
   }
   h += "</tr>";
   for (const auto& row : csv.rows) {

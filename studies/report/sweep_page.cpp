@@ -619,15 +619,25 @@ std::string points_section(const Sweep& s) {
   h += "<p>The main metrics (RMS) of every point; all its metrics are in "
        "<a href=\"sweep.csv\">sweep.csv</a>.</p>\n<table><tr><th>point</th>" +
        param_headers(s);
-  std::vector<std::size_t> cols;
+  // each series' column, with its unit (its chart's) and its metric's largest value in the sweep
+  // (round-off of it shows as 0)
+  std::map<std::string, std::pair<std::string, double>> of_column;
+  for (const Metric& m : s.metrics) {
+    const auto scale = s.scale.find(m.id);
+    for (const Series& se : m.series) {
+      of_column[se.column] = {unit_in(m.what), scale == s.scale.end() ? 0.0 : scale->second};
+    }
+  }
+  std::vector<std::pair<std::size_t, double>> cols;
   for (const Series& se : s.all_series()) {
-    cols.push_back(*s.col(se.column));
-    h += "<th>" + esc(se.column) + "</th>";
+    const auto& [unit, scale] = of_column[se.column];
+    cols.emplace_back(*s.col(se.column), scale);
+    h += "<th>" + esc(se.column) + (unit.empty() ? "" : " [" + esc(unit) + "]") + "</th>";
   }
   h += "<th>status</th></tr>";
   for (std::size_t r = 0; r < s.csv.rows.size(); ++r) {
     h += "<tr>" + num_cell(s.csv.rows[r][0]) + param_cells(s, r);
-    for (const std::size_t c : cols) h += num_cell(s.csv.rows[r][c]);
+    for (const auto& [c, scale] : cols) h += num_cell(s.csv.rows[r][c], scale);
     h += "<td" + std::string(s.status(r) == "ok" ? "" : " class=\"bad\"") + ">" + esc(s.status(r)) +
          "</td></tr>";
   }

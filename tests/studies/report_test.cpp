@@ -209,6 +209,8 @@ TEST_F(ReportTest, OptimizeRunWithParetoFrontHasItsChartAndTable) {
   EXPECT_NE(pareto.find("Msh_rms [N m]"), std::string::npos);
   EXPECT_NE(pareto.find("original design"), std::string::npos);
   EXPECT_NE(pareto.find("chosen optimum"), std::string::npos);
+  // the front's table names its columns' units
+  EXPECT_NE(html.find("<th>Fsh_rms [N]</th><th>Msh_rms [N m]</th>"), std::string::npos);
 }
 
 // the cells' text of each row of the table that follows <h3>heading</h3>
