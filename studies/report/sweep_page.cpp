@@ -492,15 +492,22 @@ std::string design_section(const Sweep& s) {
   if (const Json* v = member(j, "fingerprint")) {
     h += "<tr><th>study file fingerprint</th><td><code>" + esc(text(*v)) + "</code></td></tr>";
   }
-  h += "</table>\n<table><tr><th>parameter (path in the study file)</th><th>scale</th>"
-       "<th>from</th><th>to</th><th>values</th></tr>";
+  h += "</table>\n<table><tr><th>parameter (path in the study file)</th><th>unit</th>"
+       "<th>scale</th><th>from</th><th>to</th><th>values</th></tr>";
   if (const Json* ps = member(j, "parameters")) {
+    std::size_t i = 0;
     for (const Json& p : (*ps)) {
       const Json* from = member(p, "from");
       const Json* to = member(p, "to");
       const Json* values = member(p, "values");
-      h += "<tr><td><code>" + esc(text(p, "path")) + "</code></td><td>" + esc(text(p, "scale")) +
-           "</td>" + (from ? json_cell(*from) : "<td></td>") + (to ? json_cell(*to) : "<td></td>") +
+      // the unit of the engineer's name of the parameter (the values are SI)
+      const std::string unit = i < s.params.size() && s.params[i].label != s.params[i].path
+                                   ? unit_in(s.params[i].label)
+                                   : "";
+      ++i;
+      h += "<tr><td><code>" + esc(text(p, "path")) + "</code></td><td>" + esc(unit) + "</td><td>" +
+           esc(text(p, "scale")) + "</td>" + (from ? json_cell(*from) : "<td></td>") +
+           (to ? json_cell(*to) : "<td></td>") +
            td(values ? values_text(*values)
                      : std::string(s.design == "lhs" ? "Latin hypercube draws"
                                                      : "uniform random draws") +

@@ -222,6 +222,9 @@ TEST_F(SweepRunner, APlanarSweepsPageNamesItsParametersAndUnits) {
   EXPECT_NE(html.find("<tr><th>Msh_rms</th><td class=\"n\" title=\""), std::string::npos);
   const std::size_t msh = html.find("<tr><th>Msh_rms</th>");
   EXPECT_NE(html.find("</td><td>N m</td>", msh), std::string::npos);
+  // the design's table gives each parameter's unit
+  EXPECT_NE(html.find("<tr><td><code>scene.speeds[0]</code></td><td>rad/s</td>"),
+            std::string::npos);
   // the points' table names its metrics' units
   EXPECT_NE(html.find("<th>Fsh_rms [N]</th><th>Msh_rms [N m]</th>"), std::string::npos);
   // the four-bar's A0 is no point of this linkage: its moment is about the origin
