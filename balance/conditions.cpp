@@ -104,7 +104,7 @@ BalanceReport check_balance(const core::FourBar& model, double relative_toleranc
                                     std::abs(c.f), c.length, "m", relative_tolerance));
   r.moment.push_back(make_condition(
       "coupler.inertia", "I2 = m2 e2 (l2 - e2): the coupler is two point masses at A1 and A2",
-      std::abs(c.inertia - target_I2), c.inertia + 0.25 * c.mass * c.length * c.length, "kg m^2",
+      std::abs(c.inertia - target_I2), c.inertia + 0.25 * c.mass * c.length * c.length, "kg m²",
       relative_tolerance));
 
   // counter-rotations equal to the reduced inertias; scale: the sum of the terms' magnitudes
@@ -120,12 +120,12 @@ BalanceReport check_balance(const core::FourBar& model, double relative_toleranc
   const double J3 = model.counter_rotations.rocker.inertia;
   r.moment.push_back(make_condition(
       "counter_rotation.crank",
-      "J1 = I1 + m1 |s1|^2 + m2 (1 - e2/l2) l1^2 = " + text::digits(K.crank, 3) + " kg m^2",
-      std::abs(J1 - K.crank), std::max(scale1, J1), "kg m^2", relative_tolerance));
+      "J1 = I1 + m1 |s1|^2 + m2 (1 - e2/l2) l1^2 = " + text::digits(K.crank, 3) + " kg m²",
+      std::abs(J1 - K.crank), std::max(scale1, J1), "kg m²", relative_tolerance));
   r.moment.push_back(make_condition(
       "counter_rotation.rocker",
-      "J3 = I3 + m3 |l3 - s3|^2 + m2 (e2/l2) l3^2 = " + text::digits(K.rocker, 3) + " kg m^2",
-      std::abs(J3 - K.rocker), std::max(scale3, J3), "kg m^2", relative_tolerance));
+      "J3 = I3 + m3 |l3 - s3|^2 + m2 (e2/l2) l3^2 = " + text::digits(K.rocker, 3) + " kg m²",
+      std::abs(J3 - K.rocker), std::max(scale3, J3), "kg m²", relative_tolerance));
   return r;
 }
 

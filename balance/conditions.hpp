@@ -42,7 +42,7 @@ struct Condition {
   std::string meaning;  // one line, for people
   double residual{};    // |value - target| [unit]
   double scale{};       // what the residual is measured against [unit]
-  std::string unit;     // "kg", "m", "kg m^2"
+  std::string unit;     // "kg", "m", "kg m²"
   bool holds{};         // residual <= tolerance * scale
 };
 

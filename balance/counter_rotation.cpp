@@ -36,7 +36,7 @@ MomentBalancedDesign moment_balance(const core::FourBar& force_balanced, Vec2 cr
   for (const Condition& c : report.moment) {
     if (c.name.rfind("coupler.", 0) != 0 || c.holds) continue;
     const std::string values = fmt::sprintf(
-        "; got f2 = %.17g m, I2 = %.17g kg m^2, m2 e2 (l2 - e2) = %.17g kg m^2", coupler.f,
+        "; got f2 = %.17g m, I2 = %.17g kg m², m2 e2 (l2 - e2) = %.17g kg m²", coupler.f,
         coupler.inertia, coupler.mass * coupler.e * (coupler.length - coupler.e));
     throw InputError(
         FieldError{"", -1, "moment_balance needs a Berkof coupler: " + describe(c) + values});

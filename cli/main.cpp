@@ -370,7 +370,7 @@ void print_balance(const st::Study& study, const st::RunResult& r) {
                                               &b.model.counter_rotations.rocker};
   for (int i = 0; i < 2; ++i) {
     if (discs[i]->inertia <= 0) continue;
-    std::printf("  %-7s  counter-rotation J = %.6g kg m^2 on a shaft at %s m\n", sides[i],
+    std::printf("  %-7s  counter-rotation J = %.6g kg m² on a shaft at %s m\n", sides[i],
                 discs[i]->inertia, point_text(discs[i]->at, st::linkage_size(study)).c_str());
   }
   if (run.method.method == r.method.method && run.method.reason == r.method.reason) {
@@ -433,7 +433,7 @@ void print_planar_balance(const st::Study& study, const st::RunResult& r) {
     for (int i : run.moment->added) {
       const bd::core::planar::BalanceShaft& s =
           run.moment->linkage.shafts[static_cast<std::size_t>(i)];
-      std::printf("  %-*s  counter-rotation J = %.6g kg m^2 on a shaft at %s m, ratio %d\n", width,
+      std::printf("  %-*s  counter-rotation J = %.6g kg m² on a shaft at %s m, ratio %d\n", width,
                   l.links[static_cast<std::size_t>(s.link)].name.c_str(), s.inertia,
                   point_text(s.at, st::linkage_size(l)).c_str(), s.ratio);
     }
@@ -604,7 +604,12 @@ void print_summary(const st::Study& study, const st::RunResult& r) {
   if (status.samples == 0) {
     std::printf("  metrics  none: the run stopped before its first sample\n");
   } else {
-    if (!status.ok()) {
+    if (!status.ok() && st::is_free(study.scene)) {
+      std::printf(
+          "  partial  the metrics below cover only the motion up to the stop: the RMS values its "
+          "%zu samples, the peaks up to the stop itself\n",
+          status.samples);
+    } else if (!status.ok()) {
       std::printf(
           "  partial  the metrics below cover only the %zu samples before the run stopped\n",
           status.samples);

@@ -122,14 +122,22 @@ struct Candidate {
 
 }  // namespace
 
-std::vector<double> step_instants(std::span<const double> t, std::span<const long> steps_to) {
+std::vector<double> step_instants(std::span<const double> t, std::span<const long> steps_to,
+                                  double stop, long steps_at_stop) {
   std::vector<double> out;
   if (steps_to.size() != t.size()) return out;
-  for (std::size_t i = 0; i + 1 < t.size(); ++i) {
-    const long m = std::min(steps_to[i + 1] - steps_to[i], kMaxStepInstants + 1);
+  // m - 1 instants evenly between ta and tb, where the integrator took m steps
+  const auto between = [&out](double ta, double tb, long steps) {
+    const long m = std::min(steps, kMaxStepInstants + 1);
     for (long j = 1; j < m; ++j) {
-      out.push_back(t[i] + (t[i + 1] - t[i]) * static_cast<double>(j) / static_cast<double>(m));
+      out.push_back(ta + (tb - ta) * static_cast<double>(j) / static_cast<double>(m));
     }
+  };
+  for (std::size_t i = 0; i + 1 < t.size(); ++i)
+    between(t[i], t[i + 1], steps_to[i + 1] - steps_to[i]);
+  if (!t.empty() && stop > t.back()) {
+    between(t.back(), stop, steps_at_stop - steps_to.back());
+    out.push_back(stop);
   }
   return out;
 }

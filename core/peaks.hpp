@@ -4,6 +4,7 @@
 /// bracket of each sampled local maximum, so that the sample count no longer decides a peak.
 /// Shared by every linkage type's metrics (core/fourbar/metrics.hpp, core/planar/metrics.hpp).
 #include <functional>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -51,8 +52,14 @@ inline constexpr long kMaxStepInstants = 256;
 /// steps, so a peak the motion resolves has a local maximum near it for resolved_peak() to
 /// refine, however few the samples (a free run's peak may lie wholly between two coarse samples
 /// where neither is a local maximum). `steps_to`: the steps taken up to each sample; none when
-/// its size is not t's.
-std::vector<double> step_instants(std::span<const double> t, std::span<const long> steps_to);
+/// its size is not t's. A run that stopped short of its end (`stop` > t.back(), the instant its
+/// integration reached, `steps_at_stop` its steps there) adds the instants after its last
+/// sample in the same way, and the stop itself: its peaks are searched up to where it stopped,
+/// not only to its last sample (the loads close to a limit position are often the run's
+/// largest).
+std::vector<double> step_instants(std::span<const double> t, std::span<const long> steps_to,
+                                  double stop = std::numeric_limits<double>::quiet_NaN(),
+                                  long steps_at_stop = 0);
 
 /// The peak of x over the samples x[i] = f(t[i]) (t increasing); with fewer than kMinPeakSamples
 /// samples, over those and f evaluated evenly between them. Every sampled local maximum whose

@@ -144,10 +144,10 @@ void NlpProgram::set_up_design_variables() {
     const std::string name = std::string(core::link_name(cw.link)) + " counterweight ";
     const char* pivot = cw.link == 1 ? "A0" : "A3";
     r.w = add_variable(0.0, r.w_max(),
-                       name + "inertia of its mass about " + pivot + " (relaxed) [kg m^2]");
+                       name + "inertia of its mass about " + pivot + " (relaxed) [kg m²]");
     if (cw.shape == balance::CounterweightShape::kDisc) {
       r.disc_a = 1 / (2 * cw.density * std::numbers::pi * cw.thickness);
-      r.s = add_variable(0.0, r.s_max(), name + "own inertia (relaxed) [kg m^2]");
+      r.s = add_variable(0.0, r.s_max(), name + "own inertia (relaxed) [kg m²]");
     }
     relaxed_cw_.push_back(r);
   }

@@ -105,7 +105,7 @@ Problem DesignProblem::validate() const {
     if (v.parameter == Param::kMass && !(v.lower > 0))
       return field("link_parameters", k, ": " + what + ".lower must be > 0 kg");
     if (v.parameter == Param::kInertia && !(v.lower >= 0))
-      return field("link_parameters", k, ": " + what + ".lower must be >= 0 kg m^2");
+      return field("link_parameters", k, ": " + what + ".lower must be >= 0 kg m²");
     // mass too: the regressor's columns move the centre of mass one parameter at a time
     if (v.parameter != Param::kInertia) moved.try_emplace(v.link, "link_parameters", k);
   }
@@ -507,7 +507,7 @@ void PlanarNlp::Impl::set_up_variables() {
   }
   for (const LinkParameterVariable& v : p.link_parameters) {
     const char* unit = v.parameter == Param::kMass      ? " [kg]"
-                       : v.parameter == Param::kInertia ? " [kg m^2]"
+                       : v.parameter == Param::kInertia ? " [kg m²]"
                                                         : " [m]";
     param_var.push_back(add(
         v.lower, v.upper,
@@ -524,10 +524,10 @@ void PlanarNlp::Impl::set_up_variables() {
     r.mass = cw_var[c];
     r.mass_max = cw.mass_max;
     r.distance_max = cw.distance_max;
-    r.w = add(0.0, r.w_max(), name + "inertia of its mass about its pivot (relaxed) [kg m^2]");
+    r.w = add(0.0, r.w_max(), name + "inertia of its mass about its pivot (relaxed) [kg m²]");
     if (cw.shape == balance::CounterweightShape::kDisc) {
       r.disc_a = disc_inertia_per_mass2(cw);
-      r.s = add(0.0, r.s_max(), name + "own inertia (relaxed) [kg m^2]");
+      r.s = add(0.0, r.s_max(), name + "own inertia (relaxed) [kg m²]");
     }
     relaxed_cw.push_back(r);
   }

@@ -110,7 +110,7 @@ const char* parameter_unit(LinkParameterVariable::Parameter p) {
     case LinkParameterVariable::Parameter::kF:
       return "m";
     case LinkParameterVariable::Parameter::kInertia:
-      return "kg m^2";
+      return "kg m²";
   }
   return "";
 }

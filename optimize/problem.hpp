@@ -111,7 +111,7 @@ struct LinkParameterVariable {
 };
 /// "mass", "e", "f", "inertia".
 const char* parameter_name(LinkParameterVariable::Parameter p);
-/// "kg", "m", "m", "kg m^2".
+/// "kg", "m", "m", "kg m²".
 const char* parameter_unit(LinkParameterVariable::Parameter p);
 
 /// What to optimise, on which design, in which scene.

@@ -276,6 +276,9 @@ void bind_results(py::module_& m) {
           "method_reason", [](const Run& r) { return r.result.method.reason; },
           "why that method (what auto took, in words)")
       .def_property_readonly(
+          "method_numerics", [](const Run& r) { return r.result.method.numerics; },
+          "how that method computes: the integrator and how it keeps the joints together")
+      .def_property_readonly(
           "warnings", [](const Run& r) { return r.result.warnings; },
           "what went wrong besides the run (a report page not written)")
       .def_property_readonly(

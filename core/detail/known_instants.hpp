@@ -9,9 +9,11 @@
 #include <algorithm>
 #include <cstddef>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <optional>
 #include <span>
+#include <utility>
 
 namespace bd::core::detail {
 
@@ -19,16 +21,23 @@ namespace bd::core::detail {
 template <class State>
 class KnownInstants {
  public:
-  /// `t`: the run's sample times, increasing (the span must outlive this).
-  explicit KnownInstants(std::span<const double> t) : t_(t) {}
+  /// `t`: the run's sample times, increasing (the span must outlive this); `stop`: where a run
+  /// that stopped short of its end had integrated to, past its last sample (NaN otherwise).
+  explicit KnownInstants(std::span<const double> t,
+                         double stop = std::numeric_limits<double>::quiet_NaN())
+      : t_(t), end_(t.empty() ? stop : std::max(t.back(), stop)) {}
 
-  /// The state at time s within the samples' span, none outside it: `integrate(t0, from, s)`
+  /// The state at time s from the first sample to the end (the last sample, or the stop past
+  /// it), none outside: `integrate(t0, from, s)`
   /// continues `from`, the state at t0 <= s, to s (none where it cannot), from the latest known
   /// instant at or before s, a sample (`sample(i)`: the state of sample i) or an instant an
   /// earlier call computed, which is kept.
+  /// Takes the state at time s as known (a stopped run's state where it stopped).
+  void add(double s, State state) { known_.insert_or_assign(s, std::move(state)); }
+
   template <class SampleOf, class Integrate>
   std::optional<State> at(double s, const SampleOf& sample, const Integrate& integrate) {
-    if (t_.empty() || !(s >= t_.front()) || !(s <= t_.back())) return std::nullopt;
+    if (t_.empty() || !(s >= t_.front()) || !(s <= end_)) return std::nullopt;
     const auto i =
         static_cast<std::size_t>(std::upper_bound(t_.begin(), t_.end(), s) - t_.begin()) - 1;
     double t0 = t_[i];
@@ -46,6 +55,7 @@ class KnownInstants {
 
  private:
   std::span<const double> t_;
+  double end_;
   std::map<double, State> known_;
 };
 

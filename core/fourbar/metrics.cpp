@@ -117,7 +117,8 @@ Metrics with_peaks(const Trajectory& trajectory, double period,
   for (std::size_t k = 0; resolve && k < kMetricCount; ++k)
     any_refined = any_refined || (*resolve)[k];
   if (sample_at && any_refined) {
-    const std::vector<double> extra = step_instants(trajectory.t, trajectory.steps_to);
+    const std::vector<double> extra =
+        step_instants(trajectory.t, trajectory.steps_to, trajectory.stop_time, trajectory.steps);
     dense_t.reserve(samples.size() + extra.size());
     dense.reserve(samples.size() + extra.size());
     std::size_t e = 0;
@@ -217,7 +218,8 @@ Metrics metrics(const FourBar& model, const Trajectory& trajectory, const Simula
 Metrics metrics(const FourBar& model, const Trajectory& trajectory, const SimulateOptions& options,
                 const MetricMask* resolve, PeakList* peaks) {
   // each instant integrated from the latest instant known before it
-  detail::KnownInstants<DynamicsSample> known(trajectory.t);
+  detail::KnownInstants<DynamicsSample> known(trajectory.t, trajectory.stop_time);
+  if (trajectory.stop) known.add(trajectory.stop_time, *trajectory.stop);
   const auto sample_at = [&](double s) {
     return known.at(
         s, [&](std::size_t i) -> const DynamicsSample& { return trajectory.samples[i]; },

@@ -79,7 +79,7 @@ void check_link(const Link& l, const std::string& name) {
   require(std::isfinite(l.mass) && l.mass > 0, name + ".mass", "> 0", "kg", l.mass);
   check_finite(name + ".e", "m", l.e);
   check_finite(name + ".f", "m", l.f);
-  require(std::isfinite(l.inertia) && l.inertia >= 0, name + ".inertia", ">= 0", "kg m^2",
+  require(std::isfinite(l.inertia) && l.inertia >= 0, name + ".inertia", ">= 0", "kg m²",
           l.inertia);
 }
 
@@ -90,7 +90,7 @@ void check_load(const LinkLoad& load, const std::string& name) {
 
 // `pivot`: the joint of the link the disc is geared to [m]
 void check_counter_rotation(const CounterRotation& c, const std::string& name, const Vec2& pivot) {
-  require(std::isfinite(c.inertia) && c.inertia >= 0, name + ".inertia", ">= 0", "kg m^2",
+  require(std::isfinite(c.inertia) && c.inertia >= 0, name + ".inertia", ">= 0", "kg m²",
           c.inertia);
   check_components(name + ".at", "m", c.at);
   if (c.inertia > 0) {
@@ -114,7 +114,7 @@ FourBar make_fourbar(const FourBar& candidate) {
     check_link(link(m, k), link_name(k));
     check_load(link_load(m, k), std::string("loads.") + link_name(k));
   }
-  check_components("loads.gravity", "m/s^2", m.loads.gravity);
+  check_components("loads.gravity", "m/s²", m.loads.gravity);
   check_counter_rotation(m.counter_rotations.crank, "counter_rotations.crank", Vec2(0, 0));
   check_counter_rotation(m.counter_rotations.rocker, "counter_rotations.rocker",
                          Vec2(m.frame_length, 0));

@@ -354,6 +354,21 @@ integrators::Problem reduced_problem(const FourBar& model, const FreeScene& scen
   return problem;
 }
 
+// A free run that stops short of its end: where the integration had reached (past the last
+// sample), and the motion there where the dynamics still vouches for its values (down to
+// kSingularSin, past the limit test's kDeadCentreSin): the end of its peaks' search.
+void keep_stop(const FourBar& model, const SimulateOptions& options,
+               const integrators::Integration& integration, Trajectory& out) {
+  out.stop_time = integration.t();
+  if (out.t.empty() || !(out.stop_time > out.t.back())) return;
+  auto sample =
+      forward_dynamics(model, integration.y()[0], integration.y()[1], options.formulation);
+  DynamicsError error;
+  if (!sample || at_dead_centre(*sample, kSingularSin, error)) return;
+  continue_angles(model, out.samples.back().state, sample->state);
+  out.stop = *sample;
+}
+
 // True, with the trajectory's status and message set, when the integration stopped before
 // t_out: out of steps, failed, or at a limit position found by the root function; false when it
 // reached t_out (the state there is the next sample's).
@@ -477,7 +492,10 @@ Trajectory detail::simulate_free_reduced(const FourBar& model, const FreeScene& 
   for (std::size_t j = 1; j < samples; ++j) {
     motion.rhs_failed = false;
     const auto outcome = integration.advance(output_time(scene, j));
-    if (stopped_short(outcome, integration, motion, options, out)) break;
+    if (stopped_short(outcome, integration, motion, options, out)) {
+      keep_stop(model, options, integration, out);
+      break;
+    }
 
     const double t_reached = integration.t();
     const double theta1 = integration.y()[0], omega1 = integration.y()[1];
@@ -485,6 +503,7 @@ Trajectory detail::simulate_free_reduced(const FourBar& model, const FreeScene& 
     auto sample = forward_dynamics(model, theta1, omega1, options.formulation);
     if (!sample || at_dead_centre(*sample, kDeadCentreSin, motion.error)) {
       fail(out, sample ? motion.error : sample.error(), t_reached, theta1);
+      keep_stop(model, options, integration, out);
       break;
     }
     continue_angles(model, out.samples.back().state, sample->state);

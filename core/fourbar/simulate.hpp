@@ -3,6 +3,7 @@
 /// output at the requested instants by the integrator's dense output) and driven motion (constant
 /// crank speed, inverse dynamics per sample, no integration).
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -74,6 +75,14 @@ struct Trajectory {
   /// Free scenes: the integrator's steps taken up to each sample (0 at the first), as t; the
   /// peaks are looked for between samples where it stepped more than once (step_instants()).
   std::vector<long> steps_to;
+  /// A free run that stopped short of its end: the instant its integration had reached (past
+  /// its last sample, e.g. the limit position it stopped at), where its peaks are searched to;
+  /// NaN for a run that completed, and for a driven run.
+  double stop_time = std::numeric_limits<double>::quiet_NaN();
+  /// The motion at stop_time where it could be evaluated there (the crank at its limit
+  /// position, before the dynamics stops vouching for its values), else none: not a sample (the
+  /// samples stay evenly spaced), but the end of the peaks' search.
+  std::optional<DynamicsSample> stop;
   long rhs_evaluations{};                           // dynamics evaluations
   bool ok() const { return status == SimulationStatus::kCompleted; }
 };

@@ -1,5 +1,7 @@
 #include "core/planar/from_fourbar.hpp"
 
+#include <span>
+
 #include "core/fourbar/kinematics.hpp"
 #include "core/input_error.hpp"
 
@@ -47,33 +49,34 @@ core::Trajectory fourbar_trajectory(const Trajectory& planar) {
                     al3 = col("alpha_rocker"), r0 = col("RA0x"), r3 = col("RA3x"), f = col("Fshx"),
                     m = col("Msh"), tau = col("tau"), fi = col("Fshx_inertial"),
                     mi = col("Msh_inertial"), fs = col("Fshx_static"), ms = col("Msh_static");
+  // the four-bar's sample of a row of the table's columns
+  const auto sample_of = [&](std::span<const double> r) {
+    DynamicsSample d;
+    d.state = {r[th1], r[om1], r[al1], r[th2], r[th3], r[om2], r[om3], r[al2], r[al3]};
+    d.RA0 = Vec2(r[r0], r[r0 + 1]);
+    d.RA3 = Vec2(r[r3], r[r3 + 1]);
+    d.Fsh = Vec2(r[f], r[f + 1]);
+    d.Msh = r[m];
+    d.tau = r[tau];
+    d.Fsh_inertial = Vec2(r[fi], r[fi + 1]);
+    d.Msh_inertial = r[mi];
+    d.Fsh_static = Vec2(r[fs], r[fs + 1]);
+    d.Msh_static = r[ms];
+    if (t.column("FA1x") >= 0) d.FA1 = Vec2(r[col("FA1x")], r[col("FA1y")]);
+    if (t.column("FA2x") >= 0) d.FA2 = Vec2(r[col("FA2x")], r[col("FA2y")]);
+    if (t.column("RC1x") >= 0) d.RC1 = Vec2(r[col("RC1x")], r[col("RC1y")]);
+    if (t.column("RC3x") >= 0) d.RC3 = Vec2(r[col("RC3x")], r[col("RC3y")]);
+    return d;
+  };
   core::Trajectory out;
   out.t.reserve(t.rows());
   out.samples.reserve(t.rows());
   for (std::size_t i = 0; i < t.rows(); ++i) {
-    DynamicsSample d;
-    d.state = {t.at(i, th1), t.at(i, om1), t.at(i, al1), t.at(i, th2), t.at(i, th3),
-               t.at(i, om2), t.at(i, om3), t.at(i, al2), t.at(i, al3)};
-    d.RA0 = Vec2(t.at(i, r0), t.at(i, r0 + 1));
-    d.RA3 = Vec2(t.at(i, r3), t.at(i, r3 + 1));
-    d.Fsh = Vec2(t.at(i, f), t.at(i, f + 1));
-    d.Msh = t.at(i, m);
-    d.tau = t.at(i, tau);
-    d.Fsh_inertial = Vec2(t.at(i, fi), t.at(i, fi + 1));
-    d.Msh_inertial = t.at(i, mi);
-    d.Fsh_static = Vec2(t.at(i, fs), t.at(i, fs + 1));
-    d.Msh_static = t.at(i, ms);
-    if (t.column("FA1x") >= 0) d.FA1 = Vec2(t.at(i, col("FA1x")), t.at(i, col("FA1y")));
-    if (t.column("FA2x") >= 0) d.FA2 = Vec2(t.at(i, col("FA2x")), t.at(i, col("FA2y")));
-    if (t.column("RC1x") >= 0) {
-      d.RC1 = Vec2(t.at(i, col("RC1x")), t.at(i, col("RC1y")));
-    }
-    if (t.column("RC3x") >= 0) {
-      d.RC3 = Vec2(t.at(i, col("RC3x")), t.at(i, col("RC3y")));
-    }
     out.t.push_back(t.at(i, c_t));
-    out.samples.push_back(d);
+    out.samples.push_back(sample_of(t.row(i)));
   }
+  out.stop_time = planar.stop_time;
+  if (planar.stop_row.size() == t.width()) out.stop = sample_of(planar.stop_row);
   out.status = planar.status;
   out.message = planar.message;
   out.steps = planar.steps;

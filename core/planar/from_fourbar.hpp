@@ -19,7 +19,7 @@ Linkage linkage_of(const FourBar& fourbar, double theta1);
 
 /// The general engine's samples of that linkage as the four-bar's (its crank, coupler and rocker
 /// angles as theta1..3, the reactions at A0 and A3, the shaking force and moment, the drive
-/// torque), with the same status and message.
+/// torque), with the same status and message, and where a stopped run stopped.
 core::Trajectory fourbar_trajectory(const Trajectory& planar);
 
 }  // namespace bd::core::planar

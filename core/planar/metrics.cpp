@@ -216,8 +216,8 @@ class RowPositions {
 
 // The metrics over the run's table (sample times t), every peak resolved between the samples by
 // `row_at(s)`: the whole row at time s, or null where it cannot be evaluated; `extra`: instants
-// between the samples (increasing) whose rows the peaks' searches start from with the samples'
-// (a free run's step_instants()).
+// between the samples, and after the last up to where a stopped run stopped (increasing), whose
+// rows the peaks' searches start from with the samples' (a free run's step_instants()).
 template <class RowAt>
 std::vector<double> resolved_values(const std::vector<ColumnMetric>& metrics, const Series& table,
                                     const std::vector<double>& t, double period,
@@ -357,11 +357,14 @@ std::vector<double> metric_values(const Model& model, const SimulateOptions& opt
     FreeState state;
     std::vector<double> row;
   };
-  core::detail::KnownInstants<Known> known(t);
+  core::detail::KnownInstants<Known> known(t, run.stop_time);
   const auto sample = [&](std::size_t i) {
     const std::span<const double> r = table.row(i);
     return Known{free_state(model, run, i), std::vector<double>(r.begin(), r.end())};
   };
+  if (std::optional<FreeState> stop = free_stop_state(model, run)) {
+    known.add(run.stop_time, Known{std::move(*stop), run.stop_row});
+  }
   Series row;
   row.columns = table.columns;
   // the run continued from `from` at t0 to s; none where it cannot be, or where it lands on
@@ -393,7 +396,8 @@ std::vector<double> metric_values(const Model& model, const SimulateOptions& opt
     return last ? last->row.data() : nullptr;
   };
   std::vector<double> values =
-      resolved_values(metrics, table, t, 0.0, row_at, peaks, step_instants(t, run.steps_to));
+      resolved_values(metrics, table, t, 0.0, row_at, peaks,
+                      step_instants(t, run.steps_to, run.stop_time, run.steps));
   // where each peak lies: the inputs' values there
   if (peaks && table.rows() > 0) {
     std::vector<int> inputs;

@@ -65,7 +65,7 @@ void check_links(const Linkage& l) {
     check_value("links", k, "mass", link.mass, link.mass >= 0, ">= 0", "kg");
     check_value("links", k, "e", link.e, true, "finite", "m");
     check_value("links", k, "f", link.f, true, "finite", "m");
-    check_value("links", k, "inertia", link.inertia, link.inertia >= 0, ">= 0", "kg m^2");
+    check_value("links", k, "inertia", link.inertia, link.inertia >= 0, ">= 0", "kg m²");
   }
 }
 
@@ -210,7 +210,7 @@ void check_shafts(const Linkage& l) {
     if (!finite(b.at)) fail("shafts", k, ".at must be finite");
     if (!finite(b.eccentricity)) fail("shafts", k, ".eccentricity must be finite");
     check_value("shafts", k, "mass", b.mass, b.mass >= 0, ">= 0", "kg");
-    check_value("shafts", k, "inertia", b.inertia, b.inertia >= 0, ">= 0", "kg m^2");
+    check_value("shafts", k, "inertia", b.inertia, b.inertia >= 0, ">= 0", "kg m²");
   }
 }
 

@@ -732,15 +732,17 @@ bool advance_ok(Trajectory& out, const Motion& m, integrators::Integration& inte
   } else if (outcome == Outcome::kRoot) {
     out.status = SimulationStatus::kSingular;
     out.message = "limit position reached at " + where() +
-                  ": the inputs stop being coordinates of the motion there (the dae route "
-                  "goes through it)";
+                  ": the inputs stop describing the motion there (following every joint's "
+                  "coordinates, method truss-dae, goes through it)";
   } else if (m.failed && m.route == Route::kReduced &&
              m.error.kind == PlanarError::Kind::kAssembly) {
     // an explicit Runge-Kutta stage beyond a limit position (it cannot retry a shorter step):
     // the linkage does not close there
     out.status = SimulationStatus::kSingular;
     out.message = "limit position reached after " + at + ": a step beyond it cannot close the " +
-                  "linkage (" + m.error.detail + "); the dae route goes through it";
+                  "linkage (" + m.error.detail +
+                  "); following every joint's coordinates, method "
+                  "truss-dae, goes through it";
   } else if (m.failed) {
     out.status = status_of(m.error);
     out.message = m.error.detail + " (a step ahead of " + at + " reached it)";
@@ -795,9 +797,28 @@ double output_time(const FreeScene& scene, std::size_t j) {
                    : scene.duration * static_cast<double>(j) / static_cast<double>(last);
 }
 
+// A free run that stops short of its end: where the integration had reached (past the last
+// sample), and the motion there where it can be evaluated (`evaluate(true)`: the instant at the
+// integration's state, as a sample's but for the sensitivities): the end of its peaks' search.
+template <class Evaluate>
+void keep_stop(const Model& model, Motion& m, const integrators::Integration& integration,
+               Trajectory& out, Evaluate& evaluate) {
+  out.stop_time = integration.t();
+  const std::size_t rows = out.table.rows();
+  if (rows == 0 || !(out.stop_time > out.table.at(rows - 1, 0))) return;
+  m.failed = false;
+  ++m.evaluations;
+  if (!evaluate(true) || m.failed) return;
+  Series row;
+  row.columns = out.table.columns;
+  append_row(model, m.ws->instant, row);
+  out.stop_row = std::move(row.values);
+  out.stop_state.assign(integration.y(), integration.y() + out.state_size);
+}
+
 // The samples after the first: the integration advanced to each output time, the instant there
-// evaluated by `evaluate()` and appended to the table, until the end or a failure (every sample
-// before it kept). `where()` names a limit position reached.
+// evaluated by `evaluate(false)` and appended to the table, until the end or a failure (every
+// sample before it kept). `where()` names a limit position reached.
 template <class Where, class Evaluate>
 void sample_run(const Model& model, Motion& m, integrators::Integration& integration,
                 const FreeScene& scene, const SimulateOptions& options, Trajectory& out,
@@ -808,11 +829,15 @@ void sample_run(const Model& model, Motion& m, integrators::Integration& integra
   for (std::size_t j = 1; j < static_cast<std::size_t>(scene.samples); ++j) {
     m.failed = false;
     const auto outcome = integration.advance(output_time(scene, j));
-    if (!advance_ok(out, m, integration, outcome, options, where)) break;
+    if (!advance_ok(out, m, integration, outcome, options, where)) {
+      keep_stop(model, m, integration, out, evaluate);
+      break;
+    }
     ++m.evaluations;
-    const auto ok = evaluate();
+    const auto ok = evaluate(false);
     if (!ok) {
       fail(out, ok.error(), integration.t());
+      keep_stop(model, m, integration, out, evaluate);
       break;
     }
     append_row(model, m.ws->instant, out.table);
@@ -952,8 +977,8 @@ Trajectory free_reduced(const Model& model, Workspace& ws, const FreeScene& scen
                       std::vector<double>(integration.y(), integration.y() + dof));
   };
   m.sample_angle = ws.instant.angle;
-  sample_run(model, m, integration, scene, options, out, where, [&] {
-    if (sens != nullptr) {
+  sample_run(model, m, integration, scene, options, out, where, [&](bool at_stop) {
+    if (sens != nullptr && !at_stop) {
       if (auto ok = sample_derivatives(model, m, *sens, integration.t(), integration.y(),
                                        &integration, m.sample_angle, scratch);
           !ok) {
@@ -1000,7 +1025,7 @@ Trajectory free_dae(const Model& model, Workspace& ws, const FreeScene& scene,
   integrators::Integration integration(problem);
   std::vector<double> y(y0.size());
   const auto where = [&] { return "t = " + text::digits(integration.t(), 10) + " s"; };
-  sample_run(model, m, integration, scene, options, out, where, [&] {
+  sample_run(model, m, integration, scene, options, out, where, [&](bool /*at_stop*/) {
     y.assign(integration.y(), integration.y() + y0.size());
     project(model, ws, y.data());
     return dae_instant(m, integration.t(), y.data());
@@ -1077,18 +1102,18 @@ Trajectory simulate_free(const Model& model, const FreeScene& scene,
              : free_reduced(model, ws, scene, start, rates, options, nullptr);
 }
 
-FreeState free_state(const Model& model, const Trajectory& run, std::size_t i) {
+namespace {
+
+// the state of a run whose row (of run.table's columns) is `row` and integrator state `y`
+FreeState free_state_of(const Model& model, const Trajectory& run, std::span<const double> row,
+                        std::span<const double> y) {
   const Linkage& l = model.linkage();
-  const Series& table = run.table;
   const auto value = [&](const std::string& column) {
-    return table.at(i, static_cast<std::size_t>(table.column(column)));
+    return row[static_cast<std::size_t>(run.table.column(column))];
   };
   FreeState out;
   out.t = value("t");
-  if (run.state_size > 0 && (i + 1) * run.state_size <= run.states.size()) {
-    const auto first = run.states.begin() + static_cast<std::ptrdiff_t>(i * run.state_size);
-    out.y.assign(first, first + static_cast<std::ptrdiff_t>(run.state_size));
-  }
+  out.y.assign(y.begin(), y.end());
   out.angle.reserve(l.links.size());
   for (const Link& link : l.links) out.angle.push_back(value("theta_" + link.name));
   out.x.reserve(l.nodes.size());
@@ -1096,6 +1121,24 @@ FreeState free_state(const Model& model, const Trajectory& run, std::size_t i) {
     out.x.push_back(n.ground ? n.position : Vec2(value("x_" + n.name), value("y_" + n.name)));
   }
   return out;
+}
+
+}  // namespace
+
+FreeState free_state(const Model& model, const Trajectory& run, std::size_t i) {
+  std::span<const double> y;
+  if (run.state_size > 0 && (i + 1) * run.state_size <= run.states.size()) {
+    y = std::span<const double>(run.states).subspan(i * run.state_size, run.state_size);
+  }
+  return free_state_of(model, run, run.table.row(i), y);
+}
+
+std::optional<FreeState> free_stop_state(const Model& model, const Trajectory& run) {
+  if (run.stop_row.size() != run.table.width() || run.stop_state.size() != run.state_size ||
+      run.state_size == 0) {
+    return std::nullopt;
+  }
+  return free_state_of(model, run, run.stop_row, run.stop_state);
 }
 
 namespace {

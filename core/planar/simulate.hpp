@@ -13,6 +13,7 @@
 ///   constraints' saddle-point system with Baumgarte stabilisation, every output sample projected
 ///   onto the constraints. It passes through limit positions, as the mechanism does; it stops
 ///   only where the constraints themselves lose rank (a lock-up or bifurcation).
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -73,6 +74,14 @@ struct Trajectory {
   /// Free runs: the integrator's steps taken up to each row of `table` (0 at the first); the
   /// peaks are looked for between rows where it stepped more than once (step_instants()).
   std::vector<long> steps_to;
+  /// A free run that stopped short of its end: the instant its integration had reached (past
+  /// its last sample, e.g. the limit position it stopped at), where its peaks are searched to;
+  /// NaN for a run that completed, and for a driven run.
+  double stop_time = std::numeric_limits<double>::quiet_NaN();
+  /// The motion at stop_time where it could be evaluated there, as a row of columns(model) and
+  /// the integrator's state (as `states`); both empty otherwise. Not a sample (the samples stay
+  /// evenly spaced) but the end of the peaks' search (free_stop_state()).
+  std::vector<double> stop_row, stop_state;
   /// A free run's integrator state at each sample, `state_size` numbers per row of `table`: the
   /// inputs and their rates (z, ż) on the reduced route, every node coordinate and its rate
   /// (q, q̇) on the dae route, as integrated (before the sample's projection). Empty for a driven
@@ -120,6 +129,9 @@ struct FreeState {
 /// The state at sample i < run.table.rows() of the free run `run` (its states, and its row's
 /// angles and positions); y is empty where the run kept no states.
 FreeState free_state(const Model& model, const Trajectory& run, std::size_t i);
+/// The state where the free run `run` stopped short of its end (Trajectory::stop_time), none
+/// where it completed or its stop could not be evaluated.
+std::optional<FreeState> free_stop_state(const Model& model, const Trajectory& run);
 
 /// The free motion continued from `from` (a sample of a run, free_state(), or an instant computed
 /// so) to t >= from.t by the route, integrator and tolerances of `options` (the run's own), in

@@ -152,7 +152,7 @@ std::string fmt_scaled(double v, double scale) {
 std::string vec_text(const Vec2& v, double scale) {
   const double larger = std::max({std::abs(v.x()), std::abs(v.y()), scale});
   auto part = [&](double x) {
-    return text::is_round_off(x, larger) && x != 0 ? std::string("0") : fmt(x, "%.4g");
+    return text::is_round_off(x, larger) && x != 0 ? std::string("0") : fmt(x);
   };
   return "(" + part(v.x()) + ", " + part(v.y()) + ")";
 }

@@ -47,7 +47,8 @@ std::vector<double> numbers(const std::vector<std::string>& row);
 
 /// A point as gnuplot data, "x,y" (10 digits).
 std::string xy(const Vec2& v);
-/// A point for a table, "(x, y)" (4 digits; a component that is round-off of the larger one or
+/// A point for a table, "(x, y)" (6 significant digits, as fmt(): the study's 9.80665 m/s² shows
+/// as written; a component that is round-off of the larger one or
 /// of `scale`, a position's the linkage's size, shown as 0).
 std::string vec_text(const Vec2& v, double scale = 0);
 /// A number for a page: 6 significant digits, or "0" where it is round-off of the quantity's

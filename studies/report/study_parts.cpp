@@ -51,6 +51,9 @@ std::string run_table(const Json& run, const std::string& what, bool free) {
   if (const Json* method = member(run, "method")) {
     h += "<tr><th>method</th><td><b>" + esc(text(*method, "used")) + "</b> (requested " +
          esc(text(*method, "requested")) + ")<br>" + esc(text(*method, "reason")) + "</td></tr>";
+    if (const std::string numerics = text(*method, "numerics"); !numerics.empty()) {
+      h += "<tr><th>numerics</th><td>" + esc(numerics) + "</td></tr>";
+    }
   }
   const bool ok = text(run, "ok") == "true";
   h += "<tr><th>status</th><td class=\"" + std::string(ok ? "good" : "bad") + "\">" +
@@ -136,10 +139,11 @@ std::string peak_place(const Study& study, const Json& summary, const std::strin
 
 std::string metrics_section(const Study& study, const Json& summary, const SecondDesign& second,
                             const std::string& notes, const Scales& scales) {
-  // a run that stopped early: its metrics cover the samples before the stop only
+  // a run that stopped early: its metrics cover the motion before the stop only (a free run's
+  // peaks up to the stop itself, a driven run's the samples before it)
   const auto partial = [&](const std::string& key) {
     return text(summary, key) == "true"
-               ? std::string("<br><span class=\"bad\">partial: the samples before the stop</span>")
+               ? std::string("<br><span class=\"bad\">partial: the motion up to the stop</span>")
                : std::string();
   };
   std::string h = "<h2>Metrics</h2>\n<table><tr><th>metric</th><th>original" +

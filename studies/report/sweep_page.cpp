@@ -779,7 +779,7 @@ std::string engineer_name(const std::string& path, const Study& study) {
     return "counterweight on " + k[2] + " position " + axis(k[4]) + " [m]";
   if (is({"linkage", "inputs", "*", "torque"})) return "drive torque on " + k[2] + " [N m]";
   if (is({"linkage", "inputs", "*", "force"})) return "drive force on " + k[2] + " [N]";
-  if (is({"loads", "gravity", "*"})) return "gravity g" + axis(k[2]) + " [m/s^2]";
+  if (is({"loads", "gravity", "*"})) return "gravity g" + axis(k[2]) + " [m/s²]";
   if (is({"loads", "*", "force", "*"})) return k[1] + " force F" + axis(k[3]) + " [N]";
   if (is({"loads", "*", "moment"})) return k[1] + " moment [N m]";
   if (is({"loads", "links", "*", "force", "*"})) return k[2] + " force F" + axis(k[4]) + " [N]";

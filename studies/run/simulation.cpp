@@ -209,12 +209,7 @@ Simulation simulate_unchecked(const Study& study, const MethodChoice& method,
   // auto, free: a limit position stops the reduced equations; the DAE passes through it
   if (study.method == Method::kAuto && is_free(study.scene) &&
       s.planar.status == core::SimulationStatus::kSingular && method.method == Method::kTruss) {
-    MethodChoice dae = method;
-    dae.method = Method::kTrussDae;
-    dae.reason =
-        "planar linkage on the paper's truss elements, as a stabilised DAE in every node "
-        "coordinate: the equations reduced to the inputs stopped at a limit position (" +
-        s.planar.message + "), which the DAE passes through; integrated by CVODE Adams";
+    const MethodChoice dae = through_limits(method, s.planar.message);
     s.method = dae;
     s.planar = general_engine(model, study.scene, dae, tolerances);
   }

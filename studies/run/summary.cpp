@@ -1,11 +1,14 @@
 // summary.json: what a run computed, as one JSON document written by nlohmann-json (keys in the
 // order below, numbers in their shortest exact text; null only where a value was not computed,
 // and a number that is not finite anywhere else an internal error, never written as null).
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <variant>
+#include <vector>
 
 #include "studies/run/files.hpp"
 #include "studies/run/runner.hpp"
@@ -71,7 +74,8 @@ Json reduction_json(const MetricList& before, const MetricList& after) {
 Json method_json(const Study& study, const MethodChoice& method) {
   return {{"requested", study.method_name()},
           {"used", to_string(method.method)},
-          {"reason", method.reason}};
+          {"reason", method.reason},
+          {"numerics", method.numerics}};
 }
 
 Json inputs_json(const std::vector<double>& values) {
@@ -331,11 +335,29 @@ void add_solver_fields(Json& j, const Result& r, const OptimizedRun& o) {
                                  : Json(nullptr);
   Json variables = Json::array();
   if (static_cast<std::size_t>(r.x.size()) == o.variable_names.size()) {
+    const auto value = [&](std::size_t k) { return r.x[static_cast<Eigen::Index>(k)]; };
+    // the links whose counterweight the optimum left without mass: its position is no design
+    std::vector<std::string> massless;
+    constexpr std::string_view kMass = " counterweight mass [kg]";
+    for (std::size_t k = 0; found && k < o.variable_names.size(); ++k) {
+      const std::string& n = o.variable_names[k];
+      if (n.ends_with(kMass) && value(k) == 0)
+        massless.push_back(n.substr(0, n.size() - kMass.size()));
+    }
     for (std::size_t k = 0; k < o.variable_names.size(); ++k) {
-      variables.push_back(
-          {{"name", o.variable_names[k]},
-           {"value", found ? Json(r.x[static_cast<Eigen::Index>(k)])
-                           : value_or_null(r.x[static_cast<Eigen::Index>(k)])}});
+      const std::string& n = o.variable_names[k];
+      const bool placeless =
+          std::any_of(massless.begin(), massless.end(), [&](const std::string& l) {
+            return n.starts_with(l + " counterweight x") || n.starts_with(l + " counterweight y");
+          });
+      if (placeless) {
+        variables.push_back({{"name", n},
+                             {"value", nullptr},
+                             {"note", "no counterweight (its mass is 0): no position"}});
+      } else {
+        variables.push_back(
+            {{"name", n}, {"value", found ? Json(value(k)) : value_or_null(value(k))}});
+      }
     }
   }
   j["variables"] = variables;
@@ -406,7 +428,7 @@ Json planar_optimize_json(const Study& study, const RunResult& result) {
     j["added_inertia"] = added_inertia(l, r.design);
     // a driven scene: the optimum simulated against the regressor's values; a free scene: the
     // other route of the engine (dae) against the reduced route's
-    j["verified_with"] = is_free(study.scene) ? "dae route" : "the optimum simulated";
+    j["verified_with"] = is_free(study.scene) ? "truss-dae" : "the optimum simulated";
     j["verification_error"] = value_or_null(r.verification_error);       // null: the run failed
     j["inertial_verification_error"] = value_or_null(r.inertial_error);  // null: not computed
   }

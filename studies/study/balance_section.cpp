@@ -43,10 +43,10 @@ balance::Counterweight read_counterweight_part(const Reporter& r_, const MapRead
       path + ".at", "m", marks);
   cw.distance = cw.position.norm();
   if (const MapReader::Entry* j = m.find("inertia")) {
-    cw.inertia = read_number(r_, *j, path + ".inertia", "kg m^2");
+    cw.inertia = read_number(r_, *j, path + ".inertia", "kg m²");
     if (!(cw.inertia >= 0)) {
       r_.fail(mark_of(j->value, j->key_mark),
-              path + ".inertia must be >= 0 kg m^2, got " + text::shortest(cw.inertia));
+              path + ".inertia must be >= 0 kg m², got " + text::shortest(cw.inertia));
     }
   }
   return cw;

@@ -104,8 +104,8 @@ class FourBarSection::Impl {
       const std::string path = "linkage.counter_rotations." + side;
       const MapReader m(r_, x->value, path, x->key_mark, "(inertia, at)");
       m.check_keys({"inertia", "at"});
-      const MapReader::Entry& j = m.require("inertia", "J of the disc about its shaft in kg m^2");
-      targets[i]->inertia = read_number(r_, j, path + ".inertia", "kg m^2");
+      const MapReader::Entry& j = m.require("inertia", "J of the disc about its shaft in kg m²");
+      targets[i]->inertia = read_number(r_, j, path + ".inertia", "kg m²");
       places_.push_back({"counter_rotations." + side + ".inertia", path + ".inertia",
                          mark_of(j.value, j.key_mark)});
       const MapReader::Entry& at = m.require("at", "the shaft position [x, y] on the frame in m");
@@ -133,7 +133,7 @@ class FourBarSection::Impl {
     const CentreOfMassKeys com =
         centre_of_mass_keys(r_, m, e, path, "give s [m] and sigma [rad], or e [m] and f [m]");
     const double inertia =
-        number(m.require("inertia", "I about the centre of mass in kg m^2"), "kg m^2");
+        number(m.require("inertia", "I about the centre of mass in kg m²"), "kg m²");
     if (com.polar()) {
       const double sv = number(*com.s, "m");
       if (sv < 0) {
@@ -161,7 +161,7 @@ class FourBarSection::Impl {
     ld.check_keys({"gravity", "crank", "coupler", "rocker"});
     if (const MapReader::Entry* g = ld.find("gravity")) {
       YAML::Mark marks[2];
-      loads.gravity = read_vec2(r_, *g, "loads.gravity", "m/s^2", marks);
+      loads.gravity = read_vec2(r_, *g, "loads.gravity", "m/s²", marks);
       places_.push_back({"loads.gravity[0]", "loads.gravity[0]", marks[0]});
       places_.push_back({"loads.gravity[1]", "loads.gravity[1]", marks[1]});
     }

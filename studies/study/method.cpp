@@ -14,39 +14,45 @@ namespace {
 // "Recommendation").
 constexpr double kOpenedLoopErk8Below = 1e-8;
 
-// the integrator of a four-bar formulation at a tolerance, and why
+// the integrator of a four-bar formulation at a tolerance, and its numerics in words
 std::pair<core::Integrator, std::string> integrator_for(core::Formulation f, double tolerance) {
   if (f != core::Formulation::kOpenedLoop) {
-    return {core::Integrator::kCvodeAdams,
-            "integrated by CVODE Adams (variable order), the most correct digits per CPU time for "
-            "this smooth equation at every tolerance"};
+    return {core::Integrator::kCvodeAdams, "CVODE Adams-Moulton, variable order"};
   }
   if (tolerance < kOpenedLoopErk8Below) {
     return {core::Integrator::kErk8,
-            "integrated by the Fehlberg 8(7) Runge-Kutta pair with Baumgarte stabilisation, its "
-            "steps ending at every sample: the most correct digits per CPU time through limit "
-            "positions at tolerances below 1e-8"};
+            "Fehlberg 8(7) Runge-Kutta pair, the loop closure held by Baumgarte stabilisation, "
+            "steps ending at every sample"};
   }
   return {core::Integrator::kErk5,
-          "integrated by the Dormand-Prince 5(4) Runge-Kutta pair with Baumgarte stabilisation: "
-          "the most correct digits per CPU time through limit positions from tolerance 1e-8 up"};
+          "Dormand-Prince 5(4) Runge-Kutta pair, the loop closure held by Baumgarte "
+          "stabilisation"};
 }
 
-// what the four-bar's formulations compute, in words
+// what a four-bar formulation follows a free motion in, in words
 std::string formulation_words(core::Formulation f) {
   switch (f) {
     case core::Formulation::kMassMatrix:
-      return "closed-form four-bar on the constant mass matrix of its three truss elements, as "
-             "the reduced equation in theta1 (the cheapest exact formulation)";
+      return "the exact equation of motion in the crank angle (the links' constant mass matrix)";
     case core::Formulation::kComplexMasses:
-      return "closed-form four-bar with complex equivalent masses, as the reduced equation in "
-             "theta1";
+      return "the exact equation of motion in the crank angle (complex equivalent masses)";
     case core::Formulation::kOpenedLoop:
-      return "closed-form four-bar as an opened loop: a DAE in theta1, theta2, theta3 with the "
-             "loop closure as its constraint";
+      return "the motion followed in all three link angles, the loop kept closed";
   }
   return "";
 }
+
+constexpr const char* kAsked = "as the study asks: ";
+constexpr const char* kDriven =
+    "the drive prescribes the motion: each sample's loads from the exact equations, nothing "
+    "integrated";
+constexpr const char* kDrivenNumerics = "none: inverse dynamics at each sample";
+constexpr const char* kEveryJoint =
+    "the motion followed in every joint's coordinates, the links kept joined, through limit "
+    "positions";
+constexpr const char* kEveryJointNumerics =
+    "CVODE Adams-Moulton, variable order, on the node coordinates, the constraints held by "
+    "Baumgarte stabilisation and each sample projected onto them";
 
 MethodChoice fourbar_choice(const Study& study) {
   const bool free = is_free(study.scene);
@@ -54,49 +60,49 @@ MethodChoice fourbar_choice(const Study& study) {
   // a free crank that cannot turn fully reaches limit positions, where theta1 stops being a
   // coordinate: only the opened loop's equations go through them
   const bool reaches_limits = free && !core::crank_turns_fully(model);
-  const std::string limits = std::string("the crank cannot turn fully (") +
-                             core::to_string(core::classify_grashof(model)) +
-                             ") and reaches limit positions";
+  const std::string cannot_turn = std::string("the crank cannot turn fully (") +
+                                  core::to_string(core::classify_grashof(model)) + ")";
+  const std::string stops =
+      "; " + cannot_turn +
+      ", so the run stops at its first limit position (auto follows it through)";
   MethodChoice c;
   if (study.method == Method::kAuto) {
     c.method = reaches_limits ? Method::kOpenedLoop : Method::kMassMatrix;
   } else {
     c.method = study.method;
   }
+  const std::string asked = study.method == Method::kAuto ? "" : kAsked;
   if (c.general_engine()) {
-    c.reason =
-        "requested in the study file: the general planar engine on three truss elements, "
-        "in the node coordinates of A1 and A2";
+    c.reason = asked + "the general planar engine, the links as truss elements; ";
     if (!free) {
-      c.reason += "; no integrator: kinetostatics per sample";
+      c.reason += kDriven;
+      c.numerics = kDrivenNumerics;
     } else if (c.method == Method::kTrussDae) {
-      c.reason += ", as a stabilised DAE in every node coordinate; integrated by CVODE Adams";
+      c.reason += kEveryJoint;
+      c.numerics = kEveryJointNumerics;
     } else {
-      c.reason += ", reduced to theta1; integrated by CVODE Adams";
-      if (reaches_limits) c.reason += "; " + limits + ", where this reduced equation stops";
+      c.reason += "the motion in the crank angle";
+      if (reaches_limits) c.reason += stops;
+      c.numerics = "CVODE Adams-Moulton, variable order";
     }
     return c;
   }
   c.formulation = *formulation_of(c.method);
-  c.reason = formulation_words(c.formulation);
-  if (study.method == Method::kAuto && reaches_limits) {
-    c.reason = limits + ", where theta1 stops being a coordinate: " + c.reason +
-               ", which passes through them";
-  } else if (study.method != Method::kAuto) {
-    c.reason = "requested in the study file: " + c.reason;
-    if (reaches_limits && c.formulation != core::Formulation::kOpenedLoop) {
-      c.reason += "; " + limits +
-                  ", where this reduced equation in theta1 stops (auto would take the opened-loop "
-                  "DAE through them)";
-    }
-  }
   if (!free) {
-    c.reason += "; no integrator: kinetostatics per sample";
-  } else {
-    const auto [integrator, why] = integrator_for(c.formulation, study.tolerance);
-    c.integrator = integrator;
-    c.reason += "; " + why;
+    c.reason = asked + kDriven;
+    c.numerics = kDrivenNumerics;
+    return c;
   }
+  if (study.method == Method::kAuto && reaches_limits) {
+    c.reason = cannot_turn + ": " + formulation_words(c.formulation) +
+               ", which carries it through its limit positions";
+  } else {
+    c.reason = asked + formulation_words(c.formulation);
+    if (reaches_limits && c.formulation != core::Formulation::kOpenedLoop) c.reason += stops;
+  }
+  const auto [integrator, numerics] = integrator_for(c.formulation, study.tolerance);
+  c.integrator = integrator;
+  c.numerics = numerics;
   return c;
 }
 
@@ -108,25 +114,22 @@ MethodChoice planar_choice(const Study& study) {
                                     "is computed by truss or truss-dae"});
   }
   const std::size_t inputs = study.planar().inputs.size();
-  const std::string in_words = std::to_string(inputs) + " input" + (inputs == 1 ? "" : "s");
   MethodChoice c;
   c.method = study.method == Method::kAuto ? Method::kTruss : study.method;
-  c.reason = std::string(study.method == Method::kAuto ? "" : "requested in the study file: ") +
-             "planar linkage on the paper's truss elements, in node coordinates";
+  c.reason = study.method == Method::kAuto ? "" : kAsked;
   if (!is_free(study.scene)) {
-    c.reason += "; no integrator: kinetostatics per sample";
+    c.reason += kDriven;
+    c.numerics = kDrivenNumerics;
   } else if (c.method == Method::kTrussDae) {
-    c.reason +=
-        ", as a stabilised DAE in every node coordinate (it passes through limit "
-        "positions); integrated by CVODE Adams";
+    c.reason += kEveryJoint;
+    c.numerics = kEveryJointNumerics;
   } else {
-    c.reason += ", reduced to its " + in_words + "; integrated by CVODE Adams";
-    if (study.method == Method::kAuto) {
-      c.reason +=
-          " (at a limit position, where the inputs stop being coordinates, the run is "
-          "repeated as a stabilised DAE in every node coordinate, which passes through "
-          "it)";
-    }
+    c.reason += std::string("the motion in its ") + (inputs == 1 ? "input" : "inputs");
+    c.reason += study.method == Method::kAuto
+                    ? " (at a limit position, where they stop describing it, the run starts "
+                      "again in every joint's coordinates, which pass through it)"
+                    : " (the run stops at a limit position, where they stop describing it)";
+    c.numerics = "CVODE Adams-Moulton, variable order, on the inputs and their rates";
   }
   return c;
 }
@@ -135,6 +138,16 @@ MethodChoice planar_choice(const Study& study) {
 
 MethodChoice choose_method(const Study& study) {
   return study.is_fourbar() ? fourbar_choice(study) : planar_choice(study);
+}
+
+MethodChoice through_limits(const MethodChoice& reduced, const std::string& stop) {
+  MethodChoice c = reduced;
+  c.method = Method::kTrussDae;
+  // the stop's place: its message up to the first colon
+  c.reason = std::string(kEveryJoint) + "; in the inputs alone the run stopped (" +
+             stop.substr(0, stop.find(':')) + ")";
+  c.numerics = kEveryJointNumerics;
+  return c;
 }
 
 }  // namespace bd::studies

@@ -19,7 +19,11 @@ struct MethodChoice {
   core::Formulation formulation = core::Formulation::kMassMatrix;
   /// Free scenes: the integrator; unused in driven scenes.
   core::Integrator integrator = core::Integrator::kCvodeAdams;
+  /// What the run follows the motion in and why, in an engineer's words (one line).
   std::string reason;
+  /// How it is computed numerically: the integrator and how it keeps the joints together (the
+  /// detail behind `reason`, for summary.json and the report).
+  std::string numerics;
   /// True when the general planar engine computes the run (truss, truss-dae).
   bool general_engine() const { return method == Method::kTruss || method == Method::kTrussDae; }
   /// The general engine's route of a free scene.
@@ -41,5 +45,9 @@ struct MethodChoice {
 /// says what auto would do differently where that matters.
 /// @throws bd::InputError if a four-bar formulation is asked for a planar linkage.
 MethodChoice choose_method(const Study& study);
+
+/// The method of a planar linkage's free run on `auto` that is repeated on truss-dae because the
+/// reduced equations (`reduced`) stopped at a limit position, as the run's message `stop` says.
+MethodChoice through_limits(const MethodChoice& reduced, const std::string& stop);
 
 }  // namespace bd::studies

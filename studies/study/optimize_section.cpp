@@ -582,7 +582,7 @@ class OptimizeReader {
                   : x.key == "e"  ? P::kE
                   : x.key == "f"  ? P::kF
                                   : P::kInertia;
-      const char* unit = p == P::kMass ? "kg" : p == P::kInertia ? "kg m^2" : "m";
+      const char* unit = p == P::kMass ? "kg" : p == P::kInertia ? "kg m²" : "m";
       const std::string xp = path + "." + x.key;
       const YAML::Mark vm = mark_of(x.value, x.key_mark);
       if (!x.value.IsSequence() || x.value.size() != 2) {
@@ -602,7 +602,7 @@ class OptimizeReader {
       }
       if (p == P::kInertia && lo < 0) {
         r_.fail(mark_of(x.value[0], vm),
-                xp + " lower bound must be >= 0 kg m^2, got " + text::shortest(lo));
+                xp + " lower bound must be >= 0 kg m², got " + text::shortest(lo));
       }
       Variable v;
       v.link = link;

@@ -239,8 +239,8 @@ class PlanarSection::Impl {
                         " are drawn at the same point; they set the link's length and direction");
       }
       link.mass = non_negative(lm.require("mass", "in kg"), path + ".mass", "kg");
-      link.inertia = non_negative(lm.require("inertia", "I about the centre of mass in kg m^2"),
-                                  path + ".inertia", "kg m^2");
+      link.inertia = non_negative(lm.require("inertia", "I about the centre of mass in kg m²"),
+                                  path + ".inertia", "kg m²");
       read_centre_of_mass(lm, x, path, link);
       places_["links[" + std::to_string(l.links.size()) + "]"] = {path, x.key_mark};
       l.links.push_back(link);
@@ -383,7 +383,7 @@ class PlanarSection::Impl {
         b.eccentricity = read_vec2(r_, *v, path + ".eccentricity", "m", marks);
       }
       if (const MapReader::Entry* v = sm.find("inertia"))
-        b.inertia = non_negative(*v, path + ".inertia", "kg m^2");
+        b.inertia = non_negative(*v, path + ".inertia", "kg m²");
       places_["shafts[" + std::to_string(l.shafts.size()) + "]"] = {path, x.key_mark};
       l.shafts.push_back(b);
     }
@@ -482,7 +482,7 @@ class PlanarSection::Impl {
     m.check_keys({"gravity", "links", "nodes"});
     if (const MapReader::Entry* g = m.find("gravity")) {
       YAML::Mark marks[2];
-      l.loads.gravity = read_vec2(r_, *g, "loads.gravity", "m/s^2", marks);
+      l.loads.gravity = read_vec2(r_, *g, "loads.gravity", "m/s²", marks);
     }
     if (const MapReader::Entry* x = m.find("links"); x && !x->value.IsNull()) {
       const MapReader lm(r_, x->value, "loads.links", x->key_mark, "of link: {force, moment}");

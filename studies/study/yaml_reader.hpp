@@ -156,15 +156,15 @@ inline std::vector<UnitFactor> units_for(const std::string& si) {
   }
   if (si == "m") return {{"m", 1, 1}, {"mm", 1, 1e3}, {"cm", 1, 1e2}, {"in", 0.0254, 1}};
   if (si == "kg") return {{"kg", 1, 1}, {"g", 1, 1e3}, {"lb", 0.45359237, 1}};
-  if (si == "kg m^2") {
-    return {{"kg m^2", 1, 1},       {"kg m²", 1, 1},       {"kg mm^2", 1, 1e6}, {"kg mm²", 1, 1e6},
+  if (si == "kg m²") {
+    return {{"kg m²", 1, 1},    {"kg m^2", 1, 1},  {"kg mm^2", 1, 1e6}, {"kg mm²", 1, 1e6},
             {"g cm^2", 1, 1e7}, {"g cm²", 1, 1e7}, {"g mm^2", 1, 1e9},  {"g mm²", 1, 1e9}};
   }
   if (si == "N") return {{"N", 1, 1}, {"kN", 1e3, 1}, {"mN", 1, 1e3}};
   if (si == "N m") return {{"N m", 1, 1}, {"Nm", 1, 1}, {"N mm", 1, 1e3}, {"kN m", 1e3, 1}};
   if (si == "s") return {{"s", 1, 1}, {"ms", 1, 1e3}, {"min", 60, 1}};
   if (si == "m/s") return {{"m/s", 1, 1}, {"mm/s", 1, 1e3}};
-  if (si == "m/s^2") return {{"m/s^2", 1, 1}, {"m/s²", 1, 1}, {"g", 9.80665, 1}};
+  if (si == "m/s²") return {{"m/s²", 1, 1}, {"m/s^2", 1, 1}, {"g", 9.80665, 1}};
   if (si == "Hz") return {{"Hz", 1, 1}, {"rpm", 1, 60}};
   if (si == "N/m") return {{"N/m", 1, 1}, {"N/mm", 1e3, 1}, {"kN/m", 1e3, 1}};
   if (si == "N s/m") return {{"N s/m", 1, 1}, {"N s/mm", 1e3, 1}};

@@ -71,7 +71,7 @@ TEST(MomentBalance, SetsCounterRotationsToTheReducedInertias) {
   EXPECT_TRUE(report.force_balanced()) << report.text();
   EXPECT_TRUE(report.moment_balanced()) << report.text();
   EXPECT_FALSE(check_balance(f.model).moment_balanced());
-  std::printf("J1 = %.17g kg m^2, J3 = %.17g kg m^2\n", K.crank, K.rocker);
+  std::printf("J1 = %.17g kg m², J3 = %.17g kg m²\n", K.crank, K.rocker);
 }
 
 // Fsh and Msh of the fully balanced design against the unbalanced design's RMS in one scene
@@ -156,7 +156,7 @@ TEST(MomentBalance, RejectsDesignsItCannotBalance) {
     const std::string what = e.what();
     EXPECT_NE(what.find("coupler.inertia"), std::string::npos) << what;
     EXPECT_NE(what.find("I2 = 1.939"), std::string::npos) << what;
-    EXPECT_NE(what.find("m2 e2 (l2 - e2) = 1.9199999999999999 kg m^2"), std::string::npos) << what;
+    EXPECT_NE(what.find("m2 e2 (l2 - e2) = 1.9199999999999999 kg m²"), std::string::npos) << what;
   }
   // a shaft on its link's pivot
   const core::FourBar f = force_balance(berkof_inline(), {}, {}).model;

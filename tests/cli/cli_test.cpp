@@ -169,15 +169,16 @@ TEST_F(CliTest, SimulationStoppedEarlyExitsThreeAndKeepsResults) {
   const auto rows = static_cast<std::size_t>(std::count(csv.begin(), csv.end(), '\n') - 1);
   EXPECT_GT(rows, 1u);
   EXPECT_LT(rows, 2001u);
-  EXPECT_NE(out_.find("  partial  the metrics below cover only the " + std::to_string(rows) +
-                      " samples before the run stopped"),
+  EXPECT_NE(out_.find("  partial  the metrics below cover only the motion up to the stop: the "
+                      "RMS values its " +
+                      std::to_string(rows) + " samples, the peaks up to the stop itself"),
             std::string::npos)
       << out_;
   EXPECT_NE(read(dir_ / "res" / "summary.json").find("\"metrics_partial\": true"),
             std::string::npos);
   // and so does the report's metrics table, at its column
   EXPECT_NE(read(dir_ / "res" / "report.html")
-                .find("<th>original<br><span class=\"bad\">partial: the samples before the "
+                .find("<th>original<br><span class=\"bad\">partial: the motion up to the "
                       "stop</span></th>"),
             std::string::npos);
   EXPECT_EQ(err_.rfind("stops.yaml: simulation stopped early: ", 0), 0u) << err_;

@@ -31,7 +31,7 @@ TEST(Model, RejectsNonPhysicalValuesWithNamedMessages) {
   EXPECT_EQ(error_of(m), "crank.length must be > 0 m, got 0");
   m = samples::paper_fourbar();
   m.rocker.inertia = -0.5;
-  EXPECT_EQ(error_of(m), "rocker.inertia must be >= 0 kg m^2, got -0.5");
+  EXPECT_EQ(error_of(m), "rocker.inertia must be >= 0 kg m², got -0.5");
   m = samples::paper_fourbar();
   m.frame_length = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(error_of(m), "frame must be > 0 m, got nan");
@@ -69,11 +69,11 @@ TEST(Model, RejectionsNameTheFieldAndIndex) {
   expect_field(m, "loads.crank.force", 0, "loads.crank.force[0] must be finite N, got nan");
   m = samples::paper_fourbar();
   m.loads.gravity.y() = std::numeric_limits<double>::infinity();
-  expect_field(m, "loads.gravity", 1, "loads.gravity[1] must be finite m/s^2, got inf");
+  expect_field(m, "loads.gravity", 1, "loads.gravity[1] must be finite m/s², got inf");
   m = samples::paper_fourbar();
   m.counter_rotations.rocker.inertia = -1;
   expect_field(m, "counter_rotations.rocker.inertia", -1,
-               "counter_rotations.rocker.inertia must be >= 0 kg m^2, got -1");
+               "counter_rotations.rocker.inertia must be >= 0 kg m², got -1");
   m = samples::paper_fourbar();
   m.counter_rotations.crank.at.y() = nan;
   expect_field(m, "counter_rotations.crank.at", 1,

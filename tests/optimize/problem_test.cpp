@@ -122,7 +122,7 @@ TEST(Problem, ValidateNamesEachMistake) {
             "link_parameters[0] (coupler.mass).lower must be > 0 kg, got 0");
   EXPECT_EQ(
       message_after([](DesignProblem& p) { p.link_parameters[1].lower = -0.1; }),
-      "link_parameters[1] (coupler.inertia).lower must be >= 0 kg m^2, got -0.10000000000000001");
+      "link_parameters[1] (coupler.inertia).lower must be >= 0 kg m², got -0.10000000000000001");
   EXPECT_EQ(message_after([](DesignProblem& p) { p.link_parameters[2].upper = -2; }),
             "link_parameters[2] (rocker.e).upper must be >= lower = -1 m, got -2");
   EXPECT_EQ(message_after([nan](DesignProblem& p) { p.link_parameters[2].lower = nan; }),

@@ -211,7 +211,7 @@ TEST(DesignFiles, CounterweightMistakesAreOneLineAtTheirPlace) {
                                   "e.yaml", 15, 22, "unknown key 'where'");
   bd::testing::expect_study_error(
       with("  counterweights:\n    crank: {mass: 1, at: [0, 0], inertia: -2}\n"), "e.yaml", 15, 43,
-      "linkage.counterweights.crank.inertia must be >= 0 kg m^2");
+      "linkage.counterweights.crank.inertia must be >= 0 kg m²");
   // a four-bar's: crank and rocker only
   const std::string fourbar = read(bd::testing::example_path("paper-fourbar-driven.yaml"));
   const std::string with_coupler = bd::testing::edited(

@@ -103,7 +103,7 @@ TEST(LoadStudy, NonPhysicalValuesAreReportedWhereTheyAre) {
   expect_error(edit("    mass: 2.1\n", "    mass: -1\n"), 8, 11,
                "linkage.crank.mass must be > 0 kg, got -1");
   expect_error(edit("    inertia: 1.1\n", "    inertia: -0.5\n"), 11, 14,
-               "linkage.crank.inertia must be >= 0 kg m^2, got -0.5");
+               "linkage.crank.inertia must be >= 0 kg m², got -0.5");
   expect_error(edit("mass: 3.0,", "mass: -1.2,"), 12, 32,
                "linkage.coupler.mass must be > 0 kg, got -1.2");
   expect_error(edit("  frame: 3.2\n", "  frame: -3.2\n"), 4, 10,
@@ -331,7 +331,7 @@ TEST(LoadStudy, CounterRotationMistakes) {
     return edit("inertia: 2.1}\n", "inertia: 2.1}\n  counter_rotations:\n" + lines);  // line 15 on
   };
   expect_error(with("    crank: {inertia: -1, at: [0, -1]}\n"), 15, 22,
-               "linkage.counter_rotations.crank.inertia must be >= 0 kg m^2, got -1");
+               "linkage.counter_rotations.crank.inertia must be >= 0 kg m², got -1");
   expect_error(with("    rocker: {inertia: 1, at: [3.2, 0]}\n"), 15, 30,
                "linkage.counter_rotations.rocker.at must differ from the rocker's pivot A3 = (3.2, "
                "0) m, got [3.2, 0]");
@@ -743,7 +743,7 @@ TEST(LoadStudy, OptimizeMistakesAreReportedWhereTheyAre) {
   expect_error(opt_edit("mass: [2.0, 4.0]", "mass: [0, 4.0]"), 30, 24,
                "optimize.variables.links.coupler.mass lower bound must be > 0 kg");
   expect_error(opt_edit("inertia: [1.0, 8.0]", "inertia: [-1.0, 8.0]"), 30, 45,
-               "optimize.variables.links.coupler.inertia lower bound must be >= 0 kg m^2");
+               "optimize.variables.links.coupler.inertia lower bound must be >= 0 kg m²");
   expect_error(opt_edit("mass: [2.0, 4.0]", "mass: 3.0"), 30, 23,
                "optimize.variables.links.coupler.mass must be a list of 2 numbers [lower, "
                "upper] in kg, got '3.0'");

@@ -427,7 +427,7 @@ TEST(PlanarOptimizeStudy, TheFourBarsParetoFrontIsReachedOnTrussElements) {
             "[kg],crank counterweight x from A0 in link axes [m],crank counterweight y from A0 in "
             "link axes [m],rocker counterweight mass [kg],rocker counterweight x from A3 in link "
             "axes [m],rocker counterweight y from A3 in link axes [m],coupler mass [kg],coupler "
-            "inertia [kg m^2]");
+            "inertia [kg m²]");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);
   const nlohmann::json j = nlohmann::json::parse(bd::testing::read(out / "summary.json"));
   EXPECT_EQ(j["optimize"]["pareto"]["points"], 4);

@@ -420,7 +420,39 @@ TEST(ResolvedPeaks, StepInstantsFollowTheIntegratorsSteps) {
   EXPECT_TRUE(std::is_sorted(s.begin(), s.end()));
   EXPECT_LT(s.back(), 4.0);
   EXPECT_TRUE(core::step_instants(t, std::vector<long>{0, 5}).empty());
+  // a run that stopped at 4.5 s, 3 steps after its last sample: two instants between, and the
+  // stop
+  const std::vector<double> stopped = core::step_instants(t, steps, 4.5, steps.back() + 3);
+  ASSERT_EQ(stopped.size(), s.size() + 3);
+  EXPECT_EQ(stopped[s.size()], 4.0 + 0.5 / 3.0);
+  EXPECT_EQ(stopped[s.size() + 1], 4.0 + 1.0 / 3.0);
+  EXPECT_EQ(stopped.back(), 4.5);
 }
+
+// The triple rocker of studies/examples/triple-rocker-free.yaml as a planar study under gravity,
+// its crank drawn at 0.
+const std::string kTripleRockerPlanar =
+    "name: triple-rocker-planar\n"
+    "linkage:\n"
+    "  type: planar\n"
+    "  nodes:\n"
+    "    A0: {at: [0, 0], ground: true}\n"
+    "    A1: [2, 0]\n"
+    "    A2: [2.75, 1.8540496217739157]\n"
+    "    A3: {at: [3.5, 0], ground: true}\n"
+    "  links:\n"
+    "    crank: {nodes: [A0, A1], mass: 1.0, e: 0.8, f: 0.1, inertia: 0.4}\n"
+    "    coupler: {nodes: [A1, A2], mass: 1.5, e: 1.0, f: 0.0, inertia: 0.6}\n"
+    "    rocker: {nodes: [A3, A2], mass: 1.2, e: 0.9, f: -0.1, inertia: 0.5}\n"
+    "  inputs:\n"
+    "    crank: {link: crank}\n"
+    "loads:\n"
+    "  gravity: [0, -9.81]\n"
+    "scene:\n"
+    "  type: free\n"
+    "  rates: [1.0]\n"
+    "  duration: 20.0\n"
+    "tolerance: 1e-12\n";
 
 // A free run whose peaks lie wholly between coarse samples: the triple rocker swinging through
 // its limit positions under gravity, at 51 samples over 20 s (some 26 to 200 integrator steps
@@ -434,35 +466,13 @@ TEST(ResolvedPeaks, FreePeaksBetweenCoarseSamplesAreFoundAtTheIntegratorsSteps) 
   // the triple rocker as a four-bar study (auto: the opened loop; truss-dae: the general engine's
   // dae route, its peaks searched by the closed form) and as a planar study (auto: the reduced
   // route stops at the first limit position, the dae route runs it, its peaks searched by the
-  // general engine), its crank drawn at 0
-  const std::string planar =
-      "name: triple-rocker-planar\n"
-      "linkage:\n"
-      "  type: planar\n"
-      "  nodes:\n"
-      "    A0: {at: [0, 0], ground: true}\n"
-      "    A1: [2, 0]\n"
-      "    A2: [2.75, 1.8540496217739157]\n"
-      "    A3: {at: [3.5, 0], ground: true}\n"
-      "  links:\n"
-      "    crank: {nodes: [A0, A1], mass: 1.0, e: 0.8, f: 0.1, inertia: 0.4}\n"
-      "    coupler: {nodes: [A1, A2], mass: 1.5, e: 1.0, f: 0.0, inertia: 0.6}\n"
-      "    rocker: {nodes: [A3, A2], mass: 1.2, e: 0.9, f: -0.1, inertia: 0.5}\n"
-      "  inputs:\n"
-      "    crank: {link: crank}\n"
-      "loads:\n"
-      "  gravity: [0, -9.81]\n"
-      "scene:\n"
-      "  type: free\n"
-      "  rates: [1.0]\n"
-      "  duration: 20.0\n"
-      "tolerance: 1e-12\n";
+  // general engine)
   for (int variant = 0; variant < 3; ++variant) {
     // the variant's study at `samples` over `duration` [s]
     auto study_of = [&](int samples, double duration) {
       studies::Study study =
           variant == 2
-              ? studies::parse_study(planar, "p.yaml")
+              ? studies::parse_study(kTripleRockerPlanar, "p.yaml")
               : studies::load_study(BD_SOURCE_DIR "/studies/examples/triple-rocker-free.yaml");
       if (variant < 2) {
         study.method = variant == 0 ? studies::Method::kAuto : studies::Method::kTrussDae;
@@ -519,6 +529,72 @@ TEST(ResolvedPeaks, FreePeaksBetweenCoarseSamplesAreFoundAtTheIntegratorsSteps) 
     const double theta1 = variant < 2 ? end.trajectory.samples.back().state.theta1
                                       : end.planar.table.column_values("theta_crank").back();
     EXPECT_NEAR(a[3].inputs[0], theta1, 1e-8) << "variant " << variant;
+  }
+}
+
+// A free run that stops at a limit position: its peaks are searched up to where it stopped, not
+// only to its last sample. A designer's check found the triple rocker's RA3_max at 51 samples
+// (method truss, stopped at t = 1.2994 s, last sample 1.28 s) 8 % below a fine run's: the
+// bearing load rises steeply towards the limit. Now the coarse run's peak lies at its stop and
+// equals a 40 001-sample run's (last sample 3e-6 s before the stop), on the four-bar's mass
+// matrix, on the general engine for a four-bar study, and for a planar study. Tolerance 1e-7:
+// each run locates its stop by root finding on its own integrated state (tolerance 1e-10),
+// which moves the stop by ~5e-10 s, where RA3 changes by ~1e3 N/s.
+TEST(ResolvedPeaks, AStoppedRunsPeaksReachItsStop) {
+  // the planar study without gravity, as the four-bar example
+  std::string weightless = kTripleRockerPlanar;
+  const std::string gravity = "loads:\n  gravity: [0, -9.81]\n";
+  ASSERT_NE(weightless.find(gravity), std::string::npos);
+  weightless.erase(weightless.find(gravity), gravity.size());
+  for (int variant = 0; variant < 3; ++variant) {
+    auto run = [&](int samples) {
+      studies::Study study =
+          variant == 2
+              ? studies::parse_study(weightless, "p.yaml")
+              : studies::load_study(BD_SOURCE_DIR "/studies/examples/triple-rocker-free.yaml");
+      study.method = variant == 0 ? studies::Method::kMassMatrix : studies::Method::kTruss;
+      std::visit(
+          [&](auto& scene) {
+            if constexpr (requires { scene.duration; }) {
+              scene.samples = samples;
+              scene.duration = 2.0;
+            }
+          },
+          study.scene);
+      return studies::compute_study(study);
+    };
+    const studies::RunResult coarse = run(51), fine = run(40001);
+    const bool planar = variant == 2;
+    for (const studies::RunResult* r : {&coarse, &fine}) {
+      ASSERT_EQ(planar ? r->planar.status : r->trajectory.status, core::SimulationStatus::kSingular)
+          << "variant " << variant;
+    }
+    const double stop = planar ? coarse.planar.stop_time : coarse.trajectory.stop_time;
+    const double last =
+        planar ? coarse.planar.table.column_values("t").back() : coarse.trajectory.t.back();
+    EXPECT_GT(stop, last + 0.01) << "variant " << variant;
+    const std::string name = "RA3_max";
+    const auto find = [&](const studies::MetricList& list) {
+      const auto it = std::find_if(list.begin(), list.end(),
+                                   [&](const studies::MetricValue& m) { return m.name == name; });
+      EXPECT_NE(it, list.end());
+      return *it;
+    };
+    const studies::MetricValue a = find(coarse.metric_list), b = find(fine.metric_list);
+    EXPECT_NEAR(a.value, b.value, 1e-7 * b.value) << "variant " << variant;
+    ASSERT_TRUE(a.t);
+    EXPECT_NEAR(*a.t, stop, 1e-12) << "variant " << variant;
+    // the coarse run's samples alone fall 5 % short
+    double sampled = 0;
+    if (planar) {
+      const std::vector<double> x = coarse.planar.table.column_values("RA3x"),
+                                y = coarse.planar.table.column_values("RA3y");
+      for (std::size_t i = 0; i < x.size(); ++i)
+        sampled = std::max(sampled, std::hypot(x[i], y[i]));
+    } else {
+      sampled = core::metrics(coarse.trajectory).RA3_max;
+    }
+    EXPECT_LT(sampled, 0.95 * b.value) << "variant " << variant;
   }
 }
 

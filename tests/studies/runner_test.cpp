@@ -159,11 +159,12 @@ TEST_F(RunnerTest, DrivenSceneWritesOneRowPerSampleAndSaysWhyNoIntegrator) {
   const std::vector<std::string> lines = lines_of(read(r.timeseries));
   EXPECT_EQ(lines.size(), 361u);  // header + 360 samples, periodic end excluded
   expect_rows_match(lines, r.trajectory);
-  EXPECT_NE(r.method.reason.find("no integrator: kinetostatics per sample"), std::string::npos);
+  EXPECT_NE(r.method.reason.find("nothing integrated"), std::string::npos) << r.method.reason;
   const std::string json = bd::testing::json_view(read(r.summary));
   EXPECT_NE(json.find("\"scene\": {\"type\": \"driven\""), std::string::npos) << json;
   EXPECT_NE(json.find("\"revolutions\": 1"), std::string::npos) << json;
-  EXPECT_NE(json.find("no integrator: kinetostatics per sample"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"numerics\": \"none: inverse dynamics at each sample\""), std::string::npos)
+      << json;
   EXPECT_GT(r.metrics.tau_max, 0.0);
   EXPECT_EQ(names_in(dir_),
             (std::set<std::string>{"harmonics.csv", "report.html", "study.yaml", "summary.json",
@@ -616,6 +617,24 @@ TEST_F(RunnerTest, AnOptimumWithoutCounterweightsWritesNone) {
   EXPECT_EQ(text.find("counterweights:"), std::string::npos) << text;
   const Study back = load_study(o.study_file.string());
   bd::testing::expect_same_model(study.fourbar(), back.fourbar());
+  // summary.json's variables: each counterweight's mass 0, and no position for it (the solver's
+  // x and y there are no design)
+  const std::string json = bd::testing::json_view(read(r.summary));
+  for (const char* link : {"crank", "rocker"}) {
+    const std::string from = std::string(link) == "crank" ? "A0" : "A3";
+    EXPECT_NE(json.find("{\"name\": \"" + std::string(link) +
+                        " counterweight mass [kg]\", \"value\": 0}"),
+              std::string::npos)
+        << json;
+    for (const char* axis : {"x", "y"}) {
+      EXPECT_NE(json.find("{\"name\": \"" + std::string(link) + " counterweight " + axis +
+                          " from " + from +
+                          " in link axes [m]\", \"value\": null, \"note\": \"no counterweight "
+                          "(its mass is 0): no position\"}"),
+                std::string::npos)
+          << json;
+    }
+  }
 }
 
 // A free scene through limit positions runs on the opened loop, the one closed form that passes
