@@ -540,8 +540,16 @@ void print_scene(const st::Study& study) {
                 study.name.c_str(), d->omega1, d->revolutions, d->revolutions == 1 ? "" : "s",
                 d->theta1);
   } else if (const auto* pf = std::get_if<bd::core::planar::FreeScene>(&study.scene)) {
-    std::printf("%s: free motion over %g s from the %s\n", study.name.c_str(), pf->duration,
-                pf->start.empty() ? "drawn position" : "scene's start");
+    // where it starts and how fast each input moves then
+    const auto& inputs = study.planar().inputs;
+    std::string rates;
+    for (std::size_t k = 0; k < inputs.size(); ++k) {
+      const double rate = k < pf->rates.size() ? pf->rates[k] : 0.0;
+      rates += (k ? ", " : "") + inputs[k].name + " at " + bd::text::digits(rate, 6) +
+               (inputs[k].kind == bd::core::planar::Input::Kind::kAngle ? " rad/s" : " m/s");
+    }
+    std::printf("%s: free motion over %g s from the %s, %s\n", study.name.c_str(), pf->duration,
+                pf->start.empty() ? "drawn position" : "scene's start", rates.c_str());
   } else {
     const auto& pd = std::get<bd::core::planar::DrivenScene>(study.scene);
     std::string speeds;

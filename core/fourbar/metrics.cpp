@@ -185,6 +185,11 @@ Metrics metrics(const Trajectory& trajectory, PeakList* peaks) {
   return with_peaks(trajectory, 0.0, nullptr, peaks);
 }
 
+Metrics metrics(const Trajectory& trajectory, double period, const SampleAt& sample_at,
+                PeakList* peaks) {
+  return with_peaks(trajectory, period, sample_at, peaks);
+}
+
 Metrics metrics(const FourBar& model, const DrivenScene& scene, const Trajectory& trajectory,
                 Formulation formulation, PeakList* peaks) {
   const double period =

@@ -6,6 +6,8 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <functional>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -184,6 +186,16 @@ Metrics metrics(const Trajectory& trajectory, PeakList* peaks);
 /// receives where each lies.
 Metrics metrics(const FourBar& model, const DrivenScene& scene, const Trajectory& trajectory,
                 Formulation formulation, PeakList* peaks = nullptr);
+
+/// The sample of a run at any time t within it, none where it cannot be evaluated.
+using SampleAt = std::function<std::optional<DynamicsSample>(double t)>;
+
+/// Metrics of a run with every peak resolved between the samples by `sample_at`, the run's own
+/// evaluation at any instant (a four-bar computed by the general planar engine: that engine's,
+/// which follows the linkage closer to a dead centre than the closed forms' singular test
+/// allows). `period` > 0: the run is periodic with that period.
+Metrics metrics(const Trajectory& trajectory, double period, const SampleAt& sample_at,
+                PeakList* peaks = nullptr);
 
 /// Metrics of a free run `trajectory` = simulate_free(model, scene, options) with every peak
 /// resolved between the samples: maximised over time by the state integrated from the sample

@@ -293,13 +293,12 @@ int mobility(const Model& model) {
 
 namespace {
 
-Unexpected<PlanarError> singular_at(const Model& model, const Workspace& ws,
-                                    const std::vector<double>& inputs) {
+Unexpected<PlanarError> singular_at(const Model& model, const std::vector<double>& inputs) {
   return Unexpected<PlanarError>(
       PlanarError{PlanarError::Kind::kSingular,
                   "singular position at " + inputs_text(model, inputs) +
-                      " (the constraints and inputs lose rank: reciprocal condition " +
-                      text::digits(ws.lu.rcond(), 2) + ")"});
+                      " (the inputs do not fix the linkage's position there: a dead centre or a "
+                      "limit position)"});
 }
 
 // The chord method from ws.instant.x (the guess): Newton's steps with the factorisation of the
@@ -371,7 +370,7 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
     // a factorisation with well-sized pivots is well conditioned; estimate only the others
     if (!ws.G.allFinite() ||
         (!(ws.lu.pivot_ratio() >= kWellConditionedPivot) && !(ws.lu.rcond() >= kSingularSolution)))
-      return singular_at(model, ws, inputs);
+      return singular_at(model, inputs);
     ws.factorised = true;
     copy_values(inputs, in.input);
     return true;
@@ -403,7 +402,7 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
       // means Newton cannot go on
       Eigen::Index worst = 0;
       const double residual = s.rows > 0 ? ws.g.cwiseAbs().maxCoeff(&worst) : 0.0;
-      if (residual <= 1e-9 * model.length_scale()) return singular_at(model, ws, inputs);
+      if (residual <= 1e-9 * model.length_scale()) return singular_at(model, inputs);
       return Unexpected<PlanarError>(
           PlanarError{PlanarError::Kind::kAssembly,
                       "the linkage cannot be assembled at " + inputs_text(model, inputs) + ": " +
@@ -427,7 +426,7 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
       // integrator at tight tolerance sees as noise)
       if (last_step > kRefactorStep * model.length_scale()) return solved();
       if (!(ws.lu.pivot_ratio() >= kWellConditionedPivot) && !(ws.lu.rcond() >= kSingularSolution))
-        return singular_at(model, ws, inputs);
+        return singular_at(model, inputs);
       ws.factorised = true;
       copy_values(inputs, in.input);
       return true;
@@ -436,11 +435,11 @@ Expected<bool, PlanarError> solve_position(const Model& model, Workspace& ws,
   detail::constraint_values(s, in.x, ws.target, ws.g);
   Eigen::Index worst = 0;
   if (s.rows > 0) ws.g.cwiseAbs().maxCoeff(&worst);
-  return Unexpected<PlanarError>(PlanarError{
-      PlanarError::Kind::kAssembly, "the linkage cannot be assembled at " +
-                                        inputs_text(model, inputs) + ": " +
-                                        row_name(s, static_cast<int>(worst)) +
-                                        " does not close (Newton's method did not converge)"});
+  return Unexpected<PlanarError>(
+      PlanarError{PlanarError::Kind::kAssembly,
+                  "the linkage cannot be assembled at " + inputs_text(model, inputs) + ": " +
+                      row_name(s, static_cast<int>(worst)) +
+                      " does not close (no position found near the previous one)"});
 }
 
 Expected<bool, PlanarError> assemble(const Model& model, Workspace& ws,
@@ -456,12 +455,29 @@ Expected<bool, PlanarError> assemble(const Model& model, Workspace& ws,
   }
   std::vector<Vec2> guess;
   for (const Node& n : model.linkage().nodes) guess.push_back(n.position);
+  const std::vector<Vec2> drawn = guess;
   std::vector<double> z(inputs.size());
   for (int i = 1; i <= static_cast<int>(steps); ++i) {
     for (std::size_t k = 0; k < inputs.size(); ++k) {
       z[k] = from[k] + (inputs[k] - from[k]) * (i / steps);
     }
-    if (auto ok = solve_position(model, ws, guess, z, PositionRoute::kGeneral); !ok) return ok;
+    if (auto ok = solve_position(model, ws, guess, z, PositionRoute::kGeneral); !ok) {
+      // a drawing on a singular position of the inputs (a slider-crank drawn at a dead centre,
+      // driven from the piston) is where they do not fix the position: the way from it cannot
+      // be followed, whatever the start; say so rather than where the first step failed
+      if (i == 1 && ok.error().kind != PlanarError::Kind::kNonFinite) {
+        if (auto at_drawing = solve_position(model, ws, drawn, from, PositionRoute::kGeneral);
+            !at_drawing && at_drawing.error().kind == PlanarError::Kind::kSingular) {
+          return Unexpected<PlanarError>(PlanarError{
+              PlanarError::Kind::kSingular,
+              "the linkage cannot be moved from its drawing (" + inputs_text(model, from) +
+                  ") to " + inputs_text(model, inputs) +
+                  ": the drawing is a dead centre of the inputs (they do not fix the linkage's "
+                  "position there); draw the linkage away from it"});
+        }
+      }
+      return ok;
+    }
     guess = ws.instant.x;
   }
   if (steps < 1) return solve_position(model, ws, guess, inputs, PositionRoute::kGeneral);

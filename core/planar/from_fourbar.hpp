@@ -22,4 +22,8 @@ Linkage linkage_of(const FourBar& fourbar, double theta1);
 /// torque), with the same status and message, and where a stopped run stopped.
 core::Trajectory fourbar_trajectory(const Trajectory& planar);
 
+/// One row of such a table (`table`'s columns, e.g. a driven run's row between its samples,
+/// DrivenRows::at()) as the four-bar's sample.
+DynamicsSample fourbar_sample(const Series& table, std::span<const double> row);
+
 }  // namespace bd::core::planar

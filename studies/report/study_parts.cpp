@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <iterator>
+#include <numbers>
 #include <variant>
 
 #include "core/number_text.hpp"
@@ -121,15 +122,22 @@ std::string peak_place(const Study& study, const Json& summary, const std::strin
   const Json* t = p ? member(*p, "t") : nullptr;
   if (!t || !t->is_number()) return "";
   std::string s = "t = " + fmt(t->get<double>()) + " s";
+  // an angle as the charts' crank-angle axes have it: degrees within the turn (summary.json
+  // keeps the continuous angle in rad)
+  const auto angle = [](double rad) {
+    const double deg = std::fmod(rad * 180 / std::numbers::pi, 360.0);
+    return fmt(deg < 0 ? deg + 360 : deg) + "°";
+  };
   if (const Json* theta1 = member(*p, "theta1"); theta1 && theta1->is_number()) {
-    s += ", θ1 = " + fmt(theta1->get<double>()) + " rad";
+    s += ", θ1 = " + angle(theta1->get<double>());
   } else if (const Json* inputs = member(*p, "inputs");
              inputs && inputs->is_array() && !study.is_fourbar()) {
     const auto& in = study.planar().inputs;
     for (std::size_t k = 0; k < inputs->size() && k < in.size(); ++k) {
       if (!(*inputs)[k].is_number()) continue;
-      s += ", " + in[k].name + " = " + fmt((*inputs)[k].get<double>()) +
-           (in[k].kind == core::planar::Input::Kind::kAngle ? " rad" : " m");
+      const double v = (*inputs)[k].get<double>();
+      s += ", " + in[k].name + " = " +
+           (in[k].kind == core::planar::Input::Kind::kAngle ? angle(v) : fmt(v) + " m");
     }
   }
   return s;

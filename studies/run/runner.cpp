@@ -128,7 +128,8 @@ void write_table(const core::Series& table, const fs::path& file) {
     const std::span<const double> row = table.row(i);
     for (std::size_t k = 0; k < row.size(); ++k) {
       if (k) line.push_back(',');
-      text::append_exact(line, row[k]);
+      // a zero is written "0", never "-0" (a force with a sign of round-off; equal as numbers)
+      text::append_exact(line, row[k] == 0 ? 0.0 : row[k]);
     }
     line.push_back('\n');
     if (line.size() > (1 << 16)) {  // written in blocks of about 64 kB

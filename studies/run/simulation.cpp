@@ -199,8 +199,8 @@ Simulation simulate_unchecked(const Study& study, const MethodChoice& method,
     const core::FourBar& fb = study.fourbar();
     const core::planar::Model model(
         core::planar::linkage_of(fb, crank_angle_at_start(study.scene)));
-    s.fourbar = core::planar::fourbar_trajectory(
-        general_engine(model, planar_scene(study.scene), method, tolerances));
+    s.engine = general_engine(model, planar_scene(study.scene), method, tolerances);
+    s.fourbar = core::planar::fourbar_trajectory(s.engine);
     return s;
   }
   s.is_planar = true;
@@ -272,10 +272,27 @@ core::Metrics fourbar_metrics(const Study& study, const Simulation& simulation,
     options.absolute_tolerance = simulation.tolerances.absolute;
     return core::metrics(study.fourbar(), simulation.fourbar, options, peaks);
   }
-  const core::Formulation f = simulation.method.general_engine()
-                                  ? core::Formulation::kMassMatrix
-                                  : simulation.method.formulation;
-  return core::metrics(study.fourbar(), *driven, simulation.fourbar, f, peaks);
+  if (simulation.method.general_engine() && simulation.engine.table.rows() > 0) {
+    // the peaks resolved by the engine that computed the run: it follows the linkage closer to
+    // a dead centre than the closed forms' singular test, which declines there
+    const core::FourBar& fb = study.fourbar();
+    const core::planar::Model model(
+        core::planar::linkage_of(fb, crank_angle_at_start(study.scene)));
+    const Scene scene = planar_scene(study.scene);
+    const auto& engine_scene = std::get<core::planar::DrivenScene>(scene);
+    const core::Series& table = simulation.engine.table;
+    core::planar::DrivenRows rows(model, engine_scene, simulation.engine);
+    return core::metrics(
+        simulation.fourbar, rows.period(),
+        [&](double s) -> std::optional<core::DynamicsSample> {
+          const double* row = rows.at(s);
+          if (!row) return std::nullopt;
+          return core::planar::fourbar_sample(table, {row, table.width()});
+        },
+        peaks);
+  }
+  return core::metrics(study.fourbar(), *driven, simulation.fourbar, simulation.method.formulation,
+                       peaks);
 }
 
 std::vector<std::string> metric_names(const Study& study) {

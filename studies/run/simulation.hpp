@@ -68,6 +68,9 @@ struct Simulation {
   MethodChoice method;
   core::Trajectory fourbar;
   core::planar::Trajectory planar;
+  /// A four-bar study on the general engine (truss, truss-dae): the engine's own run, of which
+  /// `fourbar` is the four-bar's view; a driven run's peaks are resolved by the engine.
+  core::planar::Trajectory engine;
   bool is_planar{};
   Tolerances tolerances;  // a free run's, as it was integrated
 
@@ -92,7 +95,8 @@ Simulation simulate(const Study& study, const MethodChoice& method, const Tolera
 /// The run's metrics in its table's order: a four-bar's (core::kMetricTable, then
 /// core::kTotalMetrics) or a planar linkage's (core::planar::metric_table()). In a driven scene
 /// every peak is resolved between the samples by the exact inverse dynamics (core/peaks.hpp; a
-/// four-bar's by its closed form, the mass matrix's when the run took the general engine); in a
+/// four-bar's by its closed form, by the general engine when the run took it: it follows the
+/// linkage closer to a dead centre than the closed forms' singular test); in a
 /// four-bar's free scene by the state integrated from the sample before each instant
 /// (core::free_sample_from()); in a planar linkage's free scene by the run continued from its
 /// state at the latest known instant before each instant, on its route

@@ -184,13 +184,18 @@ Json balance_json(const balance::BalancedDesign& b) {
   j["force_balanced"] = b.conditions.force_balanced();
   j["moment_balanced"] = b.conditions.moment_balanced();
   Json conditions = Json::array();
-  for (const auto* group : {&b.conditions.force, &b.conditions.moment}) {
+  // each condition with whether the study asked for its balance (a force-only study's moment
+  // conditions are shown for what they are, not as failures)
+  const std::pair<const std::vector<balance::Condition>*, bool> groups[] = {
+      {&b.conditions.force, b.request.force}, {&b.conditions.moment, b.request.moment}};
+  for (const auto& [group, asked] : groups) {
     for (const balance::Condition& c : *group) {
       conditions.push_back({{"name", c.name},
                             {"residual", c.residual},
                             {"scale", c.scale},
                             {"unit", c.unit},
-                            {"holds", c.holds}});
+                            {"holds", c.holds},
+                            {"asked", asked}});
     }
   }
   j["conditions"] = conditions;

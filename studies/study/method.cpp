@@ -124,11 +124,15 @@ MethodChoice planar_choice(const Study& study) {
     c.reason += kEveryJoint;
     c.numerics = kEveryJointNumerics;
   } else {
-    c.reason += std::string("the motion in its ") + (inputs == 1 ? "input" : "inputs");
+    const bool one = inputs == 1;
+    c.reason += std::string("the motion in its ") + (one ? "input" : "inputs");
     c.reason += study.method == Method::kAuto
-                    ? " (at a limit position, where they stop describing it, the run starts "
-                      "again in every joint's coordinates, which pass through it)"
-                    : " (the run stops at a limit position, where they stop describing it)";
+                    ? std::string("; at a limit position, where ") +
+                          (one ? "it stops" : "they stop") +
+                          " describing the motion, the run starts again in every joint's "
+                          "coordinates, which pass through it"
+                    : std::string("; the run stops at a limit position, where ") +
+                          (one ? "it stops" : "they stop") + " describing the motion";
     c.numerics = "CVODE Adams-Moulton, variable order, on the inputs and their rates";
   }
   return c;

@@ -152,7 +152,8 @@ inline std::vector<UnitFactor> units_for(const std::string& si) {
   constexpr double kPi = 3.14159265358979323846;
   if (si == "rad") return {{"rad", 1, 1}, {"deg", kPi, 180}, {"°", kPi, 180}, {"rev", 2 * kPi, 1}};
   if (si == "rad/s") {
-    return {{"rad/s", 1, 1}, {"rpm", 2 * kPi, 60}, {"rev/s", 2 * kPi, 1}, {"deg/s", kPi, 180}};
+    return {{"rad/s", 1, 1},       {"rpm", 2 * kPi, 60}, {"RPM", 2 * kPi, 60},
+            {"rev/s", 2 * kPi, 1}, {"Hz", 2 * kPi, 1},   {"deg/s", kPi, 180}};
   }
   if (si == "m") return {{"m", 1, 1}, {"mm", 1, 1e3}, {"cm", 1, 1e2}, {"in", 0.0254, 1}};
   if (si == "kg") return {{"kg", 1, 1}, {"g", 1, 1e3}, {"lb", 0.45359237, 1}};
@@ -189,7 +190,10 @@ inline bool read_with_unit(const Reporter& r, const YAML::Node& node, const YAML
   for (const UnitFactor& u : units_for(si)) {
     if (unit == u.name) {
       value = number * u.factor / u.divisor;
-      r.note_unit(path + ": " + text + " = " + text::shortest(value) + " " + si);
+      // a value in the SI unit itself is no conversion to note
+      if (u.factor != 1 || u.divisor != 1) {
+        r.note_unit(path + ": " + text + " = " + text::shortest(value) + " " + si);
+      }
       return true;
     }
     known += (known.empty() ? "" : ", ") + std::string(u.name);

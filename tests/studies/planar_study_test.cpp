@@ -105,14 +105,23 @@ TEST(PlanarStudy, MistakesAreOneLineAtTheirPlace) {
   expect_error(edit(crank, "e: 0.012, f: 0, s: 0.1, inertia"), 9, 55,
                "linkage.links.crank gives its centre of mass both as {s, sigma} and as {e, f}");
   expect_error(edit(crank, "inertia"), 9, 5, "linkage.links.crank: missing the centre of mass");
-  // a start the linkage cannot reach: a slider-crank driven from the piston past its stroke;
-  // the message names where, on the way from the drawn position, it stopped closing
+  // a slider-crank drawn at its outer dead centre and driven from the piston: the drawing is
+  // where the piston does not fix the crank, so no start can be reached from it (a designer saw
+  // "cannot be assembled at stroke = 0.1775 m: input stroke does not close" for a start of 0.17,
+  // and "reciprocal condition nan" for 0.18)
   const std::string from_piston =
       edit("    crank: {link: crank}\n", "    stroke: {slider: piston}\n");
-  std::string beyond = from_piston;
-  beyond.replace(beyond.find("  speeds: [314.1592653589793]\n"), 30,
-                 "  speeds: [0.1]\n  duration: 1\n  start: [0.3]\n");
-  expect_error(beyond, 16, 1, "scene: the linkage cannot be assembled at stroke = 0.18");
+  for (const char* start : {"0.3", "0.17", "0.12"}) {
+    std::string beyond = from_piston;
+    beyond.replace(beyond.find("  speeds: [314.1592653589793]\n"), 30,
+                   "  speeds: [0.1]\n  duration: 1\n  start: [" + std::string(start) + "]\n");
+    expect_error(beyond, 16, 1,
+                 "scene: the linkage cannot be moved from its drawing (stroke = 0.18 m) to stroke "
+                 "= " +
+                     std::string(start) +
+                     " m: the drawing is a dead centre of the inputs (they do not fix the "
+                     "linkage's position there); draw the linkage away from it");
+  }
   // a scene by duration that drives the piston past its inner dead centre (rod - crank =
   // 0.10 m from O) is refused at scene.type, at the first sample beyond it, as a scene over
   // whole revolutions is where the linkage cannot turn (the run would stop there)

@@ -599,6 +599,32 @@ TEST_F(RunnerTest, OptimizedYamlLoadsBackToTheOptimumAndReproducesItsRun) {
 // An optimum without counterweights (weighing the added mass three times against the peak
 // shaking force, none pays: the original design is the optimum) writes none as data, only the
 // header's words; before, optimized.yaml listed both with mass 0 at a position.
+// A force-only balance lists the moment conditions too, each marked as not asked for: a
+// designer read their `holds: false` as failures of the balance
+TEST_F(RunnerTest, AForceBalanceMarksTheMomentConditionsAsNotAsked) {
+  const Study study =
+      load_study(BD_SOURCE_DIR "/studies/examples/paper-fourbar-driven-force-balanced.yaml");
+  const RunResult r = run_study(study, dir_);
+  ASSERT_TRUE(r.ok());
+  const nlohmann::json j = nlohmann::json::parse(read(r.summary));
+  const nlohmann::json& conditions = j.at("balance").at("conditions");
+  int force = 0, moment = 0, moment_failing = 0;
+  for (const nlohmann::json& c : conditions) {
+    const bool is_force = c.at("name").get<std::string>().starts_with("force.");
+    EXPECT_EQ(c.at("asked").get<bool>(), is_force) << c.dump();
+    if (is_force) {
+      ++force;
+      EXPECT_TRUE(c.at("holds").get<bool>()) << c.dump();
+    } else {
+      ++moment;
+      if (!c.at("holds").get<bool>()) ++moment_failing;
+    }
+  }
+  EXPECT_EQ(force, 2);
+  EXPECT_EQ(moment, 4);
+  EXPECT_GT(moment_failing, 0);  // this coupler is no Berkof coupler
+}
+
 TEST_F(RunnerTest, AnOptimumWithoutCounterweightsWritesNone) {
   const Study study = parse_study(
       bd::testing::edited_example("weighted-counterweights.yaml",

@@ -58,6 +58,23 @@ TEST(Units, ValuesWithUnitsEqualTheirSiNumbers) {
   EXPECT_NE(json.find("scene.theta1: 90 deg = 1.5707963267948966 rad"), std::string::npos) << json;
 }
 
+// the spellings of a crank speed people write: RPM as rpm, Hz as turns per second; a value in
+// the SI unit itself is read but is no conversion to list
+TEST(Units, SpeedsInRpmOrHzAndSiUnitsWrittenOut) {
+  const studies::Study rpm =
+      studies::parse_study(fourbar("0", "300 RPM", "1 m", "2.1 kg"), "u.yaml");
+  const studies::Study hz = studies::parse_study(fourbar("0", "5 Hz", "1.0", "2.1"), "u.yaml");
+  const studies::Study plain =
+      studies::parse_study(fourbar("0", "300 rpm", "1.0", "2.1"), "u.yaml");
+  EXPECT_EQ(std::get<core::DrivenScene>(rpm.scene).omega1,
+            std::get<core::DrivenScene>(plain.scene).omega1);
+  EXPECT_DOUBLE_EQ(std::get<core::DrivenScene>(hz.scene).omega1, 10 * std::numbers::pi);
+  ASSERT_EQ(rpm.units_read.size(), 1u);  // not "1 m = 1 m" nor "2.1 kg = 2.1 kg"
+  EXPECT_EQ(rpm.units_read[0].rfind("scene.omega1: 300 RPM = ", 0), 0u) << rpm.units_read[0];
+  EXPECT_EQ(rpm.fourbar().crank.length, 1.0);
+  EXPECT_EQ(rpm.fourbar().crank.mass, 2.1);
+}
+
 // the SI number of units_read is the shortest text that reads back as the value used: 50 mm is
 // "0.05 m", not 0.050000000000000003 (checked against the fewest printf digits that read back)
 TEST(Units, UnitsReadGivesTheShortestExactNumber) {
