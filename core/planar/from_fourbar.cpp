@@ -40,55 +40,30 @@ Linkage linkage_of(const FourBar& m, double theta1) {
   return make_linkage(l);
 }
 
-namespace {
+FourBarSampleOf::FourBarSampleOf(const Series& t) : t_(t) {}
 
-// the four-bar's sample of a row of a table of the engine's columns
-class SampleOf {
- public:
-  explicit SampleOf(const Series& t) : t_(t) {}
-  DynamicsSample operator()(std::span<const double> r) const {
-    DynamicsSample d;
-    d.state = {r[th1], r[om1], r[al1], r[th2], r[th3], r[om2], r[om3], r[al2], r[al3]};
-    d.RA0 = Vec2(r[r0], r[r0 + 1]);
-    d.RA3 = Vec2(r[r3], r[r3 + 1]);
-    d.Fsh = Vec2(r[f], r[f + 1]);
-    d.Msh = r[m];
-    d.tau = r[tau];
-    d.Fsh_inertial = Vec2(r[fi], r[fi + 1]);
-    d.Msh_inertial = r[mi];
-    d.Fsh_static = Vec2(r[fs], r[fs + 1]);
-    d.Msh_static = r[ms];
-    if (fa1 >= 0) d.FA1 = Vec2(r[at(fa1)], r[at(fa1) + 1]);
-    if (fa2 >= 0) d.FA2 = Vec2(r[at(fa2)], r[at(fa2) + 1]);
-    if (rc1 >= 0) d.RC1 = Vec2(r[at(rc1)], r[at(rc1) + 1]);
-    if (rc3 >= 0) d.RC3 = Vec2(r[at(rc3)], r[at(rc3) + 1]);
-    return d;
-  }
-  std::size_t time() const { return c_t; }
-
- private:
-  static std::size_t at(int c) { return static_cast<std::size_t>(c); }
-  std::size_t col(const char* name) const { return at(t_.column(name)); }
-  const Series& t_;
-  const std::size_t c_t = col("t"), th1 = col("theta_crank"), th2 = col("theta_coupler"),
-                    th3 = col("theta_rocker"), om1 = col("omega_crank"), om2 = col("omega_coupler"),
-                    om3 = col("omega_rocker"), al1 = col("alpha_crank"), al2 = col("alpha_coupler"),
-                    al3 = col("alpha_rocker"), r0 = col("RA0x"), r3 = col("RA3x"), f = col("Fshx"),
-                    m = col("Msh"), tau = col("tau"), fi = col("Fshx_inertial"),
-                    mi = col("Msh_inertial"), fs = col("Fshx_static"), ms = col("Msh_static");
-  const int fa1 = t_.column("FA1x"), fa2 = t_.column("FA2x"), rc1 = t_.column("RC1x"),
-            rc3 = t_.column("RC3x");
-};
-
-}  // namespace
-
-DynamicsSample fourbar_sample(const Series& table, std::span<const double> row) {
-  return SampleOf(table)(row);
+DynamicsSample FourBarSampleOf::operator()(std::span<const double> r) const {
+  DynamicsSample d;
+  d.state = {r[th1], r[om1], r[al1], r[th2], r[th3], r[om2], r[om3], r[al2], r[al3]};
+  d.RA0 = Vec2(r[r0], r[r0 + 1]);
+  d.RA3 = Vec2(r[r3], r[r3 + 1]);
+  d.Fsh = Vec2(r[f], r[f + 1]);
+  d.Msh = r[m];
+  d.tau = r[tau];
+  d.Fsh_inertial = Vec2(r[fi], r[fi + 1]);
+  d.Msh_inertial = r[mi];
+  d.Fsh_static = Vec2(r[fs], r[fs + 1]);
+  d.Msh_static = r[ms];
+  if (fa1 >= 0) d.FA1 = Vec2(r[at(fa1)], r[at(fa1) + 1]);
+  if (fa2 >= 0) d.FA2 = Vec2(r[at(fa2)], r[at(fa2) + 1]);
+  if (rc1 >= 0) d.RC1 = Vec2(r[at(rc1)], r[at(rc1) + 1]);
+  if (rc3 >= 0) d.RC3 = Vec2(r[at(rc3)], r[at(rc3) + 1]);
+  return d;
 }
 
 core::Trajectory fourbar_trajectory(const Trajectory& planar) {
   const Series& t = planar.table;
-  const SampleOf sample_of(t);
+  const FourBarSampleOf sample_of(t);
   core::Trajectory out;
   out.t.reserve(t.rows());
   out.samples.reserve(t.rows());

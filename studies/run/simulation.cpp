@@ -199,8 +199,12 @@ Simulation simulate_unchecked(const Study& study, const MethodChoice& method,
     const core::FourBar& fb = study.fourbar();
     const core::planar::Model model(
         core::planar::linkage_of(fb, crank_angle_at_start(study.scene)));
-    s.engine = general_engine(model, planar_scene(study.scene), method, tolerances);
-    s.fourbar = core::planar::fourbar_trajectory(s.engine);
+    core::planar::Trajectory run =
+        general_engine(model, planar_scene(study.scene), method, tolerances);
+    s.fourbar = core::planar::fourbar_trajectory(run);
+    // a driven run's peaks are resolved by the engine (fourbar_metrics()); a free run's by the
+    // closed form from its samples, which need no copy of the engine's table
+    if (!is_free(study.scene)) s.engine = std::move(run);
     return s;
   }
   s.is_planar = true;
@@ -280,14 +284,15 @@ core::Metrics fourbar_metrics(const Study& study, const Simulation& simulation,
         core::planar::linkage_of(fb, crank_angle_at_start(study.scene)));
     const Scene scene = planar_scene(study.scene);
     const auto& engine_scene = std::get<core::planar::DrivenScene>(scene);
-    const core::Series& table = simulation.engine.table;
+    const core::planar::FourBarSampleOf sample_of(simulation.engine.table);
+    const std::size_t width = simulation.engine.table.width();
     core::planar::DrivenRows rows(model, engine_scene, simulation.engine);
     return core::metrics(
         simulation.fourbar, rows.period(),
         [&](double s) -> std::optional<core::DynamicsSample> {
           const double* row = rows.at(s);
           if (!row) return std::nullopt;
-          return core::planar::fourbar_sample(table, {row, table.width()});
+          return sample_of({row, width});
         },
         peaks);
   }

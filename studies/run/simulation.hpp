@@ -68,8 +68,8 @@ struct Simulation {
   MethodChoice method;
   core::Trajectory fourbar;
   core::planar::Trajectory planar;
-  /// A four-bar study on the general engine (truss, truss-dae): the engine's own run, of which
-  /// `fourbar` is the four-bar's view; a driven run's peaks are resolved by the engine.
+  /// A four-bar study's driven run on the general engine (truss): the engine's own run, of which
+  /// `fourbar` is the four-bar's view, by which its peaks are resolved; empty otherwise.
   core::planar::Trajectory engine;
   bool is_planar{};
   Tolerances tolerances;  // a free run's, as it was integrated
